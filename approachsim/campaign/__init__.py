@@ -1,0 +1,1 @@
+"""Monte Carlo campaigns, trade studies and regressions: executors (local pool, Dask) and result storage."""

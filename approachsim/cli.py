@@ -1,0 +1,51 @@
+"""Command line: `approachsim fly | sense | navigate | evaluate | study | regress | reproduce | profiles`.
+
+Each stage owns its sub-command in its own module (`<stage>/command.py`, with `register(subparsers)`).
+User mistakes (bad profile, bad option) exit with status 2 and one line naming the field, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from approachsim.config import ProfileError
+
+COMMAND_MODULES = (
+    "approachsim.flight.command",
+)
+"""Modules that each add sub-commands; a stage adds its line here."""
+
+
+class _OneLineParser(argparse.ArgumentParser):
+    """argparse that reports a bad option as one line and exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        sys.stderr.write(f"{self.prog}: error: {message}\n")
+        raise SystemExit(2)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full parser with every stage's sub-commands."""
+    parser = _OneLineParser(prog="approachsim", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_OneLineParser)
+    for mod in COMMAND_MODULES:
+        importlib.import_module(mod).register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the `approachsim` console script; returns the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except ProfileError as e:
+        sys.stderr.write(f"approachsim: error: {e}\n")
+        return 2
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,1 @@
+"""Evaluation: navigation error at decision heights against FAA/ICAO limits, protection levels, verdicts."""

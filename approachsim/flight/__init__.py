@@ -1,0 +1,1 @@
+"""Truth: JSBSim flies the aircraft down the glidepath under a Python autopilot; the Truth record."""

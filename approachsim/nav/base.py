@@ -1,0 +1,132 @@
+"""The one filter interface every navigation filter implements, and the optimal Joseph-form Kalman filter.
+
+A filter is a small strategy object; its state is a frozen `FilterState` it returns anew (filters never
+mutate themselves). The interface, in textbook symbols:
+
+    state = f.init(x0, P0)
+    state = f.predict(state, F, Q)                   # x = F x ; P = F P F' + Q
+    state, status = f.update(state, meas)            # one scalar measurement z = h' x + v, var(v) = r
+    f.covariance(state) -> P ; state.x -> x
+
+Variants override one hook: a robust filter changes how the gain is weighted (`GainPolicy`); the U-D
+filter changes how the covariance is stored. The registry in nav/registry.py picks one by name.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class FilterState:
+    """Estimate x (n,) and its covariance storage: P (n, n), or for U-D filters the factors (U, d)."""
+
+    x: Array
+    P: Array | None = None
+    U: Array | None = None
+    d: Array | None = None
+    memory: tuple = field(default=(), compare=False)
+    """Per-filter scratch that survives steps (e.g. an adaptive filter's window); empty for most."""
+
+
+@dataclass(frozen=True)
+class ScalarMeasurement:
+    """One scalar measurement z = h' x + v with var(v) = r. `name` identifies the channel ("baro", "pr07")."""
+
+    z: float
+    h: Array
+    r: float
+    name: str = ""
+    t_s: float = float("nan")
+
+
+@dataclass(frozen=True)
+class UpdateStatus:
+    """Per-measurement record (as PX4 keeps): innovation nu, its predicted variance S, test ratio nu^2/S,
+    the gain weight applied (1 optimal, 0 rejected) and whether the measurement was used."""
+
+    name: str
+    t_s: float
+    innovation: float
+    variance: float
+    test_ratio: float
+    weight: float
+    accepted: bool
+
+
+class NavFilter(Protocol):
+    """What every filter offers (optimal, robust, U-D): see the module docstring."""
+
+    name: str
+
+    def init(self, x0: Array, P0: Array) -> FilterState: ...
+
+    def predict(self, state: FilterState, F: Array, Q: Array) -> FilterState: ...
+
+    def update(self, state: FilterState, meas: ScalarMeasurement) -> tuple[FilterState, UpdateStatus]: ...
+
+    def covariance(self, state: FilterState) -> Array: ...
+
+
+class GainPolicy(Protocol):
+    """How a filter weights the gain of one scalar update, from the normalized innovation beta = nu/sqrt(S).
+
+    Returns (weight, psi_prime): the gain used is weight * K; psi_prime scales the covariance reduction
+    (P+ = P - psi_prime K S K' in the Joseph-equivalent form). Optimal: (1, 1). Rejection: (0, 0).
+    """
+
+    def __call__(self, beta: float, name: str) -> tuple[float, float]: ...
+
+
+def optimal_policy(beta: float, name: str) -> tuple[float, float]:
+    """The optimal Kalman gain: weight 1, full covariance reduction."""
+    return 1.0, 1.0
+
+
+@dataclass(frozen=True)
+class KalmanFilter:
+    """Linear / error-state Kalman filter, covariance form, sequential scalar updates in Joseph form.
+
+    With the default policy this is the optimal filter; robust variants pass another `policy`.
+    Update (gain weight w, Joseph form with the weighted gain Kw = w K, valid for any gain):
+        S = h' P h + r ; K = P h / S ; x+ = x + Kw nu ; P+ = (I - Kw h') P (I - Kw h')' + Kw r Kw'
+    """
+
+    name: str = "kf"
+    policy: GainPolicy = optimal_policy
+
+    def init(self, x0: Array, P0: Array) -> FilterState:
+        """State from the initial estimate x0 (n,) and covariance P0 (n, n)."""
+        return FilterState(x=np.array(x0, dtype=float), P=np.array(P0, dtype=float))
+
+    def predict(self, state: FilterState, F: Array, Q: Array) -> FilterState:
+        """x = F x ; P = F P F' + Q (Q: discrete process noise)."""
+        x = F @ state.x  # x- = F x+
+        P = F @ state.P @ F.T + Q  # P- = F P+ F' + Q
+        return FilterState(x=x, P=0.5 * (P + P.T), memory=state.memory)
+
+    def update(self, state: FilterState, meas: ScalarMeasurement) -> tuple[FilterState, UpdateStatus]:
+        """One scalar update; the policy may down-weight or reject it."""
+        x, P, h, r = state.x, state.P, meas.h, meas.r
+        Ph = P @ h
+        S = float(h @ Ph + r)  # S = h' P h + r
+        nu = float(meas.z - h @ x)  # innovation
+        beta = nu / np.sqrt(S)
+        w, _ = self.policy(beta, meas.name)
+        status = UpdateStatus(meas.name, meas.t_s, nu, S, nu * nu / S, w, w > 0.0)
+        if w == 0.0:
+            return state, status
+        K = w * Ph / S  # K = P h S^-1, weighted
+        x = x + K * nu
+        A = np.eye(len(x)) - np.outer(K, h)
+        P = A @ P @ A.T + r * np.outer(K, K)  # Joseph form
+        return FilterState(x=x, P=0.5 * (P + P.T), memory=state.memory), status
+
+    def covariance(self, state: FilterState) -> Array:
+        """P (n, n)."""
+        return state.P

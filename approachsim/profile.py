@@ -1,0 +1,248 @@
+"""Profile: the typed, validated model of an approach profile file (TOML).
+
+A profile says where (runway), what flies (aircraft), in what weather (environment, terrain), how fast
+things are sampled (rates) and how many runs by default (run). Stage-specific sections (sensors, nav,
+faults, evaluation) are parsed by their own stage's config module and stored here as frozen objects.
+Feet, knots, nmi, degrees and hPa are read here and converted to SI once; nothing downstream sees them.
+
+Heights: the runway elevation and terrain heights are taken as heights above the WGS-84 ellipsoid (the
+simulator has no geoid: JSBSim's sea level is the ellipsoid), which matters to nothing that is scored.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from approachsim import units
+from approachsim.config import ProfileError, Section
+from approachsim.geo import RunwayFrame
+
+TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
+
+
+@dataclass(frozen=True)
+class Runway:
+    """Runway threshold and approach geometry (SI)."""
+
+    threshold_lat_rad: float
+    threshold_lon_rad: float
+    elevation_m: float
+    heading_rad: float
+    """True heading of the landing direction."""
+    glidepath_rad: float
+    tch_m: float
+    """Threshold crossing height of the glidepath."""
+    start_distance_m: float
+    """Distance from the threshold (along the extended centreline) where the run starts."""
+
+    @property
+    def frame(self) -> RunwayFrame:
+        """The runway frame (origin at the threshold, x along the landing direction, y right, z up)."""
+        return RunwayFrame(self.threshold_lat_rad, self.threshold_lon_rad, self.elevation_m, self.heading_rad)
+
+    def glidepath_height_m(self, along_m: np.ndarray | float) -> np.ndarray | float:
+        """Height above the threshold of the ideal glidepath at runway-frame x = along_m (negative before)."""
+        return self.tch_m - np.asarray(along_m) * math.tan(self.glidepath_rad)
+
+
+@dataclass(frozen=True)
+class AircraftChoice:
+    """Which aircraft, and the profile's overrides of its approach configuration (None: aircraft default)."""
+
+    name: str
+    approach_speed_mps: float | None
+    flaps_norm: float | None
+    gear_down: bool
+
+
+@dataclass(frozen=True)
+class Environment:
+    """Weather. wind_from_rad is the direction the wind blows from (as pilots read it), true."""
+
+    wind_speed_mps: float
+    wind_from_rad: float
+    turbulence: str
+    """One of TURBULENCE_LEVELS."""
+    isa_dev_k: float
+    qnh_pa: float
+    """The QNH set on the baro altimeter, Pa."""
+    true_qnh_pa: float
+    """The actual sea-level pressure of the day, Pa (differs from qnh_pa for a QNH-error study)."""
+
+
+@dataclass(frozen=True)
+class Terrain:
+    """Terrain height (ellipsoid, m) against runway-frame x (m, negative before the threshold).
+
+    Linear interpolation between points, held constant beyond the ends. Flat: one point.
+    """
+
+    along_m: tuple[float, ...]
+    height_m: tuple[float, ...]
+
+    def height_at(self, along_m: np.ndarray | float) -> np.ndarray:
+        """Terrain ellipsoid height (m) at runway-frame x = along_m."""
+        return np.interp(along_m, self.along_m, self.height_m)
+
+
+@dataclass(frozen=True)
+class Rates:
+    """Sample rates, Hz. The flight dynamics, autopilot and IMU all run at imu_hz."""
+
+    imu_hz: float
+
+
+@dataclass(frozen=True)
+class RunDefaults:
+    """Default Monte Carlo size, campaign seed and mode (CLI options override)."""
+
+    runs: int
+    seed: int
+    mode: str
+    """"closed" (each run flies on its own navigation solution) or "open" (truth shared)."""
+
+
+@dataclass(frozen=True)
+class Profile:
+    """A validated approach profile. Build with load_profile(path) or parse_profile(dict)."""
+
+    name: str
+    description: str
+    runway: Runway
+    aircraft: AircraftChoice
+    environment: Environment
+    terrain: Terrain
+    rates: Rates
+    run: RunDefaults
+    source: Path | None = field(default=None, compare=False)
+    """The file it came from (aircraft files are looked up beside it)."""
+
+
+def _runway(s: Section) -> Runway:
+    lat = s.number("threshold_lat_deg", lo=-85.0, hi=85.0, unit="deg")
+    lon = s.number("threshold_lon_deg", lo=-180.0, hi=180.0, unit="deg")
+    elev = s.number("elevation_ft", lo=-1500.0, hi=15000.0, unit="ft")
+    hdg = s.number("heading_true_deg", lo=0.0, hi=360.0, unit="deg")
+    gp = s.number("glidepath_deg", 3.0, lo=1.0, hi=10.0, unit="deg")
+    tch = s.number("tch_ft", 50.0, lo=0.0, hi=200.0, unit="ft")
+    start = s.number("start_distance_nmi", 10.0, lo=1.0, hi=30.0, unit="nmi")
+    s.done()
+    return Runway(
+        threshold_lat_rad=math.radians(lat),
+        threshold_lon_rad=math.radians(lon),
+        elevation_m=elev * units.FT,
+        heading_rad=math.radians(hdg % 360.0),
+        glidepath_rad=math.radians(gp),
+        tch_m=tch * units.FT,
+        start_distance_m=start * units.NMI,
+    )
+
+
+def _aircraft(s: Section) -> AircraftChoice:
+    name = s.string("name", "737")
+    if not name or "/" in name or "\\" in name or name.startswith("."):
+        raise ProfileError(f"{s.path}.name: must be a plain aircraft name (a file aircraft/<name>.toml), got {name!r}")
+    speed = s.raw("approach_speed_kt", None)
+    if speed is not None:
+        speed = s.number("approach_speed_kt", lo=80.0, hi=200.0, unit="kt") * units.KT
+    flaps = s.raw("flaps_norm", None)
+    if flaps is not None:
+        flaps = s.number("flaps_norm", lo=0.0, hi=1.0)
+    gear = s.boolean("gear_down", True)
+    s.done()
+    return AircraftChoice(name=name, approach_speed_mps=speed, flaps_norm=flaps, gear_down=gear)
+
+
+def _environment(s: Section) -> Environment:
+    ws = s.number("wind_speed_kt", 0.0, lo=0.0, hi=60.0, unit="kt")
+    wd = s.number("wind_from_deg", 0.0, lo=0.0, hi=360.0, unit="deg")
+    turb = s.string("turbulence", "none", choices=TURBULENCE_LEVELS)
+    dt = s.number("isa_dev_C", 0.0, lo=-60.0, hi=40.0, unit="C")
+    qnh = s.number("qnh_hPa", 1013.25, lo=900.0, hi=1100.0, unit="hPa")
+    true_qnh = s.number("true_qnh_hPa", qnh, lo=900.0, hi=1100.0, unit="hPa")
+    s.done()
+    return Environment(
+        wind_speed_mps=ws * units.KT,
+        wind_from_rad=math.radians(wd % 360.0),
+        turbulence=turb,
+        isa_dev_k=dt,
+        qnh_pa=qnh * units.HPA,
+        true_qnh_pa=true_qnh * units.HPA,
+    )
+
+
+def _terrain(s: Section, runway: Runway) -> Terrain:
+    if not s.has("distance_nmi") and not s.has("height_ft"):
+        s.done()
+        return Terrain(along_m=(0.0,), height_m=(runway.elevation_m,))
+    dist = s.numbers("distance_nmi", min_len=2, unit="nmi before the threshold")
+    hgt = s.numbers("height_ft", min_len=2, unit="ft")
+    s.done()
+    if len(dist) != len(hgt):
+        raise ProfileError(
+            f"{s.path}.height_ft: needs one height per distance_nmi value ({len(dist)}), got {len(hgt)}"
+        )
+    if any(b >= a for a, b in zip(dist, dist[1:], strict=False)):
+        raise ProfileError(f"{s.path}.distance_nmi: must decrease strictly (far to near the threshold)")
+    if any(h < -1500.0 or h > 15000.0 for h in hgt):
+        raise ProfileError(f"{s.path}.height_ft: every height must be in [-1500, 15000] ft")
+    along = tuple(-d * units.NMI for d in dist)  # distance before the threshold is negative x
+    return Terrain(along_m=along, height_m=tuple(h * units.FT for h in hgt))
+
+
+def _rates(s: Section) -> Rates:
+    imu = s.number("imu_hz", 120.0, lo=50.0, hi=1000.0, unit="Hz")
+    s.done()
+    return Rates(imu_hz=imu)
+
+
+def _run(s: Section) -> RunDefaults:
+    runs = s.integer("runs", 20, lo=1, hi=100000)
+    seed = s.integer("seed", 1, lo=0, hi=2**63 - 1)
+    mode = s.string("mode", "closed", choices=("closed", "open"))
+    s.done()
+    return RunDefaults(runs=runs, seed=seed, mode=mode)
+
+
+def parse_profile(data: dict, source: Path | None = None) -> Profile:
+    """Validate a profile given as the dict TOML parsing gives; ProfileError names the first bad field."""
+    top = Section(data, "")
+    name = top.string("name", source.stem if source is not None else "profile")
+    description = top.string("description", "")
+    runway = _runway(top.section("runway", default_empty=False))
+    aircraft = _aircraft(top.section("aircraft"))
+    env = _environment(top.section("environment"))
+    terrain = _terrain(top.section("terrain"), runway)
+    rates = _rates(top.section("rates"))
+    run = _run(top.section("run"))
+    top.done()
+    return Profile(
+        name=name,
+        description=description,
+        runway=runway,
+        aircraft=aircraft,
+        environment=env,
+        terrain=terrain,
+        rates=rates,
+        run=run,
+        source=source,
+    )
+
+
+def load_profile(path: str | Path) -> Profile:
+    """Read and validate a profile file. Missing file, bad TOML and bad fields all raise ProfileError."""
+    p = Path(path)
+    if not p.is_file():
+        raise ProfileError(f"profile: no such file {str(p)!r}")
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise ProfileError(f"profile: {str(p)!r} is not a UTF-8 text file") from None
+    except tomllib.TOMLDecodeError as e:
+        raise ProfileError(f"profile: {str(p)!r} is not valid TOML ({e})") from None
+    return parse_profile(data, source=p.resolve())

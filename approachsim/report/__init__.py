@@ -1,0 +1,1 @@
+"""Figures and report pages (the only stage that imports matplotlib)."""

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The README's test command: install the package with its test extras, lint, check layering, run pytest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+python -m pip install --quiet -e ".[test]"
+ruff check .
+lint-imports
+set +e
+python -m pytest -q "$@"
+status=$?
+set -e
+if [ "$status" -eq 5 ]; then
+  echo "pytest collected no tests: failing" >&2
+  exit 1
+fi
+exit "$status"
