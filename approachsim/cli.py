@@ -1,6 +1,6 @@
 """Command line: `approachsim fly | sense | navigate | evaluate | study | regress | reproduce | profiles`.
 
-Each stage owns its sub-command in its own module (`<stage>/command.py`, with `register(subparsers)`).
+Each sub-command lives in its own module under approachsim/commands/, with `register(subparsers)`.
 User mistakes (bad profile, bad option) exit with status 2 and one line naming the field, never a traceback.
 """
 
@@ -14,9 +14,9 @@ from collections.abc import Sequence
 from approachsim.config import ProfileError
 
 COMMAND_MODULES = (
-    "approachsim.flight.command",
+    "approachsim.commands.fly",
 )
-"""Modules that each add sub-commands; a stage adds its line here."""
+"""Modules that each add sub-commands; a new command adds its line here."""
 
 
 class _OneLineParser(argparse.ArgumentParser):

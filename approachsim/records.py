@@ -7,6 +7,7 @@ base) put the run axis first: (runs, time, ...). All SI; frames in the field nam
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
+from typing import Protocol
 
 import numpy as np
 
@@ -72,3 +73,37 @@ class Truth:
     def slice(self, sl: slice) -> Truth:
         """The record restricted to time indices `sl`."""
         return Truth(**{k: v[sl] for k, v in self.arrays().items()}, runway=self.runway)
+
+
+@dataclass(frozen=True)
+class NavSolution:
+    """The navigation system's output for one run at the IMU rate (time on axis 0), for the IMU point.
+
+    Feed-forward convention: output = INS - estimated error. Covariances are the filter's own claim.
+    """
+
+    t_s: Array
+    """(n,) time since the start of the run, s (same time base as the Truth)."""
+    r_ecef: Array
+    """(n, 3) estimated position, ECEF, m."""
+    v_ned: Array
+    """(n, 3) estimated velocity relative to the Earth, NED, m/s."""
+    euler_rad: Array
+    """(n, 3) estimated roll, pitch, heading, rad."""
+    P_pos_ned: Array
+    """(n, 3, 3) the filter's position-error covariance in local NED axes, m^2."""
+    clock_bias_m: Array
+    """(n,) estimated GPS receiver clock bias, m (nan where there is no GPS clock state)."""
+    clock_bias_sigma_m: Array
+    """(n,) its claimed 1-sigma, m (nan where none)."""
+
+
+class NavigationSource(Protocol):
+    """Where the autopilot's guidance reads position and velocity: the truth, or the navigation solution.
+
+    The flight loop calls step(k, truth) once per step, after writing row k of the (preallocated, being
+    filled) truth arrays; the source may read rows <= k only. It returns the position (runway frame:
+    along, cross, height above threshold, m) and NED velocity (m/s) that guidance should fly on.
+    """
+
+    def step(self, k: int, truth: Truth) -> tuple[Array, Array]: ...

@@ -1,0 +1,1 @@
+"""CLI sub-commands, one module each (`register(subparsers)`): the edge where stages are composed."""
