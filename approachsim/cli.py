@@ -15,6 +15,7 @@ from approachsim.config import ProfileError
 
 COMMAND_MODULES = (
     "approachsim.commands.fly",
+    "approachsim.commands.reproduce",
 )
 """Modules that each add sub-commands; a new command adds its line here."""
 

@@ -1,0 +1,37 @@
+"""Filters by name, so a profile can choose one ("ekf", "rkf-gate", "ud", ...) and fail at load if unknown.
+
+Each entry is a factory taking the filter's tuning keywords (from the profile's nav section) and returning
+an object with the NavFilter interface of nav/base.py. A variant adds one line here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
+from typing import Any
+
+from approachsim.config import ProfileError
+from approachsim.nav.base import KalmanFilter, NavFilter
+
+
+def _ekf(**tuning: Any) -> NavFilter:
+    if tuning:
+        raise ProfileError(f"nav.filter_tuning.{sorted(tuning)[0]}: unknown key (the optimal 'ekf' takes no tuning)")
+    return KalmanFilter(name="ekf")
+
+
+FILTERS: Mapping[str, Callable[..., NavFilter]] = MappingProxyType(
+    {
+        "ekf": _ekf,
+    }
+)
+"""Filter factories by name (read-only)."""
+
+
+def make_filter(name: str, **tuning: Any) -> NavFilter:
+    """The filter called `name`, built with its tuning; ProfileError names the allowed filters."""
+    try:
+        factory = FILTERS[name]
+    except KeyError:
+        raise ProfileError(f"nav.filter: must be one of {', '.join(sorted(FILTERS))}; got {name!r}") from None
+    return factory(**tuning)
