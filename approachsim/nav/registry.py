@@ -12,6 +12,7 @@ from typing import Any
 
 from approachsim.config import ProfileError
 from approachsim.nav.base import KalmanFilter, NavFilter
+from approachsim.nav.ud import make_robust_ud, make_ud
 
 
 def _ekf(**tuning: Any) -> NavFilter:
@@ -23,6 +24,12 @@ def _ekf(**tuning: Any) -> NavFilter:
 FILTERS: Mapping[str, Callable[..., NavFilter]] = MappingProxyType(
     {
         "ekf": _ekf,
+        "ud": make_ud,  # Bierman update, Thornton/MWGS propagation (Chernodarov sec. 4)
+        "robust-ud": make_robust_ud,  # tuning key influence = gauss | laplace | gauss-laplace | huber
+        "robust-ud-gauss": lambda **t: make_robust_ud("gauss", name="robust-ud-gauss", **t),
+        "robust-ud-laplace": lambda **t: make_robust_ud("laplace", name="robust-ud-laplace", **t),
+        "robust-ud-gauss-laplace": lambda **t: make_robust_ud("gauss-laplace", name="robust-ud-gauss-laplace", **t),
+        "robust-ud-huber": lambda **t: make_robust_ud("huber", name="robust-ud-huber", **t),
     }
 )
 """Filter factories by name (read-only)."""

@@ -1,0 +1,256 @@
+"""U-D factorized Kalman filter (Bierman update, Thornton / MWGS propagation) and its robust variant.
+
+The covariance is stored as P = U diag(d) U' (U unit upper triangular, d >= 0), never formed during the
+filter steps, so it stays symmetric and non-negative where the covariance form loses definiteness
+(Bierman 1977). Only the covariance storage differs from the Joseph-form `KalmanFilter` of nav/base.py: with
+the Gauss influence function both give the same x and P (to round-off) on well-conditioned problems.
+
+Robust variant (Chernodarov, sec. 4, eq. 3 and the Joseph-Bierman update):
+    v_j = z_j - H_j m_{j-1};  beta_j = v_j / alpha_j;  psi_j = psi(beta_j);  psi'_j = psi'(beta_j)
+    f_j = H_j U_{j-1};  V_j = D_{j-1} f_j'
+    alpha~_j^2 = f_j V_j psi'_j + alpha_j^2;  K_j = U_{j-1} V_j / alpha~_j^2
+    m_j = m_{j-1} + K_j alpha_j psi_j
+    MWGS{ W = [K_j f_j psi'_j - U_{j-1} : K_j],  D = diag(D_{j-1}, alpha_j^2 psi'_j) } -> U_j, D_j
+with the scaling parameter alpha_j = sqrt(r_j) (the measurement noise std: then psi = beta gives exactly the
+Kalman update, as the paper's Gauss case must). The MWGS update equals the optimal update with the noise
+variance inflated to r / psi' (psi' = 0: P unchanged), so it is computed here by Bierman's scalar update
+with r / psi' (`mwgs_robust_update` keeps the paper's literal MWGS form for the tests to compare).
+
+Which branch of the influence function applies is decided by the innovation normalized by its predicted
+standard deviation, b = v / sqrt(S), S = h' P h + r, so that the paper's 3-sigma rule (eq. 4-6,
+|beta| < 3 for beta ~ N(0, 1)) holds whatever the size of P relative to r.
+
+Influence functions (psi, psi'), evaluated at beta_j = v_j / alpha_j:
+    gauss          psi = beta, psi' = 1                                  (everywhere)
+    laplace        Gauss for |b| < outer; psi = sign(beta), psi' = 0     (off-design, |b| >= outer)
+    gauss-laplace  Gauss for |b| < inner; psi = beta / 3, psi' = 1/3     (inner <= |b| < outer, the
+                   vicinity of the 3-sigma tolerance); Laplace beyond outer. The paper's approximation
+                   psi_lg = beta / 3 of eq. 7-10 reaches psi_l = 1 at |beta| = 3.
+    huber          psi = beta for |b| <= k, psi = beta k / |b| beyond (Huber 1981), with the secant slope
+                   psi' = psi / beta (our choice: with Huber's derivative psi' = 0 the gain would jump to
+                   P h / r at the corner; the secant keeps the update a consistent noise inflation).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from approachsim.config import ProfileError
+from approachsim.nav.base import FilterState, ScalarMeasurement, UpdateStatus
+
+Array = np.ndarray
+
+Influence = Literal["gauss", "laplace", "gauss-laplace", "huber"]
+INFLUENCES: tuple[str, ...] = ("gauss", "laplace", "gauss-laplace", "huber")
+
+
+# --------------------------------------------------------------------------------------------------------------
+# factorization kernels (plain array functions)
+
+
+def ud_factor(P: Array) -> tuple[Array, Array]:
+    """P (n, n) symmetric non-negative -> (U unit upper triangular (n, n), d (n,)) with P = U diag(d) U'.
+
+    Zero (or round-off negative) pivots give d = 0 and a zero column above the diagonal.
+    """
+    P = np.array(P, dtype=float)
+    n = P.shape[0]
+    U = np.eye(n)
+    d = np.zeros(n)
+    for j in range(n - 1, -1, -1):
+        d[j] = P[j, j]
+        if d[j] > 0.0:
+            U[:j, j] = P[:j, j] / d[j]
+            P[:j, :j] -= d[j] * np.outer(U[:j, j], U[:j, j])
+        else:
+            d[j] = 0.0
+    return U, d
+
+
+def mwgs(W: Array, dw: Array) -> tuple[Array, Array]:
+    """Modified weighted Gram-Schmidt (Bierman 1977; Thornton): W (n, m), weights dw (m,) >= 0
+    -> (U (n, n) unit upper, d (n,)) with U diag(d) U' = W diag(dw) W'."""
+    W = np.array(W, dtype=float)
+    n = W.shape[0]
+    U = np.eye(n)
+    d = np.zeros(n)
+    for k in range(n - 1, -1, -1):
+        c = dw * W[k]
+        d[k] = float(W[k] @ c)
+        if d[k] > 0.0:
+            U[:k, k] = (W[:k] @ c) / d[k]
+            W[:k] -= np.outer(U[:k, k], W[k])
+        else:
+            d[k] = 0.0
+    return U, d
+
+
+def thornton_predict(U: Array, d: Array, F: Array, Q: Array) -> tuple[Array, Array]:
+    """P- = F P F' + Q on U-D factors: MWGS of W = [F U : G], D = diag(d, q) with Q = G diag(q) G' (Chernodarov
+    eq. 3, prediction; G, q from the U-D factorization of Q)."""
+    G, q = ud_factor(Q)
+    W = np.hstack([F @ U, G])
+    return mwgs(W, np.concatenate([d, q]))
+
+
+def bierman_update(U: Array, d: Array, h: Array, r: float) -> tuple[Array, Array, Array, float]:
+    """Bierman's scalar measurement update of P = U diag(d) U' with z = h' x + v, var(v) = r > 0.
+
+    Returns (U+, d+, K, S): the updated factors, the Kalman gain K = P h / S and S = h' P h + r.
+    """
+    n = len(d)
+    f = U.T @ h  # f = U' h
+    v = d * f  # v = D f
+    U_new = U.copy()
+    d_new = d.copy()
+    b = np.zeros(n)
+    alpha = float(r)
+    for j in range(n):
+        alpha_prev = alpha
+        alpha = alpha_prev + f[j] * v[j]  # alpha_j = alpha_{j-1} + f_j v_j
+        d_new[j] = d[j] * alpha_prev / alpha
+        lam = -f[j] / alpha_prev
+        col = U[:j, j].copy()
+        U_new[:j, j] = col + lam * b[:j]
+        b[:j] += col * v[j]
+        b[j] = v[j]
+    return U_new, d_new, b / alpha, alpha
+
+
+def mwgs_robust_update(U: Array, d: Array, h: Array, r: float, psi_prime: float) -> tuple[Array, Array, Array]:
+    """The paper's literal robust covariance update (Chernodarov sec. 4): f = h'U, V = D f',
+    a2 = f V psi' + r, K = U V / a2, MWGS{[K f psi' - U : K], diag(D, r psi')} -> (U+, d+); returns (U+, d+, K)."""
+    f = h @ U
+    V = d * f
+    a2 = float(f @ V) * psi_prime + r
+    K = U @ V / a2
+    W = np.hstack([np.outer(K, f) * psi_prime - U, K[:, None]])
+    U_new, d_new = mwgs(W, np.concatenate([d, [r * psi_prime]]))
+    return U_new, d_new, K
+
+
+# --------------------------------------------------------------------------------------------------------------
+# influence functions
+
+
+@dataclass(frozen=True)
+class InfluenceFunction:
+    """psi(beta), psi'(beta) of seed 004 sec. 4; the branch is chosen on b = v / sqrt(S) (see module doc).
+
+    kind: one of INFLUENCES; outer: the 3-sigma tolerance of eq. 6 (Laplace beyond it); inner: start of the
+    Gauss-Laplace band (gauss-laplace only); huber_k: Huber's corner (huber only). All in units of sigma.
+    """
+
+    kind: Influence = "gauss"
+    outer: float = 3.0
+    inner: float = 2.0
+    huber_k: float = 3.0
+
+    def __post_init__(self) -> None:
+        if self.kind not in INFLUENCES:
+            raise ValueError(f"influence: must be one of {', '.join(INFLUENCES)}; got {self.kind!r}")
+        for name in ("outer", "inner", "huber_k"):
+            value = getattr(self, name)
+            if not isinstance(value, int | float) or not np.isfinite(value) or value <= 0.0:
+                raise ValueError(f"{name}: must be a positive number of sigmas; got {value!r}")
+        if self.inner >= self.outer:
+            raise ValueError(f"inner: must be below outer ({self.outer}); got {self.inner!r}")
+
+    def __call__(self, beta: float, b: float) -> tuple[float, float]:
+        """(psi, psi') at the scaled residual beta = v / alpha, branch chosen by b = v / sqrt(S)."""
+        ab = abs(b)
+        if self.kind == "gauss":
+            return beta, 1.0
+        if self.kind == "huber":
+            if ab <= self.huber_k:
+                return beta, 1.0
+            w = self.huber_k / ab
+            return beta * w, w
+        if ab >= self.outer:  # Laplace: psi = sign(beta), psi' = 0
+            return float(np.sign(beta)), 0.0
+        if self.kind == "gauss-laplace" and ab >= self.inner:
+            return beta / 3.0, 1.0 / 3.0  # psi_lg = beta / 3, psi'_lg = 1/3 (eq. 7-10)
+        return beta, 1.0
+
+
+# --------------------------------------------------------------------------------------------------------------
+# the filter
+
+
+@dataclass(frozen=True)
+class UDFilter:
+    """NavFilter on U-D factors (state.U, state.d; state.P is None). Gauss influence: the plain U-D filter."""
+
+    name: str = "ud"
+    influence: InfluenceFunction = InfluenceFunction()
+
+    def init(self, x0: Array, P0: Array) -> FilterState:
+        """State from x0 (n,) and P0 (n, n), P0 stored as its U-D factors."""
+        U, d = ud_factor(0.5 * (np.asarray(P0, float) + np.asarray(P0, float).T))
+        return FilterState(x=np.array(x0, dtype=float), U=U, d=d)
+
+    def predict(self, state: FilterState, F: Array, Q: Array) -> FilterState:
+        """x- = F x+ ; P- = F P+ F' + Q by Thornton's MWGS (Chernodarov eq. 3)."""
+        U, d = thornton_predict(state.U, state.d, np.asarray(F, float), np.asarray(Q, float))
+        return FilterState(x=F @ state.x, U=U, d=d, memory=state.memory)
+
+    def update(self, state: FilterState, meas: ScalarMeasurement) -> tuple[FilterState, UpdateStatus]:
+        """One scalar robust update (Chernodarov sec. 4 with alpha = sqrt(r)); Bierman on r / psi'."""
+        x, U, d, h, r = state.x, state.U, state.d, np.asarray(meas.h, float), float(meas.r)
+        f = U.T @ h
+        hph = float(f @ (d * f))  # h' P h
+        S = hph + r  # S = h' P h + r
+        nu = float(meas.z - h @ x)  # innovation v_j = z_j - H_j m_{j-1}
+        alpha = np.sqrt(r)
+        psi, dpsi = self.influence(nu / alpha, nu / np.sqrt(S))
+        step = (U @ (d * f)) * (alpha * psi) / (hph * dpsi + r)  # K_j alpha_j psi_j, K_j = U V / alpha~^2
+        weight = 1.0 if nu == 0.0 else float(alpha * psi * S / ((hph * dpsi + r) * nu))
+        status = UpdateStatus(meas.name, meas.t_s, nu, S, nu * nu / S, weight, True)
+        if dpsi > 0.0:
+            U, d, _, _ = bierman_update(U, d, h, r / dpsi)  # = MWGS{[K f psi' - U : K], diag(D, r psi')}
+        return FilterState(x=x + step, U=U, d=d, memory=state.memory), status
+
+    def covariance(self, state: FilterState) -> Array:
+        """P = U diag(d) U' (n, n)."""
+        return (state.U * state.d) @ state.U.T
+
+
+# --------------------------------------------------------------------------------------------------------------
+# registry factories (profile tuning checked here; errors name the field)
+
+_TUNING_KEYS = {
+    "gauss": (),
+    "laplace": ("outer",),
+    "gauss-laplace": ("inner", "outer"),
+    "huber": ("huber_k",),
+}
+
+
+def make_ud(**tuning: object) -> UDFilter:
+    """The plain U-D filter (registry name 'ud'); it takes no tuning."""
+    if tuning:
+        raise ProfileError(f"nav.filter_tuning.{sorted(tuning)[0]}: unknown key (the plain 'ud' takes no tuning)")
+    return UDFilter(name="ud")
+
+
+def make_robust_ud(influence: object = "gauss-laplace", *, name: str = "robust-ud", **tuning: object) -> UDFilter:
+    """The robust U-D filter with influence function `influence` and its keys (outer, inner, huber_k; sigma)."""
+    if influence not in INFLUENCES:
+        raise ProfileError(f"nav.filter_tuning.influence: must be one of {', '.join(INFLUENCES)}; got {influence!r}")
+    allowed = _TUNING_KEYS[str(influence)]
+    for key, value in sorted(tuning.items()):
+        if key not in allowed:
+            raise ProfileError(
+                f"nav.filter_tuning.{key}: unknown key for influence {influence!r}"
+                f" (allowed: {', '.join(allowed) or 'none'})"
+            )
+        if isinstance(value, bool) or not isinstance(value, int | float) or not 0.0 < float(value) < float("inf"):
+            raise ProfileError(f"nav.filter_tuning.{key}: must be a positive number of sigma; got {value!r}")
+    try:
+        fn = InfluenceFunction(str(influence), **{k: float(v) for k, v in tuning.items()})  # type: ignore[arg-type]
+    except ValueError as e:
+        raise ProfileError(f"nav.filter_tuning.{e}") from None
+    return UDFilter(name=name, influence=fn)
