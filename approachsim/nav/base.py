@@ -93,8 +93,11 @@ class KalmanFilter:
     """Linear / error-state Kalman filter, covariance form, sequential scalar updates in Joseph form.
 
     With the default policy this is the optimal filter; robust variants pass another `policy`.
-    Update (gain weight w, Joseph form with the weighted gain Kw = w K, valid for any gain):
-        S = h' P h + r ; K = P h / S ; x+ = x + Kw nu ; P+ = (I - Kw h') P (I - Kw h')' + Kw r Kw'
+    Update (policy returns the gain weight w and the covariance-reduction factor psi' in [0, 1]):
+        S = h' P h + r ; K = P h / S ; x+ = x + w K nu
+        P+ = P - psi' K S K', computed in Joseph form with the gain Kc = c K, c = 1 - sqrt(1 - psi'),
+        since (I - Kc h') P (I - Kc h')' + Kc r Kc' = P - c (2 - c) K S K' = P - psi' K S K'.
+    Optimal (1, 1): c = 1, the usual Joseph form. Rejection (0, 0): state and P unchanged.
     """
 
     name: str = "kf"
@@ -117,14 +120,18 @@ class KalmanFilter:
         S = float(h @ Ph + r)  # S = h' P h + r
         nu = float(meas.z - h @ x)  # innovation
         beta = nu / np.sqrt(S)
-        w, _ = self.policy(beta, meas.name)
+        w, psi_prime = self.policy(beta, meas.name)
+        w, psi_prime = float(w), float(psi_prime)
+        if not 0.0 <= psi_prime <= 1.0:
+            raise ValueError(f"gain policy of {self.name!r}: psi_prime must be in [0, 1], got {psi_prime}")
         status = UpdateStatus(meas.name, meas.t_s, nu, S, nu * nu / S, w, w > 0.0)
-        if w == 0.0:
+        if w == 0.0 and psi_prime == 0.0:
             return state, status
-        K = w * Ph / S  # K = P h S^-1, weighted
-        x = x + K * nu
-        A = np.eye(len(x)) - np.outer(K, h)
-        P = A @ P @ A.T + r * np.outer(K, K)  # Joseph form
+        K = Ph / S  # K = P h S^-1
+        x = x + w * K * nu  # x+ = x + w K nu
+        Kc = (1.0 - np.sqrt(1.0 - psi_prime)) * K  # Joseph gain giving P - psi' K S K'
+        A = np.eye(len(x)) - np.outer(Kc, h)
+        P = A @ P @ A.T + r * np.outer(Kc, Kc)  # Joseph form
         return FilterState(x=x, P=0.5 * (P + P.T), memory=state.memory), status
 
     def covariance(self, state: FilterState) -> Array:

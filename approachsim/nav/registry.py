@@ -12,6 +12,7 @@ from typing import Any
 
 from approachsim.config import ProfileError
 from approachsim.nav.base import KalmanFilter, NavFilter
+from approachsim.nav.robust import adaptive_filter, gate_filter
 from approachsim.nav.ud import make_robust_ud, make_ud
 
 
@@ -21,9 +22,32 @@ def _ekf(**tuning: Any) -> NavFilter:
     return KalmanFilter(name="ekf")
 
 
+def _robust_bound(kind: str, tuning: dict[str, Any]) -> float:
+    """The `bound` keyword of a robust filter (confidence half-width, sigma), checked; ProfileError names it."""
+    unknown = sorted(set(tuning) - {"bound"})
+    if unknown:
+        raise ProfileError(f"nav.filter_tuning.{unknown[0]}: unknown key ('{kind}' takes only 'bound')")
+    bound = tuning.get("bound", 3.0)
+    if isinstance(bound, bool) or not isinstance(bound, int | float) or not 0.0 < float(bound) < float("inf"):
+        raise ProfileError(
+            f"nav.filter_tuning.bound: must be a positive number of sigma (e.g. 3.0) for '{kind}'; got {bound!r}"
+        )
+    return float(bound)
+
+
+def _rkf_gate(**tuning: Any) -> NavFilter:
+    return gate_filter(_robust_bound("rkf-gate", tuning))
+
+
+def _rkf_adaptive(**tuning: Any) -> NavFilter:
+    return adaptive_filter(_robust_bound("rkf-adaptive", tuning))
+
+
 FILTERS: Mapping[str, Callable[..., NavFilter]] = MappingProxyType(
     {
         "ekf": _ekf,
+        "rkf-gate": _rkf_gate,  # Hajiyev & Saltoglu eqs. 20-24
+        "rkf-adaptive": _rkf_adaptive,  # Manero Contreras & Hajiyev eqs. 20-30
         "ud": make_ud,  # Bierman update, Thornton/MWGS propagation (Chernodarov sec. 4)
         "robust-ud": make_robust_ud,  # tuning key influence = gauss | laplace | gauss-laplace | huber
         "robust-ud-gauss": lambda **t: make_robust_ud("gauss", name="robust-ud-gauss", **t),
