@@ -1,0 +1,62 @@
+"""The profile's [evaluation] section: decision heights, which limits the verdict uses, integrity factors.
+
+    [evaluation]
+    dh_cat1_ft = 200         # decision heights above the threshold, ft
+    dh_cat2_ft = 100
+    dh_cat3_ft = 50
+    verdict = "faa"          # "faa": FAA 1-sigma table only; "faa+icao": also the ICAO 95 % accuracy
+    k_v = 5.33               # protection-level factors (standards.md 1.5)
+    k_h = 6.0
+    series_runs = 3          # runs whose full time series are kept
+    flight_group = 25        # open loop: runs sharing one flown truth (one turbulence realization)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from approachsim import units
+from approachsim.config import ProfileError, Section
+from approachsim.evaluate.limits import CATEGORIES, DEFAULT_DH_FT, K_H_PA, K_V_PA
+
+VERDICTS = ("faa", "faa+icao")
+
+
+def _default_dh() -> dict[str, float]:
+    return dict(DEFAULT_DH_FT)
+
+
+@dataclass(frozen=True)
+class EvaluationConfig:
+    """How a campaign is scored. dh_ft maps category -> decision height above the threshold, ft."""
+
+    dh_ft: dict[str, float] = field(default_factory=_default_dh)
+    verdict: str = "faa"
+    k_v: float = K_V_PA
+    k_h: float = K_H_PA
+    series_runs: int = 3
+    flight_group: int = 25
+
+    def dh_m(self, category: str) -> float:
+        """Decision height of `category` above the threshold, m."""
+        return self.dh_ft[category] * units.FT
+
+
+def parse_evaluation(s: Section) -> EvaluationConfig:
+    """Read an [evaluation] table (all keys optional); ProfileError names a bad field."""
+    keys = ("dh_cat1_ft", "dh_cat2_ft", "dh_cat3_ft")
+    dh = {
+        c: s.number(k, DEFAULT_DH_FT[c], lo=10.0, hi=1000.0, unit="ft")
+        for c, k in zip(CATEGORIES, keys, strict=True)
+    }
+    if not dh["CAT I"] > dh["CAT II"] > dh["CAT III"]:
+        raise ProfileError(f"{s.path}.dh_cat2_ft: decision heights must decrease from CAT I to CAT III, got {dh}")
+    verdict = s.string("verdict", "faa", choices=VERDICTS)
+    k_v = s.number("k_v", K_V_PA, lo=1.0, hi=20.0)
+    k_h = s.number("k_h", K_H_PA, lo=1.0, hi=20.0)
+    series_runs = s.integer("series_runs", 3, lo=0, hi=1000)
+    flight_group = s.integer("flight_group", 25, lo=1, hi=10000)
+    s.done()
+    return EvaluationConfig(
+        dh_ft=dh, verdict=verdict, k_v=k_v, k_h=k_h, series_runs=series_runs, flight_group=flight_group
+    )

@@ -1,0 +1,110 @@
+"""Campaign summary: the contract's summary.json (design.md "Output contract") and the detailed statistics.
+
+Input is the per-run scalar table (column -> array over the runs that completed, as score.py names them).
+summary.json holds exactly the contract's keys; everything else (intervals, ICAO columns, integrity,
+time-averaged RMS, FTE / TSE) goes to the details dictionary.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict
+
+import numpy as np
+
+from approachsim import units
+from approachsim.evaluate.config import EvaluationConfig
+from approachsim.evaluate.integrity import REGIONS
+from approachsim.evaluate.limits import CATEGORIES
+from approachsim.evaluate.score import CATEGORY_KEYS
+from approachsim.evaluate.stats import error_stats
+from approachsim.evaluate.timeavg import STATES, campaign_rms_ft
+from approachsim.evaluate.verdict import CategoryResult, best_category, category_verdict
+
+SCHEMA = "approachsim.summary/1"
+
+
+def _num(x: float) -> float | int | None:
+    """JSON-safe number: None for nan/inf, int for integral heights."""
+    if x is None or not math.isfinite(x):
+        return None
+    return int(x) if float(x).is_integer() and abs(x) < 1e15 else float(x)
+
+
+def _col(columns: Mapping[str, np.ndarray], name: str) -> np.ndarray:
+    return np.asarray(columns.get(name, np.empty(0)), dtype=float)
+
+
+def verdicts(columns: Mapping[str, np.ndarray], cfg: EvaluationConfig) -> list[CategoryResult]:
+    """Score every category from the per-run table (errors converted to ft here)."""
+    out = []
+    for cat in CATEGORIES:
+        key = CATEGORY_KEYS[cat]
+        lat = _col(columns, f"{key}_lateral_m") / units.FT
+        ver = _col(columns, f"{key}_vertical_m") / units.FT
+        out.append(category_verdict(cat, cfg.dh_ft[cat], lat, ver, cfg.verdict))
+    return out
+
+
+def contract_summary(
+    results: list[CategoryResult], *, profile: str, runs: int, seed: int, closed_loop: bool, failed_runs: int
+) -> dict:
+    """summary.json, exactly the contract's keys."""
+    dhs = {}
+    for r in results:
+        dhs[r.category] = {
+            "height_ft": _num(r.height_ft),
+            "lateral_1sigma_ft": _num(r.lateral.rms),
+            "vertical_1sigma_ft": _num(r.vertical.rms),
+            "lateral_95_ft": _num(r.lateral.p95),
+            "vertical_95_ft": _num(r.vertical.p95),
+            "limit_lateral_1sigma_ft": _num(r.limits.lateral_1sigma_ft),
+            "limit_vertical_1sigma_ft": _num(r.limits.vertical_1sigma_ft),
+            "meets": bool(r.meets),
+        }
+    return {
+        "schema": SCHEMA,
+        "profile": profile,
+        "runs": int(runs),
+        "seed": int(seed),
+        "closed_loop": bool(closed_loop),
+        "decision_heights": dhs,
+        "best_category": best_category(results),
+        "failed_runs": int(failed_runs),
+    }
+
+
+def _stats_ft(x_m: np.ndarray) -> dict:
+    return {k: _num(v) for k, v in asdict(error_stats(x_m).scaled(1.0 / units.FT)).items()}
+
+
+def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cfg: EvaluationConfig) -> dict:
+    """Everything beside the contract: intervals, ICAO limits, integrity, FTE / TSE, seed 002's figure."""
+    cats = {}
+    for r in results:
+        key = CATEGORY_KEYS[r.category]
+        entry = {
+            "height_ft": _num(r.height_ft),
+            "meets": r.meets,
+            "meets_faa_1sigma": r.meets_faa,
+            "meets_icao_95": r.meets_icao,
+            "limits_ft": {k: _num(v) for k, v in asdict(r.limits).items()},
+        }
+        for comp in ("along", "lateral", "vertical", "vpl", "hpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert"):
+            entry[f"{comp}_ft"] = _stats_ft(_col(columns, f"{key}_{comp}_m"))
+        for axis, name in (("v", "vertical"), ("h", "horizontal")):
+            entry[f"stanford_{name}"] = {
+                reg: int(np.nansum(_col(columns, f"{key}_{axis}_{reg}"))) for reg in REGIONS
+            }
+        av = _col(columns, f"{key}_availability")
+        entry["availability"] = _num(float(np.mean(av))) if av.size else None
+        cats[r.category] = entry
+    ta = campaign_rms_ft({s: _col(columns, f"ta_{s}_ft2") for s in STATES})
+    return {
+        "verdict_limits": cfg.verdict,
+        "k_v": cfg.k_v,
+        "k_h": cfg.k_h,
+        "categories": cats,
+        "time_averaged_rms_ft": {k: _num(v) for k, v in ta.items()},
+    }

@@ -1,0 +1,152 @@
+"""End to end scoring on synthetic truth / navigation pairs with known errors: values, verdicts, contract."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from evalpairs import cross_axis_ned, make_nav, make_truth
+from scipy import stats as sps
+
+from approachsim import units
+from approachsim.config import ProfileError, Section
+from approachsim.evaluate.config import EvaluationConfig, parse_evaluation
+from approachsim.evaluate.score import RunScoreError, score_run
+from approachsim.evaluate.summary import contract_summary, details, verdicts
+
+CFG = EvaluationConfig()
+CONTRACT_DH_KEYS = {
+    "height_ft", "lateral_1sigma_ft", "vertical_1sigma_ft", "lateral_95_ft", "vertical_95_ft",
+    "limit_lateral_1sigma_ft", "limit_vertical_1sigma_ft", "meets",
+}
+
+
+def _campaign(errors_ned: list[np.ndarray], **truth_kw) -> tuple[dict, dict]:
+    truth = make_truth(hz=4.0, **truth_kw)
+    rows = [score_run(truth, make_nav(truth, e), CFG)[0] for e in errors_ned]
+    cols = {k: np.array([r[k] for r in rows]) for k in rows[0]}
+    res = verdicts(cols, CFG)
+    s = contract_summary(res, profile="synthetic", runs=len(rows), seed=0, closed_loop=False, failed_runs=0)
+    return s, details(cols, res, CFG)
+
+
+def _e(lateral_ft: float, vertical_ft: float) -> np.ndarray:
+    return lateral_ft * units.FT * cross_axis_ned() + np.array([0.0, 0.0, -vertical_ft * units.FT])
+
+
+def test_constant_bias_cat_i_only():
+    s, _ = _campaign([_e(20.0, 5.0)] * 5)
+    d = s["decision_heights"]
+    # near the decision heights the runway axes and the local axes agree to < 1e-4 rad
+    assert d["CAT I"]["lateral_1sigma_ft"] == pytest.approx(20.0, abs=0.01)
+    assert d["CAT I"]["vertical_1sigma_ft"] == pytest.approx(5.0, abs=0.01)
+    assert d["CAT I"]["lateral_95_ft"] == pytest.approx(20.0, abs=0.01)
+    assert [d[c]["meets"] for c in ("CAT I", "CAT II", "CAT III")] == [True, False, False]
+    assert s["best_category"] == "CAT I"
+
+
+def test_constant_bias_cat_ii_and_none():
+    s, _ = _campaign([_e(-8.0, 2.5)] * 3)  # sign of a bias does not help it
+    assert [s["decision_heights"][c]["meets"] for c in ("CAT I", "CAT II", "CAT III")] == [True, True, False]
+    assert s["best_category"] == "CAT II"
+    s, _ = _campaign([_e(30.0, 1.0)] * 3)  # lateral fails CAT I and CAT II; CAT III fails vertically... 30 > 6.8
+    assert s["best_category"] is None
+
+
+def test_known_gaussian_campaign_matches_known_values():
+    rng = np.random.default_rng(2026)
+    n = 400
+    mu_lat, sig_lat, sig_ver = 2.0, 4.0, 1.5  # ft
+    lat = rng.normal(mu_lat, sig_lat, n)
+    ver = rng.normal(0.0, sig_ver, n)
+    s, det = _campaign([_e(a, b) for a, b in zip(lat, ver, strict=True)])
+    c1 = s["decision_heights"]["CAT I"]
+    # the scored values are the sample values (each run's error is constant in time)
+    assert c1["lateral_1sigma_ft"] == pytest.approx(np.sqrt(np.mean(lat**2)), rel=1e-4)
+    assert c1["vertical_95_ft"] == pytest.approx(np.percentile(np.abs(ver), 95), rel=1e-4)
+    # and near the population values, inside the reported intervals
+    rms_true = math.hypot(mu_lat, sig_lat)
+    lat_stats = det["categories"]["CAT I"]["lateral_ft"]
+    assert c1["lateral_1sigma_ft"] == pytest.approx(rms_true, rel=0.08)
+    assert c1["vertical_95_ft"] == pytest.approx(sps.norm.ppf(0.975) * sig_ver, rel=0.1)
+    assert lat_stats["mean"] == pytest.approx(mu_lat, abs=0.5)
+    assert lat_stats["rms_lo"] < rms_true < lat_stats["rms_hi"]
+    # verdicts of the true distribution: 4.5 ft / 1.5 ft meets CAT I and CAT II, not CAT III (vertical 1.0)
+    assert [s["decision_heights"][c]["meets"] for c in ("CAT I", "CAT II", "CAT III")] == [True, True, False]
+
+
+def test_summary_has_exactly_the_contract_keys():
+    s, det = _campaign([_e(1.0, 0.5)] * 2)
+    assert set(s) == {"schema", "profile", "runs", "seed", "closed_loop", "decision_heights", "best_category",
+                      "failed_runs"}
+    assert s["schema"] == "approachsim.summary/1"
+    assert list(s["decision_heights"]) == ["CAT I", "CAT II", "CAT III"]
+    for cat, h, lims in (("CAT I", 200, (28.1, 6.8)), ("CAT II", 100, (8.6, 2.8)), ("CAT III", 50, (6.8, 1.0))):
+        e = s["decision_heights"][cat]
+        assert set(e) == CONTRACT_DH_KEYS
+        assert e["height_ft"] == h
+        assert (e["limit_lateral_1sigma_ft"], e["limit_vertical_1sigma_ft"]) == lims
+    assert det["categories"]["CAT III"]["limits_ft"]["vertical_al_ft"] == pytest.approx(5.2 / units.FT)
+
+
+def test_integrity_counts_and_availability_with_known_covariance():
+    truth = make_truth(hz=4.0)
+    # sigma_D = 0.98 m -> VPL 5.22 m > CAT III VAL 5.2 m: unavailable; < CAT II VAL 5.3 m: available
+    nav = make_nav(truth, _e(0.0, 1.0), sigma_ned_m=(1.0, 1.0, 0.98))
+    sc, arrays, _ = score_run(truth, nav, CFG)
+    assert sc["cat1_vpl_m"] == pytest.approx(5.33 * 0.98)
+    assert sc["cat1_hpl_m"] == pytest.approx(6.0)
+    assert sc["cat3_availability"] == 0.0 and sc["cat2_availability"] == 1.0
+    k = int(sc["cat1_v_normal"] + sc["cat1_v_mi"] + sc["cat1_v_hmi"] + sc["cat1_v_unavailable"])
+    assert k == sc["cat1_v_normal"] > 0  # 0.3 m error < 5.22 m VPL < 10 m VAL at every epoch
+    assert sc["cat3_v_unavailable"] > 0 and sc["cat3_v_normal"] == 0
+    # a 12 m vertical error under a 5.33 m VPL (sigma 1 m): hazardously misleading against the 10 m CAT I VAL
+    sc2, _, _ = score_run(truth, make_nav(truth, np.array([0.0, 0.0, -12.0])), CFG)
+    assert sc2["cat1_v_hmi"] == k and sc2["cat1_v_normal"] == 0
+    assert np.nanmax(np.abs(arrays["vertical_m"] - 1.0 * units.FT)) < 1e-3
+
+
+def test_fte_tse_identity():
+    truth = make_truth(hz=4.0, loc_dev_m=10.0)
+    sc, _, _ = score_run(truth, make_nav(truth, 2.0 * cross_axis_ned()), CFG)
+    assert sc["cat1_tse_lat_m"] == pytest.approx(10.0)
+    assert sc["cat1_lateral_m"] == pytest.approx(2.0, abs=1e-3)
+    assert sc["cat1_fte_lat_m"] == pytest.approx(sc["cat1_tse_lat_m"] + sc["cat1_lateral_m"])
+
+
+def test_time_averaged_rms_in_feet():
+    truth = make_truth(hz=4.0)
+    e = np.array([3.0, -4.0, 1.0])  # N, E, D metres
+    sc, _, _ = score_run(truth, make_nav(truth, e), CFG, clock_bias_true_m=np.full(len(truth), -2.0))
+    assert sc["ta_latitude_ft2"] == pytest.approx((3.0 / units.FT) ** 2, rel=1e-4)
+    assert sc["ta_longitude_ft2"] == pytest.approx((4.0 / units.FT) ** 2, rel=1e-4)
+    assert sc["ta_altitude_ft2"] == pytest.approx((1.0 / units.FT) ** 2, rel=1e-4)
+    assert sc["ta_clock_bias_ft2"] == pytest.approx((2.0 / units.FT) ** 2)
+
+
+def test_unscorable_runs_raise_with_a_reason():
+    truth = make_truth(hz=4.0, dur_s=150.0)  # stops at 175 m: never reaches 200 ft
+    with pytest.raises(RunScoreError, match="CAT I decision height"):
+        score_run(truth, make_nav(truth, np.zeros(3)), CFG)
+    truth = make_truth(hz=4.0)
+    nav = make_nav(truth, np.zeros(3))
+    r = nav.r_ecef.copy()
+    r[-100:] = np.nan
+    with pytest.raises(RunScoreError, match="diverged"):
+        score_run(truth, type(nav)(**{**nav.__dict__, "r_ecef": r}), CFG)
+
+
+def test_evaluation_section_parsing():
+    cfg = parse_evaluation(Section({"dh_cat2_ft": 120, "verdict": "faa+icao"}, "evaluation"))
+    assert cfg.dh_ft == {"CAT I": 200.0, "CAT II": 120.0, "CAT III": 50.0} and cfg.verdict == "faa+icao"
+    for bad, field in (
+        ({"dh_cat1_ft": "200"}, "evaluation.dh_cat1_ft"),
+        ({"dh_cat3_ft": 150}, "evaluation.dh_cat2_ft"),
+        ({"verdict": "icao"}, "evaluation.verdict"),
+        ({"k_v": 0}, "evaluation.k_v"),
+        ({"series_runs": -1}, "evaluation.series_runs"),
+        ({"bogus": 1}, "evaluation.bogus"),
+    ):
+        with pytest.raises(ProfileError, match=field.replace(".", r"\.")):
+            parse_evaluation(Section(bad, "evaluation"))
