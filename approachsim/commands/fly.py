@@ -1,0 +1,69 @@
+"""`approachsim fly PROFILE --out DIR [--seed S] [--run I]`: fly one approach, write its truth and figures.
+
+Writes DIR/truth.npz + DIR/truth.json (the truth record and its schema, see docs/truth.md and
+approachsim.flight.truthfile), DIR/flight.json (termination, tracking statistics) and the figures
+DIR/vertical.png, DIR/lateral.png, DIR/airspeed.png, DIR/attitude.png; prints a short summary.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from approachsim.config import ProfileError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the `fly` sub-command."""
+    p = sub.add_parser("fly", help="fly one closed-loop approach (truth navigation) and write the truth record")
+    p.add_argument("profile", type=Path, help="approach profile (TOML)")
+    p.add_argument("--out", required=True, type=Path, help="output directory")
+    p.add_argument("--seed", type=int, default=None, help="campaign seed (default: the profile's run.seed)")
+    p.add_argument("--run", type=int, default=0, help="run index within the campaign (default 0)")
+    p.add_argument("--no-figures", action="store_true", help="write the truth files only")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Fly, write the truth, the figures and flight.json; print a summary."""
+    from approachsim.flight.run import Approach, tracking_stats
+    from approachsim.flight.truthfile import save_truth
+    from approachsim.profile import load_profile
+
+    profile = load_profile(args.profile)
+    seed = profile.run.seed if args.seed is None else args.seed
+    if seed < 0:
+        raise ProfileError(f"--seed: must be >= 0, got {seed}")
+    if args.run < 0:
+        raise ProfileError(f"--run: must be >= 0, got {args.run}")
+    if args.out.exists() and not args.out.is_dir():
+        raise ProfileError(f"--out: {str(args.out)!r} exists and is not a directory")
+    result = Approach(profile).fly(seed=seed, run=args.run)
+    args.out.mkdir(parents=True, exist_ok=True)
+    save_truth(args.out / "truth.npz", result.truth, meta={"profile": profile.name, "seed": seed, "run": args.run})
+    stats = tracking_stats(result, profile)
+    summary = {
+        "profile": profile.name,
+        "seed": seed,
+        "run": args.run,
+        "termination": result.termination,
+        "duration_s": float(result.truth.t_s[-1]),
+        "lowest_height_ft": result.lowest_height_ft,
+        **stats,
+    }
+    (args.out / "flight.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    if not args.no_figures:
+        from approachsim.report.flight import write_flight_figures
+
+        write_flight_figures(result, profile, args.out)
+    print(
+        f"{profile.name}: seed {seed} run {args.run}: {result.termination} after {summary['duration_s']:.1f} s, "
+        f"lowest {result.lowest_height_ft:.0f} ft above threshold"
+    )
+    print(
+        f"  1000-200 ft: vertical RMS {stats['vertical_rms_ft']:.2f} ft, lateral RMS {stats['lateral_rms_ft']:.2f} ft, "
+        f"CAS {stats['cas_min_kt']:.1f}-{stats['cas_max_kt']:.1f} kt"
+    )
+    print(f"  wrote {args.out / 'truth.npz'} (+ truth.json schema, flight.json{'' if args.no_figures else ', figures'})")
+    return 0

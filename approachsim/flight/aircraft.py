@@ -1,0 +1,143 @@
+"""Aircraft approach configuration: aircraft/<name>.toml (JSBSim model name, approach speed, flaps, gear, IMU
+location, autopilot gains), read strictly and converted to SI.
+
+Lookup order for `<name>.toml`: the `aircraft/` directory beside the profile's directory (``profiles/../aircraft``),
+then the repository's `aircraft/` next to the installed package. Errors name the file and field (ProfileError).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from approachsim import units
+from approachsim.config import ProfileError, Section
+from approachsim.flight.design import AutopilotGains
+from approachsim.profile import Profile
+
+IN = 0.0254
+"""Metres per inch (exact)."""
+
+
+@dataclass(frozen=True)
+class Aircraft:
+    """An aircraft's approach configuration, SI."""
+
+    name: str
+    jsbsim_model: str
+    approach_speed_mps: float
+    """Calibrated approach speed, m/s."""
+    flaps_norm: float
+    gear_down: bool
+    engine_lag_s: float
+    """First-order throttle-to-thrust lag used in the loop design, s."""
+    imu_location_struct_m: tuple[float, float, float]
+    """IMU location in JSBSim's structural frame (x aft, y right, z up), m."""
+    gains: AutopilotGains
+    source: Path
+
+
+def aircraft_dirs(profile: Profile | None) -> list[Path]:
+    """Directories searched for aircraft files, in order."""
+    dirs = []
+    if profile is not None and profile.source is not None:
+        dirs.append(Path(profile.source).resolve().parent.parent / "aircraft")
+    dirs.append(Path(__file__).resolve().parent.parent.parent / "aircraft")
+    return dirs
+
+
+def find_aircraft_file(name: str, profile: Profile | None = None) -> Path:
+    """The aircraft file for `name`; ProfileError (naming aircraft.name) when none exists."""
+    dirs = aircraft_dirs(profile)
+    for d in dirs:
+        p = d / f"{name}.toml"
+        if p.is_file():
+            return p
+    raise ProfileError(
+        f"aircraft.name: no aircraft file {name}.toml in {', '.join(str(d) for d in dirs)}"
+    )
+
+
+def _gains(s: Section) -> AutopilotGains:
+    def pos(key: str) -> float:
+        return s.number(key, lo=0.0)
+
+    g = AutopilotGains(
+        k_theta=pos("k_theta"),
+        k_q=pos("k_q"),
+        k_gs_p=pos("k_gs_p"),
+        k_gs_d=pos("k_gs_d"),
+        k_gs_i=pos("k_gs_i"),
+        k_v_p=pos("k_v_p"),
+        k_v_i=pos("k_v_i"),
+        tau_v_s=s.number("tau_v_s", lo=0.0, lo_open=True, unit="s"),
+        k_phi=pos("k_phi"),
+        k_p=pos("k_p"),
+        k_beta=pos("k_beta"),
+        k_loc_p=pos("k_loc_p"),
+        k_loc_d=pos("k_loc_d"),
+        k_loc_i=pos("k_loc_i"),
+        bank_limit_rad=math.radians(s.number("bank_limit_deg", lo=0.0, hi=35.0, lo_open=True, unit="deg")),
+        pitch_limit_rad=math.radians(s.number("pitch_limit_deg", lo=0.0, hi=20.0, lo_open=True, unit="deg")),
+    )
+    s.done()
+    return g
+
+
+def parse_aircraft(data: dict, source: Path) -> Aircraft:
+    """Validate the dict of an aircraft file."""
+    top = Section(data, "")
+    name = top.string("name")
+    top.string("description", "")
+    model = top.section("model", default_empty=False)
+    jsbsim_model = model.string("jsbsim_model")
+    model.done()
+    ap = top.section("approach", default_empty=False)
+    speed = ap.number("approach_speed_kt", lo=80.0, hi=200.0, unit="kt") * units.KT
+    flaps = ap.number("flaps_norm", lo=0.0, hi=1.0)
+    gear = ap.boolean("gear_down")
+    lag = ap.number("engine_lag_s", lo=0.0, hi=10.0, lo_open=True, unit="s")
+    ap.done()
+    imu = top.section("imu", default_empty=False)
+    loc = tuple(imu.number(f"location_{c}_in", unit="in") * IN for c in "xyz")
+    imu.done()
+    gains = _gains(top.section("autopilot", default_empty=False))
+    top.done()
+    return Aircraft(
+        name=name,
+        jsbsim_model=jsbsim_model,
+        approach_speed_mps=speed,
+        flaps_norm=flaps,
+        gear_down=gear,
+        engine_lag_s=lag,
+        imu_location_struct_m=loc,  # type: ignore[arg-type]
+        gains=gains,
+        source=source,
+    )
+
+
+def load_aircraft(profile: Profile) -> Aircraft:
+    """The profile's aircraft with the profile's overrides (approach speed, flaps, gear) applied."""
+    path = find_aircraft_file(profile.aircraft.name, profile)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as e:
+        raise ProfileError(f"aircraft.name: {str(path)!r} is not valid TOML ({e})") from None
+    try:
+        ac = parse_aircraft(data, path)
+    except ProfileError as e:
+        raise ProfileError(f"aircraft file {path.name}: {e}") from None
+    choice = profile.aircraft
+    return Aircraft(
+        name=ac.name,
+        jsbsim_model=ac.jsbsim_model,
+        approach_speed_mps=ac.approach_speed_mps if choice.approach_speed_mps is None else choice.approach_speed_mps,
+        flaps_norm=ac.flaps_norm if choice.flaps_norm is None else choice.flaps_norm,
+        gear_down=choice.gear_down,
+        engine_lag_s=ac.engine_lag_s,
+        imu_location_struct_m=ac.imu_location_struct_m,
+        gains=ac.gains,
+        source=ac.source,
+    )

@@ -1,0 +1,111 @@
+"""Approach autopilot: glideslope and localizer guidance, pitch and roll inner loops, autothrottle.
+
+Guidance flies on the navigation source's position (runway frame) and NED velocity; the inner loops use the
+aircraft's own attitude, body rates, sideslip and calibrated airspeed (AHRS and air data). The laws, whose
+linearization approachsim.flight.design checks loop at a time (gains from the aircraft file):
+
+    d   = h - h_gp(x),  d' = -v_down + x' tan(gp)                  glidepath deviation (m, + above) and rate
+    theta_c = theta_0 - (k_gs_p d + k_gs_d d' + k_gs_i int d)      limited to theta_0 +- pitch_limit
+    de  = -k_theta (theta_c - theta) + k_q q                       elevator, added to the trimmed pitch trim
+    e_f <- e_f + dt/tau_v (V_c - V_cas - e_f)                      filtered speed error (turbulence)
+    thr = thr_0 + k_v_p e_f + k_v_i int e_f                        autothrottle (integral frozen at saturation)
+    y, y' = cross-track deviation (m, + right) and its rate
+    phi_c = -(k_loc_p y + k_loc_d y' + k_loc_i int y)              limited to +- bank_limit
+    da  = k_phi (phi_c - phi) - k_p p                              aileron
+    dr  = -k_beta beta                                             rudder (crab into the wind; the FCS adds its yaw damper)
+
+Sign conventions of the 737 FCS: + elevator = nose down, + aileron = roll right, + rudder = nose left.
+Everything is plain float arithmetic: it runs once per JSBSim step.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from approachsim.flight.design import AutopilotGains
+
+
+@dataclass(frozen=True)
+class Trim:
+    """The trimmed state the autopilot regulates about."""
+
+    theta_rad: float
+    throttle: float
+    cas_mps: float
+    """Commanded calibrated airspeed, m/s."""
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Approach geometry the guidance needs: runway heading, glidepath angle, threshold crossing height."""
+
+    heading_rad: float
+    glidepath_rad: float
+    tch_m: float
+
+
+class Autopilot:
+    """The approach autopilot of one run: holds its integrators and filter state (re-create per run)."""
+
+    def __init__(self, gains: AutopilotGains, trim: Trim, geometry: Geometry, dt_s: float) -> None:
+        self.g = gains
+        self.trim = trim
+        self.dt = dt_s
+        self._ch = math.cos(geometry.heading_rad)
+        self._sh = math.sin(geometry.heading_rad)
+        self._tan_gp = math.tan(geometry.glidepath_rad)
+        self._tch = geometry.tch_m
+        self.int_d = 0.0
+        self.int_y = 0.0
+        self.e_f = 0.0
+        self.int_e = 0.0
+
+    def deviations(self, x: float, y: float, z: float, vn: float, ve: float, vd: float) -> tuple[float, ...]:
+        """Glidepath deviation d (m, + above), its rate (m/s), cross-track y (m, + right) and its rate (m/s)."""
+        x_dot = vn * self._ch + ve * self._sh
+        y_dot = -vn * self._sh + ve * self._ch
+        d = z - (self._tch - x * self._tan_gp)
+        d_dot = -vd + x_dot * self._tan_gp
+        return d, d_dot, y, y_dot
+
+    def step(
+        self,
+        x: float, y: float, z: float, vn: float, ve: float, vd: float,
+        phi: float, theta: float, p: float, q: float, beta: float, cas: float,
+    ) -> tuple[float, float, float, float]:
+        """One control step: guidance position (runway frame, m) and NED velocity (m/s), attitude (rad),
+        body rates (rad/s), sideslip (rad), calibrated airspeed (m/s) -> elevator, aileron, rudder, throttle."""
+        g = self.g
+        dt = self.dt
+        d, d_dot, y, y_dot = self.deviations(x, y, z, vn, ve, vd)
+        # glidepath -> pitch command (integral frozen while the command is limited)
+        th_off = -(g.k_gs_p * d + g.k_gs_d * d_dot + g.k_gs_i * self.int_d)
+        lim = g.pitch_limit_rad
+        if -lim < th_off < lim:
+            self.int_d += d * dt
+        else:
+            th_off = lim if th_off > 0.0 else -lim
+        theta_c = self.trim.theta_rad + th_off
+        de = -g.k_theta * (theta_c - theta) + g.k_q * q
+        # autothrottle on the filtered speed error
+        self.e_f += dt / g.tau_v_s * (self.trim.cas_mps - cas - self.e_f)
+        thr = self.trim.throttle + g.k_v_p * self.e_f + g.k_v_i * self.int_e
+        if 0.0 < thr < 1.0:
+            self.int_e += self.e_f * dt
+        else:
+            thr = 1.0 if thr >= 1.0 else 0.0
+        # localizer -> bank command
+        phi_c = -(g.k_loc_p * y + g.k_loc_d * y_dot + g.k_loc_i * self.int_y)
+        blim = g.bank_limit_rad
+        if -blim < phi_c < blim:
+            self.int_y += y * dt
+        else:
+            phi_c = blim if phi_c > 0.0 else -blim
+        da = g.k_phi * (phi_c - phi) - g.k_p * p
+        dr = -g.k_beta * beta
+        return _clip1(de), _clip1(da), _clip1(dr), thr
+
+
+def _clip1(u: float) -> float:
+    return 1.0 if u > 1.0 else (-1.0 if u < -1.0 else u)

@@ -1,0 +1,249 @@
+"""Autopilot loop design check: the landing-configuration linearization closed with the autopilot, loop at a time.
+
+The plant is JSBSim's FGLinearization of the trimmed aircraft in still air (states Vt, alpha, theta, q, beta,
+phi, p, psi, r, lat, lon, alt; inputs throttle, aileron, elevator, rudder commands), converted to SI. The
+latitude, longitude and altitude states are dropped (they feed nothing back at these time scales) and replaced
+by the guidance states the autopilot closes on: glidepath deviation d (m), its integral, cross-track y (m), its
+integral, the filtered airspeed perturbation and its integral, and a first-order engine lag between the
+throttle command and the thrust the linearization sees (the linearization has no engine state; the lag is the
+aircraft file's `engine_lag_s`, measured from a throttle step).
+
+The control laws are the same as autopilot.py's, linearized (no limits):
+
+    theta_c = theta_0 - (k_gs_p d + k_gs_d d' + k_gs_i int d)              glidepath  -> pitch command
+    de      = -k_theta (theta_c - theta) + k_q q                           pitch      -> elevator (+ = nose down)
+    thr     = thr_0 + k_v_p e_f + k_v_i int e_f,  e_f = lowpass(V_c - V)   autothrottle
+    phi_c   = -(k_loc_p y + k_loc_d y' + k_loc_i int y)                    localizer  -> bank command
+    da      = k_phi (phi_c - phi) - k_p p                                  roll       -> aileron (+ = roll right)
+    dr      = -k_beta beta                                                 sideslip   -> rudder (+ = nose left)
+
+Each loop is broken at one point with every other loop closed (the classical loop-at-a-time check):
+"elevator", "throttle", "aileron", "rudder" at the actuator commands, "glidepath" at theta_c and "localizer"
+at phi_c. `loop_margins` returns python-control's gain and phase margins of each broken loop L(s); the
+closed-loop system must be stable for them to mean anything, which `closed_loop_poles` shows.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from approachsim import units
+
+Array = np.ndarray
+
+LOOPS = ("elevator", "throttle", "aileron", "rudder", "glidepath", "localizer")
+"""The break points of the loop-at-a-time margin check."""
+
+# indices into the 12-state JSBSim linearization
+_VT, _ALPHA, _THETA, _Q, _BETA, _PHI, _P, _PSI, _R, _LAT, _LON, _ALT = range(12)
+_THR, _DA, _DE, _DR = range(4)
+
+
+@dataclass(frozen=True)
+class AutopilotGains:
+    """Autopilot gains and filter constants, SI (rad, m, s; surface and throttle commands normalized)."""
+
+    k_theta: float
+    """Elevator per pitch-attitude error, 1/rad."""
+    k_q: float
+    """Elevator per pitch rate, s/rad."""
+    k_gs_p: float
+    """Pitch command per glidepath deviation, rad/m."""
+    k_gs_d: float
+    """Pitch command per glidepath deviation rate, rad s/m."""
+    k_gs_i: float
+    """Pitch command per integrated glidepath deviation, rad/(m s)."""
+    k_v_p: float
+    """Throttle per filtered airspeed error, s/m."""
+    k_v_i: float
+    """Throttle per integrated filtered airspeed error, 1/m."""
+    tau_v_s: float
+    """Time constant of the first-order filter on the airspeed error, s."""
+    k_phi: float
+    """Aileron per bank error, 1/rad."""
+    k_p: float
+    """Aileron per roll rate, s/rad."""
+    k_beta: float
+    """Rudder per sideslip, 1/rad."""
+    k_loc_p: float
+    """Bank command per cross-track deviation, rad/m."""
+    k_loc_d: float
+    """Bank command per cross-track rate, rad s/m."""
+    k_loc_i: float
+    """Bank command per integrated cross-track deviation, rad/(m s)."""
+    bank_limit_rad: float
+    """Bank command limit, rad."""
+    pitch_limit_rad: float
+    """Limit of the pitch command's departure from the trim pitch, rad."""
+
+
+@dataclass(frozen=True)
+class Linearization:
+    """The FGLinearization of the trimmed aircraft (JSBSim units, as JSBSim gives them) and its trim point."""
+
+    A: Array
+    """(12, 12) system matrix, states Vt (ft/s), alpha, theta, q, beta, phi, p, psi, r (rad, rad/s), lat, lon, alt (ft)."""
+    B: Array
+    """(12, 4) input matrix, inputs throttle, aileron, elevator, rudder commands (normalized)."""
+    vt_mps: float
+    """Trim true airspeed, m/s."""
+    gamma_rad: float
+    """Trim flight-path angle, rad."""
+
+
+@dataclass(frozen=True)
+class ClosedLoop:
+    """The linear closed loop with one loop broken: x' = A x + B w, u = C x (u: the controller's output at the
+    break, w: what the plant receives there). The loop transfer function is L = -C (sI - A)^-1 B."""
+
+    A: Array
+    B: Array
+    C: Array
+
+
+def _si_plant(lin: Linearization) -> tuple[Array, Array]:
+    """The 9 rigid-body states (Vt m/s, alpha, theta, q, beta, phi, p, psi, r) plus altitude rate row, SI."""
+    keep = [_VT, _ALPHA, _THETA, _Q, _BETA, _PHI, _P, _PSI, _R]
+    scale = np.ones(12)
+    scale[_VT] = units.FPS
+    scale[_ALT] = units.FT
+    a_si = (scale[:, None] * lin.A) / scale[None, :]
+    b_si = scale[:, None] * lin.B
+    return a_si, b_si, keep
+
+
+def closed_loop(lin: Linearization, g: AutopilotGains, glidepath_rad: float, engine_lag_s: float,
+                break_at: str | None) -> ClosedLoop:
+    """The linear aircraft + autopilot with the loop `break_at` (one of LOOPS, or None) opened.
+
+    State: 9 rigid-body states, then d, int d, y, int y, v_f, int e_f, engine thrust state (16 in all).
+    """
+    if break_at is not None and break_at not in LOOPS:
+        raise ValueError(f"break_at must be one of {LOOPS} or None, got {break_at!r}")
+    a_si, b_si, keep = _si_plant(lin)
+    n_r = len(keep)
+    iD, iZD, iY, iZY, iVF, iZV, iENG = range(n_r, n_r + 7)
+    n = n_r + 7
+    ix = {s: i for i, s in enumerate(keep)}
+    v0 = lin.vt_mps
+    gs = math.tan(glidepath_rad) * math.cos(lin.gamma_rad)
+
+    # rows of the signals as linear functions of the state (controller outputs before the break)
+    def row() -> Array:
+        return np.zeros(n)
+
+    # d' = h' + tan(gp) x', x' ~ cos(gamma0) Vt: the altitude-rate row of the linearization plus the path term
+    d_dot = row()
+    d_dot[:n_r] = a_si[_ALT, keep]
+    d_dot[ix[_VT]] += gs
+    y_dot = row()  # y' = V0 (psi + beta): ground track relative to the runway heading
+    y_dot[ix[_PSI]] = v0
+    y_dot[ix[_BETA]] = v0
+
+    theta_c = row()  # perturbation of the pitch command
+    theta_c[iD] = -g.k_gs_p
+    theta_c -= g.k_gs_d * d_dot
+    theta_c[iZD] = -g.k_gs_i
+    phi_c = row()
+    phi_c[iY] = -g.k_loc_p
+    phi_c -= g.k_loc_d * y_dot
+    phi_c[iZY] = -g.k_loc_i
+
+    # signals: the outer-loop commands, possibly replaced by the break input w
+    w_theta = break_at == "glidepath"
+    w_phi = break_at == "localizer"
+    theta_c_used = row() if w_theta else theta_c
+    phi_c_used = row() if w_phi else phi_c
+    # elevator: de = -k_theta (theta_c - theta) + k_q q, plus -k_theta w when the glidepath loop is broken
+    de = -g.k_theta * theta_c_used
+    de[ix[_THETA]] += g.k_theta
+    de[ix[_Q]] += g.k_q
+    da = g.k_phi * phi_c_used
+    da[ix[_PHI]] -= g.k_phi
+    da[ix[_P]] -= g.k_p
+    dr = row()
+    dr[ix[_BETA]] = -g.k_beta
+    thr = row()
+    thr[iVF] = -g.k_v_p  # e_f = -v_f (speed error = command - speed)
+    thr[iZV] = g.k_v_i
+
+    ctrl = {"elevator": de, "throttle": thr, "aileron": da, "rudder": dr}
+    A = np.zeros((n, n))
+    Bw = np.zeros((n, 1))
+    # plant inputs: throttle goes through the engine lag; surfaces act at once
+    b_thr, b_da, b_de, b_dr = (b_si[keep, j] for j in range(4))
+    A[:n_r, :n_r] = a_si[np.ix_(keep, keep)]
+    A[:n_r, iENG] += b_thr
+    for name, b in (("aileron", b_da), ("elevator", b_de), ("rudder", b_dr)):
+        if break_at == name:
+            Bw[:n_r, 0] += b
+        else:
+            A[:n_r, :] += np.outer(b, ctrl[name])
+    if w_theta:  # the pitch loop receives theta_c = w
+        Bw[:n_r, 0] += b_de * (-g.k_theta)
+    if w_phi:
+        Bw[:n_r, 0] += b_da * g.k_phi
+    A[iD, :] = d_dot
+    A[iZD, iD] = 1.0
+    A[iY, :] = y_dot
+    A[iZY, iY] = 1.0
+    A[iVF, ix[_VT]] = 1.0 / g.tau_v_s
+    A[iVF, iVF] = -1.0 / g.tau_v_s
+    A[iZV, iVF] = -1.0
+    A[iENG, iENG] = -1.0 / engine_lag_s
+    if break_at == "throttle":
+        Bw[iENG, 0] = 1.0 / engine_lag_s
+    else:
+        A[iENG, :] += thr / engine_lag_s
+    if break_at is None:
+        C = np.zeros((1, n))
+    else:
+        C = {"glidepath": theta_c, "localizer": phi_c}.get(break_at, ctrl.get(break_at))[None, :]
+    return ClosedLoop(A=A, B=Bw, C=C)
+
+
+def loop_transfer(cl: ClosedLoop) -> control.StateSpace:
+    """L(s) of a broken loop, sign chosen for python-control's negative-feedback convention."""
+    return control.ss(cl.A, cl.B, -cl.C, np.zeros((1, 1)))
+
+
+@dataclass(frozen=True)
+class LoopMargin:
+    """Margins of one broken loop: worst gain margin (dB, either direction), worst phase margin (deg),
+    gain-crossover frequency (rad/s)."""
+
+    loop: str
+    gm_db: float
+    pm_deg: float
+    wc_rad_s: float
+
+
+def margins(L: control.StateSpace) -> tuple[float, float, float]:
+    """Worst gain margin (dB, up or down), worst phase margin (deg) and the first gain crossover (rad/s)."""
+    gm, pm, _sm, wpc, wgc, _wms = control.stability_margins(L, returnall=True)
+    gm = np.atleast_1d(np.asarray(gm, dtype=float))
+    pm = np.atleast_1d(np.asarray(pm, dtype=float))
+    wgc = np.atleast_1d(np.asarray(wgc, dtype=float))
+    gm_db = float(np.min(np.abs(20.0 * np.log10(gm[np.isfinite(gm) & (gm > 0)])))) if np.any(
+        np.isfinite(gm) & (gm > 0)) else math.inf
+    pm_deg = float(np.min(np.abs(pm))) if pm.size else math.inf
+    wc = float(np.min(wgc)) if wgc.size else math.nan
+    return gm_db, pm_deg, wc
+
+
+def loop_margins(lin: Linearization, g: AutopilotGains, glidepath_rad: float, engine_lag_s: float) -> list[LoopMargin]:
+    """Gain and phase margin of every loop in LOOPS, broken one at a time with the others closed."""
+    out = []
+    for name in LOOPS:
+        gm_db, pm_deg, wc = margins(loop_transfer(closed_loop(lin, g, glidepath_rad, engine_lag_s, name)))
+        out.append(LoopMargin(loop=name, gm_db=gm_db, pm_deg=pm_deg, wc_rad_s=wc))
+    return out
+
+
+def closed_loop_poles(lin: Linearization, g: AutopilotGains, glidepath_rad: float, engine_lag_s: float) -> Array:
+    """Eigenvalues of the fully closed linear loop (all real parts must be negative), 1/s."""
+    return np.linalg.eigvals(closed_loop(lin, g, glidepath_rad, engine_lag_s, None).A)

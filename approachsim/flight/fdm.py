@@ -1,0 +1,175 @@
+"""The JSBSim wrapper: the only module in approachsim that imports jsbsim.
+
+It creates an FGFDMExec with the model data bundled in the jsbsim wheel, sets the integrators, the
+atmosphere, wind and turbulence, trims, linearizes, and reads and writes properties through cached
+property nodes. Every JSBSim unit (ft, fps, lbf, slug, psf, Rankine, kt) is converted to SI here.
+
+Integrators (`simulation/integrator/*`): JSBSim 1.3.3 defaults to rectangular Euler for the rotational
+rate and attitude but Adams-Bashforth 2 for the translational rate (AB3 for position). We set the
+translational rate to rectangular Euler as well, so that the state sampled after step k+1 is exactly
+
+    v_eci[k+1] = v_eci[k] + dt (C_ib[k] f_body[k] + G(r[k]))      (JSBSim FGPropagate, eRectEuler)
+    q_ib[k+1]  = normalize(q_ib[k] + dt/2 q_ib[k] * w_ib_body[k])
+
+with f_body[k], w_ib_body[k] the values read after step k (JSBSim runs FGPropagate first in a step, then
+computes forces and accelerations at the new state). The sampled specific force and inertial rate of row k
+are therefore the ones that carry the state from row k to row k+1: an IMU model and a strapdown integrator
+see exactly what the aircraft did. Euler at 1/120 s is well inside the accuracy of the aerodynamic model.
+
+Turbulence: the profile's level maps to JSBSim's MIL-F-8785C (Dryden, `atmosphere/turb-type` 3) with the
+wind speed at 20 ft and the probability-of-exceedance index of FGWinds' documentation and MIL-F-8785C
+fig. 7 (low altitude: W20 = 15, 30, 45 kt for light, moderate, severe):
+
+    none: off; light: W20 25 ft/s, index 3 (1e-2); moderate: 50 ft/s, index 4 (1e-3); severe: 75 ft/s, index 6 (1e-5)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import jsbsim
+import numpy as np
+
+from approachsim import units
+from approachsim.flight.design import Linearization
+
+TURBULENCE_MILSPEC = {
+    "none": None,
+    "light": (25.0, 3),
+    "moderate": (50.0, 4),
+    "severe": (75.0, 6),
+}
+"""Profile turbulence level -> (MIL-F-8785C wind speed at 20 ft AGL, ft/s; probability-of-exceedance index)."""
+
+INTEGRATOR_RECT_EULER = 1
+"""JSBSim's FGPropagate integrator code for rectangular Euler."""
+
+RANKINE_PER_K = 1.8
+
+
+@dataclass(frozen=True)
+class InitialCondition:
+    """Where and how the run starts (SI). Wind is given as the direction it blows FROM (true, rad)."""
+
+    lat_rad: float
+    lon_rad: float
+    h_m: float
+    """Ellipsoid height (JSBSim's sea level is the ellipsoid), m."""
+    heading_rad: float
+    cas_mps: float
+    gamma_rad: float
+    flaps_norm: float
+    gear_down: bool
+    terrain_m: float
+    """Terrain elevation under the start point, m."""
+    wind_speed_mps: float = 0.0
+    wind_from_rad: float = 0.0
+    isa_dev_k: float = 0.0
+    sl_pressure_pa: float = 101325.0
+    """The day's sea-level pressure (true QNH), Pa."""
+
+
+class FDM:
+    """One JSBSim instance flying one aircraft model at a fixed time step dt_s.
+
+    Build once per run (creating it costs a few ms; a fresh instance guarantees that no filter,
+    turbulence or engine state leaks from one run into the next).
+    """
+
+    def __init__(self, model: str, dt_s: float) -> None:
+        fdm = jsbsim.FGFDMExec(None)
+        fdm.set_debug_level(0)
+        if not fdm.load_model(model):
+            raise ValueError(f"JSBSim could not load the aircraft model {model!r}")
+        fdm.disable_input()  # 737.xml opens TCP/UDP input sockets at run_ic() otherwise
+        fdm.disable_output()
+        fdm.set_dt(dt_s)
+        self._fdm = fdm
+        self._pm = fdm.get_property_manager()
+        self.dt_s = float(dt_s)
+        self._set_integrators()
+
+    def _set_integrators(self) -> None:
+        for name in ("rate/rotational", "rate/translational", "position/rotational"):
+            self._fdm[f"simulation/integrator/{name}"] = INTEGRATOR_RECT_EULER
+
+    def node(self, name: str):
+        """The cached property node of `name` (get_double_value / set_double_value); KeyError when unknown."""
+        n = self._pm.get_node(name, False)
+        if n is None:
+            raise KeyError(f"JSBSim property {name!r} does not exist")
+        return n
+
+    def __getitem__(self, name: str) -> float:
+        return float(self._fdm[name])
+
+    def __setitem__(self, name: str, value: float) -> None:
+        self._fdm[name] = value
+
+    @property
+    def run(self):
+        """The bound FGFDMExec.run (one time step); returns False when JSBSim stops."""
+        return self._fdm.run
+
+    def set_atmosphere(self, isa_dev_k: float, sl_pressure_pa: float) -> None:
+        """ISA temperature deviation (K) and the day's sea-level pressure (Pa)."""
+        self._fdm["atmosphere/delta-T"] = isa_dev_k * RANKINE_PER_K
+        self._fdm["atmosphere/P-sl-psf"] = sl_pressure_pa / units.PSF
+
+    def set_turbulence(self, level: str, seed: int) -> None:
+        """Milspec (Dryden) turbulence at the profile's level; seed the instance's random generator."""
+        self._fdm["simulation/randomseed"] = int(seed)
+        spec = TURBULENCE_MILSPEC[level]
+        if spec is None:
+            self._fdm["atmosphere/turb-type"] = 0
+            return
+        w20_fps, index = spec
+        self._fdm["atmosphere/turb-type"] = 3
+        self._fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = w20_fps
+        self._fdm["atmosphere/turbulence/milspec/severity"] = index
+
+    def initialize_and_trim(self, ic: InitialCondition) -> None:
+        """Set the initial conditions, start the engines, trim (full, mode 1) and take the settling step.
+
+        Wind goes through ic/vw-* (run_ic and do_trim clear atmosphere/wind-*); JSBSim's wind direction is
+        where the wind blows TO. The speed and flight-path angle are set again after the wind.
+        """
+        f = self._fdm
+        self.set_atmosphere(ic.isa_dev_k, ic.sl_pressure_pa)
+        f["ic/lat-geod-rad"] = ic.lat_rad
+        f["ic/long-gc-rad"] = ic.lon_rad
+        f["ic/terrain-elevation-ft"] = ic.terrain_m / units.FT
+        f["ic/h-sl-ft"] = ic.h_m / units.FT
+        f["ic/psi-true-rad"] = ic.heading_rad
+        f["ic/vc-kts"] = ic.cas_mps / units.KT
+        f["ic/gamma-rad"] = ic.gamma_rad
+        if ic.wind_speed_mps > 0.0:
+            f["ic/vw-mag-fps"] = ic.wind_speed_mps / units.FPS
+            f["ic/vw-dir-deg"] = math.degrees(ic.wind_from_rad + math.pi) % 360.0
+            f["ic/vc-kts"] = ic.cas_mps / units.KT
+            f["ic/gamma-rad"] = ic.gamma_rad
+        f["gear/gear-cmd-norm"] = 1.0 if ic.gear_down else 0.0
+        f["fcs/flap-cmd-norm"] = ic.flaps_norm
+        if not f.run_ic():
+            raise RuntimeError("JSBSim run_ic failed")
+        f["propulsion/set-running"] = -1
+        try:
+            f.do_trim(1)
+        except jsbsim.TrimFailureError as e:
+            raise RuntimeError(
+                f"JSBSim could not trim at {ic.cas_mps / units.KT:.0f} KCAS, flaps {ic.flaps_norm}, "
+                f"gamma {math.degrees(ic.gamma_rad):.1f} deg: {e}"
+            ) from None
+        f.run()  # the first step after trim snaps the engines to the trimmed throttle; controls move after it
+
+    def linearize(self, gamma_rad: float) -> Linearization:
+        """JSBSim's FGLinearization at the current (trimmed, still-air) state."""
+        lin = jsbsim.FGLinearization(self._fdm)
+        A, B, _C, _D = lin.state_space
+        return Linearization(
+            A=np.array(A, dtype=float),
+            B=np.array(B, dtype=float),
+            vt_mps=float(self._fdm["velocities/vt-fps"]) * units.FPS,
+            gamma_rad=gamma_rad,
+        )

@@ -1,0 +1,312 @@
+"""The approach run loop: JSBSim flies the profile's approach under the autopilot and produces the Truth record.
+
+Two lines fly the default profile on truth navigation:
+
+    approach = Approach(load_profile("profiles/default.toml"))
+    result = approach.fly(seed=1, run=0)
+
+`Approach` parses the aircraft and linearizes it once; `fly` builds a fresh JSBSim instance per run (a few
+ms), sets the day's atmosphere, wind and seeded turbulence, trims on the glidepath and steps at the IMU
+rate. After writing Truth row k it calls `nav_source.step(k, truth)` (records.NavigationSource) and the
+autopilot flies guidance on the position and velocity it returns; what guidance flew on is kept in the
+FlightResult, so that
+
+    flight technical error = guidance estimate - desired path,  navigation error = estimate - truth,
+    total system error = truth - desired path.
+
+The run ends when the IMU descends to `stop_height_m` above the threshold ("reached stop height"), or on
+ground contact, divergence or timeout (each a termination reason). The Truth arrays are preallocated for
+the longest permitted run and trimmed at the end; a navigation source sees the preallocated record and may
+read rows <= k only.
+
+Truth is of the IMU point (aircraft file [imu]): position, velocity and specific force are moved from the
+CG with the rigid-body lever-arm terms (f_imu = f_cg + w_ib' x l + w_ib x (w_ib x l), v_imu = v_cg +
+C_nb (w_eb x l)); the lever arm l is fixed at trim (the CG moves by well under a millimetre as fuel burns).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from approachsim import geo, units
+from approachsim.flight.aircraft import Aircraft, load_aircraft
+from approachsim.flight.autopilot import Autopilot, Geometry, Trim
+from approachsim.flight.design import Linearization
+from approachsim.flight.fdm import FDM
+from approachsim.flight.trim import start_condition
+from approachsim.profile import Profile
+from approachsim.records import NavigationSource, Truth
+from approachsim.seeding import stream_int
+
+Array = np.ndarray
+
+STOP_HEIGHT_M = 50.0 * units.FT
+"""Default end of the run: the IMU 50 ft above the threshold (the CAT III decision height)."""
+
+# column layout of the one (n, 36) buffer the Truth arrays are views of while flying
+_COLS = {
+    "t_s": (0, 1), "lat_rad": (1, 1), "lon_rad": (2, 1), "h_m": (3, 1), "r_ecef": (4, 3), "v_ned": (7, 3),
+    "q_nb": (10, 4), "euler_rad": (14, 3), "w_ib_body": (17, 3), "f_body": (20, 3), "p_static_pa": (23, 1),
+    "t_air_k": (24, 1), "h_agl_m": (25, 1), "r_rwy": (26, 3), "gs_dev_m": (29, 1), "loc_dev_m": (30, 1),
+    "controls": (31, 4), "airspeed_mps": (35, 1),
+}
+_NCOL = 36
+_CTRL = 31
+
+_READ = (
+    "position/lat-geod-rad", "position/long-gc-rad", "position/geod-alt-ft",
+    "velocities/v-north-fps", "velocities/v-east-fps", "velocities/v-down-fps",
+    "attitude/phi-rad", "attitude/theta-rad", "attitude/psi-rad",
+    "velocities/pi-rad_sec", "velocities/qi-rad_sec", "velocities/ri-rad_sec",
+    "velocities/p-rad_sec", "velocities/q-rad_sec", "velocities/r-rad_sec",
+    "accelerations/pidot-rad_sec2", "accelerations/qidot-rad_sec2", "accelerations/ridot-rad_sec2",
+    "forces/fbx-total-lbs", "forces/fby-total-lbs", "forces/fbz-total-lbs", "inertia/mass-slugs",
+    "atmosphere/P-psf", "atmosphere/T-R", "velocities/vc-kts", "aero/beta-rad",
+    "gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW",
+)
+
+
+def _truth_views(buf: Array, runway) -> Truth:
+    kw = {}
+    for name, (c, w) in _COLS.items():
+        kw[name] = buf[:, c] if w == 1 else buf[:, c:c + w]
+    return Truth(**kw, runway=runway)
+
+
+class TruthSource:
+    """The default navigation source: guidance flies on the true IMU position and velocity."""
+
+    def step(self, k: int, truth: Truth) -> tuple[Array, Array]:
+        """Row k of the truth's runway-frame position (m) and NED velocity (m/s)."""
+        return truth.r_rwy[k], truth.v_ned[k]
+
+
+@dataclass(frozen=True)
+class FlightResult:
+    """One flown approach. Arrays have time on axis 0, on the Truth's time base."""
+
+    truth: Truth
+    guidance_r_rwy: Array
+    """(n, 3) the position guidance flew on (runway frame: along, cross, height above threshold), m."""
+    guidance_v_ned: Array
+    """(n, 3) the NED velocity guidance flew on, m/s."""
+    termination: str
+    """Why the run ended: "reached stop height", "ground contact", "diverged", "timeout"."""
+    lowest_height_ft: float
+    """Lowest true IMU height above the threshold reached, ft."""
+    seed: int
+    run: int
+    turbulence_seed: int
+    """The simulation/randomseed JSBSim used."""
+
+    def reached(self, height_ft: float) -> bool:
+        """True when the aircraft descended to height_ft above the threshold."""
+        return self.lowest_height_ft <= height_ft
+
+
+class Approach:
+    """A profile's approach, ready to fly many times: the aircraft is parsed and linearized once."""
+
+    def __init__(self, profile: Profile, *, stop_height_m: float = STOP_HEIGHT_M) -> None:
+        self.profile = profile
+        self.aircraft: Aircraft = load_aircraft(profile)
+        self.dt_s = 1.0 / profile.rates.imu_hz
+        self.stop_height_m = stop_height_m
+        self._lin: Linearization | None = None
+
+    @property
+    def linearization(self) -> Linearization:
+        """FGLinearization of the trimmed start condition in still air on a standard day (computed once)."""
+        if self._lin is None:
+            fdm = FDM(self.aircraft.jsbsim_model, self.dt_s)
+            fdm.initialize_and_trim(start_condition(self.profile, self.aircraft, still_air=True))
+            self._lin = fdm.linearize(-self.profile.runway.glidepath_rad)
+        return self._lin
+
+    def fly(self, seed: int, run: int = 0, nav_source: NavigationSource | None = None,
+            max_time_s: float | None = None) -> FlightResult:
+        """Fly run `run` of the campaign seeded `seed`; guidance flies on nav_source (default: truth)."""
+        prof = self.profile
+        ac = self.aircraft
+        rw = prof.runway
+        dt = self.dt_s
+        src = TruthSource() if nav_source is None else nav_source
+        ic = start_condition(prof, ac)
+        fdm = FDM(ac.jsbsim_model, dt)
+        fdm.initialize_and_trim(ic)
+        turb_seed = stream_int(seed, run, "turbulence")
+        fdm.set_turbulence(prof.environment.turbulence, turb_seed)
+
+        # time budget: twice the still-air time to the threshold, at least 60 s
+        if max_time_s is None:
+            max_time_s = max(60.0, 2.0 * rw.start_distance_m / ac.approach_speed_mps)
+        n_max = int(math.ceil(max_time_s / dt)) + 1
+        buf = np.full((n_max, _NCOL), np.nan)
+        gbuf = np.full((n_max, 6), np.nan)
+        truth = _truth_views(buf, rw.frame)
+
+        nodes = [fdm.node(n) for n in _READ]
+        getters = [n.get_double_value for n in nodes]
+        set_de = fdm.node("fcs/elevator-cmd-norm").set_double_value
+        set_da = fdm.node("fcs/aileron-cmd-norm").set_double_value
+        set_dr = fdm.node("fcs/rudder-cmd-norm").set_double_value
+        set_thr = [fdm.node(f"fcs/throttle-cmd-norm[{i}]").set_double_value for i in range(2)]
+        pitch_trim = fdm["fcs/pitch-trim-cmd-norm"]
+        terrain = prof.terrain
+        flat_terrain = len(terrain.along_m) == 1
+        set_terrain = fdm.node("position/terrain-elevation-asl-ft").set_double_value
+
+        # constants: lever arm (body axes, m), geodesy, runway frame
+        cg = (fdm["inertia/cg-x-in"], fdm["inertia/cg-y-in"], fdm["inertia/cg-z-in"])
+        imu = ac.imu_location_struct_m
+        IN = 0.0254
+        lx = cg[0] * IN - imu[0]  # structural x aft, body x forward
+        ly = imu[1] - cg[1] * IN
+        lz = cg[2] * IN - imu[2]  # structural z up, body z down
+        r_n, r_e = geo.radii(ic.lat_rad)
+        r_n, r_e = float(r_n), float(r_e)
+        a, e2 = geo.A_WGS84, geo.E2_WGS84
+        c_rwy = rw.frame.c_ecef_to_rwy
+        o = rw.frame.origin_ecef
+        ox, oy, oz = float(o[0]), float(o[1]), float(o[2])
+        c00, c01, c02 = (float(v) for v in c_rwy[0])
+        c10, c11, c12 = (float(v) for v in c_rwy[1])
+        h_thr = rw.elevation_m
+        tan_gp = math.tan(rw.glidepath_rad)
+        tch = rw.tch_m
+        FT, FPS, KT = units.FT, units.FPS, units.KT
+        LBF_PER_SLUG = units.LBF / units.SLUG  # (lbf/slug) -> m/s^2
+        PSF = units.PSF
+        sin, cos, sqrt = math.sin, math.cos, math.sqrt
+
+        trim = Trim(theta_rad=fdm["attitude/theta-rad"], throttle=fdm["fcs/throttle-cmd-norm[0]"],
+                    cas_mps=ac.approach_speed_mps)
+        ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m), dt)
+        ap_step = ap.step
+        stop_h = self.stop_height_m
+        run_step = fdm.run
+        termination = "timeout"
+        lowest = math.inf
+        k = 0
+        de = da = dr = 0.0
+        thr = trim.throttle
+        for k in range(n_max):
+            if k > 0:
+                run_step()
+            (lat, lon, h_ft, vn_f, ve_f, vd_f, phi, th, psi, pi_, qi, ri, p, q, r, pid, qid, rid,
+             fx, fy, fz, m, p_psf, t_r, vc_kt, beta, w0, w1, w2) = [gv() for gv in getters]
+            h = h_ft * FT
+            # body -> NED direction cosines from the Euler angles
+            sf, cf, st, ct, sp, cp = sin(phi), cos(phi), sin(th), cos(th), sin(psi), cos(psi)
+            n00, n01, n02 = ct * cp, sf * st * cp - cf * sp, cf * st * cp + sf * sp
+            n10, n11, n12 = ct * sp, sf * st * sp + cf * cp, cf * st * sp - sf * cp
+            n20, n21, n22 = -st, sf * ct, cf * ct
+            # lever-arm terms: w_eb x l (velocity), w_ib' x l + w_ib x (w_ib x l) (specific force)
+            ux, uy, uz = q * lz - r * ly, r * lx - p * lz, p * ly - q * lx
+            wx, wy, wz = qi * lz - ri * ly, ri * lx - pi_ * lz, pi_ * ly - qi * lx
+            s = LBF_PER_SLUG / m
+            fbx = fx * s + (qid * lz - rid * ly) + (qi * wz - ri * wy)
+            fby = fy * s + (rid * lx - pid * lz) + (ri * wx - pi_ * wz)
+            fbz = fz * s + (pid * ly - qid * lx) + (pi_ * wy - qi * wx)
+            vn = vn_f * FPS + n00 * ux + n01 * uy + n02 * uz
+            ve = ve_f * FPS + n10 * ux + n11 * uy + n12 * uz
+            vd = vd_f * FPS + n20 * ux + n21 * uy + n22 * uz
+            # IMU position: geodetic offset of C_nb l, then ECEF and runway frame
+            dn = n00 * lx + n01 * ly + n02 * lz
+            dE = n10 * lx + n11 * ly + n12 * lz
+            dd = n20 * lx + n21 * ly + n22 * lz
+            lat_i = lat + dn / (r_n + h)
+            slat, clat = sin(lat_i), cos(lat_i)
+            lon_i = lon + dE / ((r_e + h) * cos(lat))
+            h_i = h - dd
+            re_i = a / sqrt(1.0 - e2 * slat * slat)
+            x_e = (re_i + h_i) * clat * cos(lon_i)
+            y_e = (re_i + h_i) * clat * sin(lon_i)
+            z_e = (re_i * (1.0 - e2) + h_i) * slat
+            dx, dy, dz = x_e - ox, y_e - oy, z_e - oz
+            xr = c00 * dx + c01 * dy + c02 * dz
+            yr = c10 * dx + c11 * dy + c12 * dz
+            zr = h_i - h_thr
+            if flat_terrain:
+                terr = terrain.height_m[0]
+            else:
+                terr = float(np.interp(xr, terrain.along_m, terrain.height_m))
+                set_terrain(terr / FT)
+            # body -> NED quaternion (scalar first) from the Euler angles
+            s1, c1 = sin(0.5 * phi), cos(0.5 * phi)
+            s2, c2 = sin(0.5 * th), cos(0.5 * th)
+            s3, c3 = sin(0.5 * psi), cos(0.5 * psi)
+            buf[k] = (
+                k * dt, lat_i, lon_i, h_i, x_e, y_e, z_e, vn, ve, vd,
+                c1 * c2 * c3 + s1 * s2 * s3, s1 * c2 * c3 - c1 * s2 * s3,
+                c1 * s2 * c3 + s1 * c2 * s3, c1 * c2 * s3 - s1 * s2 * c3,
+                phi, th, psi, pi_, qi, ri, fbx, fby, fbz, p_psf * PSF, t_r / 1.8, h_i - terr,
+                xr, yr, zr, zr - (tch - xr * tan_gp), yr, de, da, dr, thr, vc_kt * KT,
+            )
+            # the navigation source sees row k, then the termination checks on the true state
+            gr, gv = src.step(k, truth)
+            gx, gy, gz = float(gr[0]), float(gr[1]), float(gr[2])
+            gvn, gve, gvd = float(gv[0]), float(gv[1]), float(gv[2])
+            gbuf[k] = (gx, gy, gz, gvn, gve, gvd)
+            if zr < lowest:
+                lowest = zr
+            if zr <= stop_h:
+                termination = "reached stop height"
+                break
+            if w0 > 0.0 or w1 > 0.0 or w2 > 0.0 or h_i - terr <= 0.0:
+                termination = "ground contact"
+                break
+            if abs(phi) > 1.0 or abs(zr - (tch - xr * tan_gp)) > 300.0 or abs(yr) > 1500.0:
+                termination = "diverged"
+                break
+            # the controls for the next step
+            de, da, dr, thr = ap_step(gx, gy, gz, gvn, gve, gvd, phi, th, p, q, beta, vc_kt * KT)
+            buf[k, _CTRL:_CTRL + 4] = (de + pitch_trim, da, dr, thr)
+            set_de(de)
+            set_da(da)
+            set_dr(dr)
+            set_thr[0](thr)
+            set_thr[1](thr)
+        n = k + 1
+        if termination != "timeout":
+            # the autopilot did not run on the last row: the controls of the previous step still act
+            buf[k, _CTRL:_CTRL + 4] = (de + pitch_trim, da, dr, thr)
+        final = Truth(**{name: np.ascontiguousarray(v[:n]) for name, v in truth.arrays().items()}, runway=rw.frame)
+        return FlightResult(
+            truth=final,
+            guidance_r_rwy=np.ascontiguousarray(gbuf[:n, :3]),
+            guidance_v_ned=np.ascontiguousarray(gbuf[:n, 3:]),
+            termination=termination,
+            lowest_height_ft=lowest / FT,
+            seed=seed,
+            run=run,
+            turbulence_seed=turb_seed,
+        )
+
+
+def tracking_stats(result: FlightResult, profile: Profile, upper_ft: float = 1000.0,
+                   lower_ft: float = 200.0) -> dict[str, float]:
+    """RMS and max of the true vertical and lateral deviation (ft) while the IMU is between upper_ft and
+    lower_ft above the threshold, and the calibrated airspeed range there (kt)."""
+    tr = result.truth
+    z_ft = tr.r_rwy[:, 2] / units.FT
+    sel = (z_ft <= upper_ft) & (z_ft >= lower_ft)
+    if not np.any(sel):
+        nan = math.nan
+        return {"vertical_rms_ft": nan, "lateral_rms_ft": nan, "vertical_max_ft": nan, "lateral_max_ft": nan,
+                "cas_min_kt": nan, "cas_max_kt": nan, "samples": 0}
+    v = tr.gs_dev_m[sel] / units.FT
+    lat = tr.loc_dev_m[sel] / units.FT
+    cas = tr.airspeed_mps[sel] / units.KT
+    return {
+        "vertical_rms_ft": float(np.sqrt(np.mean(v**2))),
+        "lateral_rms_ft": float(np.sqrt(np.mean(lat**2))),
+        "vertical_max_ft": float(np.max(np.abs(v))),
+        "lateral_max_ft": float(np.max(np.abs(lat))),
+        "cas_min_kt": float(cas.min()),
+        "cas_max_kt": float(cas.max()),
+        "samples": int(sel.sum()),
+    }
