@@ -1,0 +1,84 @@
+"""RunResult: what one Monte Carlo run hands back to the campaign, and its JSON-line form.
+
+Small on purpose: named per-run scalars (SI, units in the names), small fixed-size arrays (e.g. error on a
+height grid) and, for a few runs, full time series. A run that failed carries its error text instead.
+The JSON line round-trips every float64 bit for bit (Python's shortest repr), so results read back from
+disk after a resume equal those computed in memory.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+Array = np.ndarray
+
+
+def _empty() -> dict:
+    return {}
+
+
+@dataclass(frozen=True, eq=False)
+class RunResult:
+    """One run's outcome. run: index in the campaign; ok False means error says why (and nothing was scored)."""
+
+    run: int
+    ok: bool
+    error: str | None = None
+    scalars: Mapping[str, float] = field(default_factory=_empty)
+    """Named per-run numbers (SI; the unit is in the name where not)."""
+    arrays: Mapping[str, Array] = field(default_factory=_empty)
+    """Small (k,) float arrays of the same length for every run (stored in the results table)."""
+    series: Mapping[str, Array] | None = None
+    """Time series kept for this run (equal-length (n,) arrays, written to their own file), or None."""
+
+    @classmethod
+    def failed(cls, run: int, error: str) -> RunResult:
+        """A run that raised or diverged, with the reason (one line)."""
+        return cls(run=run, ok=False, error=" ".join(str(error).split()) or "failed")
+
+    def record(self) -> dict:
+        """The JSON-line dictionary (without the time series, which go to their own file)."""
+        return {
+            "run": int(self.run),
+            "ok": bool(self.ok),
+            "error": self.error,
+            "scalars": {k: float(v) for k, v in self.scalars.items()},
+            "arrays": {k: [float(x) for x in np.asarray(v, dtype=float)] for k, v in self.arrays.items()},
+        }
+
+    def json_line(self) -> str:
+        """One line of JSON (nan written as NaN), no trailing newline."""
+        return json.dumps(self.record(), separators=(",", ":"), allow_nan=True)
+
+    @classmethod
+    def from_record(cls, d: Mapping) -> RunResult:
+        """Inverse of record()."""
+        return cls(
+            run=int(d["run"]),
+            ok=bool(d["ok"]),
+            error=d.get("error"),
+            scalars={k: float(v) for k, v in d.get("scalars", {}).items()},
+            arrays={k: np.asarray(v, dtype=float) for k, v in d.get("arrays", {}).items()},
+        )
+
+    def same_as(self, other: RunResult) -> bool:
+        """Bit-identical outcome (scalars and arrays; nan equals nan)."""
+        if (self.run, self.ok, self.error) != (other.run, other.ok, other.error):
+            return False
+        if list(self.scalars) != list(other.scalars) or list(self.arrays) != list(other.arrays):
+            return False
+        for k, v in self.scalars.items():
+            w = other.scalars[k]
+            if not (v == w or (math.isnan(v) and math.isnan(w))):
+                return False
+            if math.copysign(1.0, v) != math.copysign(1.0, w):
+                return False
+        return all(
+            np.array_equal(np.asarray(v).view(np.uint64), np.asarray(other.arrays[k]).view(np.uint64))
+            for k, v in self.arrays.items()
+        )

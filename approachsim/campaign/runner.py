@@ -1,0 +1,223 @@
+"""The generic Monte Carlo campaign runner: local process pool by default, an existing Dask cluster on request.
+
+A campaign is N runs of a picklable per-run function `run_fn(profile, seed, run_index) -> RunResult`
+(or, where runs share work, a group function `group_fn(profile, seed, run_indices) -> list[RunResult]`,
+called on fixed, executor-independent groups of consecutive run indices). Every run draws its randomness
+from (seed, run_index) only (approachsim.seeding), so the result of a run does not depend on the executor,
+the worker, the chunking or on resuming: local and Dask results are bit-identical.
+
+A run that raises is recorded as failed with its error and the campaign goes on. Results are appended to
+the store as each task finishes, so `resume=True` after an interruption reruns only what had not finished.
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+import os
+import sys
+import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, TextIO
+
+from approachsim.campaign.result import RunResult
+from approachsim.campaign.store import CampaignStore
+from approachsim.config import ProfileError
+
+RunFn = Callable[[Any, int, int], RunResult]
+GroupFn = Callable[[Any, int, Sequence[int]], list[RunResult]]
+
+
+class SchedulerError(ProfileError):
+    """The Dask scheduler address cannot be reached (a user mistake: exit 2)."""
+
+
+def _one_line(e: BaseException) -> str:
+    return f"{type(e).__name__}: {' '.join(str(e).split())}"
+
+
+def run_task(run_fn: RunFn | None, group_fn: GroupFn | None, profile: Any, seed: int, runs: Sequence[int]) -> list:
+    """Execute a chunk of runs in the worker; every failure becomes a failed RunResult (never an exception)."""
+    if group_fn is not None:
+        try:
+            out = list(group_fn(profile, seed, list(runs)))
+        except Exception as e:  # the group's shared work failed: every run of it fails with that reason
+            return [RunResult.failed(i, _one_line(e)) for i in runs]
+        got = {r.run for r in out}
+        missing = [RunResult.failed(i, "group function returned no result for this run") for i in runs if i not in got]
+        return out + missing
+    results = []
+    for i in runs:
+        try:
+            r = run_fn(profile, seed, i)
+            if not isinstance(r, RunResult) or r.run != i:
+                raise TypeError(f"run function must return RunResult(run={i}), got {r!r:.80}")
+        except Exception as e:
+            r = RunResult.failed(i, _one_line(e))
+        results.append(r)
+    return results
+
+
+@dataclass
+class Progress:
+    """A one-line progress bar on stderr: done / total runs, failures, elapsed and remaining time."""
+
+    total: int
+    done: int = 0
+    failed: int = 0
+    stream: TextIO | None = None
+    enabled: bool = True
+    _t0: float = 0.0
+    _last: float = -1.0
+    _start_done: int = 0
+
+    def start(self) -> None:
+        self._t0 = time.monotonic()
+        self._start_done = self.done
+        self.draw(force=True)
+
+    def update(self, results: Sequence[RunResult]) -> None:
+        self.done += len(results)
+        self.failed += sum(not r.ok for r in results)
+        self.draw()
+
+    def draw(self, force: bool = False) -> None:
+        if not self.enabled:
+            return
+        now = time.monotonic()
+        if not force and now - self._last < 0.25 and self.done < self.total:
+            return
+        self._last = now
+        el = now - self._t0
+        new = self.done - self._start_done
+        eta = el / new * (self.total - self.done) if new > 0 else float("nan")
+        w = 30
+        fill = int(w * self.done / max(self.total, 1))
+        s = self.stream or sys.stderr
+        eta_s = f"{eta:5.0f} s left" if math.isfinite(eta) else "   ?  s left"
+        s.write(f"\r[{'#' * fill}{'.' * (w - fill)}] {self.done}/{self.total} runs, {self.failed} failed, "
+                f"{el:5.0f} s, {eta_s}")
+        if self.done >= self.total:
+            s.write("\n")
+        s.flush()
+
+
+def plan_chunks(todo: Sequence[int], *, workers: int, group_size: int | None, per_task: int | None = None) -> list:
+    """Split the runs to do into tasks: whole fixed groups (g*size .. (g+1)*size-1) or balanced chunks."""
+    todo = sorted(todo)
+    if group_size:
+        groups: dict[int, list[int]] = {}
+        for i in todo:
+            groups.setdefault(i // group_size, []).append(i)
+        return [groups[g] for g in sorted(groups)]
+    if per_task is None:
+        per_task = max(1, min(32, math.ceil(len(todo) / (4 * max(workers, 1)))))
+    return [todo[k : k + per_task] for k in range(0, len(todo), per_task)]
+
+
+def _local(tasks: list, workers: int, args: tuple) -> Iterator[list[RunResult]]:
+    run_fn, group_fn, profile, seed = args
+    if workers <= 1 or len(tasks) <= 1:
+        for t in tasks:
+            yield run_task(run_fn, group_fn, profile, seed, t)
+        return
+    ctx = multiprocessing.get_context("fork") if sys.platform.startswith("linux") else None
+    with ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=ctx) as pool:
+        pending = {pool.submit(run_task, run_fn, group_fn, profile, seed, t) for t in tasks}
+        while pending:
+            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for f in finished:
+                yield f.result()
+
+
+def _dask(tasks: list, address: str, args: tuple, timeout_s: float) -> Iterator[list[RunResult]]:
+    try:
+        from distributed import Client, as_completed
+    except ImportError as e:  # pragma: no cover - distributed is a declared dependency
+        raise SchedulerError(f"--scheduler: dask.distributed is not installed ({e})") from None
+    try:
+        client = Client(address, timeout=f"{timeout_s}s")
+    except (OSError, TimeoutError, ValueError) as e:
+        raise SchedulerError(f"--scheduler: cannot connect to {address!r} ({_one_line(e)})") from None
+    try:
+        run_fn, group_fn, profile, seed = args
+        futures = [client.submit(run_task, run_fn, group_fn, profile, seed, t, pure=False) for t in tasks]
+        for f in as_completed(futures):
+            yield f.result()
+    finally:
+        client.close()
+
+
+@dataclass(frozen=True)
+class CampaignResult:
+    """All runs of a campaign in run order (0..runs-1); newly_run counts the runs executed this time."""
+
+    results: list[RunResult]
+    newly_run: int
+    wall_s: float
+
+    @property
+    def failed(self) -> list[RunResult]:
+        return [r for r in self.results if not r.ok]
+
+    @property
+    def ok(self) -> list[RunResult]:
+        return [r for r in self.results if r.ok]
+
+
+def run_campaign(
+    profile: Any,
+    *,
+    seed: int,
+    runs: int,
+    run_fn: RunFn | None = None,
+    group_fn: GroupFn | None = None,
+    group_size: int | None = None,
+    out_dir: Path | None = None,
+    meta: Mapping[str, Any] | None = None,
+    resume: bool = False,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    per_task: int | None = None,
+    progress: bool = True,
+    progress_stream: TextIO | None = None,
+    scheduler_timeout_s: float = 10.0,
+) -> CampaignResult:
+    """Run runs 0..runs-1 (those not already in out_dir when resuming) and return them all, in order.
+
+    Exactly one of run_fn / group_fn (with group_size). workers: local processes (default all cores; 1 runs
+    in this process). scheduler: address of an existing Dask scheduler instead of the local pool.
+    """
+    if (run_fn is None) == (group_fn is None):
+        raise ValueError("give exactly one of run_fn and group_fn")
+    if group_fn is not None and not group_size:
+        raise ValueError("group_fn needs group_size")
+    workers = workers or os.cpu_count() or 1
+    store = CampaignStore(out_dir) if out_dir is not None else None
+    done: dict[int, RunResult] = {}
+    if store is not None:
+        done = store.start({**(meta or {}), "runs": runs}, resume=resume)
+    done = {i: r for i, r in done.items() if i < runs}
+    todo = [i for i in range(runs) if i not in done]
+    tasks = plan_chunks(todo, workers=workers, group_size=group_size if group_fn else None, per_task=per_task)
+    bar = Progress(total=runs, done=len(done), failed=sum(not r.ok for r in done.values()),
+                   stream=progress_stream, enabled=progress)
+    t0 = time.monotonic()
+    bar.start()
+    args = (run_fn, group_fn, profile, seed)
+    source = _dask(tasks, scheduler, args, scheduler_timeout_s) if scheduler else _local(tasks, workers, args)
+    newly = 0
+    for chunk in source:
+        if store is not None:
+            store.append(chunk)
+        for r in chunk:
+            done[r.run] = r
+        newly += len(chunk)
+        bar.update(chunk)
+    results = [done[i] for i in range(runs)]
+    if store is not None:
+        store.write_tables(results)
+    return CampaignResult(results=results, newly_run=newly, wall_s=time.monotonic() - t0)

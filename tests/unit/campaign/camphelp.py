@@ -1,0 +1,37 @@
+"""A synthetic, picklable per-run function for the campaign runner tests (no flight, no filter).
+
+Its "profile" is a plain dict: sleep_s (per run), fail_runs (indices that raise), series_runs.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from approachsim.campaign.result import RunResult
+from approachsim.seeding import stream
+
+
+def synth_run(profile: dict, seed: int, run: int) -> RunResult:
+    """A run whose numbers come only from stream(seed, run, 'synthetic')."""
+    rng = stream(seed, run, "synthetic")
+    x = rng.normal(1.0, 2.0, 200)
+    if run in profile.get("fail_runs", ()):
+        raise RuntimeError(f"synthetic failure in run {run}\n(second line)")
+    time.sleep(profile.get("sleep_s", 0.0))
+    keep = run < profile.get("series_runs", 0)
+    return RunResult(
+        run=run,
+        ok=True,
+        scalars={"mean_m": float(x.mean()), "rms_m": float(np.sqrt(np.mean(x**2))), "nan_m": float("nan")},
+        arrays={"first_m": x[:7].copy()},
+        series={"t_s": np.arange(20.0), "x_m": x[:20].copy()} if keep else None,
+    )
+
+
+def synth_group(profile: dict, seed: int, runs: list[int]) -> list[RunResult]:
+    """The same runs computed as a group (as open loop shares one flight per group)."""
+    if profile.get("fail_group") in runs:
+        raise RuntimeError("shared flight failed")
+    return [synth_run(profile, seed, i) for i in runs]
