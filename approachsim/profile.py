@@ -20,6 +20,7 @@ import numpy as np
 
 from approachsim import units
 from approachsim.config import ProfileError, Section
+from approachsim.evaluate.config import EvaluationConfig, parse_evaluation
 from approachsim.geo import RunwayFrame
 
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
@@ -121,6 +122,8 @@ class Profile:
     run: RunDefaults
     source: Path | None = field(default=None, compare=False)
     """The file it came from (aircraft files are looked up beside it)."""
+    evaluation: EvaluationConfig = field(default_factory=EvaluationConfig)
+    """How campaigns are scored ([evaluation]: decision heights, verdict limits; evaluate/config.py)."""
 
 
 def _runway(s: Section) -> Runway:
@@ -220,6 +223,7 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
     terrain = _terrain(top.section("terrain"), runway)
     rates = _rates(top.section("rates"))
     run = _run(top.section("run"))
+    evaluation = parse_evaluation(top.section("evaluation"))
     top.done()
     return Profile(
         name=name,
@@ -231,6 +235,7 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
         rates=rates,
         run=run,
         source=source,
+        evaluation=evaluation,
     )
 
 

@@ -13,7 +13,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from approachsim import units
 from approachsim.config import ProfileError, Section
@@ -22,20 +22,23 @@ from approachsim.evaluate.limits import CATEGORIES, DEFAULT_DH_FT, K_H_PA, K_V_P
 VERDICTS = ("faa", "faa+icao")
 
 
-def _default_dh() -> dict[str, float]:
-    return dict(DEFAULT_DH_FT)
-
-
 @dataclass(frozen=True)
 class EvaluationConfig:
-    """How a campaign is scored. dh_ft maps category -> decision height above the threshold, ft."""
+    """How a campaign is scored (hashable: a Profile holds it). Decision heights above the threshold, ft."""
 
-    dh_ft: dict[str, float] = field(default_factory=_default_dh)
+    dh_cat1_ft: float = DEFAULT_DH_FT["CAT I"]
+    dh_cat2_ft: float = DEFAULT_DH_FT["CAT II"]
+    dh_cat3_ft: float = DEFAULT_DH_FT["CAT III"]
     verdict: str = "faa"
     k_v: float = K_V_PA
     k_h: float = K_H_PA
     series_runs: int = 3
     flight_group: int = 25
+
+    @property
+    def dh_ft(self) -> dict[str, float]:
+        """Category -> decision height above the threshold, ft."""
+        return dict(zip(CATEGORIES, (self.dh_cat1_ft, self.dh_cat2_ft, self.dh_cat3_ft), strict=True))
 
     def dh_m(self, category: str) -> float:
         """Decision height of `category` above the threshold, m."""
@@ -58,5 +61,5 @@ def parse_evaluation(s: Section) -> EvaluationConfig:
     flight_group = s.integer("flight_group", 25, lo=1, hi=10000)
     s.done()
     return EvaluationConfig(
-        dh_ft=dh, verdict=verdict, k_v=k_v, k_h=k_h, series_runs=series_runs, flight_group=flight_group
+        *dh.values(), verdict=verdict, k_v=k_v, k_h=k_h, series_runs=series_runs, flight_group=flight_group
     )
