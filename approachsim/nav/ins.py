@@ -1,0 +1,286 @@
+"""Strapdown inertial navigation: WGS-84 local-level NED mechanization from IMU increments.
+
+The INS integrates gyro and accelerometer increments (delta-theta, delta-v over one IMU interval, body
+axes) into geodetic position (lat, lon, ellipsoid height), NED velocity relative to the Earth and the
+body-to-NED attitude matrix. Earth rate, transport rate, Coriolis and normal gravity varying with latitude
+and height (geo.normal_gravity) are all modelled (Groves, *Principles of GNSS, Inertial and Multisensor
+Integrated Navigation Systems*, 2nd ed., sec. 5.4-5.5; Titterton & Weston ch. 3).
+
+Integration is second-order accurate in the step (the global error falls as dt^2):
+    attitude  C(+) = Exp(-w_in^n dt) C(-) Exp(dtheta)                     (Groves eq. 5.47 exact form)
+    velocity  v(+) = v(-) + C(-) (dv + 1/2 dtheta x dv) - 1/2 [w_in^n dt x] C(-) dv
+                           + (g(h_mid) - (2 w_ie + w_en) x v_mid) dt          (Groves eq. 5.84-5.86)
+    position  trapezoid / midpoint of the old and new velocity              (Groves eq. 5.38)
+with w_in = w_ie + w_en evaluated at the interval midpoint. The increments are those of the IMU record:
+the integral over [t_{k-1}, t_k] of the body rate / specific force (sensors/imu.py documents how the
+samples k-1, k form increment k).
+
+Every function is a plain array function over a leading run axis: a state holds (N,) / (N, 3) / (N, 3, 3)
+arrays, so many Monte Carlo runs step together. An optional 3rd-order baro damping loop (nav/vertical_loop.py,
+seed 003 eq. 3, 7) stabilizes the vertical channel.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from approachsim import geo
+from approachsim.nav import vertical_loop as vl
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class InsState:
+    """INS navigation state of N runs (run axis first). SI; the attitude matrix maps body to NED axes.
+
+    a_comp_mps2 is the baro loop's compensator output (m/s^2, up-positive; zero without a loop).
+    """
+
+    lat_rad: Array
+    """(N,) geodetic latitude, rad."""
+    lon_rad: Array
+    """(N,) longitude, rad."""
+    h_m: Array
+    """(N,) height above the WGS-84 ellipsoid, m."""
+    v_ned: Array
+    """(N, 3) velocity relative to the Earth, NED, m/s."""
+    c_bn: Array
+    """(N, 3, 3) attitude: v_ned = c_bn @ v_body."""
+    a_comp_mps2: Array
+    """(N,) baro damping loop compensator (seed 003 eq. 3, delta-a), m/s^2."""
+
+
+def cross(a: Array, b: Array) -> Array:
+    """a x b for vectors on the last axis (..., 3); a fast stand-in for np.cross on small arrays."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
+def skew(v: Array) -> Array:
+    """Cross-product matrices (..., 3, 3) of vectors (..., 3): skew(a) @ b = a x b."""
+    v = np.asarray(v, dtype=float)
+    k = np.zeros(v.shape + (3,))
+    k[..., 0, 1], k[..., 0, 2] = -v[..., 2], v[..., 1]
+    k[..., 1, 0], k[..., 1, 2] = v[..., 2], -v[..., 0]
+    k[..., 2, 0], k[..., 2, 1] = -v[..., 1], v[..., 0]
+    return k
+
+
+def rotation_exp(phi: Array) -> Array:
+    """Rotation matrices (..., 3, 3) Exp([phi x]) of rotation vectors phi (..., 3), rad (Rodrigues).
+
+    Exp = cos(a) I + sin(a)/a [phi x] + (1 - cos a)/a^2 phi phi', a = |phi|.
+    """
+    phi = np.asarray(phi, dtype=float)
+    a2 = np.einsum("...i,...i->...", phi, phi)
+    small = a2 < 1e-12
+    a = np.sqrt(a2)
+    a_safe = np.where(small, 1.0, a)
+    # sin(a)/a and (1 - cos a)/a^2, with their Taylor series near zero
+    s = np.where(small, 1.0 - a2 / 6.0, np.sin(a) / a_safe)
+    c = np.where(small, 0.5 - a2 / 24.0, (1.0 - np.cos(a)) / (a_safe * a_safe))
+    r = (c[..., None, None] * phi[..., :, None]) * phi[..., None, :]
+    cos_a = 1.0 - c * a2
+    for i in range(3):
+        r[..., i, i] += cos_a
+    sx, sy, sz = s * phi[..., 0], s * phi[..., 1], s * phi[..., 2]
+    r[..., 0, 1] -= sz
+    r[..., 0, 2] += sy
+    r[..., 1, 0] += sz
+    r[..., 1, 2] -= sx
+    r[..., 2, 0] -= sy
+    r[..., 2, 1] += sx
+    return r
+
+
+def earth_rate_ned(lat_rad: Array) -> Array:
+    """Earth rotation w_ie in NED axes (..., 3), rad/s: (W cos L, 0, -W sin L)."""
+    lat = np.asarray(lat_rad, dtype=float)
+    out = np.zeros(lat.shape + (3,))
+    out[..., 0] = geo.OMEGA_E * np.cos(lat)
+    out[..., 2] = -geo.OMEGA_E * np.sin(lat)
+    return out
+
+
+def transport_rate_ned(lat_rad: Array, h_m: Array, v_ned: Array) -> Array:
+    """Transport rate w_en in NED axes (..., 3), rad/s (Groves eq. 5.44)."""
+    r_n, r_e = geo.radii(lat_rad)
+    h = np.asarray(h_m, dtype=float)
+    v = np.asarray(v_ned, dtype=float)
+    out = np.empty(v.shape)
+    out[..., 0] = v[..., 1] / (r_e + h)
+    out[..., 1] = -v[..., 0] / (r_n + h)
+    out[..., 2] = -v[..., 1] * np.tan(lat_rad) / (r_e + h)
+    return out
+
+
+def gravity_ned(lat_rad: Array, h_m: Array) -> Array:
+    """Normal gravity vector (gravitation + centrifugal) in NED (..., 3), m/s^2: (0, 0, g(L, h))."""
+    g = geo.normal_gravity(lat_rad, h_m)
+    out = np.zeros(np.shape(g) + (3,))
+    out[..., 2] = g
+    return out
+
+
+def euler_from_cbn(c_bn: Array) -> Array:
+    """Roll, pitch, heading (..., 3), rad, of body-to-NED matrices (zyx convention); heading in [0, 2 pi)."""
+    c = np.asarray(c_bn, dtype=float)
+    roll = np.arctan2(c[..., 2, 1], c[..., 2, 2])
+    pitch = -np.arcsin(np.clip(c[..., 2, 0], -1.0, 1.0))
+    yaw = np.mod(np.arctan2(c[..., 1, 0], c[..., 0, 0]), 2.0 * np.pi)
+    return np.stack([roll, pitch, yaw], axis=-1)
+
+
+def cbn_from_euler(euler_rad: Array) -> Array:
+    """Body-to-NED matrices (..., 3, 3) from roll, pitch, heading (..., 3), rad (zyx convention)."""
+    e = np.asarray(euler_rad, dtype=float)
+    cr, sr = np.cos(e[..., 0]), np.sin(e[..., 0])
+    cp, sp = np.cos(e[..., 1]), np.sin(e[..., 1])
+    cy, sy = np.cos(e[..., 2]), np.sin(e[..., 2])
+    return np.stack(
+        [
+            np.stack([cp * cy, sr * sp * cy - cr * sy, cr * sp * cy + sr * sy], axis=-1),
+            np.stack([cp * sy, sr * sp * sy + cr * cy, cr * sp * sy - sr * cy], axis=-1),
+            np.stack([-sp, sr * cp, cr * cp], axis=-1),
+        ],
+        axis=-2,
+    )
+
+
+def cbn_from_quaternion(q_nb: Array) -> Array:
+    """Body-to-NED matrices (..., 3, 3) from quaternions (..., 4), scalar first (Truth.q_nb)."""
+    q = np.asarray(q_nb, dtype=float)
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=-1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=-1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=-1),
+        ],
+        axis=-2,
+    )
+
+
+def init_state(lat_rad: Array, lon_rad: Array, h_m: Array, v_ned: Array, c_bn: Array) -> InsState:
+    """An INS state from arrays with a leading run axis (scalars / single vectors get N = 1)."""
+    lat = np.atleast_1d(np.asarray(lat_rad, dtype=float)).copy()
+    c = np.asarray(c_bn, dtype=float)
+    return InsState(
+        lat_rad=lat,
+        lon_rad=np.broadcast_to(np.asarray(lon_rad, dtype=float), lat.shape).copy(),
+        h_m=np.broadcast_to(np.asarray(h_m, dtype=float), lat.shape).copy(),
+        v_ned=np.broadcast_to(np.asarray(v_ned, dtype=float), lat.shape + (3,)).copy(),
+        c_bn=np.broadcast_to(c, lat.shape + (3, 3)).copy(),
+        a_comp_mps2=np.zeros_like(lat),
+    )
+
+
+def perturb(state: InsState, dp_ned_m: Array, dv_ned_mps: Array, psi_rad: Array) -> InsState:
+    """The state with errors added: position error dp (NED, m), velocity error dv (m/s), attitude error psi.
+
+    Error convention (errormodel.py): INS = truth + error; attitude C_ins = (I - [psi x]) C_true, exactly
+    C_ins = Exp(-psi) C_true.
+    """
+    dp = np.asarray(dp_ned_m, dtype=float)
+    r_n, r_e = geo.radii(state.lat_rad)
+    lat = state.lat_rad + dp[..., 0] / (r_n + state.h_m)
+    lon = state.lon_rad + dp[..., 1] / ((r_e + state.h_m) * np.cos(state.lat_rad))
+    h = state.h_m - dp[..., 2]
+    c = rotation_exp(-np.asarray(psi_rad, dtype=float)) @ state.c_bn
+    return replace(state, lat_rad=lat, lon_rad=lon, h_m=h, v_ned=state.v_ned + dv_ned_mps, c_bn=c)
+
+
+def step(
+    s: InsState,
+    dtheta_body: Array,
+    dv_body: Array,
+    dt_s: float,
+    *,
+    h_baro_m: Array | None = None,
+    loop: vl.LoopGains | None = None,
+) -> InsState:
+    """Advance the INS by one IMU interval dt_s (s) with increments dtheta (rad) and dv (m/s), body axes (N, 3).
+
+    With `loop` and `h_baro_m` (N,) given, the 3rd-order baro damping loop (seed 003 eq. 3 / 7) corrects
+    height, vertical velocity and its compensator from the loop error e = h_ins - h_baro at the interval start.
+    """
+    lat0, h0, v0, c0 = s.lat_rad, s.h_m, s.v_ned, s.c_bn
+    dth = np.asarray(dtheta_body, dtype=float)
+    dvb = np.asarray(dv_body, dtype=float)
+    w_ie0 = earth_rate_ned(lat0)
+    w_in0 = w_ie0 + transport_rate_ned(lat0, h0, v0)
+    # specific-force increment in NED: rotation (1/2 dtheta x dv) and frame-rotation compensation (Groves 5.86)
+    cdv = np.einsum("nij,nj->ni", c0, dvb + 0.5 * cross(dth, dvb))
+    cdv0 = np.einsum("nij,nj->ni", c0, dvb)
+    dv_f = cdv - 0.5 * dt_s * cross(w_in0, cdv0)
+    # gravity and Coriolis at the predicted midpoint
+    h_mid = h0 - 0.5 * dt_s * v0[:, 2]
+    r_n0, _ = geo.radii(lat0)
+    lat_mid = lat0 + 0.5 * dt_s * v0[:, 0] / (r_n0 + h0)
+    g_mid = gravity_ned(lat_mid, h_mid)
+    cor0 = cross(w_ie0 + w_in0, v0)  # (2 w_ie + w_en) x v at the interval start
+    v_mid = v0 + 0.5 * (dv_f + (g_mid - cor0) * dt_s)
+    cor = cross(2.0 * earth_rate_ned(lat_mid) + transport_rate_ned(lat_mid, h_mid, v_mid), v_mid)
+    v1 = v0 + dv_f + (g_mid - cor) * dt_s
+    a_comp = s.a_comp_mps2
+    dh_loop = 0.0
+    if loop is not None and h_baro_m is not None:
+        e = h0 - np.asarray(h_baro_m, dtype=float)  # loop error e = h_ins - h_baro (seed 003 eq. 3)
+        k1, k2 = vl.branch_corrections(loop, e)
+        v1 = v1.copy()
+        v1[:, 2] += (k2 + a_comp) * dt_s  # v_up' = ... - k2(e) - a_c  (v_D = -v_up)
+        a_comp = a_comp + loop.c3 * e * dt_s  # a_c' = C3 e
+        dh_loop = -k1 * dt_s  # h' = v_up - k1(e)
+    # position: trapezoid of the velocity, radii at the midpoint
+    v_m = 0.5 * (v0 + v1)
+    h1 = h0 - dt_s * v_m[:, 2] + dh_loop
+    r_n, _ = geo.radii(lat0)
+    lat_mid = lat0 + 0.5 * dt_s * v_m[:, 0] / (r_n + 0.5 * (h0 + h1))
+    r_n, r_e = geo.radii(lat_mid)
+    hm = 0.5 * (h0 + h1)
+    lat1 = lat0 + dt_s * v_m[:, 0] / (r_n + hm)
+    lon1 = s.lon_rad + dt_s * v_m[:, 1] / ((r_e + hm) * np.cos(lat_mid))
+    # attitude: body rotation dtheta, navigation-frame rotation w_in at the midpoint
+    w_in_mid = earth_rate_ned(lat_mid) + transport_rate_ned(lat_mid, hm, v_m)
+    c1 = rotation_exp(-w_in_mid * dt_s) @ c0 @ rotation_exp(dth)
+    return InsState(lat1, lon1, h1, v1, c1, a_comp)
+
+
+def orthonormalize(c: Array) -> Array:
+    """Nearest rotation matrices (..., 3, 3) to c, by one symmetric correction C (3 I - C'C) / 2."""
+    return 0.5 * c @ (3.0 * np.eye(3) - np.swapaxes(c, -1, -2) @ c)
+
+
+def position_ecef(s: InsState) -> Array:
+    """ECEF positions (N, 3) of the INS states, m."""
+    return geo.geodetic_to_ecef(s.lat_rad, s.lon_rad, s.h_m)
+
+
+def position_error_ned(lat_rad: Array, lon_rad: Array, h_m: Array, lat_true: Array, lon_true: Array,
+                       h_true: Array) -> Array:
+    """Position error (estimate - truth) in local NED metres (..., 3) from geodetic coordinates."""
+    r_n, r_e = geo.radii(lat_true)
+    dlon = np.angle(np.exp(1j * (np.asarray(lon_rad) - lon_true)))
+    return np.stack(
+        [
+            (np.asarray(lat_rad) - lat_true) * (r_n + h_true),
+            dlon * (r_e + h_true) * np.cos(lat_true),
+            -(np.asarray(h_m) - h_true),
+        ],
+        axis=-1,
+    )
+
+
+def attitude_error(c_ins: Array, c_true: Array) -> Array:
+    """Attitude error psi (..., 3), rad, with C_ins = (I - [psi x]) C_true (small-angle, NED axes)."""
+    d = np.asarray(c_ins) @ np.swapaxes(np.asarray(c_true), -1, -2)  # = I - [psi x]
+    return 0.5 * np.stack([d[..., 1, 2] - d[..., 2, 1], d[..., 2, 0] - d[..., 0, 2], d[..., 0, 1] - d[..., 1, 0]],
+                          axis=-1)
