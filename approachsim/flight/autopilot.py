@@ -24,6 +24,7 @@ import math
 from dataclasses import dataclass
 
 from approachsim.flight.design import AutopilotGains
+from approachsim.geo import A_WGS84, E2_WGS84
 
 
 @dataclass(frozen=True)
@@ -43,6 +44,10 @@ class Geometry:
     heading_rad: float
     glidepath_rad: float
     tch_m: float
+    threshold_lat_rad: float
+    """Geodetic latitude of the threshold: the local north turns by the meridian convergence as the aircraft
+    moves east of it (dpsi = d_east sin(lat) / (R_E cos(lat)), 0.1 deg at 10 nmi), which rotates the runway
+    axes seen in the aircraft's NED frame."""
 
 
 class Autopilot:
@@ -56,6 +61,9 @@ class Autopilot:
         self._sh = math.sin(geometry.heading_rad)
         self._tan_gp = math.tan(geometry.glidepath_rad)
         self._tch = geometry.tch_m
+        lat0 = geometry.threshold_lat_rad
+        r_e = A_WGS84 / math.sqrt(1.0 - E2_WGS84 * math.sin(lat0) ** 2)
+        self._conv_per_east_m = math.sin(lat0) / (r_e * math.cos(lat0))
         self.int_d = 0.0
         self.int_y = 0.0
         self.e_f = 0.0
@@ -63,8 +71,12 @@ class Autopilot:
 
     def deviations(self, x: float, y: float, z: float, vn: float, ve: float, vd: float) -> tuple[float, ...]:
         """Glidepath deviation d (m, + above), its rate (m/s), cross-track y (m, + right) and its rate (m/s)."""
-        x_dot = vn * self._ch + ve * self._sh
-        y_dot = -vn * self._sh + ve * self._ch
+        ch, sh = self._ch, self._sh
+        conv = (x * sh + y * ch) * self._conv_per_east_m  # runway heading in the local NED minus at the threshold
+        x0 = vn * ch + ve * sh
+        y0 = -vn * sh + ve * ch
+        x_dot = x0 + conv * y0  # small-angle rotation by the convergence (|conv| < 0.01 rad)
+        y_dot = y0 - conv * x0
         d = z - (self._tch - x * self._tan_gp)
         d_dot = -vd + x_dot * self._tan_gp
         return d, d_dot, y, y_dot

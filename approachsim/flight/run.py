@@ -184,7 +184,7 @@ class Approach:
 
         trim = Trim(theta_rad=fdm["attitude/theta-rad"], throttle=fdm["fcs/throttle-cmd-norm[0]"],
                     cas_mps=ac.approach_speed_mps)
-        ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m), dt)
+        ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m, rw.threshold_lat_rad), dt)
         ap_step = ap.step
         stop_h = self.stop_height_m
         run_step = fdm.run
