@@ -16,6 +16,7 @@ from approachsim.config import ProfileError
 COMMAND_MODULES = (
     "approachsim.commands.fly",
     "approachsim.commands.reproduce",
+    "approachsim.commands.evaluate",
 )
 """Modules that each add sub-commands; a new command adds its line here."""
 

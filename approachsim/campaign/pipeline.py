@@ -1,0 +1,119 @@
+"""The one place where a Monte Carlo run is composed: fly -> sense -> navigate -> score.
+
+Stages are used through their public entry points only:
+
+    flight      approachsim.flight.run.Approach(profile).fly(seed=, run=, nav_source=) -> FlightResult
+    sensors     approachsim.sensors (the profile's sensor suite) -> sensor records
+    navigation  approachsim.nav.system -> records.NavSolution (and, closed loop, a NavigationSource)
+    scoring     approachsim.evaluate.score.score_run(truth, nav, cfg) -> scalars, arrays, series
+
+A stage that is not importable makes `require_stages` raise PipelineUnavailable (the CLI prints it and
+exits 1): numbers are never invented for a missing stage.
+
+Work sharing: the campaign runs fixed groups of consecutive runs (evaluation.flight_group) per task, so
+the aircraft is parsed and linearized once per group. Open loop: the truth of a group is flown once (on
+truth navigation, with the turbulence of the group's first run) and shared by every run of the group, each
+with its own sensor and filter noise. Closed loop: each run flies on its own navigation solution.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from approachsim.campaign.result import RunResult
+
+STAGES = (
+    ("approachsim.flight.run", "Approach", "flight (JSBSim truth)"),
+    ("approachsim.nav.system", None, "navigation system"),
+)
+"""(module, required attribute, what) of every stage the pipeline needs."""
+
+
+class PipelineUnavailable(RuntimeError):
+    """A stage of the per-run pipeline is not available in this installation (exit 1, not a user error)."""
+
+
+def require_stages() -> None:
+    """Raise PipelineUnavailable naming the first stage that cannot be imported."""
+    for mod, attr, what in STAGES:
+        try:
+            m = importlib.import_module(mod)
+        except ImportError as e:
+            raise PipelineUnavailable(
+                f"the {what} stage ({mod}) is not available: {e}; approachsim evaluate cannot score without it"
+            ) from None
+        if attr is not None and not hasattr(m, attr):
+            raise PipelineUnavailable(f"the {what} stage ({mod}) has no {attr}; cannot run the pipeline")
+
+
+@dataclass(frozen=True)
+class PipelineSpec:
+    """What the campaign runner needs: the group function (picklable) and the group size."""
+
+    group_fn: Any
+    group_size: int
+    closed_loop: bool
+
+
+def spec_for(profile: Any, mode: str) -> PipelineSpec:
+    """The campaign functions of `mode` ("closed" or "open") for this profile (after require_stages)."""
+    require_stages()
+    size = profile.evaluation.flight_group
+    if mode == "open":
+        return PipelineSpec(open_loop_group, size, False)
+    return PipelineSpec(closed_loop_group, size, True)
+
+
+def _score(profile: Any, run: int, truth: Any, nav: Any, clock_true: Any) -> RunResult:
+    from approachsim.evaluate.score import score_run
+
+    cfg = profile.evaluation
+    scalars, arrays, series = score_run(
+        truth, nav, cfg, clock_bias_true_m=clock_true, keep_series=run < cfg.series_runs
+    )
+    return RunResult(run=run, ok=True, scalars=scalars, arrays=arrays, series=series)
+
+
+def _approach(profile: Any) -> Any:
+    from approachsim import units
+    from approachsim.flight.run import Approach
+
+    lowest_dh_ft = min(profile.evaluation.dh_ft.values())
+    # fly a little below the lowest decision height so that its crossing is bracketed by samples
+    return Approach(profile, stop_height_m=max(lowest_dh_ft - 20.0, 5.0) * units.FT)
+
+
+def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunResult]:
+    """Fly the group's truth once (turbulence of its first run), then sense, navigate and score each run."""
+    from approachsim.nav import system
+
+    first = (runs[0] // profile.evaluation.flight_group) * profile.evaluation.flight_group
+    flight = _approach(profile).fly(seed=seed, run=first)
+    out = []
+    for i in runs:
+        try:
+            nav, clock_true = system.navigate(profile, flight.truth, seed=seed, run=i)
+            out.append(_score(profile, i, flight.truth, nav, clock_true))
+        except Exception as e:
+            out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
+    return out
+
+
+def closed_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunResult]:
+    """Each run flies on its own navigation solution; the aircraft is parsed once for the group."""
+    from approachsim.nav import system
+
+    approach = _approach(profile)
+    out = []
+    for i in runs:
+        try:
+            source = system.closed_loop_source(profile, seed=seed, run=i)
+            flight = approach.fly(seed=seed, run=i, nav_source=source)
+            nav, clock_true = source.solution(flight.truth)
+            out.append(_score(profile, i, flight.truth, nav, clock_true))
+        except Exception as e:
+            out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
+    return out

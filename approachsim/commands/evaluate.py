@@ -1,0 +1,97 @@
+"""`approachsim evaluate PROFILE [--runs N] [--seed S] [--out DIR] [--mode closed|open] [--workers K]
+[--scheduler ADDR] [--resume]`: the Monte Carlo evaluation of a profile against CAT I / II / III.
+
+Writes DIR/summary.json (design.md's output contract), DIR/details.json (intervals, ICAO columns,
+integrity, FTE / TSE, time-averaged RMS), DIR/runs.parquet (one row per run), DIR/heights.parquet (per-run
+error profiles against height), DIR/series/ (time series of the first evaluation.series_runs runs),
+DIR/runs.jsonl + DIR/campaign.json (the resumable record), the figures and DIR/report.html; prints the
+verdict table. Bad options exit 2 with one line; a missing pipeline stage exits 1 with one line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import sys
+from pathlib import Path
+
+from approachsim.config import ProfileError
+
+MAX_RUNS = 100000
+MAX_WORKERS = 1024
+_ADDRESS = re.compile(r"^(tcp|tls|inproc|ws|wss|ucx)://\S+$|^[A-Za-z0-9_.\-\[\]:]+:\d+$")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the `evaluate` sub-command."""
+    p = sub.add_parser("evaluate", help="Monte Carlo evaluation of a profile against FAA CAT I/II/III")
+    p.add_argument("profile", type=Path, help="approach profile (TOML)")
+    p.add_argument("--runs", type=int, default=None, help="Monte Carlo runs (default: the profile's run.runs)")
+    p.add_argument("--seed", type=int, default=None, help="campaign seed (default: the profile's run.seed)")
+    p.add_argument("--out", type=Path, default=None, help="output directory (default: evaluate-<profile name>)")
+    p.add_argument("--mode", choices=("closed", "open"), default=None,
+                   help="closed: each run flies on its own navigation; open: truth shared (default: profile)")
+    p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
+    p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler (tcp://host:port)")
+    p.add_argument("--resume", action="store_true", help="continue the campaign in --out, keeping finished runs")
+    p.add_argument("--no-report", action="store_true", help="skip figures and report.html")
+    p.set_defaults(func=run)
+
+
+def check_options(args: argparse.Namespace, profile) -> tuple[int, int, str, Path]:
+    """Validate the options against the profile: (runs, seed, mode, out); ProfileError names the option."""
+    runs = profile.run.runs if args.runs is None else args.runs
+    if not 1 <= runs <= MAX_RUNS:
+        raise ProfileError(f"--runs: must be in [1, {MAX_RUNS}], got {runs}")
+    seed = profile.run.seed if args.seed is None else args.seed
+    if not 0 <= seed < 2**63:
+        raise ProfileError(f"--seed: must be in [0, 2^63), got {seed}")
+    mode = profile.run.mode if args.mode is None else args.mode
+    if args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
+        raise ProfileError(f"--workers: must be in [1, {MAX_WORKERS}], got {args.workers}")
+    if args.scheduler is not None:
+        if args.workers is not None:
+            raise ProfileError("--workers: not used with --scheduler (the Dask cluster has its own workers)")
+        if not _ADDRESS.match(args.scheduler):
+            raise ProfileError(f"--scheduler: must be an address like tcp://host:8786, got {args.scheduler!r}")
+    out = args.out if args.out is not None else Path(f"evaluate-{profile.name}")
+    if out.exists() and not out.is_dir():
+        raise ProfileError(f"--out: {str(out)!r} exists and is not a directory")
+    return runs, seed, mode, out
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the campaign, write the outputs, print the verdict table."""
+    from approachsim.campaign.outputs import evaluate_results, verdict_table, write_json
+    from approachsim.campaign.pipeline import PipelineUnavailable, spec_for
+    from approachsim.campaign.runner import run_campaign
+    from approachsim.campaign.store import profile_digest
+    from approachsim.profile import load_profile
+
+    profile = load_profile(args.profile)
+    runs, seed, mode, out = check_options(args, profile)
+    try:
+        spec = spec_for(profile, mode)
+    except PipelineUnavailable as e:
+        sys.stderr.write(f"approachsim evaluate: {e}\n")
+        return 1
+    meta = {"profile": profile.name, "profile_digest": profile_digest(profile), "seed": seed, "mode": mode}
+    res = run_campaign(
+        profile, seed=seed, runs=runs, group_fn=spec.group_fn, group_size=spec.group_size, out_dir=out,
+        meta=meta, resume=args.resume, workers=args.workers or os.cpu_count(), scheduler=args.scheduler,
+    )
+    summary, det = evaluate_results(res.results, profile.evaluation, profile=profile.name, seed=seed,
+                                    closed_loop=spec.closed_loop)
+    write_json(out / "summary.json", summary)
+    write_json(out / "details.json", det)
+    if not args.no_report:
+        from approachsim.report.evaluate import write_report
+
+        write_report(out, res.results, summary, det)
+    print(verdict_table(summary, det))
+    if res.failed:
+        first = res.failed[0]
+        print(f"{len(res.failed)} run(s) failed; first: run {first.run}: {first.error}")
+    print(f"wrote {out / 'summary.json'}" + ("" if args.no_report else f", {out / 'report.html'}"))
+    return 0

@@ -1,0 +1,242 @@
+"""Figures and the self-contained HTML report of an evaluation campaign (verdict table first).
+
+Figures (PNG files in DIR and embedded as base64 in DIR/report.html):
+
+* errors_vs_height.png: lateral and vertical navigation error of every run against true height above the
+  threshold, the +-1 sigma envelope (RMS over runs at each height, bias included, the contract's sigma)
+  and each category's FAA 1-sigma limit drawn at its decision height;
+* histograms_dh.png: the distribution of lateral and vertical error over runs at each decision height;
+* stanford.png: vertical and horizontal Stanford diagrams (error against protection level, per epoch of
+  the runs that kept time series) with the CAT I alert limit, and the all-run region counts;
+* availability.png: fraction of runs whose protection levels are within each category's alert limits,
+  against height.
+
+Uses matplotlib's object API (Figure, no pyplot state), so it is safe in workers and threads.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+from pathlib import Path
+
+import numpy as np
+from matplotlib.colors import LogNorm
+from matplotlib.figure import Figure
+
+from approachsim import units
+from approachsim.campaign.result import RunResult
+from approachsim.evaluate.limits import CATEGORIES, LIMITS
+from approachsim.evaluate.score import CATEGORY_KEYS, HEIGHT_GRID_FT
+
+COLORS = {"CAT I": "tab:green", "CAT II": "tab:orange", "CAT III": "tab:red"}
+
+
+def _stack(results: list[RunResult], name: str) -> np.ndarray:
+    rows = [np.asarray(r.arrays[name], dtype=float) for r in results if r.ok and name in r.arrays]
+    return np.array(rows) if rows else np.empty((0, HEIGHT_GRID_FT.size))
+
+
+def _rms(a: np.ndarray) -> np.ndarray:
+    n = np.sum(np.isfinite(a), axis=0)
+    s = np.nansum(a**2, axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(n > 0, np.sqrt(s / np.maximum(n, 1)), np.nan)
+
+
+def fig_errors_vs_height(results: list[RunResult], dh_ft: dict[str, float]) -> Figure:
+    """Lateral and vertical error (ft) of all runs against height above the threshold, +-1 sigma, limits."""
+    fig = Figure(figsize=(10, 7), constrained_layout=True)
+    axes = fig.subplots(2, 1, sharex=True)
+    for ax, name, label, lim_key in (
+        (axes[0], "lateral_m", "lateral (cross-track) error, ft", "lateral_1sigma_ft"),
+        (axes[1], "vertical_m", "vertical error, ft", "vertical_1sigma_ft"),
+    ):
+        a = _stack(results, name) / units.FT
+        h = HEIGHT_GRID_FT
+        for row in a:
+            ax.plot(h, row, color="0.6", lw=0.5, alpha=0.5)
+        if a.shape[0]:
+            s = _rms(a)
+            ax.plot(h, s, color="tab:blue", lw=2, label="+-1 sigma (RMS over runs)")
+            ax.plot(h, -s, color="tab:blue", lw=2)
+        for cat in CATEGORIES:
+            lim = getattr(LIMITS[cat], lim_key)
+            ax.errorbar([dh_ft[cat]], [0.0], yerr=[[lim], [lim]], color=COLORS[cat], capsize=6, lw=2,
+                        label=f"{cat} 1-sigma limit at DH {dh_ft[cat]:g} ft")
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+        ax.axhline(0.0, color="k", lw=0.5)
+    axes[0].legend(fontsize=8, loc="upper right")
+    axes[1].set_xlabel("true height above threshold, ft")
+    axes[1].set_xlim(HEIGHT_GRID_FT.max(), 0.0)
+    fig.suptitle(f"Navigation error against height, {a.shape[0]} runs")
+    return fig
+
+
+def fig_histograms(results: list[RunResult], dh_ft: dict[str, float]) -> Figure:
+    """Histograms over runs of the lateral and vertical error (ft) at each decision height."""
+    fig = Figure(figsize=(12, 6), constrained_layout=True)
+    axes = fig.subplots(2, 3)
+    for j, cat in enumerate(CATEGORIES):
+        key = CATEGORY_KEYS[cat]
+        for i, (comp, lim) in enumerate(
+            (("lateral", LIMITS[cat].lateral_1sigma_ft), ("vertical", LIMITS[cat].vertical_1sigma_ft))
+        ):
+            ax = axes[i, j]
+            x = np.array([r.scalars[f"{key}_{comp}_m"] for r in results if r.ok]) / units.FT
+            if x.size:
+                ax.hist(x, bins=max(5, min(40, x.size // 3)), color=COLORS[cat], alpha=0.8)
+            for s in (-lim, lim):
+                ax.axvline(s, color="k", ls="--", lw=1)
+            ax.set_title(f"{cat} (DH {dh_ft[cat]:g} ft): {comp}", fontsize=9)
+            ax.set_xlabel("error, ft (dashed: FAA 1-sigma limit)", fontsize=8)
+    return fig
+
+
+def _series(out_dir: Path) -> list[dict[str, np.ndarray]]:
+    import pyarrow.parquet as pq
+
+    d = out_dir / "series"
+    if not d.is_dir():
+        return []
+    return [{k: np.asarray(v) for k, v in pq.read_table(p).to_pydict().items()} for p in sorted(d.glob("*.parquet"))]
+
+
+def fig_stanford(series: list[dict[str, np.ndarray]], det: dict) -> Figure:
+    """Stanford diagrams (PE against PL, per epoch of the series runs) against the CAT I alert limits."""
+    fig = Figure(figsize=(11, 5), constrained_layout=True)
+    axes = fig.subplots(1, 2)
+    lim = LIMITS["CAT I"]
+    for ax, pe_k, pl_k, al, name in (
+        (axes[0], "vertical_m", "vpl_m", lim.vertical_al_m, "vertical"),
+        (axes[1], "hpe_m", "hpl_m", lim.horizontal_al_m, "horizontal"),
+    ):
+        pe = np.concatenate([np.abs(s[pe_k]) for s in series]) if series else np.empty(0)
+        pl = np.concatenate([s[pl_k] for s in series]) if series else np.empty(0)
+        ok = np.isfinite(pe) & np.isfinite(pl)
+        top = max(2.0 * al, float(np.max(pl[ok], initial=0.0)) * 1.1, float(np.max(pe[ok], initial=0.0)) * 1.1)
+        if ok.any():
+            ax.hist2d(pe[ok], pl[ok], bins=80, range=[[0, top], [0, top]], norm=LogNorm(), cmap="viridis")
+        ax.plot([0, top], [0, top], "k-", lw=1)
+        ax.axhline(al, color="r", lw=1)
+        ax.axvline(al, color="r", lw=1)
+        counts = det["categories"]["CAT I"][f"stanford_{name}"]
+        ax.set_title(
+            f"{name}: AL {al:.1f} m (CAT I). All runs, epochs: normal {counts['normal']}, MI {counts['mi']}, "
+            f"HMI {counts['hmi']}, unavailable {counts['unavailable']}",
+            fontsize=8,
+        )
+        ax.set_xlabel("position error, m")
+        ax.set_ylabel("protection level, m")
+        ax.set_xlim(0, top)
+        ax.set_ylim(0, top)
+    return fig
+
+
+def fig_availability(results: list[RunResult]) -> Figure:
+    """Fraction of runs with VPL <= VAL and HPL <= HAL of each category, against height above threshold."""
+    fig = Figure(figsize=(10, 4), constrained_layout=True)
+    ax = fig.subplots()
+    vpl, hpl = _stack(results, "vpl_m"), _stack(results, "hpl_m")
+    for cat in CATEGORIES:
+        if vpl.shape[0]:
+            ok = np.isfinite(vpl) & np.isfinite(hpl)
+            av = (vpl <= LIMITS[cat].vertical_al_m) & (hpl <= LIMITS[cat].horizontal_al_m) & ok
+            frac = np.where(ok.sum(0) > 0, av.sum(0) / np.maximum(ok.sum(0), 1), np.nan)
+            ax.plot(HEIGHT_GRID_FT, frac, color=COLORS[cat], label=cat)
+    ax.set_xlim(HEIGHT_GRID_FT.max(), 0.0)
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlabel("true height above threshold, ft")
+    ax.set_ylabel("availability (fraction of runs)")
+    ax.legend()
+    ax.grid(True, alpha=0.3)
+    return fig
+
+
+def _png(fig: Figure, path: Path) -> str:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    data = buf.getvalue()
+    path.write_bytes(data)
+    return base64.b64encode(data).decode("ascii")
+
+
+def _cell(x) -> str:
+    if x is None:
+        return "--"
+    if isinstance(x, bool):
+        return "YES" if x else "no"
+    if isinstance(x, float):
+        return f"{x:.3g}" if abs(x) < 1e4 else f"{x:.4g}"
+    return html.escape(str(x))
+
+
+def _table(header: list[str], rows: list[list]) -> str:
+    h = "".join(f"<th>{html.escape(c)}</th>" for c in header)
+    body = "".join("<tr>" + "".join(f"<td>{_cell(c)}</td>" for c in row) + "</tr>" for row in rows)
+    return f"<table><tr>{h}</tr>{body}</table>"
+
+
+def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: dict) -> Path:
+    """Write the figures and DIR/report.html (verdict table first, images embedded); returns its path."""
+    out_dir = Path(out_dir)
+    dh_ft = {c: float(summary["decision_heights"][c]["height_ft"]) for c in CATEGORIES}
+    imgs = {
+        "errors_vs_height": fig_errors_vs_height(results, dh_ft),
+        "histograms_dh": fig_histograms(results, dh_ft),
+        "stanford": fig_stanford(_series(out_dir), det),
+        "availability": fig_availability(results),
+    }
+    b64 = {k: _png(f, out_dir / f"{k}.png") for k, f in imgs.items()}
+    verdict_rows = []
+    for cat, e in summary["decision_heights"].items():
+        lim = det["categories"][cat]["limits_ft"]
+        verdict_rows.append([
+            cat, e["height_ft"], e["lateral_1sigma_ft"], lim["lateral_1sigma_ft"], e["vertical_1sigma_ft"],
+            lim["vertical_1sigma_ft"], e["lateral_95_ft"], lim["lateral_95_ft"], e["vertical_95_ft"],
+            lim["vertical_95_ft"], e["meets"],
+        ])
+    detail_rows = []
+    for cat, c in det["categories"].items():
+        for comp in ("lateral", "vertical", "along", "vpl", "hpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert"):
+            s = c[f"{comp}_ft"]
+            detail_rows.append([cat, comp, s["n"], s["rms"], s["rms_lo"], s["rms_hi"], s["mean"], s["std"], s["p95"],
+                                s["p95_lo"], s["p95_hi"]])
+    integ_rows = [
+        [cat, axis, *(c[f"stanford_{axis}"][k] for k in ("normal", "mi", "hmi", "unavailable")), c["availability"]]
+        for cat, c in det["categories"].items()
+        for axis in ("vertical", "horizontal")
+    ]
+    ta = det["time_averaged_rms_ft"]
+    failures = det.get("failures", {})
+    title = f"approachsim evaluation: {summary['profile']}"
+    parts = [
+        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>",
+        "<style>body{font-family:sans-serif;margin:2em;max-width:1200px}table{border-collapse:collapse;"
+        "margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}"
+        "img{max-width:100%}</style></head><body>",
+        f"<h1>{html.escape(title)}</h1>",
+        f"<p><b>Best category met: {html.escape(str(summary['best_category'] or 'none'))}</b> &mdash; "
+        f"{summary['runs']} runs ({summary['failed_runs']} failed), seed {summary['seed']}, "
+        f"{'closed' if summary['closed_loop'] else 'open'} loop. 1-sigma = RMS over runs, bias included. "
+        f"Verdict uses: {html.escape(det['verdict_limits'])}.</p>",
+        _table(["category", "DH ft", "lateral 1σ ft", "FAA limit", "vertical 1σ ft", "FAA limit", "lateral 95% ft",
+                "ICAO 95%", "vertical 95% ft", "ICAO 95%", "meets"], verdict_rows),
+        "<h2>Statistics at decision height (ft; 95 % intervals for the number of runs)</h2>",
+        _table(["category", "error", "n", "RMS", "RMS lo", "RMS hi", "mean", "std", "95%", "95% lo", "95% hi"],
+               detail_rows),
+        "<h2>Integrity (epochs over the approach down to each DH)</h2>",
+        _table(["category", "axis", "normal", "MI", "HMI", "unavailable", "availability"], integ_rows),
+        "<h2>Time-averaged RMS over the approach (Gray &amp; Maybeck Tables 3-6 quantity), ft</h2>",
+        _table(list(ta), [list(ta.values())]),
+    ]
+    if failures:
+        parts.append("<h2>Failed runs</h2>" + _table(["run", "reason"], [[k, v] for k, v in failures.items()]))
+    for k in imgs:
+        parts.append(f"<h2>{k.replace('_', ' ')}</h2><img alt='{k}' src='data:image/png;base64,{b64[k]}'>")
+    parts.append("</body></html>")
+    path = out_dir / "report.html"
+    path.write_text("\n".join(parts), encoding="utf-8")
+    return path
