@@ -1,0 +1,64 @@
+"""`approachsim evaluate` at the edge: every bad option exits 2 with one line; a missing stage exits 1."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from approachsim.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+DEFAULT = str(ROOT / "profiles" / "default.toml")
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["--runs", "0"], "--runs"),
+        (["--runs", "100001"], "--runs"),
+        (["--runs", "ten"], "--runs"),
+        (["--seed", "-1"], "--seed"),
+        (["--seed", "1.5"], "--seed"),
+        (["--mode", "sideways"], "--mode"),
+        (["--workers", "0"], "--workers"),
+        (["--workers", "two"], "--workers"),
+        (["--scheduler", "not an address"], "--scheduler"),
+        (["--scheduler", "tcp://127.0.0.1:8786", "--workers", "2"], "--workers"),
+        (["--bogus"], "--bogus"),
+    ],
+)
+def test_bad_option_exits_2_with_one_line(argv, needle, capsys, tmp_path):
+    with pytest.raises(SystemExit) as e:
+        code = main(["evaluate", DEFAULT, "--out", str(tmp_path / "o"), *argv])
+        raise SystemExit(code)
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and needle in err, err
+
+
+def test_bad_out_and_profile_exit_2(tmp_path, capsys):
+    f = tmp_path / "file"
+    f.write_text("x")
+    assert main(["evaluate", DEFAULT, "--out", str(f)]) == 2
+    assert main(["evaluate", str(tmp_path / "missing.toml")]) == 2
+    bad = tmp_path / "bad.toml"
+    bad.write_text(Path(DEFAULT).read_text() + "\n[evaluation]\ndh_cat1_ft = 'high'\n")
+    assert main(["evaluate", str(bad)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 3 and "--out" in err[0] and "missing.toml" in err[1] and "evaluation.dh_cat1_ft" in err[2]
+
+
+def test_missing_navigation_stage_exits_1_with_one_line(tmp_path):
+    code = (
+        "import sys; sys.modules['approachsim.nav.system'] = None\n"
+        "from approachsim.cli import main\n"
+        f"sys.exit(main(['evaluate', {DEFAULT!r}, '--runs', '2', '--out', {str(tmp_path / 'o')!r}]))\n"
+    )
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 1
+    assert p.stderr.count("\n") == 1 and "navigation system" in p.stderr, p.stderr
+    assert p.stdout == ""
+    assert not (tmp_path / "o" / "summary.json").exists()

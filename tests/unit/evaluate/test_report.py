@@ -1,0 +1,48 @@
+"""Outputs of a scored campaign on synthetic pairs: stored runs, summary.json, verdict table, HTML report."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+from evalpairs import cross_axis_ned, make_nav, make_truth
+
+from approachsim import units
+from approachsim.campaign.outputs import evaluate_results, verdict_table, write_json
+from approachsim.campaign.result import RunResult
+from approachsim.campaign.store import CampaignStore
+from approachsim.evaluate.config import EvaluationConfig
+from approachsim.evaluate.score import score_run
+from approachsim.report.evaluate import write_report
+
+
+def test_outputs_and_report(tmp_path):
+    cfg = EvaluationConfig()
+    truth = make_truth(hz=4.0)
+    rng = np.random.default_rng(5)
+    results = []
+    for i in range(12):
+        e = rng.normal(0.0, 3.0) * units.FT * cross_axis_ned() + np.array([0.0, 0.0, rng.normal(0.0, 1.0)])
+        sc, arr, ser = score_run(truth, make_nav(truth, e, sigma_ned_m=(2.0, 2.0, 1.0)), cfg, keep_series=i < 2)
+        results.append(RunResult(run=i, ok=True, scalars=sc, arrays=arr, series=ser))
+    results.append(RunResult.failed(12, "RunScoreError: the true aircraft never descended through 200 ft"))
+    store = CampaignStore(tmp_path)
+    store.start({"seed": 1}, resume=False)
+    store.append(results)
+    store.write_tables(results)
+    summary, det = evaluate_results(results, cfg, profile="synthetic", seed=1, closed_loop=False)
+    write_json(tmp_path / "summary.json", summary)
+    back = json.loads((tmp_path / "summary.json").read_text())
+    assert back == summary and back["runs"] == 13 and back["failed_runs"] == 1
+    lat = np.array([r.scalars["cat1_lateral_m"] for r in results[:12]]) / units.FT
+    assert back["decision_heights"]["CAT I"]["lateral_1sigma_ft"] == np.sqrt(np.mean(lat**2))
+    table = verdict_table(summary, det)
+    assert table.splitlines()[0] == "synthetic: 13 runs (1 failed), seed 1, open loop"
+    assert "CAT III" in table and "best category:" in table
+    page = write_report(tmp_path, results, summary, det).read_text()
+    # the verdict table comes before any figure, and the figures are embedded
+    assert page.index("<table>") < page.index("<img")
+    assert page.count("data:image/png;base64,") == 4
+    assert "never descended" in page
+    for name in ("errors_vs_height", "histograms_dh", "stanford", "availability"):
+        assert (tmp_path / f"{name}.png").stat().st_size > 1000
