@@ -46,6 +46,9 @@ Array = np.ndarray
 STOP_HEIGHT_M = 50.0 * units.FT
 """Default end of the run: the IMU 50 ft above the threshold (the CAT III decision height)."""
 
+LINEARIZATION_HEIGHT_M = 1000.0 * units.FT
+"""Height above the threshold of the design linearization (the top of the 1000-200 ft scored segment)."""
+
 # column layout of the one (n, 36) buffer the Truth arrays are views of while flying
 _COLS = {
     "t_s": (0, 1), "lat_rad": (1, 1), "lon_rad": (2, 1), "h_m": (3, 1), "r_ecef": (4, 3), "v_ned": (7, 3),
@@ -119,10 +122,13 @@ class Approach:
 
     @property
     def linearization(self) -> Linearization:
-        """FGLinearization of the trimmed start condition in still air on a standard day (computed once)."""
+        """FGLinearization in still air on a standard day, trimmed on the glidepath 1000 ft above the threshold
+        (the top of the scored segment), in the approach configuration (computed once)."""
         if self._lin is None:
+            rw = self.profile.runway
+            along = -(LINEARIZATION_HEIGHT_M - rw.tch_m) / math.tan(rw.glidepath_rad)
             fdm = FDM(self.aircraft.jsbsim_model, self.dt_s)
-            fdm.initialize_and_trim(start_condition(self.profile, self.aircraft, still_air=True))
+            fdm.initialize_and_trim(start_condition(self.profile, self.aircraft, still_air=True, along_m=along))
             self._lin = fdm.linearize(-self.profile.runway.glidepath_rad)
         return self._lin
 
@@ -134,6 +140,7 @@ class Approach:
         rw = prof.runway
         dt = self.dt_s
         src = TruthSource() if nav_source is None else nav_source
+        on_truth = type(src) is TruthSource
         ic = start_condition(prof, ac)
         fdm = FDM(ac.jsbsim_model, dt)
         fdm.initialize_and_trim(ic)
@@ -247,10 +254,13 @@ class Approach:
                 xr, yr, zr, zr - (tch - xr * tan_gp), yr, de, da, dr, thr, vc_kt * KT,
             )
             # the navigation source sees row k, then the termination checks on the true state
-            gr, gv = src.step(k, truth)
-            gx, gy, gz = float(gr[0]), float(gr[1]), float(gr[2])
-            gvn, gve, gvd = float(gv[0]), float(gv[1]), float(gv[2])
-            gbuf[k] = (gx, gy, gz, gvn, gve, gvd)
+            if on_truth:  # TruthSource.step would return exactly these values: skip the array round trip
+                gx, gy, gz, gvn, gve, gvd = xr, yr, zr, vn, ve, vd
+            else:
+                gr, gv = src.step(k, truth)
+                gx, gy, gz = float(gr[0]), float(gr[1]), float(gr[2])
+                gvn, gve, gvd = float(gv[0]), float(gv[1]), float(gv[2])
+                gbuf[k] = (gx, gy, gz, gvn, gve, gvd)
             if zr < lowest:
                 lowest = zr
             if zr <= stop_h:
@@ -274,6 +284,9 @@ class Approach:
         if termination != "timeout":
             # the autopilot did not run on the last row: the controls of the previous step still act
             buf[k, _CTRL:_CTRL + 4] = (de + pitch_trim, da, dr, thr)
+        if on_truth:
+            gbuf[:n, :3] = buf[:n, _COLS["r_rwy"][0]:_COLS["r_rwy"][0] + 3]
+            gbuf[:n, 3:] = buf[:n, _COLS["v_ned"][0]:_COLS["v_ned"][0] + 3]
         final = Truth(**{name: np.ascontiguousarray(v[:n]) for name, v in truth.arrays().items()}, runway=rw.frame)
         return FlightResult(
             truth=final,

@@ -13,11 +13,13 @@ from approachsim.flight.fdm import InitialCondition
 from approachsim.profile import Profile
 
 
-def start_condition(profile: Profile, aircraft: Aircraft, *, still_air: bool = False) -> InitialCondition:
-    """The trimmed start of the profile's approach (still_air: no wind, standard day, for the linearization)."""
+def start_condition(profile: Profile, aircraft: Aircraft, *, still_air: bool = False,
+                    along_m: float | None = None) -> InitialCondition:
+    """The trimmed start of the profile's approach, on the glidepath at runway-frame x = along_m (default: the
+    start distance). still_air: no wind, standard day (for the linearization)."""
     rw = profile.runway
     frame = rw.frame
-    along = -rw.start_distance_m
+    along = -rw.start_distance_m if along_m is None else along_m
     lat, lon, _ = geo.ecef_to_geodetic(frame.to_ecef([along, 0.0, 0.0]))
     h = rw.elevation_m + float(rw.glidepath_height_m(along))
     env = profile.environment
