@@ -118,7 +118,7 @@ def fig_stanford(series: list[dict[str, np.ndarray]], det: dict) -> Figure:
         ok = np.isfinite(pe) & np.isfinite(pl)
         top = max(2.0 * al, float(np.max(pl[ok], initial=0.0)) * 1.1, float(np.max(pe[ok], initial=0.0)) * 1.1)
         if ok.any():
-            ax.hist2d(pe[ok], pl[ok], bins=80, range=[[0, top], [0, top]], norm=LogNorm(), cmap="viridis")
+            ax.hist2d(pe[ok], pl[ok], bins=80, range=[[0, top], [0, top]], norm=LogNorm(), cmap="viridis", cmin=1)
         ax.plot([0, top], [0, top], "k-", lw=1)
         ax.axhline(al, color="r", lw=1)
         ax.axvline(al, color="r", lw=1)
