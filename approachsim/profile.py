@@ -22,6 +22,7 @@ from approachsim import units
 from approachsim.config import ProfileError, Section
 from approachsim.evaluate.config import EvaluationConfig, parse_evaluation
 from approachsim.geo import RunwayFrame
+from approachsim.sensors.config import SensorsConfig, parse_faults, parse_sensors
 
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
 
@@ -124,6 +125,10 @@ class Profile:
     """The file it came from (aircraft files are looked up beside it)."""
     evaluation: EvaluationConfig = field(default_factory=EvaluationConfig)
     """How campaigns are scored ([evaluation]: decision heights, verdict limits; evaluate/config.py)."""
+    sensors: SensorsConfig = field(default_factory=SensorsConfig)
+    """The sensor suite ([sensors]; sensors/config.py). Default: seed 002's suite without the pseudolite."""
+    faults: tuple = ()
+    """Declared sensor faults ([[faults]]; sensors/faults.py FaultSpec), in profile order."""
 
 
 def _runway(s: Section) -> Runway:
@@ -224,6 +229,8 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
     rates = _rates(top.section("rates"))
     run = _run(top.section("run"))
     evaluation = parse_evaluation(top.section("evaluation"))
+    sensors = parse_sensors(top.section("sensors"))
+    faults = parse_faults(top.sections("faults"), sensors)
     top.done()
     return Profile(
         name=name,
@@ -236,6 +243,8 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
         run=run,
         source=source,
         evaluation=evaluation,
+        sensors=sensors,
+        faults=faults,
     )
 
 

@@ -107,3 +107,115 @@ class NavigationSource(Protocol):
     """
 
     def step(self, k: int, truth: Truth) -> tuple[Array, Array]: ...
+
+
+# --- sensor records (approachsim/sensors, issue 3) -------------------------------------------------------
+# Sample axis first for one run; (runs, samples, ...) for the fields marked "per run" when several Monte Carlo
+# runs are measured at once (t_s, index and the geometry of the ranging sources stay without a run axis
+# unless the truth itself had one). valid is False where the sensor gives no measurement (out of range,
+# not visible, outage); values are nan there. fault is the ground-truth fault label of each sample
+# (sensors/faults.py FAULT_CODES: 0 none, 1 outage, 2 spike, 3 iam, 4 cbm, 5 mni, 6 step, 7 ramp).
+
+
+@dataclass(frozen=True)
+class ImuSamples:
+    """Strapdown IMU output: increments over each IMU interval (t_{k-1}, t_k], body axes (sensors/imu.py)."""
+
+    t_s: Array
+    """(m,) end time t_k of each interval, s."""
+    dt_s: float
+    """IMU interval, s."""
+    dtheta_body: Array
+    """(m, 3) per run: angle increments, rad."""
+    dv_body: Array
+    """(m, 3) per run: velocity increments (integrated specific force), m/s."""
+    valid: Array
+    """(m,) per run: increment delivered."""
+    fault: Array
+    """(m,) per run: fault label (int8)."""
+
+
+@dataclass(frozen=True)
+class BaroSamples:
+    """Barometric altimeter: indicated altitude above MSL with the profile's QNH setting (sensors/baro.py)."""
+
+    t_s: Array
+    """(m,) sample times, s."""
+    h_baro_m: Array
+    """(m,) per run: indicated altitude above mean sea level (= ellipsoid in this simulator), m."""
+    sigma_m: Array
+    """(m,) white-noise 1-sigma of each sample (the nominal R of a filter), m."""
+    valid: Array
+    """(m,) per run."""
+    fault: Array
+    """(m,) per run: fault label (int8)."""
+
+
+@dataclass(frozen=True)
+class RadaltSamples:
+    """Radar altimeter: antenna height above the terrain (sensors/radalt.py)."""
+
+    t_s: Array
+    """(m,) sample times, s."""
+    h_agl_m: Array
+    """(m,) per run: measured height above terrain, m (nan where not valid)."""
+    sigma_m: Array
+    """(m,) per run: seed 002 noise 1-sigma sqrt((0.01 h)^2 + floor^2), m, at the true height."""
+    valid: Array
+    """(m,) per run: below maximum range and within the attitude limits."""
+    fault: Array
+    """(m,) per run: fault label (int8)."""
+
+
+@dataclass(frozen=True)
+class GnssSamples:
+    """GPS code pseudoranges to the 24 nominal slots (sensors/gnss.py); channels on the last axis."""
+
+    t_s: Array
+    """(m,) receive times, s."""
+    prn: Array
+    """(24,) PRN of each channel (standards.md 2.1, MAAST almmops numbering)."""
+    r_sv_ecef: Array
+    """(m, 24, 3) satellite positions, ECEF, m (the broadcast-ephemeris position a receiver would use)."""
+    pseudorange_m: Array
+    """(m, 24) per run: pseudorange, m (nan where not valid)."""
+    sigma_m: Array
+    """(m, 24) nominal 1-sigma of each pseudorange (the UERE model at its elevation), m."""
+    elevation_rad: Array
+    """(m, 24) elevation of each satellite at the true antenna position, rad."""
+    azimuth_rad: Array
+    """(m, 24) azimuth, rad from true north, clockwise."""
+    visible: Array
+    """(m, 24) above the elevation mask."""
+    valid: Array
+    """(m, 24) per run: visible, selected (all in view or best-PDOP four) and not in an outage."""
+    pdop: Array
+    """(m,) PDOP of the selected set (inf when fewer than 4)."""
+    clock_bias_m: Array
+    """(m,) per run: true receiver clock bias in the pseudoranges (c times seconds), m."""
+    clock_drift_mps: Array
+    """(m,) per run: true receiver clock drift, m/s."""
+    fault: Array
+    """(m, 24) per run: fault label (int8)."""
+
+
+@dataclass(frozen=True)
+class PseudoliteSamples:
+    """Ground pseudolite code pseudoranges (sensors/pseudolite.py); one channel per unit on the last axis."""
+
+    t_s: Array
+    """(m,) receive times, s."""
+    r_pl_ecef: Array
+    """(p, 3) surveyed (published) transmitter positions, ECEF, m: what the navigation system uses."""
+    pseudorange_m: Array
+    """(m, p) per run: pseudorange, m (nan where not valid); includes the receiver clock bias."""
+    sigma_m: Array
+    """(m, p) nominal 1-sigma (code noise and multipath), m."""
+    elevation_rad: Array
+    """(m, p) elevation of the aircraft seen from each transmitter, rad."""
+    valid: Array
+    """(m, p) per run: within range and above the transmitter's elevation mask, not in an outage."""
+    clock_bias_m: Array
+    """(m,) per run: true receiver clock bias included (same clock as the GNSS channels in a suite), m."""
+    fault: Array
+    """(m, p) per run: fault label (int8)."""

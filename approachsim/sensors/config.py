@@ -1,0 +1,227 @@
+"""The profile's [sensors] table and [[faults]] array, parsed strictly into frozen config objects.
+
+Feet and degrees at this edge only (max_range_ft, mask_deg, pseudolite positions in ft); everything else is
+SI with the unit in the key. A profile without [sensors] gets DEFAULT_SENSORS (seed 002's suite: 2 nmi/h
+INS, baro, P-code GPS best four, radar altimeter below 3000 ft, no pseudolite). Every key is documented in
+profiles/default.toml.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from approachsim import units
+from approachsim.config import ProfileError, Section
+from approachsim.sensors.faults import FAULT_KINDS, FaultSpec
+from approachsim.sensors.gnss.clock import OSCILLATORS
+from approachsim.sensors.gnss.constellation import parse_epoch
+from approachsim.sensors.gnss.receiver import CODE_PRESETS
+from approachsim.sensors.presets import PRESETS
+
+SENSOR_NAMES = ("imu", "baro", "radalt", "gnss", "pseudolite")
+"""Sensor names: profile tables, random-stream names and record names."""
+
+
+@dataclass(frozen=True)
+class ImuConfig:
+    """[sensors.imu]: grade preset name, optional quantization steps (rad, m/s; 0 = none)."""
+
+    grade: str = "nav-2.0"
+    gyro_quant_rad: float = 0.0
+    accel_quant_mps: float = 0.0
+
+
+@dataclass(frozen=True)
+class BaroConfig:
+    """[sensors.baro]: seed 001 / 003 error model (m, s, dimensionless)."""
+
+    rate_hz: float = 10.0
+    bias_sigma_m: float = 1.0
+    bias_tau_s: float = 100.0
+    scale_factor_sigma: float = 0.0
+    noise_sigma_m: float = 1.0
+
+
+@dataclass(frozen=True)
+class RadaltConfig:
+    """[sensors.radalt]: seed 002 noise, optional seed 000 Markov error, maximum range (m)."""
+
+    rate_hz: float = 1.0
+    max_range_m: float = 3000.0 * units.FT
+    percent_sigma: float = 0.01
+    floor_m: float = 0.5
+    markov_sigma_m: float = 0.0
+    markov_tau_s: float = 100.0
+
+
+@dataclass(frozen=True)
+class GnssConfig:
+    """[sensors.gnss]: code preset, selection, mask (rad), rate, epoch (UTC ISO), receiver oscillator."""
+
+    code: str = "P(Y)"
+    selection: str = "best4"
+    mask_rad: float = math.radians(5.0)
+    rate_hz: float = 1.0
+    epoch_utc: str = "2026-01-01T12:00:00Z"
+    oscillator: str = "tcxo"
+    clock_bias0_sigma_m: float = 300.0
+    clock_drift0_sigma_mps: float = 3.0
+
+
+@dataclass(frozen=True)
+class PseudoliteConfig:
+    """[sensors.pseudolite]: units at runway-frame (along, cross, height above threshold) m; error model.
+
+    Pseudolites are channels of the GPS receiver: they sample at the GNSS rate with its receiver clock."""
+
+    positions_rwy: tuple[tuple[float, float, float], ...] = ((0.0, -150.0, 10.0),)
+    synchronized: bool = True
+    code_noise_m: float = 0.3
+    multipath_m: float = 0.5
+    multipath_tau_s: float = 30.0
+    survey_sigma_m: float = 0.05
+    tropo_ppm_sigma: float = 30.0
+    max_range_m: float = 50e3
+
+
+@dataclass(frozen=True)
+class SensorsConfig:
+    """The sensor suite of a profile; None: the sensor is not fitted."""
+
+    imu: ImuConfig = field(default_factory=ImuConfig)
+    baro: BaroConfig | None = field(default_factory=BaroConfig)
+    radalt: RadaltConfig | None = field(default_factory=RadaltConfig)
+    gnss: GnssConfig | None = field(default_factory=GnssConfig)
+    pseudolite: PseudoliteConfig | None = None
+
+
+DEFAULT_SENSORS = SensorsConfig()
+"""The suite of a profile with no [sensors] table (seed 002 without the pseudolite)."""
+
+
+FAULT_TARGETS = {"imu": ("dv", "dtheta"), "baro": ("h",), "radalt": ("h",), "gnss": ("pseudorange",),
+                 "pseudolite": ("pseudorange",)}
+"""Fault targets per sensor (the first is the default)."""
+
+
+def _enabled(s: Section, default: bool) -> bool:
+    """The table's `enabled` flag; a disabled table may hold nothing else (done() rejects other keys)."""
+    return s.boolean("enabled", default)
+
+
+def parse_sensors(s: Section) -> SensorsConfig:
+    """Parse [sensors]; absent sub-tables take the defaults; `enabled = false` removes a sensor."""
+    imu_s = s.section("imu")
+    grade = imu_s.string("grade", "nav-2.0", choices=tuple(PRESETS))
+    imu = ImuConfig(
+        grade=grade,
+        gyro_quant_rad=imu_s.number("gyro_quant_rad", 0.0, lo=0.0, unit="rad"),
+        accel_quant_mps=imu_s.number("accel_quant_mps", 0.0, lo=0.0, unit="m/s"),
+    )
+    imu_s.done()
+
+    b = s.section("baro")
+    baro = None
+    if _enabled(b, True):
+        baro = BaroConfig(
+            rate_hz=b.number("rate_hz", 10.0, lo=0.1, hi=1000.0, unit="Hz"),
+            bias_sigma_m=b.number("bias_sigma_m", 1.0, lo=0.0, unit="m"),
+            bias_tau_s=b.number("bias_tau_s", 100.0, lo=0.0, lo_open=True, unit="s"),
+            scale_factor_sigma=b.number("scale_factor_sigma", 0.0, lo=0.0, hi=0.5),
+            noise_sigma_m=b.number("noise_sigma_m", 1.0, lo=0.0, unit="m"),
+        )
+    b.done()
+
+    r = s.section("radalt")
+    radalt = None
+    if _enabled(r, True):
+        radalt = RadaltConfig(
+            rate_hz=r.number("rate_hz", 1.0, lo=0.1, hi=1000.0, unit="Hz"),
+            max_range_m=r.number("max_range_ft", 3000.0, lo=100.0, hi=10000.0, unit="ft") * units.FT,
+            percent_sigma=r.number("percent_of_height", 1.0, lo=0.0, hi=10.0, unit="%") / 100.0,
+            floor_m=r.number("floor_m", 0.5, lo=0.0, hi=10.0, unit="m"),
+            markov_sigma_m=r.number("markov_sigma_m", 0.0, lo=0.0, unit="m"),
+            markov_tau_s=r.number("markov_tau_s", 100.0, lo=0.0, lo_open=True, unit="s"),
+        )
+    r.done()
+
+    g = s.section("gnss")
+    gnss = None
+    if _enabled(g, True):
+        epoch = g.string("epoch_utc", "2026-01-01T12:00:00Z")
+        try:
+            parse_epoch(epoch)
+        except ValueError as e:
+            raise ProfileError(f"{g.path}.epoch_utc: {e}") from None
+        gnss = GnssConfig(
+            code=g.string("code", "P(Y)", choices=tuple(CODE_PRESETS)),
+            selection=g.string("selection", "best4", choices=("best4", "all")),
+            mask_rad=math.radians(g.number("mask_deg", 5.0, lo=0.0, hi=45.0, unit="deg")),
+            rate_hz=g.number("rate_hz", 1.0, lo=0.1, hi=100.0, unit="Hz"),
+            epoch_utc=epoch,
+            oscillator=g.string("oscillator", "tcxo", choices=tuple(OSCILLATORS)),
+            clock_bias0_sigma_m=g.number("clock_bias0_sigma_m", 300.0, lo=0.0, unit="m"),
+            clock_drift0_sigma_mps=g.number("clock_drift0_sigma_mps", 3.0, lo=0.0, unit="m/s"),
+        )
+    g.done()
+
+    p = s.section("pseudolite")
+    pseudolite = None
+    if _enabled(p, False):
+        units_s = p.sections("units")
+        pos = []
+        for u in units_s:
+            pos.append((
+                u.number("along_ft", lo=-200000.0, hi=50000.0, unit="ft") * units.FT,
+                u.number("cross_ft", lo=-50000.0, hi=50000.0, unit="ft") * units.FT,
+                u.number("height_ft", 30.0, lo=-500.0, hi=2000.0, unit="ft") * units.FT,
+            ))
+            u.done()
+        if not 1 <= len(pos) <= 2:
+            raise ProfileError(f"{p.path}.units: needs one or two [[{p.path}.units]] tables, got {len(pos)}")
+        pseudolite = PseudoliteConfig(
+            positions_rwy=tuple(pos),
+            synchronized=p.boolean("synchronized", True),
+            code_noise_m=p.number("code_noise_m", 0.3, lo=0.0, unit="m"),
+            multipath_m=p.number("multipath_m", 0.5, lo=0.0, unit="m"),
+            multipath_tau_s=p.number("multipath_tau_s", 30.0, lo=0.0, lo_open=True, unit="s"),
+            survey_sigma_m=p.number("survey_sigma_m", 0.05, lo=0.0, unit="m"),
+            tropo_ppm_sigma=p.number("tropo_ppm_sigma", 30.0, lo=0.0, unit="ppm"),
+            max_range_m=p.number("max_range_nmi", 27.0, lo=0.1, hi=200.0, unit="nmi") * units.NMI,
+        )
+    p.done()
+    s.done()
+    return SensorsConfig(imu=imu, baro=baro, radalt=radalt, gnss=gnss, pseudolite=pseudolite)
+
+
+def parse_faults(items: list[Section], sensors: SensorsConfig) -> tuple[FaultSpec, ...]:
+    """Parse [[faults]]; a fault on a sensor the suite does not fit is an error naming it."""
+    out = []
+    for f in items:
+        sensor = f.string("sensor", choices=SENSOR_NAMES)
+        if sensor != "imu" and getattr(sensors, sensor) is None:
+            raise ProfileError(f"{f.path}.sensor: {sensor!r} is not fitted (enable [sensors.{sensor}])")
+        kind = f.string("kind", choices=FAULT_KINDS)
+        start = f.number("start_s", 0.0, lo=0.0, unit="s")
+        end = f.number("end_s", math.inf, lo=0.0, unit="s") if f.has("end_s") else math.inf
+        if end <= start:
+            raise ProfileError(f"{f.path}.end_s: must be after start_s ({start:g} s), got {end:g}")
+        steps = f.raw("steps", [])
+        if not isinstance(steps, list) or any(isinstance(x, bool) or not isinstance(x, int) or x < 0 for x in steps):
+            raise ProfileError(f"{f.path}.steps: must be a list of sample numbers (integers >= 0), got {steps!r}")
+        channel = f.raw("channel", None)
+        if channel is not None:
+            channel = f.integer("channel", lo=0)
+        target = f.raw("target", None)
+        if target is not None:
+            target = f.string("target", choices=FAULT_TARGETS[sensor])
+        spec = FaultSpec(
+            sensor=sensor, kind=kind, start_s=start, end_s=end, target=target, channel=channel,
+            magnitude=f.number("magnitude", 0.0), rate=f.number("rate", 0.0),
+            factor=f.number("factor", 1.0, lo=0.0, lo_open=True), k=f.number("k", 1.0, lo=0.0),
+            steps=tuple(steps), every=f.integer("every", 1, lo=1),
+        )
+        f.done()
+        out.append(spec)
+    return tuple(out)

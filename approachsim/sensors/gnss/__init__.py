@@ -1,0 +1,7 @@
+"""GPS: nominal constellation (constellation.py), receiver clock (clock.py), pseudoranges (receiver.py)."""
+
+from approachsim.sensors.gnss.clock import ClockModel
+from approachsim.sensors.gnss.constellation import Constellation
+from approachsim.sensors.gnss.receiver import CODE_PRESETS, GnssErrorBudget, GnssReceiver
+
+__all__ = ["CODE_PRESETS", "ClockModel", "Constellation", "GnssErrorBudget", "GnssReceiver"]

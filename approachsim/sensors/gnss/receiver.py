@@ -1,0 +1,208 @@
+"""GPS code pseudoranges to the nominal constellation, with the error budget of standards.md 2.3.
+
+    rho_i = |r_sv,i - r| + b_rx + E_i + F(el_i) I_i + M(el_i) T_i + m_i + n_i
+
+b_rx   receiver clock bias (two-state, clock.py; passed in so GNSS and pseudolites share one receiver clock),
+E_i    satellite clock + ephemeris error, Gauss-Markov (sigma, 2 h),
+I_i    zenith ionospheric residual, Gauss-Markov (30 min), mapped by the thin-shell obliquity F(el) at 350 km,
+T_i    zenith tropospheric residual, Gauss-Markov (1 h), mapped by the DO-229 1.001 / sqrt(0.002001 + sin^2 el),
+m_i    multipath, Gauss-Markov (60 s), n_i code noise, white.
+Correlation times are engineering choices (the budgets give only 1-sigma), documented here and configurable.
+
+Presets (1-sigma, m; NRC 1995 Table C-1 [S11]):
+  P(Y) (PPS, dual frequency): clock/ephemeris 3.6, multipath 1.8, noise 0.6, atmospheric 0.7 split as
+        iono zenith 0.3 and tropo zenith 0.2 (Kaplan's 0.2 m tropo residual), which RSS to 0.7 m at 30 deg;
+        UERE 4.1 m.
+  C/A (SPS, SA off): clock/ephemeris 3.6, multipath 1.2, noise 0.6, atmospheric 7.0 as iono zenith 4.0
+        (7.0 m slant at 30 deg, F = 1.75) and tropo zenith 0.2; UERE 8.0 m.
+
+Satellite positions are those at the receive time (no light-time or Sagnac terms): the record carries them,
+so a navigation filter that uses the record's r_sv_ecef sees exactly the modelled geometry.
+Selection: "all" (every SV above the mask) or "best4" (the four of lowest PDOP, seed 002, chosen afresh at
+each epoch). Channels are the 24 slots, in SLOTS order; invisible or unselected channels are nan and invalid.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from approachsim import geo
+from approachsim.records import GnssSamples, Truth
+from approachsim.sensors import base
+from approachsim.sensors.gnss.clock import ClockModel
+from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
+
+Array = np.ndarray
+
+IONO_SHELL_M = 350e3
+"""Thin-shell ionosphere height, m (Klobuchar / DO-229)."""
+
+
+@dataclass(frozen=True)
+class GnssErrorBudget:
+    """1-sigma (m) and correlation times (s) of the per-satellite errors."""
+
+    clock_ephemeris_m: float
+    iono_zenith_m: float
+    tropo_zenith_m: float
+    multipath_m: float
+    code_noise_m: float
+    clock_ephemeris_tau_s: float = 7200.0
+    iono_tau_s: float = 1800.0
+    tropo_tau_s: float = 3600.0
+    multipath_tau_s: float = 60.0
+
+
+CODE_PRESETS: dict[str, GnssErrorBudget] = {
+    "P(Y)": GnssErrorBudget(clock_ephemeris_m=3.6, iono_zenith_m=0.3, tropo_zenith_m=0.2, multipath_m=1.8,
+                            code_noise_m=0.6),
+    "C/A": GnssErrorBudget(clock_ephemeris_m=3.6, iono_zenith_m=4.0, tropo_zenith_m=0.2, multipath_m=1.2,
+                           code_noise_m=0.6),
+}
+"""Receiver code presets (module docstring gives the sources)."""
+
+
+def iono_obliquity(el_rad: Array) -> Array:
+    """Thin-shell ionospheric obliquity factor 1 / sqrt(1 - (R cos el / (R + h_I))^2)."""
+    x = geo.A_WGS84 * np.cos(el_rad) / (geo.A_WGS84 + IONO_SHELL_M)
+    return 1.0 / np.sqrt(1.0 - x * x)
+
+
+def tropo_mapping(el_rad: Array) -> Array:
+    """Tropospheric mapping 1.001 / sqrt(0.002001 + sin^2 el) (RTCA DO-229 A.4.2.4)."""
+    return 1.001 / np.sqrt(0.002001 + np.sin(el_rad) ** 2)
+
+
+def best_pdop_four(u_los: Array, visible: Array) -> Array:
+    """Selection mask (n, k): per epoch the four visible channels of lowest PDOP (all visible if < 4)."""
+    n, k = visible.shape
+    sel = np.zeros((n, k), dtype=bool)
+    for i in range(n):
+        idx = np.flatnonzero(visible[i])
+        if idx.size <= 4:
+            sel[i, idx] = True
+            continue
+        combos = np.array(list(itertools.combinations(idx, 4)))
+        g = np.concatenate([-u_los[i, combos], np.ones(combos.shape + (1,))], axis=-1)  # (c, 4, 4)
+        q = np.linalg.inv(np.einsum("cki,ckj->cij", g, g))
+        pdop2 = q[:, 0, 0] + q[:, 1, 1] + q[:, 2, 2]
+        sel[i, combos[int(np.argmin(pdop2))]] = True
+    return sel
+
+
+def draw_receiver_clock(clock: ClockModel, t_s: Array, rate_hz: float, rng: base.RngLike) -> base.SensorErrors:
+    """A receiver clock realization at rate_hz on time base t_s: series bias (m,) m, drift (m,) m/s."""
+
+    def one(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
+        c0 = g.standard_normal(2)
+        b, d = clock.series(c0, g.standard_normal((m, 2)), dt)
+        return {"bias": b, "drift": d}
+
+    return base.make_errors(t_s, rate_hz, rng, one)
+
+
+@dataclass(frozen=True)
+class GnssReceiver:
+    """GPS receiver: constellation, code preset, mask, selection, rate; the clock model it carries."""
+
+    constellation: Constellation = field(default_factory=Constellation.nominal)
+    budget: GnssErrorBudget = field(default_factory=lambda: CODE_PRESETS["P(Y)"])
+    clock: ClockModel = field(default_factory=ClockModel)
+    mask_rad: float = math.radians(5.0)
+    selection: str = "best4"
+    rate_hz: float = 1.0
+    name: str = "gnss"
+
+    fault_targets: ClassVar[tuple[tuple[str, str, str], ...]] = (("pseudorange", "pseudorange_m", "noise"),)
+
+    def __post_init__(self) -> None:
+        if self.selection not in ("all", "best4"):
+            raise ValueError(f"selection must be 'all' or 'best4', got {self.selection!r}")
+
+    def draw(self, t_s: Array, rng: base.RngLike) -> base.SensorErrors:
+        """series (m, 24) m: clock_ephemeris, iono_zenith, tropo_zenith, multipath, noise."""
+        b = self.budget
+        k = self.constellation.prn.shape[0]
+
+        def one(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
+            z = g.standard_normal((m, 5 * k))
+            return {
+                "clock_ephemeris": base.gauss_markov(z[:, 0:k], b.clock_ephemeris_m, b.clock_ephemeris_tau_s, dt),
+                "iono_zenith": base.gauss_markov(z[:, k : 2 * k], b.iono_zenith_m, b.iono_tau_s, dt),
+                "tropo_zenith": base.gauss_markov(z[:, 2 * k : 3 * k], b.tropo_zenith_m, b.tropo_tau_s, dt),
+                "multipath": base.gauss_markov(z[:, 3 * k : 4 * k], b.multipath_m, b.multipath_tau_s, dt),
+                "noise": b.code_noise_m * z[:, 4 * k : 5 * k],
+            }
+
+        return base.make_errors(t_s, self.rate_hz, rng, one)
+
+    def draw_clock(self, t_s: Array, rng: base.RngLike) -> base.SensorErrors:
+        """The receiver clock at this receiver's samples: series bias (m,) m and drift (m,) m/s."""
+        return draw_receiver_clock(self.clock, t_s, self.rate_hz, rng)
+
+    def geometry(self, truth: Truth, rows: Array, t_s: Array) -> dict[str, Array]:
+        """Satellite positions, ranges, lines of sight, look angles, visibility, selection and DOPs."""
+        r_rx = truth.r_ecef[rows]
+        r_sv = self.constellation.positions_ecef(t_s)
+        rng_m, u, el, az = look_angles(r_rx, r_sv)
+        visible = el >= self.mask_rad
+        lat, lon, _ = geo.ecef_to_geodetic(r_rx)
+        c_ned = geo.c_ecef_to_ned(lat, lon)
+        sel = visible if self.selection == "all" else best_pdop_four(u, visible)
+        _, pdop, _, _ = dops(u, sel, c_ned)
+        return {"r_sv": r_sv, "range": rng_m, "u": u, "el": el, "az": az, "visible": visible, "sel": sel,
+                "pdop": pdop}
+
+    def sigma_m(self, el_rad: Array) -> Array:
+        """Nominal 1-sigma pseudorange error at elevation el (m): RSS of the budget with its mappings."""
+        b = self.budget
+        return np.sqrt(
+            b.clock_ephemeris_m**2 + (b.iono_zenith_m * iono_obliquity(el_rad)) ** 2
+            + (b.tropo_zenith_m * tropo_mapping(el_rad)) ** 2 + b.multipath_m**2 + b.code_noise_m**2
+        )
+
+    def apply(
+        self, truth: Truth, errors: base.SensorErrors, clock: base.SensorErrors | None = None
+    ) -> GnssSamples:
+        """Pseudoranges at the truth rows of `errors`; `clock` from draw_clock (None: a zero receiver clock)."""
+        geo_ = self.geometry(truth, errors.rows, errors.t_s)
+        s = errors.series
+        el = geo_["el"]
+        pr = (
+            geo_["range"] + s["clock_ephemeris"] + iono_obliquity(el) * s["iono_zenith"]
+            + tropo_mapping(el) * s["tropo_zenith"] + s["multipath"] + s["noise"]
+        )
+        shape_t = pr.shape[:-1]
+        if clock is None:
+            cb = np.zeros(shape_t)
+            cd = np.zeros(shape_t)
+        else:
+            cb = np.broadcast_to(clock.series["bias"], shape_t)
+            cd = np.broadcast_to(clock.series["drift"], shape_t)
+        pr = pr + cb[..., None]
+        valid = np.broadcast_to(geo_["sel"], pr.shape).copy()
+        return GnssSamples(
+            t_s=errors.t_s, prn=self.constellation.prn, r_sv_ecef=geo_["r_sv"],
+            pseudorange_m=np.where(valid, pr, np.nan), sigma_m=self.sigma_m(el), elevation_rad=el,
+            azimuth_rad=geo_["az"], visible=geo_["visible"], valid=valid, pdop=geo_["pdop"],
+            clock_bias_m=np.array(cb), clock_drift_mps=np.array(cd), fault=np.zeros(pr.shape, dtype=np.int8),
+        )
+
+    def measure(
+        self, truth: Truth, rng: base.RngLike, *, noise: bool = True, clock_rng: base.RngLike | None = None
+    ) -> GnssSamples:
+        """apply(truth, draw(t, rng), draw_clock(t, clock_rng)); no clock_rng: a zero receiver clock.
+
+        noise=False zeroes every error including the clock: pseudorange = geometric range.
+        """
+        e = self.draw(truth.t_s, rng)
+        c = None if clock_rng is None else self.draw_clock(truth.t_s, clock_rng)
+        if not noise:
+            e = e.zeroed()
+            c = None if c is None else c.zeroed()
+        return self.apply(truth, e, c)

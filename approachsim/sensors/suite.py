@@ -1,0 +1,177 @@
+"""The sensor suite of a profile: builds each sensor from [sensors], wraps it with its [[faults]], and draws
+each sensor's errors from its own named random stream (approachsim.seeding.stream(seed, run, name)).
+
+Streams: "imu", "baro", "radalt", "gnss", "pseudolite", and "receiver_clock" for the GPS receiver clock
+that the GNSS and pseudolite channels share. A sensor's output depends only on its own stream(s), the
+truth and its configuration, so adding or removing a sensor leaves every other sensor's output
+bit-identical (tests/unit/sensors/test_suite.py).
+
+    suite = SensorSuite.from_profile(profile)
+    records = suite.measure(truth, seed=1, runs=range(100))         # {name: record}, run axis first
+    errors = suite.draw(t_longest, seed=1, runs=[7])                # closed loop: draw once ...
+    recs_k = suite.apply(truth, suite.take(errors, "baro", sl))     # ... apply sample by sample
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, replace
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from approachsim.seeding import stream
+from approachsim.sensors import base
+from approachsim.sensors.baro import Baro
+from approachsim.sensors.config import SENSOR_NAMES, SensorsConfig
+from approachsim.sensors.faults import Faulted, FaultSpec
+from approachsim.sensors.gnss.clock import ClockModel
+from approachsim.sensors.gnss.constellation import Constellation
+from approachsim.sensors.gnss.receiver import CODE_PRESETS, GnssReceiver, draw_receiver_clock
+from approachsim.sensors.imu import Imu
+from approachsim.sensors.presets import PRESETS
+from approachsim.sensors.pseudolite import Pseudolite
+from approachsim.sensors.radalt import RadarAltimeter
+
+Array = np.ndarray
+CLOCK_STREAM = "receiver_clock"
+"""Random stream of the GPS receiver clock shared by the GNSS and pseudolite channels."""
+
+
+def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = ()) -> dict[str, Any]:
+    """Sensor objects by name from a SensorsConfig (runway frame for pseudolites, QNH setting in Pa)."""
+    grade = replace(PRESETS[cfg.imu.grade], gyro_quant_rad=cfg.imu.gyro_quant_rad,
+                    accel_quant_mps=cfg.imu.accel_quant_mps)
+    out: dict[str, Any] = {"imu": Imu(grade)}
+    if cfg.baro is not None:
+        b = cfg.baro
+        out["baro"] = Baro(setting_pa=qnh_pa, rate_hz=b.rate_hz, bias_sigma_m=b.bias_sigma_m,
+                           bias_tau_s=b.bias_tau_s, scale_factor_sigma=b.scale_factor_sigma,
+                           noise_sigma_m=b.noise_sigma_m)
+    if cfg.radalt is not None:
+        r = cfg.radalt
+        out["radalt"] = RadarAltimeter(rate_hz=r.rate_hz, max_range_m=r.max_range_m, percent_sigma=r.percent_sigma,
+                                       floor_m=r.floor_m, markov_sigma_m=r.markov_sigma_m,
+                                       markov_tau_s=r.markov_tau_s)
+    gnss_rate = 1.0
+    if cfg.gnss is not None:
+        g = cfg.gnss
+        gnss_rate = g.rate_hz
+        out["gnss"] = GnssReceiver(
+            constellation=Constellation.nominal(g.epoch_utc), budget=CODE_PRESETS[g.code],
+            clock=ClockModel.named(g.oscillator, g.clock_bias0_sigma_m, g.clock_drift0_sigma_mps),
+            mask_rad=g.mask_rad, selection=g.selection, rate_hz=g.rate_hz,
+        )
+    if cfg.pseudolite is not None:
+        p = cfg.pseudolite
+        out["pseudolite"] = Pseudolite(
+            runway=runway, positions_rwy=p.positions_rwy, synchronized=p.synchronized, code_noise_m=p.code_noise_m,
+            multipath_m=p.multipath_m, multipath_tau_s=p.multipath_tau_s, survey_sigma_m=p.survey_sigma_m,
+            tropo_ppm_sigma=p.tropo_ppm_sigma, max_range_m=p.max_range_m, rate_hz=gnss_rate,
+        )
+    faults = tuple(faults)
+    for name in list(out):
+        mine = tuple(f for f in faults if f.sensor == name)
+        if mine:
+            out[name] = Faulted(out[name], mine)
+    return out
+
+
+@dataclass(frozen=True)
+class SuiteErrors:
+    """Drawn errors of a suite: per sensor name, plus the receiver clock (None without GNSS/pseudolite)."""
+
+    sensors: Mapping[str, base.SensorErrors]
+    clock: base.SensorErrors | None
+
+
+@dataclass(frozen=True)
+class SensorSuite:
+    """Named sensors (possibly fault-wrapped) and the receiver clock model of the ranging channels."""
+
+    sensors: Mapping[str, Any]
+    clock: ClockModel | None
+    clock_rate_hz: float
+
+    @classmethod
+    def from_config(
+        cls, cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = ()
+    ) -> SensorSuite:
+        """Build from a SensorsConfig."""
+        sensors = build_sensors(cfg, runway, qnh_pa, faults)
+        clock = None
+        rate = 1.0
+        if cfg.gnss is not None:
+            clock = ClockModel.named(cfg.gnss.oscillator, cfg.gnss.clock_bias0_sigma_m, cfg.gnss.clock_drift0_sigma_mps)
+            rate = cfg.gnss.rate_hz
+        elif cfg.pseudolite is not None:
+            clock = ClockModel()
+        return cls(sensors=MappingProxyType(dict(sensors)), clock=clock, clock_rate_hz=rate)
+
+    @classmethod
+    def from_profile(cls, profile: Any) -> SensorSuite:
+        """The suite of a Profile (its sensors, faults, runway and QNH setting)."""
+        return cls.from_config(profile.sensors, profile.runway.frame, profile.environment.qnh_pa, profile.faults)
+
+    def without(self, *names: str) -> SensorSuite:
+        """The same suite with sensors removed (the clock stays while a ranging sensor remains)."""
+        keep = {k: v for k, v in self.sensors.items() if k not in names}
+        has_ranging = "gnss" in keep or "pseudolite" in keep
+        return SensorSuite(MappingProxyType(keep), self.clock if has_ranging else None, self.clock_rate_hz)
+
+    @staticmethod
+    def _rng(seed: int, runs: int | Iterable[int], name: str) -> base.RngLike:
+        if isinstance(runs, int | np.integer):
+            return stream(seed, int(runs), name)
+        return [stream(seed, int(r), name) for r in runs]
+
+    def draw(self, t_s: Array, seed: int, runs: int | Iterable[int]) -> SuiteErrors:
+        """Every sensor's errors on time base t_s from its own stream; runs: one run index or several."""
+        runs = runs if isinstance(runs, int | np.integer) else list(runs)
+        errs = {name: s.draw(t_s, self._rng(seed, runs, name)) for name, s in self.sensors.items()}
+        clock = None
+        if self.clock is not None:
+            clock = draw_receiver_clock(self.clock, t_s, self.clock_rate_hz, self._rng(seed, runs, CLOCK_STREAM))
+        return SuiteErrors(MappingProxyType(errs), clock)
+
+    def apply(self, truth: Any, errors: SuiteErrors, names: Iterable[str] | None = None) -> dict[str, Any]:
+        """Records by sensor name (only `names` when given) from truth and drawn errors."""
+        out = {}
+        for name in names if names is not None else self.sensors:
+            s = self.sensors[name]
+            e = errors.sensors[name]
+            if name in ("gnss", "pseudolite"):
+                clk = None if errors.clock is None else errors.clock.take(_clock_rows(errors.clock, e))
+                out[name] = s.apply(truth, e, clock=clk)
+            else:
+                out[name] = s.apply(truth, e)
+        return out
+
+    def measure(
+        self, truth: Any, seed: int, runs: int | Iterable[int], *, noise: bool = True
+    ) -> dict[str, Any]:
+        """apply(truth, draw(truth.t_s, seed, runs)); noise=False gives every sensor's exact value."""
+        e = self.draw(truth.t_s, seed, runs)
+        if not noise:
+            e = SuiteErrors(
+                MappingProxyType({k: v.zeroed() for k, v in e.sensors.items()}),
+                None if e.clock is None else e.clock.zeroed(),
+            )
+        return self.apply(truth, e)
+
+    @staticmethod
+    def take(errors: SuiteErrors, name: str, sl: slice | Array) -> SuiteErrors:
+        """The suite errors restricted to samples `sl` of sensor `name` (for sample-by-sample closed loops)."""
+        return SuiteErrors(MappingProxyType({name: errors.sensors[name].take(sl)}), errors.clock)
+
+
+def _clock_rows(clock: base.SensorErrors, e: base.SensorErrors) -> Array:
+    """Positions in the clock's samples of the sensor samples in `e` (same receiver grid)."""
+    pos = np.searchsorted(clock.rows, e.rows)
+    if np.any(pos >= clock.rows.shape[0]) or not np.array_equal(clock.rows[np.minimum(pos, len(clock) - 1)], e.rows):
+        raise ValueError("GNSS / pseudolite samples must lie on the receiver clock's sample grid")
+    return pos
+
+
+__all__ = ["CLOCK_STREAM", "SENSOR_NAMES", "SensorSuite", "SuiteErrors", "build_sensors"]
