@@ -63,10 +63,9 @@ def check_options(args: argparse.Namespace, profile) -> tuple[int, int, str, Pat
 
 def run(args: argparse.Namespace) -> int:
     """Run the campaign, write the outputs, print the verdict table."""
-    from approachsim.campaign.outputs import evaluate_results, verdict_table, write_json
+    from approachsim.campaign.evaluation import evaluate_profile
+    from approachsim.campaign.outputs import verdict_table
     from approachsim.campaign.pipeline import PipelineUnavailable, spec_for
-    from approachsim.campaign.runner import run_campaign
-    from approachsim.campaign.store import profile_digest
     from approachsim.profile import load_profile
 
     profile = load_profile(args.profile)
@@ -76,22 +75,18 @@ def run(args: argparse.Namespace) -> int:
     except PipelineUnavailable as e:
         sys.stderr.write(f"approachsim evaluate: {e}\n")
         return 1
-    meta = {"profile": profile.name, "profile_digest": profile_digest(profile), "seed": seed, "mode": mode}
-    res = run_campaign(
-        profile, seed=seed, runs=runs, group_fn=spec.group_fn, group_size=spec.group_size, out_dir=out,
-        meta=meta, resume=args.resume, workers=args.workers or os.cpu_count(), scheduler=args.scheduler,
+    ev = evaluate_profile(
+        profile, runs=runs, seed=seed, mode=mode, out_dir=out, workers=args.workers or os.cpu_count(),
+        scheduler=args.scheduler, resume=args.resume, spec=spec,
     )
-    summary, det = evaluate_results(res.results, profile.evaluation, profile=profile.name, seed=seed,
-                                    closed_loop=spec.closed_loop)
-    write_json(out / "summary.json", summary)
-    write_json(out / "details.json", det)
+    summary, det = ev.summary, ev.details
+    failed = [r for r in ev.results if not r.ok]
     if not args.no_report:
         from approachsim.report.evaluate import write_report
 
-        write_report(out, res.results, summary, det)
+        write_report(out, ev.results, summary, det)
     print(verdict_table(summary, det))
-    if res.failed:
-        first = res.failed[0]
-        print(f"{len(res.failed)} run(s) failed; first: run {first.run}: {first.error}")
+    if failed:
+        print(f"{len(failed)} run(s) failed; first: run {failed[0].run}: {failed[0].error}")
     print(f"wrote {out / 'summary.json'}" + ("" if args.no_report else f", {out / 'report.html'}"))
     return 0
