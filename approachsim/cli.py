@@ -17,6 +17,7 @@ COMMAND_MODULES = (
     "approachsim.commands.fly",
     "approachsim.commands.reproduce",
     "approachsim.commands.evaluate",
+    "approachsim.commands.study",
 )
 """Modules that each add sub-commands; a new command adds its line here."""
 

@@ -240,3 +240,26 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
     path = out_dir / "report.html"
     path.write_text("\n".join(parts), encoding="utf-8")
     return path
+
+
+def write_study_figure(out_dir: Path, rows: list[dict]) -> Path:
+    """DIR/study.png: lateral and vertical 1-sigma error at each decision height per variant, with limits."""
+    fig = Figure(figsize=(max(8.0, 1.2 * len(rows) + 4.0), 7), constrained_layout=True)
+    axes = fig.subplots(2, 1, sharex=True)
+    x = np.arange(len(rows))
+    w = 0.8 / len(CATEGORIES)
+    for ax, comp, lim_key in ((axes[0], "lateral", "lateral_1sigma_ft"), (axes[1], "vertical", "vertical_1sigma_ft")):
+        for j, cat in enumerate(CATEGORIES):
+            tag = cat.replace(" ", "")
+            vals = np.array([np.nan if r[f"{tag}_{comp}_1sigma_ft"] is None else r[f"{tag}_{comp}_1sigma_ft"]
+                             for r in rows])
+            ax.bar(x + (j - 1) * w, vals, w, color=COLORS[cat], label=f"{cat} (limit dashed)")
+            ax.axhline(getattr(LIMITS[cat], lim_key), color=COLORS[cat], ls="--", lw=1)
+        ax.set_yscale("log")
+        ax.set_ylabel(f"{comp} 1-sigma at DH, ft")
+        ax.grid(True, axis="y", alpha=0.3)
+    axes[0].legend(fontsize=8)
+    axes[1].set_xticks(x, [r["variant"] for r in rows], rotation=30, ha="right", fontsize=8)
+    path = Path(out_dir) / "study.png"
+    fig.savefig(path, dpi=110)
+    return path

@@ -1,0 +1,53 @@
+"""`approachsim study FILE --out DIR [--workers K] [--scheduler ADDR] [--resume]`: a trade study.
+
+Evaluates every variant of the study file (campaign/study.py documents the format) into DIR/<variant>/
+(summary.json, details.json, run tables), then writes DIR/study.json, DIR/study.csv and DIR/study.png and
+prints the comparison table. Bad study fields or options exit 2 with one line, before anything runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from approachsim.config import ProfileError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the `study` sub-command."""
+    p = sub.add_parser("study", help="trade study: evaluate every variant of a study file and compare")
+    p.add_argument("study", type=Path, help="study file (TOML)")
+    p.add_argument("--out", required=True, type=Path, help="output directory")
+    p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
+    p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler (tcp://host:port)")
+    p.add_argument("--resume", action="store_true", help="continue an interrupted study, keeping finished runs")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Validate, run every variant, write and print the comparison."""
+    from approachsim.campaign.pipeline import PipelineUnavailable, require_stages
+    from approachsim.campaign.study import comparison_table, load_study, run_study
+    from approachsim.commands.evaluate import _ADDRESS, MAX_WORKERS
+
+    study = load_study(args.study)
+    if args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
+        raise ProfileError(f"--workers: must be in [1, {MAX_WORKERS}], got {args.workers}")
+    if args.scheduler is not None and not _ADDRESS.match(args.scheduler):
+        raise ProfileError(f"--scheduler: must be an address like tcp://host:8786, got {args.scheduler!r}")
+    if args.out.exists() and not args.out.is_dir():
+        raise ProfileError(f"--out: {str(args.out)!r} exists and is not a directory")
+    try:
+        require_stages()
+    except PipelineUnavailable as e:
+        sys.stderr.write(f"approachsim study: {e}\n")
+        return 1
+    rows = run_study(study, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume)
+    from approachsim.report.evaluate import write_study_figure
+
+    write_study_figure(args.out, rows)
+    print(f"study {study.name}: {len(rows)} variants x {study.runs} runs, seed {study.seed}, {study.mode} loop")
+    print(comparison_table(rows))
+    print(f"wrote {args.out / 'study.csv'}, {args.out / 'study.json'}, {args.out / 'study.png'}")
+    return 0
