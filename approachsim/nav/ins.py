@@ -284,3 +284,31 @@ def attitude_error(c_ins: Array, c_true: Array) -> Array:
     d = np.asarray(c_ins) @ np.swapaxes(np.asarray(c_true), -1, -2)  # = I - [psi x]
     return 0.5 * np.stack([d[..., 1, 2] - d[..., 2, 1], d[..., 2, 0] - d[..., 0, 2], d[..., 0, 1] - d[..., 1, 0]],
                           axis=-1)
+
+
+def align_stationary(dtheta_body: Array, dv_body: Array, lat_rad: Array) -> Array:
+    """Analytic stationary alignment (leveling + gyrocompassing, TRIAD) from increments over the alignment.
+
+    dtheta_body, dv_body: (N, m, 3) increments of a motionless IMU (rad, m/s); lat_rad (N,) known latitude.
+    The mean specific force is -g (up) and the mean rate is the Earth rate, both in body axes; the
+    body-to-NED matrix follows from the NED triad of (g, w_ie, g x w_ie) (Groves eq. 5.101-5.103, Titterton
+    sec. 10.2). Accelerometer biases tilt the result and the east gyro bias turns its heading, which is
+    what makes a real INS drift the way its grade says. Returns (N, 3, 3).
+    """
+    f_b = -np.mean(np.asarray(dv_body, dtype=float), axis=-2)  # points down (gravity direction), body axes
+    w_b = np.mean(np.asarray(dtheta_body, dtype=float), axis=-2)
+    lat = np.asarray(lat_rad, dtype=float)
+    n = np.broadcast_to(lat, f_b.shape[:-1])
+    down_n = np.zeros(n.shape + (3,))
+    down_n[..., 2] = 1.0
+    w_n = earth_rate_ned(n)
+
+    def triad(a: Array, b: Array) -> Array:
+        t1 = a / np.linalg.norm(a, axis=-1, keepdims=True)
+        t2 = cross(a, b)
+        t2 = t2 / np.linalg.norm(t2, axis=-1, keepdims=True)
+        return np.stack([t1, t2, cross(t1, t2)], axis=-1)  # columns t1, t2, t3
+
+    m_b = triad(f_b, w_b)
+    m_n = triad(down_n, w_n)
+    return m_n @ np.swapaxes(m_b, -1, -2)  # C_bn maps body triad onto NED triad

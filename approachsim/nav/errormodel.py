@@ -1,0 +1,231 @@
+"""INS error-state model: the continuous dynamics F, the noise G Q G' and their discretization (Van Loan).
+
+Error convention: error = INS - truth (the feed-forward output is INS - estimated error, seed 002 sec. 5).
+States (a `StateLayout` says which are present and where):
+
+    dp   (3)  position error, local NED axes at the true position, m
+    dv   (3)  velocity error, NED, m/s
+    psi  (3)  attitude error, NED: C_ins = (I - [psi x]) C_true, rad
+    bg   (3)  gyro bias, body axes, rad/s         (random constant + random walk)
+    ba   (3)  accelerometer bias, body, m/s^2    (random constant + random walk)
+    bb   (1)  baro bias, m                        (first-order Gauss-Markov, seed 001 eq. 2, seed 003 eq. 1)
+    sb   (1)  baro scale factor                   (random constant, seed 003 eq. 1)
+    clk  (2)  GPS receiver clock bias (m) and drift (m/s)   (seed 002 two-state clock, sec. 6)
+    ac   (1)  baro damping-loop compensator, m/s^2 (only when the INS runs the 3rd-order loop, seed 003 eq. 3)
+
+Dynamics (Titterton & Weston eq. 12.8, 12.12; Groves eq. 14.64-14.66 with the position error in metres):
+
+    dp'  = dv + (velocity-dependent frame terms)
+    dv'  = [f_n x] psi + C_bn ba - (2 w_ie + w_en) x dv + v x (2 dw_ie + dw_en) + (2 g / R) dp_D e_D
+    psi' = -w_in x psi + dw_ie + dw_en - C_bn bg
+    bg' = w_bg, ba' = w_ba ; bb' = -bb / tau_b + w_b ; sb' = 0 ; clk' = [[0, 1], [0, 0]] clk + w_clk
+
+With the baro loop (seed 003 eq. 3, linearized gains C1, C2, C3, loop error e = dh - bb - S h - v_b):
+    dh' += -C1 e ; dv_up' += -C2 e - ac ; ac' = C3 e    (dh = -dp_D, dv_up = -dv_D)
+and the baro white noise v_b enters the process noise through the gains.
+
+Discretization over the aiding interval: Phi = expm(F dt) and Qd from Van Loan's method (scipy.linalg.expm).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg import expm
+
+from approachsim import geo
+from approachsim.nav import ins
+from approachsim.nav import vertical_loop as vl
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class StateLayout:
+    """Which error states are present and their index ranges; `n` states in all."""
+
+    baro_scale: bool = True
+    clock: bool = True
+    loop: bool = False
+    index: dict[str, slice] = field(init=False, compare=False)
+    n: int = field(init=False, compare=False)
+
+    def __post_init__(self) -> None:
+        sizes = [("dp", 3), ("dv", 3), ("psi", 3), ("bg", 3), ("ba", 3), ("bb", 1)]
+        if self.baro_scale:
+            sizes.append(("sb", 1))
+        if self.clock:
+            sizes.append(("clk", 2))
+        if self.loop:
+            sizes.append(("ac", 1))
+        index, i = {}, 0
+        for name, k in sizes:
+            index[name] = slice(i, i + k)
+            i += k
+        object.__setattr__(self, "index", index)
+        object.__setattr__(self, "n", i)
+
+    def has(self, name: str) -> bool:
+        """True when the layout holds state group `name`."""
+        return name in self.index
+
+    def i(self, name: str, k: int = 0) -> int:
+        """Index of element k of state group `name`."""
+        return self.index[name].start + k
+
+    @property
+    def groups(self) -> tuple[str, ...]:
+        """State group names in order."""
+        return tuple(self.index)
+
+
+@dataclass(frozen=True)
+class ErrorNoise:
+    """Process-noise strengths and correlation times of the error model (continuous-time, SI).
+
+    gyro_arw_rad_sqrts: angle random walk (rad/sqrt(s)); accel_vrw_mps_sqrts: velocity random walk;
+    gyro_bias_rw: gyro bias random-walk density (rad/s/sqrt(s)); accel_bias_rw (m/s^2/sqrt(s));
+    baro_bias_sigma_m, baro_bias_tau_s: baro bias Gauss-Markov; baro_noise_sigma_m and baro_rate_hz: the
+    baro white noise (enters the process only through the damping loop); clock_sf, clock_sg: clock
+    bias / drift noise densities (m^2/s, m^2/s^3: c^2 h0/2 and c^2 2 pi^2 h_-2, sensors/gnss/clock.py).
+    """
+
+    gyro_arw_rad_sqrts: float
+    accel_vrw_mps_sqrts: float
+    gyro_bias_rw: float
+    accel_bias_rw: float
+    baro_bias_sigma_m: float
+    baro_bias_tau_s: float
+    baro_noise_sigma_m: float = 1.0
+    baro_rate_hz: float = 10.0
+    clock_sf: float = 0.0
+    clock_sg: float = 0.0
+
+
+def _dw_in(lat: float, h: float, v: Array, r_n: float, r_e: float) -> tuple[Array, Array, Array]:
+    """Jacobians of w_ie + w_en (NED) with respect to dp (3), dv (3): (3, 3) each; and w_ie (3,)."""
+    tl, cl, sl = np.tan(lat), np.cos(lat), np.sin(lat)
+    rn, re = r_n + h, r_e + h
+    vn, ve = v[0], v[1]
+    om = geo.OMEGA_E
+    d_dp = np.zeros((3, 3))
+    d_dv = np.zeros((3, 3))
+    # Earth rate through latitude: dL = dp_N / (R_N + h)
+    d_dp[0, 0] += -om * sl / rn
+    d_dp[2, 0] += -om * cl / rn
+    # transport rate (Groves eq. 5.44), dh = -dp_D
+    d_dv[0, 1] = 1.0 / re
+    d_dp[0, 2] += ve / re**2
+    d_dv[1, 0] = -1.0 / rn
+    d_dp[1, 2] += -vn / rn**2
+    d_dv[2, 1] = -tl / re
+    d_dp[2, 0] += -ve / (re * cl**2 * rn)
+    d_dp[2, 2] += -ve * tl / re**2
+    return d_dp, d_dv, np.array([om * cl, 0.0, -om * sl])
+
+
+def dynamics(
+    layout: StateLayout,
+    lat_rad: float,
+    h_m: float,
+    v_ned: Array,
+    f_ned: Array,
+    c_bn: Array,
+    noise: ErrorNoise,
+    loop: vl.LoopGains | None = None,
+) -> tuple[Array, Array]:
+    """Continuous error dynamics F (n, n) and process-noise spectral density G Q G' (n, n) about a nav state.
+
+    lat_rad, h_m, v_ned (3,), f_ned (3,) specific force in NED (m/s^2), c_bn (3, 3): the INS solution
+    (the best available linearization point). The module docstring gives the equations.
+    """
+    n = layout.n
+    F = np.zeros((n, n))
+    Qc = np.zeros((n, n))
+    ix = layout.index
+    P, V, A = ix["dp"], ix["dv"], ix["psi"]
+    v = np.asarray(v_ned, dtype=float)
+    r_n, r_e = (float(x) for x in geo.radii(lat_rad))
+    rn, re = r_n + h_m, r_e + h_m
+    tl = np.tan(lat_rad)
+    vn, ve, vd = v
+    # position error (metres) kinematics, from lat' = vN/(R_N+h), lon' = vE/((R_E+h) cos L), h' = -vD
+    F[P, V] = np.eye(3)
+    fp = np.array(
+        [
+            [-vd / rn, 0.0, vn / rn],
+            [ve * tl / rn, -vd / re - tl * vn / rn, ve / re],
+            [0.0, 0.0, 0.0],
+        ]
+    )
+    F[P, P] = fp
+    d_dp, d_dv, w_ie = _dw_in(lat_rad, h_m, v, r_n, r_e)
+    w_en = np.array([ve / re, -vn / rn, -ve * tl / re])
+    w_in = w_ie + w_en
+    # velocity error: [f x] psi + C ba - (2 w_ie + w_en) x dv + v x (2 dw_ie + dw_en) + dg
+    d_ie_dp = np.zeros((3, 3))
+    d_ie_dp[0, 0] = -geo.OMEGA_E * np.sin(lat_rad) / rn
+    d_ie_dp[2, 0] = -geo.OMEGA_E * np.cos(lat_rad) / rn
+    d_en_dp = d_dp - d_ie_dp
+    vx = ins.skew(v)
+    F[V, A] = ins.skew(np.asarray(f_ned, dtype=float))
+    F[V, V] = -ins.skew(2.0 * w_ie + w_en) + vx @ d_dv
+    F[V, P] = vx @ (2.0 * d_ie_dp + d_en_dp)
+    dg_dh = float((geo.normal_gravity(lat_rad, h_m + 10.0) - geo.normal_gravity(lat_rad, h_m - 10.0)) / 20.0)
+    F[V.start + 2, P.start + 2] += -dg_dh  # dg_D = (dg/dh) dh = -(dg/dh) dp_D  (about +2 g / R)
+    F[V, ix["ba"]] = c_bn
+    # attitude error: -w_in x psi + dw_in - C bg
+    F[A, A] = -ins.skew(w_in)
+    F[A, P] = d_dp
+    F[A, V] = d_dv
+    F[A, ix["bg"]] = -c_bn
+    # sensor error states
+    i_bb = layout.i("bb")
+    F[i_bb, i_bb] = -1.0 / noise.baro_bias_tau_s
+    Qc[i_bb, i_bb] = 2.0 * noise.baro_bias_sigma_m**2 / noise.baro_bias_tau_s
+    Qc[V, V] = noise.accel_vrw_mps_sqrts**2 * np.eye(3)
+    Qc[A, A] = noise.gyro_arw_rad_sqrts**2 * np.eye(3)
+    Qc[ix["bg"], ix["bg"]] = noise.gyro_bias_rw**2 * np.eye(3)
+    Qc[ix["ba"], ix["ba"]] = noise.accel_bias_rw**2 * np.eye(3)
+    if layout.has("clk"):
+        ic = layout.i("clk")
+        F[ic, ic + 1] = 1.0
+        Qc[ic, ic] = noise.clock_sf
+        Qc[ic + 1, ic + 1] = noise.clock_sg
+    if layout.has("ac"):
+        if loop is None:
+            raise ValueError("layout has the loop state 'ac' but no loop gains were given")
+        lin = loop.linearized()
+        ia = layout.i("ac")
+        i_h, i_v = P.start + 2, V.start + 2  # dp_D = -dh, dv_D = -dv_up
+        # loop error e = dh - bb - S h - v_b, written in dp_D: e = -dp_D - bb - h sb - v_b
+        e_row = np.zeros(n)
+        e_row[i_h] = -1.0
+        e_row[i_bb] = -1.0
+        if layout.has("sb"):
+            e_row[layout.i("sb")] = -h_m
+        F[i_h, :] += lin.c1 * e_row  # dp_D' = -dh' gets +C1 e
+        F[i_v, :] += lin.c2 * e_row  # dv_D' = -dv_up' gets +C2 e + ac
+        F[i_v, ia] += 1.0
+        F[ia, :] += lin.c3 * e_row  # ac' = C3 e
+        g = np.zeros(n)  # the baro white noise through the gains
+        g[i_h], g[i_v], g[ia] = -lin.c1, -lin.c2, -lin.c3
+        Qc += np.outer(g, g) * noise.baro_noise_sigma_m**2 / noise.baro_rate_hz
+    return F, Qc
+
+
+def van_loan(F: Array, Qc: Array, dt_s: float) -> tuple[Array, Array]:
+    """Discrete Phi = expm(F dt) and Qd = int_0^dt Phi(s) Qc Phi(s)' ds by Van Loan's method (1978).
+
+    M = [[-F, Qc], [0, F']] dt ; expm(M) = [[., Phi^-1 Qd], [0, Phi']] ; Qd = Phi (Phi^-1 Qd).
+    """
+    n = F.shape[0]
+    M = np.zeros((2 * n, 2 * n))
+    M[:n, :n] = -F * dt_s
+    M[:n, n:] = Qc * dt_s
+    M[n:, n:] = F.T * dt_s
+    E = expm(M)
+    phi = E[n:, n:].T
+    qd = phi @ E[:n, n:]
+    return phi, 0.5 * (qd + qd.T)
