@@ -18,6 +18,7 @@ COMMAND_MODULES = (
     "approachsim.commands.reproduce",
     "approachsim.commands.evaluate",
     "approachsim.commands.study",
+    "approachsim.commands.regress",
 )
 """Modules that each add sub-commands; a new command adds its line here."""
 

@@ -43,7 +43,7 @@ def require_stages() -> None:
             m = importlib.import_module(mod)
         except ImportError as e:
             raise PipelineUnavailable(
-                f"the {what} stage ({mod}) is not available: {e}; approachsim evaluate cannot score without it"
+                f"the {what} stage ({mod}) is not available: {e}; cannot evaluate without it"
             ) from None
         if attr is not None and not hasattr(m, attr):
             raise PipelineUnavailable(f"the {what} stage ({mod}) has no {attr}; cannot run the pipeline")
