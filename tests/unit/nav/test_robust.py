@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from approachsim.config import ProfileError
@@ -152,3 +154,17 @@ def test_registry_builds_and_checks_tuning(name: str) -> None:
         make_filter(name, bound=-2)
     with pytest.raises(ProfileError, match=r"nav\.filter_tuning\.gate"):
         make_filter(name, gate=3.0)
+
+
+@settings(derandomize=True, max_examples=60, deadline=None)
+@given(beta=st.floats(-30.0, 30.0), seed=st.integers(0, 10_000), bound=st.floats(0.5, 6.0))
+def test_robust_updates_keep_p_symmetric_psd_and_never_above_the_prediction(beta: float, seed: int, bound: float):
+    """For any innovation, P+ is symmetric positive semi-definite and P- - P+ is PSD (no covariance growth)."""
+    x, P = _random_state(seed)
+    r = 4.0
+    meas = ScalarMeasurement(_innovation_for(beta, x, P, r), H_ROW, r, "z")
+    for f in (gate_filter(bound), adaptive_filter(bound)):
+        new, _ = f.update(f.init(x, P), meas)
+        np.testing.assert_allclose(new.P, new.P.T, rtol=0, atol=1e-12)
+        assert np.linalg.eigvalsh(new.P).min() > -1e-9
+        assert np.linalg.eigvalsh(P - new.P).min() > -1e-9
