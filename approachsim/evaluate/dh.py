@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from approachsim.geo import c_ecef_to_ned
 from approachsim.records import NavSolution, Truth
 
 Array = np.ndarray
@@ -45,13 +44,21 @@ def runway_errors(truth: Truth, nav: NavSolution) -> RunwayErrors:
     if not np.allclose(nav.t_s[:n], truth.t_s[:n], rtol=0.0, atol=1e-6):
         raise ValueError("navigation solution and truth are not on the same time base")
     dr = nav.r_ecef[:n] - truth.r_ecef[:n]
-    c_ned = c_ecef_to_ned(truth.lat_rad[:n], truth.lon_rad[:n])
-    e_ned = np.einsum("nij,nj->ni", c_ned, dr)
+    e_ned = ecef_to_ned_vectors(dr, truth.lat_rad[:n], truth.lon_rad[:n])
     e_rwy = dr @ truth.runway.c_ecef_to_rwy.T
     hat = truth.runway.height_above_threshold(truth.h_m[:n])
     return RunwayErrors(
         t_s=truth.t_s[:n], hat_m=hat, along_m=e_rwy[:, 0], lateral_m=e_rwy[:, 1], vertical_m=-e_ned[:, 2], e_ned=e_ned
     )
+
+
+def ecef_to_ned_vectors(d_ecef: Array, lat_rad: Array, lon_rad: Array) -> Array:
+    """Rotate ECEF vectors (n, 3) into the local NED axes at (lat, lon) per row (geo.c_ecef_to_ned, unrolled)."""
+    sl, cl = np.sin(lat_rad), np.cos(lat_rad)
+    so, co = np.sin(lon_rad), np.cos(lon_rad)
+    x, y, z = d_ecef[:, 0], d_ecef[:, 1], d_ecef[:, 2]
+    t = co * x + so * y
+    return np.stack([-sl * t + cl * z, -so * x + co * y, -cl * t - sl * z], axis=-1)
 
 
 def dh_crossing(hat_m: Array, dh_m: float) -> tuple[int, float] | None:

@@ -85,7 +85,7 @@ def score_run(
                 scalars[f"{key}_{axis}_{region}"] = float(count)
         avail = availability(integ.vpl_m[win], integ.hpl_m[win], lim.vertical_al_m, lim.horizontal_al_m)
         scalars[f"{key}_availability"] = float(np.mean(avail))
-    for state, ms in mean_square_ft2(state_errors_m(truth, nav, clock_bias_true_m)).items():
+    for state, ms in mean_square_ft2(state_errors_m(truth, nav, clock_bias_true_m, e_ned=err.e_ned)).items():
         scalars[f"ta_{state}_ft2"] = ms
     grid_m = HEIGHT_GRID_FT * units.FT
     arrays = {

@@ -3,7 +3,8 @@
 Gray & Maybeck (1995) Tables 3-6 give "time-averaged rms errors" in feet per error state. Each run
 contributes the time average of its squared error over the approach; the campaign figure is the square
 root of the mean over runs of those averages (RMS over time and runs). Latitude and longitude errors are
-expressed as distances at the aircraft ((R_N + h) dlat, (R_E + h) cos(lat) dlon).
+expressed as distances at the aircraft ((R_N + h) dlat, (R_E + h) cos(lat) dlon), i.e. the north and east
+components of the position error.
 """
 
 from __future__ import annotations
@@ -11,28 +12,26 @@ from __future__ import annotations
 import numpy as np
 
 from approachsim import units
-from approachsim.geo import ecef_to_geodetic, radii
+from approachsim.evaluate.dh import ecef_to_ned_vectors
 from approachsim.records import NavSolution, Truth
 
 STATES = ("latitude", "longitude", "altitude", "clock_bias")
 
 
 def state_errors_m(
-    truth: Truth, nav: NavSolution, clock_bias_true_m: np.ndarray | None = None
+    truth: Truth, nav: NavSolution, clock_bias_true_m: np.ndarray | None = None, e_ned: np.ndarray | None = None
 ) -> dict[str, np.ndarray]:
     """Per-epoch errors (estimate - truth), m: latitude and longitude as distances, altitude, clock bias.
 
-    clock_bias_true_m: the receiver's true clock bias (from the GNSS sensor), or None (clock error nan).
+    The position error is rotated into local NED at the true position (north = latitude error as a distance,
+    east = longitude error, up = altitude error; exact to |error|^2 / R, under a micrometre); e_ned may be
+    passed when already computed. clock_bias_true_m: the receiver's true clock bias (from the GNSS sensor)
+    on the truth's time base, or None (clock error nan).
     """
     n = min(len(truth), nav.t_s.shape[0])
-    lat, lon, h = ecef_to_geodetic(nav.r_ecef[:n])
-    r_n, r_e = radii(truth.lat_rad[:n])
-    dlon = (lon - truth.lon_rad[:n] + np.pi) % (2.0 * np.pi) - np.pi
-    out = {
-        "latitude": (lat - truth.lat_rad[:n]) * (r_n + truth.h_m[:n]),
-        "longitude": dlon * (r_e + truth.h_m[:n]) * np.cos(truth.lat_rad[:n]),
-        "altitude": h - truth.h_m[:n],
-    }
+    if e_ned is None:
+        e_ned = ecef_to_ned_vectors(nav.r_ecef[:n] - truth.r_ecef[:n], truth.lat_rad[:n], truth.lon_rad[:n])
+    out = {"latitude": e_ned[:n, 0], "longitude": e_ned[:n, 1], "altitude": -e_ned[:n, 2]}
     if clock_bias_true_m is None:
         out["clock_bias"] = np.full(n, np.nan)
     else:
