@@ -1,0 +1,69 @@
+"""Autopilot geometry and signs: deviations from the ideal glidepath and centreline, and the direction of
+each loop's response, checked without JSBSim."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from approachsim import units
+from approachsim.flight.aircraft import load_aircraft
+from approachsim.flight.autopilot import Autopilot, Geometry, Trim
+from approachsim.profile import load_profile
+
+GP = math.radians(3.0)
+TCH = 50.0 * units.FT
+
+
+@pytest.fixture()
+def ap():
+    ac = load_aircraft(load_profile("profiles/default.toml"))
+    geom = Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0)
+    return Autopilot(ac.gains, Trim(theta_rad=0.02, throttle=0.47, cas_mps=72.0), geom, 1.0 / 120.0)
+
+
+def _on_path(x):
+    return TCH - x * math.tan(GP)
+
+
+def test_on_the_glidepath_flying_down_it_has_zero_deviation(ap):
+    x = -5000.0
+    v = 70.0
+    d, d_dot, y, y_dot = ap.deviations(x, 0.0, _on_path(x), v, 0.0, v * math.tan(GP))
+    assert d == pytest.approx(0.0, abs=1e-9)
+    assert d_dot == pytest.approx(0.0, abs=1e-9)
+    assert y == 0.0 and y_dot == pytest.approx(0.0, abs=1e-12)
+
+
+def test_deviation_signs(ap):
+    x = -3000.0
+    d, _, y, y_dot = ap.deviations(x, 12.0, _on_path(x) + 7.0, 70.0, 1.5, 3.67)
+    assert d == pytest.approx(7.0)
+    assert y == 12.0
+    assert y_dot == pytest.approx(1.5)  # heading north: east velocity drifts right
+
+
+def test_above_the_path_pitches_down_and_right_of_centreline_banks_left(ap):
+    x = -3000.0
+    de, da, dr, thr = ap.step(x, 30.0, _on_path(x) + 10.0, 70.0, 0.0, 3.67, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0)
+    assert de > 0.0  # + elevator = nose down
+    assert da < 0.0  # bank left towards the centreline
+    assert thr == pytest.approx(0.47, abs=1e-6)  # on speed
+
+
+def test_slow_adds_throttle_and_sideslip_gets_rudder(ap):
+    for _ in range(120):
+        _, _, dr, thr = ap.step(-3000.0, 0.0, _on_path(-3000.0), 70.0, 0.0, 3.67, 0.0, 0.02, 0.0, 0.0, 0.05, 67.0)
+    assert thr > 0.47
+    assert dr < 0.0  # beta > 0 (wind from the right): yaw right, rudder negative
+
+
+def test_meridian_convergence_rotates_the_runway_axes():
+    """East of the threshold at 60 N, flying the runway's true heading is not flying parallel to it."""
+    ac = load_aircraft(load_profile("profiles/default.toml"))
+    lat = math.radians(60.0)
+    ap = Autopilot(ac.gains, Trim(0.0, 0.5, 72.0), Geometry(0.0, GP, TCH, lat), 1 / 120)
+    # 10 km east of a north-pointing runway: the local north differs by 10e3 tan(60 deg)/R ~ 0.156 deg
+    _, _, _, y_dot = ap.deviations(0.0, 10e3, 0.0, 70.0, 0.0, 0.0)
+    assert y_dot == pytest.approx(-70.0 * 10e3 * math.tan(lat) / 6.394e6, rel=0.01)
