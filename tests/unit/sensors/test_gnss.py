@@ -1,0 +1,101 @@
+"""GPS: constellation geometry at the default airport, exact pseudoranges, clock, selection, error budget."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from approachsim import geo, synthetic
+from approachsim.sensors.gnss import CODE_PRESETS, ClockModel, Constellation, GnssReceiver
+from approachsim.sensors.gnss.constellation import MU_GPS, dops, look_angles
+from approachsim.sensors.gnss.receiver import best_pdop_four
+
+
+def test_orbits_are_circular_kepler_with_the_right_period():
+    c = Constellation.nominal("2026-01-01T00:00:00Z")
+    period = 2 * math.pi * math.sqrt(c.a_m**3 / MU_GPS)
+    assert period == pytest.approx(43077.0, abs=5.0)  # standards.md 2.1: 11.966 h
+    r = c.positions_ecef(np.array([0.0, period]))
+    assert np.allclose(np.linalg.norm(r, axis=-1), 26559800.0, atol=1e-3)
+    # after one period the inertial position repeats: ECEF rotates by OMEGA_E * period about z
+    a = geo.OMEGA_E * period
+    rz = np.array([[math.cos(a), math.sin(a), 0], [-math.sin(a), math.cos(a), 0], [0, 0, 1]])
+    assert np.allclose(r[1], r[0] @ rz.T, atol=1e-3)
+    # inclination 55 deg: maximum |z| / a = sin 55
+    t = np.linspace(0, period, 400)
+    z = c.positions_ecef(t)[..., 2]
+    assert np.max(np.abs(z)) / c.a_m == pytest.approx(math.sin(math.radians(55.0)), rel=1e-4)
+
+
+def test_geometry_at_the_default_airport_over_a_day(runway):
+    """>= 5 SVs above the 5 deg mask and PDOP < 6 (all in view) every 10 minutes for 24 h (sky plot: sense)."""
+    c = Constellation.nominal("2026-01-01T12:00:00Z")
+    t = np.arange(0, 86400 + 1, 600.0)
+    r_rx = np.tile(runway.origin_ecef, (t.shape[0], 1))
+    _, u, el, _ = look_angles(r_rx, c.positions_ecef(t))
+    vis = el >= math.radians(5.0)
+    lat, lon, _ = geo.ecef_to_geodetic(r_rx)
+    _, pdop, hdop, vdop = dops(u, vis, geo.c_ecef_to_ned(lat, lon))
+    assert vis.sum(axis=1).min() >= 5
+    assert pdop.max() < 6.0
+    assert np.allclose(pdop**2, hdop**2 + vdop**2)
+
+
+def test_best_four_is_the_minimum_pdop_combination(runway):
+    c = Constellation.nominal("2026-01-01T12:00:00Z")
+    r_rx = runway.origin_ecef[None, :]
+    _, u, el, _ = look_angles(r_rx, c.positions_ecef(np.array([0.0])))
+    vis = el >= math.radians(5.0)
+    sel = best_pdop_four(u, vis)
+    c_ned = geo.c_ecef_to_ned(runway.threshold_lat_rad, runway.threshold_lon_rad)[None]
+    _, p_sel, _, _ = dops(u, sel, c_ned)
+    best = np.inf
+    for combo in itertools.combinations(np.flatnonzero(vis[0]), 4):
+        m = np.zeros_like(vis)
+        m[0, list(combo)] = True
+        best = min(best, dops(u, m, c_ned)[1][0])
+    assert sel.sum() == 4 and p_sel[0] == pytest.approx(best, rel=1e-12)
+    _, p_all, _, _ = dops(u, vis, c_ned)
+    assert p_all[0] < p_sel[0]
+
+
+def test_noise_false_pseudorange_is_geometric_range(descent):
+    rx = GnssReceiver(selection="all")
+    rec = rx.measure(descent, np.random.default_rng(0), noise=False)
+    rows = np.arange(0, len(descent), 20)
+    rng = np.linalg.norm(rec.r_sv_ecef - descent.r_ecef[rows][:, None, :], axis=-1)
+    ok = rec.valid
+    assert ok.sum(axis=1).min() >= 5
+    assert np.max(np.abs(rec.pseudorange_m[ok] - rng[ok])) < 1e-3
+    assert np.all(np.isnan(rec.pseudorange_m[~ok]))
+
+
+def test_pseudorange_minus_clock_bias_is_geometric_range(descent):
+    zero = replace(CODE_PRESETS["C/A"], clock_ephemeris_m=0.0, iono_zenith_m=0.0, tropo_zenith_m=0.0,
+                   multipath_m=0.0, code_noise_m=0.0)
+    rx = GnssReceiver(budget=zero, clock=ClockModel.named("tcxo", 1e5, 50.0))
+    rec = rx.measure(descent, np.random.default_rng(0), clock_rng=np.random.default_rng(1))
+    rows = np.arange(0, len(descent), 20)
+    rng = np.linalg.norm(rec.r_sv_ecef - descent.r_ecef[rows][:, None, :], axis=-1)
+    assert np.ptp(rec.clock_bias_m) > 1000.0  # a real, drifting clock
+    resid = rec.pseudorange_m - rec.clock_bias_m[:, None] - rng
+    assert np.nanmax(np.abs(resid)) < 1e-3
+
+
+def test_pseudorange_error_matches_the_budget(runway):
+    """Per-SV errors at 1 Hz over 2000 runs: RSS matches sigma(el) within 5 % (P(Y) and C/A)."""
+    tr = synthetic.stationary(runway.threshold_lat_rad, runway.threshold_lon_rad, runway.threshold_h_m, 2.0, 1.0)
+    for code, uere_30deg in (("P(Y)", 4.1), ("C/A", 8.0)):
+        rx = GnssReceiver(budget=CODE_PRESETS[code], selection="all")
+        rec = rx.measure(tr, [np.random.default_rng(i) for i in range(2000)])
+        exact = rx.measure(tr, np.random.default_rng(0), noise=False)
+        err = rec.pseudorange_m - exact.pseudorange_m
+        ok = exact.valid
+        assert err[:, ok].std(axis=0) == pytest.approx(rec.sigma_m[ok], rel=0.05)
+        assert abs(np.nanmean(err[:, ok])) < 0.05 * rec.sigma_m[ok].min()
+        # the NRC 1995 UERE the preset is built from, at 30 deg elevation
+        assert rx.sigma_m(np.array(math.radians(30.0))) == pytest.approx(uere_30deg, rel=0.03)
