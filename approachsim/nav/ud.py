@@ -161,19 +161,99 @@ class InfluenceFunction:
 
     def __call__(self, beta: float, b: float) -> tuple[float, float]:
         """(psi, psi') at the scaled residual beta = v / alpha, branch chosen by b = v / sqrt(S)."""
-        ab = abs(b)
+        psi, dpsi = self.arrays(np.asarray(beta, float), np.asarray(b, float))
+        return float(psi), float(dpsi)
+
+    def arrays(self, beta: Array, b: Array) -> tuple[Array, Array]:
+        """Vectorized (psi, psi') for arrays beta = v / alpha and b = v / sqrt(S) of one shape."""
+        ab = np.abs(b)
+        one = np.ones_like(beta)
         if self.kind == "gauss":
-            return beta, 1.0
+            return beta * one, one
         if self.kind == "huber":
-            if ab <= self.huber_k:
-                return beta, 1.0
-            w = self.huber_k / ab
+            w = np.where(ab <= self.huber_k, 1.0, self.huber_k / np.maximum(ab, self.huber_k))
             return beta * w, w
-        if ab >= self.outer:  # Laplace: psi = sign(beta), psi' = 0
-            return float(np.sign(beta)), 0.0
-        if self.kind == "gauss-laplace" and ab >= self.inner:
-            return beta / 3.0, 1.0 / 3.0  # psi_lg = beta / 3, psi'_lg = 1/3 (eq. 7-10)
-        return beta, 1.0
+        psi, dpsi = beta * one, one
+        if self.kind == "gauss-laplace":
+            band = (ab >= self.inner) & (ab < self.outer)
+            psi, dpsi = np.where(band, beta / 3.0, psi), np.where(band, 1.0 / 3.0, dpsi)  # psi_lg = beta / 3
+        out = ab >= self.outer  # Laplace: psi = sign(beta), psi' = 0
+        return np.where(out, np.sign(beta), psi), np.where(out, 0.0, dpsi)
+
+
+# --------------------------------------------------------------------------------------------------------------
+# batched kernels: many independent filters (Monte Carlo runs) at once; U (runs, n, n), d (runs, n), x (runs, n)
+
+
+def mwgs_batch(W: Array, dw: Array) -> tuple[Array, Array]:
+    """`mwgs` over a leading runs axis: W (runs, n, m), dw (runs, m) -> U (runs, n, n), d (runs, n)."""
+    W = np.array(W, dtype=float)
+    R, n, _ = W.shape
+    U = np.broadcast_to(np.eye(n), (R, n, n)).copy()
+    d = np.zeros((R, n))
+    for k in range(n - 1, -1, -1):
+        c = dw * W[:, k]
+        dk = np.einsum("rm,rm->r", W[:, k], c)
+        pos = dk > 0.0
+        safe = np.where(pos, dk, 1.0)
+        col = np.where(pos[:, None], np.einsum("rim,rm->ri", W[:, :k], c) / safe[:, None], 0.0)
+        U[:, :k, k] = col
+        W[:, :k] -= col[:, :, None] * W[:, k, None, :]
+        d[:, k] = np.where(pos, dk, 0.0)
+    return U, d
+
+
+def thornton_predict_batch(U: Array, d: Array, F: Array, Q: Array) -> tuple[Array, Array]:
+    """`thornton_predict` over runs (F, Q shared): MWGS of [F U : G], diag(d, q)."""
+    G, q = ud_factor(Q)
+    R = U.shape[0]
+    W = np.concatenate([np.einsum("ij,rjk->rik", F, U), np.broadcast_to(G, (R, *G.shape))], axis=2)
+    return mwgs_batch(W, np.concatenate([d, np.broadcast_to(q, (R, q.size))], axis=1))
+
+
+def bierman_update_batch(U: Array, d: Array, h: Array, r: Array) -> tuple[Array, Array]:
+    """`bierman_update` over runs: h (n,) shared, r (runs,) > 0 (np.inf leaves that run's factors unchanged)."""
+    R, n = d.shape
+    f = np.einsum("rji,j->ri", U, h)  # f = U' h
+    v = d * f
+    U_new = U.copy()
+    d_new = d.copy()
+    b = np.zeros((R, n))
+    keep = ~np.isfinite(r)
+    alpha = np.where(keep, 1.0, r)
+    for j in range(n):
+        alpha_prev = alpha
+        alpha = alpha_prev + f[:, j] * v[:, j]
+        d_new[:, j] = np.where(keep, d[:, j], d[:, j] * alpha_prev / alpha)
+        lam = -f[:, j] / alpha_prev
+        col = U[:, :j, j].copy()
+        U_new[:, :j, j] = np.where(keep[:, None], col, col + lam[:, None] * b[:, :j])
+        b[:, :j] += col * v[:, j, None]
+        b[:, j] = v[:, j]
+    return U_new, d_new
+
+
+def robust_update_batch(
+    x: Array, U: Array, d: Array, z: Array, h: Array, r: float, influence: InfluenceFunction
+) -> tuple[Array, Array, Array, Array, Array, Array]:
+    """`UDFilter.update` over runs with one shared h (n,) and r; z (runs,).
+
+    Returns (x+, U+, d+, innovation, S, weight), the last three (runs,).
+    """
+    f = np.einsum("rji,j->ri", U, h)
+    hph = np.einsum("ri,ri->r", f, d * f)
+    S = hph + r
+    nu = z - x @ h
+    alpha = np.sqrt(r)
+    psi, dpsi = influence.arrays(nu / alpha, nu / np.sqrt(S))
+    Ph = np.einsum("rij,rj->ri", U, d * f)
+    denom = hph * dpsi + r
+    x_new = x + Ph * (alpha * psi / denom)[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        weight = np.where(nu == 0.0, 1.0, alpha * psi * S / (denom * nu))
+        r_eff = np.where(dpsi > 0.0, r / dpsi, np.inf)
+    U_new, d_new = bierman_update_batch(U, d, h, r_eff)
+    return x_new, U_new, d_new, nu, S, weight
 
 
 # --------------------------------------------------------------------------------------------------------------
