@@ -1,0 +1,55 @@
+"""Benchmark: wall time of one default approach (closed loop on truth, Truth record filled at 120 Hz) and its
+ratio to raw JSBSim stepping of the same number of steps, same trimmed start, same turbulence, no autopilot.
+
+Run: python benchmarks/bench_fly.py [--repeat 5]. Prints medians and the ratio (target <= 3).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from pathlib import Path
+
+from approachsim.flight.fdm import FDM
+from approachsim.flight.run import Approach
+from approachsim.flight.trim import start_condition
+from approachsim.profile import load_profile
+from approachsim.seeding import stream_int
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--profile", default=str(ROOT / "profiles" / "default.toml"))
+    args = ap.parse_args()
+    profile = load_profile(args.profile)
+    approach = Approach(profile)
+    approach.fly(seed=1)  # warm up (imports, first FGFDMExec)
+    fly_s, raw_s = [], []
+    n = 0
+    for i in range(args.repeat):
+        t0 = time.perf_counter()
+        r = approach.fly(seed=1, run=i)
+        fly_s.append(time.perf_counter() - t0)
+        n = len(r.truth)
+        fdm = FDM(approach.aircraft.jsbsim_model, approach.dt_s)
+        t0 = time.perf_counter()
+        fdm.initialize_and_trim(start_condition(profile, approach.aircraft))
+        fdm.set_turbulence(profile.environment.turbulence, stream_int(1, i, "turbulence"))
+        step = fdm.run
+        for _ in range(n - 1):
+            step()
+        raw_s.append(time.perf_counter() - t0)
+    fly, raw = statistics.median(fly_s), statistics.median(raw_s)
+    print(f"profile {profile.name}: {n} steps at {profile.rates.imu_hz:g} Hz = {n / profile.rates.imu_hz:.1f} s of flight")
+    print(f"approach (FDM build + trim + closed loop + truth): median {fly:.3f} s  ({fly / n * 1e6:.1f} us/step, "
+          f"{n / profile.rates.imu_hz / fly:.0f}x real time)")
+    print(f"raw JSBSim (trim + run() only):                     median {raw:.3f} s  ({raw / n * 1e6:.1f} us/step)")
+    print(f"ratio approach / raw: {fly / raw:.2f}  (target <= 3)")
+
+
+if __name__ == "__main__":
+    main()
