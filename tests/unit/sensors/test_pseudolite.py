@@ -1,0 +1,50 @@
+"""Pseudolite: exact geometric range with noise=False, shared receiver clock, visibility, survey error."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from approachsim.sensors.gnss import GnssReceiver
+from approachsim.sensors.pseudolite import Pseudolite
+
+
+def test_noise_false_is_geometric_range_to_the_published_position(descent, runway):
+    pl = Pseudolite(runway, positions_rwy=((300.0, -150.0, 9.0), (-3000.0, 100.0, 3.0)), synchronized=False)
+    rec = pl.measure(descent, np.random.default_rng(0), noise=False)
+    rows = np.arange(0, len(descent), 20)
+    rng = np.linalg.norm(rec.r_pl_ecef[None] - descent.r_ecef[rows][:, None], axis=-1)
+    assert rec.valid.all()
+    assert np.max(np.abs(rec.pseudorange_m - rng)) < 1e-3
+    # published position: runway frame x, y and height above threshold
+    back = runway.from_ecef(rec.r_pl_ecef)
+    # (the local vertical tilts by d / R from the threshold one: a sub-millimetre shift of x, y at 3 km)
+    assert back[:, :2] == pytest.approx(np.array([[300.0, -150.0], [-3000.0, 100.0]]), abs=2e-3)
+
+
+def test_receiver_clock_is_shared_with_gnss(descent, runway):
+    rx = GnssReceiver()
+    clk = rx.draw_clock(descent.t_s, np.random.default_rng(8))
+    pl = Pseudolite(runway, survey_sigma_m=0.0, tropo_ppm_sigma=0.0, multipath_m=0.0, code_noise_m=0.0)
+    rec = pl.apply(descent, pl.draw(descent.t_s, np.random.default_rng(1)), clock=clk)
+    g = rx.apply(descent, rx.draw(descent.t_s, np.random.default_rng(2)), clock=clk)
+    assert np.array_equal(rec.clock_bias_m, g.clock_bias_m)
+    rows = np.arange(0, len(descent), 20)
+    rng = np.linalg.norm(rec.r_pl_ecef[None] - descent.r_ecef[rows][:, None], axis=-1)
+    assert np.max(np.abs(rec.pseudorange_m - rec.clock_bias_m[:, None] - rng)) < 1e-3
+
+
+def test_visibility_range_and_mask(descent, runway):
+    pl = Pseudolite(runway, positions_rwy=((0.0, 0.0, 0.0),), max_range_m=10e3)
+    rec = pl.measure(descent, np.random.default_rng(0))
+    rng = np.linalg.norm(rec.r_pl_ecef[None] - descent.r_ecef[::20][:, None], axis=-1)[:, 0]
+    assert np.array_equal(rec.valid[:, 0], rng <= 10e3)
+    high = Pseudolite(runway, positions_rwy=((0.0, 0.0, 2000.0),))  # transmitter above the aircraft: masked
+    assert not high.measure(descent, np.random.default_rng(0)).valid.any()
+
+
+def test_survey_error_is_a_constant_per_run(descent, runway):
+    pl = Pseudolite(runway, survey_sigma_m=1.0, code_noise_m=0.0, multipath_m=0.0, tropo_ppm_sigma=0.0)
+    e = pl.draw(descent.t_s, [np.random.default_rng(i) for i in range(3000)])
+    assert e.constants["survey"].shape == (3000, 1, 3)
+    assert e.constants["survey"].std() == pytest.approx(1.0, rel=0.05)
