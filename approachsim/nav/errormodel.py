@@ -12,6 +12,14 @@ States (a `StateLayout` says which are present and where):
     sb   (1)  baro scale factor                   (random constant, seed 003 eq. 1)
     clk  (2)  GPS receiver clock bias (m) and drift (m/s)   (seed 002 two-state clock, sec. 6)
     ac   (1)  baro damping-loop compensator, m/s^2 (only when the INS runs the 3rd-order loop, seed 003 eq. 3)
+    gse  (k)  per-GPS-channel slow range error (SV clock/ephemeris + mapped iono + tropo), m, Gauss-Markov
+    gmp  (k)  per-GPS-channel multipath, m, Gauss-Markov
+    pmp  (p)  per-pseudolite multipath, m, Gauss-Markov
+    ptr  (p)  per-pseudolite tropospheric residual, fraction of the range (random constant)
+    pclk (2p) per-pseudolite transmitter clock bias and drift (unsynchronized pseudolites only)
+
+The channel states are what make the filter honest about time-correlated range errors: seed 002's 2-state
+GPS model absorbed them in a tuned R; here they are carried (and decoupled, so discretized exactly).
 
 Dynamics (Titterton & Weston eq. 12.8, 12.12; Groves eq. 14.64-14.66 with the position error in metres):
 
@@ -48,6 +56,12 @@ class StateLayout:
     baro_scale: bool = True
     clock: bool = True
     loop: bool = False
+    n_sv: int = 0
+    """GPS channels with their own error states (0: none)."""
+    n_pl: int = 0
+    """Pseudolites with their own error states (0: none)."""
+    pl_clock: bool = False
+    """Pseudolites carry their own clock (unsynchronized)."""
     index: dict[str, slice] = field(init=False, compare=False)
     n: int = field(init=False, compare=False)
 
@@ -59,6 +73,12 @@ class StateLayout:
             sizes.append(("clk", 2))
         if self.loop:
             sizes.append(("ac", 1))
+        if self.n_sv:
+            sizes += [("gse", self.n_sv), ("gmp", self.n_sv)]
+        if self.n_pl:
+            sizes += [("pmp", self.n_pl), ("ptr", self.n_pl)]
+            if self.pl_clock:
+                sizes.append(("pclk", 2 * self.n_pl))
         index, i = {}, 0
         for name, k in sizes:
             index[name] = slice(i, i + k)
@@ -101,6 +121,22 @@ class ErrorNoise:
     baro_rate_hz: float = 10.0
     clock_sf: float = 0.0
     clock_sg: float = 0.0
+    gse_sigma_m: float | Array = 0.0
+    """Per-channel slow range-error 1-sigma (scalar or (n_sv,) by elevation), m."""
+    gse_tau_s: float = 1800.0
+    gmp_sigma_m: float = 0.0
+    gmp_tau_s: float = 60.0
+    pmp_sigma_m: float = 0.0
+    pmp_tau_s: float = 30.0
+    pclk_sf: float = 0.0
+    pclk_sg: float = 0.0
+
+
+def _markov(F: Array, Qc: Array, sl: slice, sigma: float | Array, tau_s: float) -> None:
+    """First-order Gauss-Markov states x' = -x / tau + w, E[w w'] = 2 sigma^2 / tau (in place)."""
+    k = np.arange(sl.start, sl.stop)
+    F[k, k] = -1.0 / tau_s
+    Qc[k, k] = 2.0 * np.broadcast_to(np.asarray(sigma, dtype=float), k.shape) ** 2 / tau_s
 
 
 def _dw_in(lat: float, h: float, v: Array, r_n: float, r_e: float) -> tuple[Array, Array, Array]:
@@ -193,6 +229,17 @@ def dynamics(
         F[ic, ic + 1] = 1.0
         Qc[ic, ic] = noise.clock_sf
         Qc[ic + 1, ic + 1] = noise.clock_sg
+    if layout.has("gse"):
+        _markov(F, Qc, ix["gse"], noise.gse_sigma_m, noise.gse_tau_s)
+        _markov(F, Qc, ix["gmp"], noise.gmp_sigma_m, noise.gmp_tau_s)
+    if layout.has("pmp"):
+        _markov(F, Qc, ix["pmp"], noise.pmp_sigma_m, noise.pmp_tau_s)
+    if layout.has("pclk"):
+        for j in range(layout.n_pl):
+            ic = layout.i("pclk", 2 * j)
+            F[ic, ic + 1] = 1.0
+            Qc[ic, ic] = noise.pclk_sf
+            Qc[ic + 1, ic + 1] = noise.pclk_sg
     if layout.has("ac"):
         if loop is None:
             raise ValueError("layout has the loop state 'ac' but no loop gains were given")
@@ -215,6 +262,24 @@ def dynamics(
     return F, Qc
 
 
+def _expm(M: Array) -> Array:
+    """Matrix exponential by scaling and squaring of an 8th-order Taylor series (error < 1e-15 relative for
+    the small, well-scaled matrices here); scipy.linalg.expm when the norm is large."""
+    norm = float(np.abs(M).sum(axis=0).max())
+    if norm > 1e3:
+        return expm(M)
+    s = max(0, int(np.ceil(np.log2(max(norm, 1e-300) / 0.25))))
+    A = M / 2.0**s
+    E = np.eye(M.shape[0])
+    term = np.eye(M.shape[0])
+    for k in range(1, 9):
+        term = term @ A / k
+        E = E + term
+    for _ in range(s):
+        E = E @ E
+    return E
+
+
 def van_loan(F: Array, Qc: Array, dt_s: float) -> tuple[Array, Array]:
     """Discrete Phi = expm(F dt) and Qd = int_0^dt Phi(s) Qc Phi(s)' ds by Van Loan's method (1978).
 
@@ -225,7 +290,29 @@ def van_loan(F: Array, Qc: Array, dt_s: float) -> tuple[Array, Array]:
     M[:n, :n] = -F * dt_s
     M[:n, n:] = Qc * dt_s
     M[n:, n:] = F.T * dt_s
-    E = expm(M)
+    E = _expm(M)
     phi = E[n:, n:].T
     qd = phi @ E[:n, n:]
     return phi, 0.5 * (qd + qd.T)
+
+
+def discretize(F: Array, Qc: Array, dt_s: float) -> tuple[Array, Array]:
+    """Phi, Qd over dt_s: decoupled scalar states (first-order Markov / random constants) in closed form,
+    the coupled rest by Van Loan. Same result as van_loan(F, Qc, dt_s), much cheaper with channel states."""
+    n = F.shape[0]
+    off = (F != 0.0) | (Qc != 0.0)
+    np.fill_diagonal(off, False)
+    lone = ~(off.any(axis=0) | off.any(axis=1))
+    core = np.flatnonzero(~lone)
+    phi = np.zeros((n, n))
+    qd = np.zeros((n, n))
+    if core.size:
+        p_c, q_c = van_loan(F[np.ix_(core, core)], Qc[np.ix_(core, core)], dt_s)
+        phi[np.ix_(core, core)] = p_c
+        qd[np.ix_(core, core)] = q_c
+    k = np.flatnonzero(lone)
+    a = F[k, k]
+    phi[k, k] = np.exp(a * dt_s)
+    safe = np.where(a == 0.0, 1.0, a)
+    qd[k, k] = Qc[k, k] * np.where(a == 0.0, dt_s, np.expm1(2.0 * a * dt_s) / (2.0 * safe))
+    return phi, qd

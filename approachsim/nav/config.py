@@ -1,0 +1,112 @@
+"""The profile's [nav] table: which filter and its tuning, aiding rate, feedback, baro loop, initial errors.
+
+    [nav]
+    filter = "ekf"                 # a name in nav/registry.py FILTERS
+    aiding_rate_hz = 1.0           # filter predict / update rate (seed 002: 1 s)
+    feedback = false               # false: feed-forward (output = INS - estimated error, seed 002); true: resets
+    gps_coupling = "tight"         # "tight" (pseudoranges) or "loose" (position fixes from the pseudoranges)
+    channel_states = true          # per-channel range-error states (honest covariance) or white-noise R only
+    baro_loop = "none"             # "none" | "constant" | "tanh" | "sinh": INS 3rd-order damping loop (seed 003)
+    baro_loop_tau_s = 100.0        # loop time constant (seed 003 eq. 5), s
+    baro_loop_b_per_m = 0.5        # adaptive slope b of tanh / sinh (eq. 7, 16), 1/m
+    [nav.filter_tuning]            # passed to the filter factory (robust gates, U-D options ...)
+    [nav.initial_error]            # 1-sigma INS errors at the start of the approach (seed 002 assumption 12:
+    position_m = 5.0               #   after an 8-min alignment and an hour of GPS-aided flight)
+    velocity_mps = 0.05
+    tilt_mrad = 0.05
+    heading_mrad = 0.5
+
+A bad key or value raises ProfileError naming the field; an unknown filter fails here, at load.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
+
+from approachsim.config import ProfileError, Section
+from approachsim.nav import registry
+from approachsim.nav import vertical_loop as vl
+
+LOOP_FORMS = ("none",) + tuple(vl.GAIN_FORMS)
+
+
+@dataclass(frozen=True)
+class InitialError:
+    """1-sigma INS errors at the start of the run (drawn per run; the filter's P0), SI."""
+
+    position_m: float = 5.0
+    velocity_mps: float = 0.05
+    tilt_rad: float = 0.05e-3
+    heading_rad: float = 0.5e-3
+
+
+@dataclass(frozen=True)
+class NavConfig:
+    """The navigation system of a profile (module docstring lists the keys)."""
+
+    filter: str = "ekf"
+    filter_tuning: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
+    aiding_rate_hz: float = 1.0
+    feedback: bool = False
+    gps_coupling: str = "tight"
+    channel_states: bool = True
+    baro_loop: str = "none"
+    baro_loop_tau_s: float = 100.0
+    baro_loop_b_per_m: float = 0.5
+    initial_error: InitialError = field(default_factory=InitialError)
+
+    def make_filter(self) -> Any:
+        """The filter object named by `filter`, with its tuning."""
+        return registry.make_filter(self.filter, **dict(self.filter_tuning))
+
+    def loop_gains(self) -> vl.LoopGains | None:
+        """The damping-loop gains (None without a loop). Adaptive forms keep the constant small-signal gains:
+        C_KF = C / b so that C_KF f(b e) has slope C at e = 0 (seed 003 eq. 7 linearizes to eq. 3)."""
+        if self.baro_loop == "none":
+            return None
+        g = vl.constant_gains(self.baro_loop_tau_s)
+        if self.baro_loop == "constant":
+            return g
+        b = self.baro_loop_b_per_m
+        return vl.LoopGains(g.c1 / b, g.c2 / b, g.c3, form=self.baro_loop, b1_per_m=b, b2_per_m=b)
+
+
+DEFAULT_NAV = NavConfig()
+
+
+def parse_nav(s: Section) -> NavConfig:
+    """Parse [nav]; absent keys take the defaults above."""
+    name = s.string("filter", "ekf")
+    tuning = s.raw("filter_tuning", {})  # the filter factory validates its own keys
+    if not isinstance(tuning, dict):
+        raise ProfileError(f"{s.path}.filter_tuning: must be a table, got {type(tuning).__name__}")
+    rate = s.number("aiding_rate_hz", 1.0, lo=0.01, hi=100.0, unit="Hz")
+    feedback = s.boolean("feedback", False)
+    coupling = s.string("gps_coupling", "tight", choices=("tight", "loose"))
+    channel = s.boolean("channel_states", True)
+    loop = s.string("baro_loop", "none", choices=LOOP_FORMS)
+    tau = s.number("baro_loop_tau_s", 100.0, lo=1.0, hi=10000.0, unit="s")
+    b = s.number("baro_loop_b_per_m", 0.5, lo=0.0, lo_open=True, hi=100.0, unit="1/m")
+    ie = s.section("initial_error")
+    init = InitialError(
+        position_m=ie.number("position_m", 5.0, lo=0.0, hi=1e5, unit="m"),
+        velocity_mps=ie.number("velocity_mps", 0.05, lo=0.0, hi=100.0, unit="m/s"),
+        tilt_rad=ie.number("tilt_mrad", 0.05, lo=0.0, hi=100.0, unit="mrad") * 1e-3,
+        heading_rad=ie.number("heading_mrad", 0.5, lo=0.0, hi=1000.0, unit="mrad") * 1e-3,
+    )
+    ie.done()
+    s.done()
+    cfg = NavConfig(
+        filter=name, filter_tuning=MappingProxyType(tuning), aiding_rate_hz=rate, feedback=feedback,
+        gps_coupling=coupling, channel_states=channel, baro_loop=loop, baro_loop_tau_s=tau,
+        baro_loop_b_per_m=b, initial_error=init,
+    )
+    try:
+        cfg.make_filter()  # unknown filter or bad tuning fails at load, not an hour into a campaign
+    except ProfileError:
+        raise
+    except (TypeError, ValueError) as e:
+        raise ProfileError(f"{s.path}.filter_tuning: {e}") from None
+    return cfg

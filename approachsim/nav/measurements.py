@@ -1,0 +1,134 @@
+"""Scalar measurement rows of the error-state filter: z = h' x + v for each aiding observation.
+
+Every observation is a *difference* measurement (seed 002 sec. 6): the value the INS predicts minus the
+value the sensor reports, so that z is a function of the error state x (error = INS - truth). Where the
+measurement is nonlinear in the error (ranges to nearby pseudolites, terrain under the radar altimeter) the
+row is an EKF linearization about the current estimate x_hat: with g(x) the exact difference,
+
+    z_lin = z - g(x_hat) + h' x_hat        so that the innovation z_lin - h' x_hat = z - g(x_hat).
+
+Rows (index names from errormodel.StateLayout):
+    baro      z = h_ins - h_baro        = -dp_D - bb - h sb + v                      (seed 002; seed 003 eq. 6)
+    radalt    z = (h_ins - T(ins)) - h_R = -dp_D - grad T . dp_h + v, R = (0.01 h)^2 + floor^2 (seed 002)
+    range     z = |r_ins - r_tx| - rho  = e . dp - clk - gse - gmp (+ pseudolite terms) + v   (seed 002 sec. 6)
+    position  z = p_ins - p_gps (NED, per axis)  (loosely-coupled option)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from approachsim import geo
+from approachsim.nav.base import ScalarMeasurement
+from approachsim.nav.errormodel import StateLayout
+
+Array = np.ndarray
+
+
+def _row(layout: StateLayout) -> Array:
+    return np.zeros(layout.n)
+
+
+def baro(layout: StateLayout, h_ins_m: float, h_baro_m: float, sigma_m: float, t_s: float,
+         name: str = "baro") -> ScalarMeasurement:
+    """Baro altitude difference: h = [-1 at dp_D, -1 at bb, -h at sb]; R = sigma^2 (white noise), m."""
+    h = _row(layout)
+    h[layout.i("dp", 2)] = -1.0  # dh = -dp_D
+    h[layout.i("bb")] = -1.0
+    if layout.has("sb"):
+        h[layout.i("sb")] = -h_ins_m
+    return ScalarMeasurement(z=float(h_ins_m - h_baro_m), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
+
+
+def radalt(
+    layout: StateLayout,
+    x_hat: Array,
+    lat_rad: float,
+    lon_rad: float,
+    h_ins_m: float,
+    h_agl_m: float,
+    sigma_m: float,
+    terrain_h: Callable[[Array], Array],
+    t_s: float,
+    name: str = "radalt",
+) -> ScalarMeasurement:
+    """Radar altimeter: INS height above the terrain database minus the measured height above terrain.
+
+    terrain_h(r_ecef (..., 3)) -> terrain ellipsoid height (...,), m. The terrain gradient enters through
+    the horizontal position error (central differences over 10 m).
+    """
+    c_ne = geo.c_ecef_to_ned(lat_rad, lon_rad).T
+    r_ins = geo.geodetic_to_ecef(lat_rad, lon_rad, h_ins_m)
+    dp_hat = x_hat[layout.index["dp"]]
+    r_hat = r_ins - c_ne @ dp_hat  # corrected position (truth estimate)
+    steps = np.array([[10.0, 0, 0], [-10.0, 0, 0], [0, 10.0, 0], [0, -10.0, 0]]) @ c_ne.T
+    t4 = terrain_h(r_hat + steps)
+    grad = np.array([(t4[0] - t4[1]) / 20.0, (t4[2] - t4[3]) / 20.0])  # dT/dN, dT/dE, m/m
+    t_ins = float(terrain_h(r_ins))
+    t_hat = float(terrain_h(r_hat))
+    z = (h_ins_m - t_ins) - h_agl_m
+    g_hat = (h_ins_m - t_ins) - ((h_ins_m + dp_hat[2]) - t_hat)  # exact difference at x_hat
+    h = _row(layout)
+    h[layout.i("dp", 0)] = -grad[0]
+    h[layout.i("dp", 1)] = -grad[1]
+    h[layout.i("dp", 2)] = -1.0
+    return ScalarMeasurement(z=float(z - g_hat + h @ x_hat), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
+
+
+def pseudorange(
+    layout: StateLayout,
+    x_hat: Array,
+    r_ins_ecef: Array,
+    c_ecef_ned: Array,
+    r_tx_ecef: Array,
+    rho_m: float,
+    sigma_m: float,
+    t_s: float,
+    name: str,
+    *,
+    sv: int | None = None,
+    pl: int | None = None,
+) -> ScalarMeasurement:
+    """A code pseudorange to a satellite (sv = its channel) or pseudolite (pl = its unit), tightly coupled.
+
+    z = |r_ins - r_tx| - rho ; g(x) = |r_ins - r_tx| - |r_ins - C' dp - r_tx| - clk - (channel errors);
+    h: e' at dp (e the unit vector transmitter -> corrected position, NED), -1 at the receiver clock and
+    the channel's error states; pseudolite troposphere: -range at ptr. R = sigma^2 (white code noise), m.
+    """
+    h = _row(layout)
+    dp_hat = x_hat[layout.index["dp"]]
+    r_hat = r_ins_ecef - c_ecef_ned.T @ dp_hat
+    d_hat = r_hat - r_tx_ecef
+    rng_hat = float(np.linalg.norm(d_hat))
+    e_ned = c_ecef_ned @ (d_hat / rng_hat)
+    rng_ins = float(np.linalg.norm(r_ins_ecef - r_tx_ecef))
+    h[layout.index["dp"]] = e_ned
+    if layout.has("clk"):
+        h[layout.i("clk")] = -1.0
+    if sv is not None and layout.has("gse"):
+        h[layout.i("gse", sv)] = -1.0
+        h[layout.i("gmp", sv)] = -1.0
+    if pl is not None and layout.has("pmp"):
+        h[layout.i("pmp", pl)] = -1.0
+        h[layout.i("ptr", pl)] = -rng_hat
+        if layout.has("pclk"):
+            h[layout.i("pclk", 2 * pl)] = -1.0
+    z = rng_ins - rho_m
+    lin = h.copy()
+    lin[layout.index["dp"]] = 0.0
+    g_hat = rng_ins - rng_hat + float(lin @ x_hat)  # exact in dp, linear in the rest
+    return ScalarMeasurement(z=float(z - g_hat + h @ x_hat), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
+
+
+def gps_position(layout: StateLayout, dp_ins_minus_gps_ned: Array, sigma_ned_m: Array, t_s: float
+                 ) -> list[ScalarMeasurement]:
+    """Loosely coupled: the INS minus GPS position in NED (3,), m, as three scalars with sigmas (3,)."""
+    out = []
+    for k, axis in enumerate("NED"):
+        h = _row(layout)
+        h[layout.i("dp", k)] = 1.0
+        out.append(ScalarMeasurement(z=float(dp_ins_minus_gps_ned[k]), h=h, r=float(sigma_ned_m[k] ** 2),
+                                     name=f"gps_{axis}", t_s=t_s))
+    return out

@@ -1,0 +1,466 @@
+"""The navigation system: strapdown INS + error-state filter over sensor records, as one composable object.
+
+    nav = NavSystem.from_profile(profile)
+    run = nav.run(truth, records, rng)               # records: {name: record} from sensors.suite
+    run.solution (NavSolution), run.status (StatusLog), run.x, run.P_diag (filter history at the epochs)
+
+The INS integrates every IMU increment; at each aiding epoch (nav.aiding_rate_hz) the filter predicts with
+the discretized error model (errormodel.dynamics + discretize, linearized about the INS solution) and takes
+every available scalar measurement in turn (baro, radar altimeter below its range, each valid pseudorange,
+each pseudolite range), each giving an UpdateStatus. Output (seed 002 feed-forward) = INS - estimated error;
+with `feedback` the estimate is fed back into the INS (and the IMU bias estimates into the increments) and
+the corresponding error states reset to zero.
+
+The same epoch machinery serves the closed loop (closed_loop.py): `start`, `imu_step`, `aid`, `output`.
+Several Monte Carlo runs can share one call: the INS is stepped for all of them at once (run axis first);
+each run has its own filter state.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from approachsim import geo
+from approachsim.nav import errormodel as em
+from approachsim.nav import ins
+from approachsim.nav import measurements as meas
+from approachsim.nav import vertical_loop as vl
+from approachsim.nav.base import FilterState, NavFilter, UpdateStatus
+from approachsim.nav.config import DEFAULT_NAV, NavConfig
+from approachsim.records import NavSolution, Truth
+from approachsim.sensors.config import DEFAULT_SENSORS, SensorsConfig
+from approachsim.sensors.gnss.clock import ClockModel
+from approachsim.sensors.gnss.receiver import CODE_PRESETS, iono_obliquity, tropo_mapping
+from approachsim.sensors.presets import PRESETS
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class StatusLog:
+    """Every scalar measurement's status record of one run, in processing order (1-D arrays, length u)."""
+
+    t_s: Array
+    name: Array
+    """(u,) channel name ("baro", "radalt", "gps07", "pl0", ...), str."""
+    innovation: Array
+    variance: Array
+    """(u,) predicted innovation variance S = h' P h + r."""
+    test_ratio: Array
+    """(u,) nu^2 / S (the NIS of a scalar)."""
+    weight: Array
+    accepted: Array
+
+    @classmethod
+    def from_records(cls, recs: list[UpdateStatus]) -> StatusLog:
+        """Arrays from a list of UpdateStatus."""
+        return cls(
+            t_s=np.array([r.t_s for r in recs], dtype=float),
+            name=np.array([r.name for r in recs], dtype=str),
+            innovation=np.array([r.innovation for r in recs], dtype=float),
+            variance=np.array([r.variance for r in recs], dtype=float),
+            test_ratio=np.array([r.test_ratio for r in recs], dtype=float),
+            weight=np.array([r.weight for r in recs], dtype=float),
+            accepted=np.array([r.accepted for r in recs], dtype=bool),
+        )
+
+
+@dataclass(frozen=True)
+class NavRun:
+    """One run's navigation output: the solution at the IMU rate and the filter history at the epochs."""
+
+    solution: NavSolution
+    status: StatusLog
+    t_epoch_s: Array
+    """(e,) aiding epoch times, s."""
+    x: Array
+    """(e, n) estimated error state after the epoch's updates (feedback: the residual after the reset)."""
+    P_diag: Array
+    """(e, n) its variances."""
+    P_nav: Array
+    """(e, 9, 9) covariance of the navigation errors (dp, dv, psi) after the updates."""
+    true_error_nav: Array | None
+    """(e, 9) INS - truth error (dp NED m, dv m/s, psi rad) of the *output* at the epochs, when truth is given."""
+    layout: em.StateLayout = field(compare=False)
+
+
+@dataclass
+class _Run:
+    """Mutable per-run filter bookkeeping inside one NavSystem pass (never leaves this module)."""
+
+    fs: FilterState
+    statuses: list
+    bg_fb: Array
+    ba_fb: Array
+
+
+def _epoch_index(t_rec: Array, t: float, tol: float) -> int | None:
+    """Index of the record sample at time t (within tol), or None."""
+    i = int(np.searchsorted(t_rec, t - tol))
+    if i < t_rec.shape[0] and abs(t_rec[i] - t) <= tol:
+        return i
+    return None
+
+
+@dataclass(frozen=True)
+class NavSystem:
+    """INS + filter configured from a profile's [nav] and [sensors] (+ the runway and terrain)."""
+
+    nav: NavConfig
+    sensors: SensorsConfig
+    runway: geo.RunwayFrame
+    terrain_h: Callable[[Array], Array]
+    """Terrain ellipsoid height (m) at ECEF points (..., 3): the filter's terrain database."""
+    filter: NavFilter = field(compare=False)
+    layout: em.StateLayout = field(compare=False)
+
+    @classmethod
+    def build(cls, nav: NavConfig = DEFAULT_NAV, sensors: SensorsConfig = DEFAULT_SENSORS,
+              runway: geo.RunwayFrame | None = None, terrain: Any = None) -> NavSystem:
+        """From configs; runway defaults to a frame at SFO 28R, terrain to flat at the threshold height."""
+        rwy = runway or geo.RunwayFrame(np.radians(37.6117), np.radians(-122.3581), 4.0, np.radians(298.0))
+
+        if terrain is None:
+            def terrain_h(r: Array) -> Array:
+                return np.full(np.shape(r)[:-1], rwy.threshold_h_m)
+        else:
+            def terrain_h(r: Array) -> Array:
+                return terrain.height_at(rwy.from_ecef(r)[..., 0])
+
+        n_sv = 0
+        if sensors.gnss is not None and nav.channel_states and nav.gps_coupling == "tight":
+            n_sv = 24
+        n_pl = len(sensors.pseudolite.positions_rwy) if sensors.pseudolite is not None and nav.channel_states else 0
+        layout = em.StateLayout(
+            baro_scale=sensors.baro is not None and sensors.baro.scale_factor_sigma > 0.0,
+            clock=sensors.gnss is not None or sensors.pseudolite is not None,
+            loop=nav.baro_loop != "none",
+            n_sv=n_sv,
+            n_pl=n_pl,
+            pl_clock=n_pl > 0 and not sensors.pseudolite.synchronized,
+        )
+        return cls(nav=nav, sensors=sensors, runway=rwy, terrain_h=terrain_h, filter=nav.make_filter(),
+                   layout=layout)
+
+    @classmethod
+    def from_profile(cls, profile: Any) -> NavSystem:
+        """The navigation system of a Profile (its [nav], [sensors], runway and terrain)."""
+        nav = getattr(profile, "nav", DEFAULT_NAV)
+        return cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain)
+
+    # --- models -------------------------------------------------------------------------------------------
+
+    def _clock(self) -> ClockModel:
+        g = self.sensors.gnss
+        if g is not None:
+            return ClockModel.named(g.oscillator, g.clock_bias0_sigma_m, g.clock_drift0_sigma_mps)
+        return ClockModel()
+
+    def noise(self, elevation_rad: Array | None = None) -> em.ErrorNoise:
+        """Process noise from the sensor configuration (the filter knows the sensors' error budgets)."""
+        g = PRESETS[self.sensors.imu.grade]
+        b = self.sensors.baro
+        clk = self._clock()
+        kw: dict[str, Any] = {}
+        if self.sensors.gnss is not None:
+            bud = CODE_PRESETS[self.sensors.gnss.code]
+            el = np.full(24, np.radians(30.0)) if elevation_rad is None else np.nan_to_num(elevation_rad, nan=0.5)
+            el = np.maximum(el, np.radians(2.0))
+            kw.update(
+                gse_sigma_m=np.sqrt(bud.clock_ephemeris_m**2 + (bud.iono_zenith_m * iono_obliquity(el)) ** 2
+                                    + (bud.tropo_zenith_m * tropo_mapping(el)) ** 2),
+                gse_tau_s=min(bud.clock_ephemeris_tau_s, bud.iono_tau_s, bud.tropo_tau_s),
+                gmp_sigma_m=bud.multipath_m, gmp_tau_s=bud.multipath_tau_s,
+            )
+        if self.sensors.pseudolite is not None:
+            p = self.sensors.pseudolite
+            kw.update(pmp_sigma_m=p.multipath_m, pmp_tau_s=p.multipath_tau_s)
+            if not p.synchronized:
+                pc = ClockModel.named("ocxo", 30.0, 0.03)
+                q = pc.q(1.0)
+                kw.update(pclk_sf=q[0, 0] - q[1, 1] / 3.0, pclk_sg=q[1, 1])
+        q1 = clk.q(1.0)  # Q(1 s) = [[S_f + S_g / 3, S_g / 2], [., S_g]]
+        return em.ErrorNoise(
+            gyro_arw_rad_sqrts=g.gyro_arw_rad_sqrts,
+            accel_vrw_mps_sqrts=g.accel_vrw_mps_sqrts,
+            gyro_bias_rw=np.sqrt(2.0 * g.gyro_bi_radps**2 / g.gyro_bi_tau_s),
+            accel_bias_rw=np.sqrt(2.0 * g.accel_bi_mps2**2 / g.accel_bi_tau_s),
+            baro_bias_sigma_m=b.bias_sigma_m if b is not None else 1.0,
+            baro_bias_tau_s=b.bias_tau_s if b is not None else 100.0,
+            baro_noise_sigma_m=b.noise_sigma_m if b is not None else 1.0,
+            baro_rate_hz=b.rate_hz if b is not None else 10.0,
+            clock_sf=float(q1[0, 0] - q1[1, 1] / 3.0),
+            clock_sg=float(q1[1, 1]),
+            **kw,
+        )
+
+    def initial_covariance(self) -> Array:
+        """P0: the profile's initial INS errors, the IMU grade's biases, the sensors' error budgets."""
+        lay, ie = self.layout, self.nav.initial_error
+        g = PRESETS[self.sensors.imu.grade]
+        nz = self.noise()
+        d = np.zeros(lay.n)
+        d[lay.index["dp"]] = ie.position_m**2
+        d[lay.index["dv"]] = ie.velocity_mps**2
+        d[lay.index["psi"]] = [ie.tilt_rad**2, ie.tilt_rad**2, ie.heading_rad**2]
+        d[lay.index["bg"]] = g.gyro_bias_radps**2 + g.gyro_bi_radps**2
+        # scale factor and misalignment under 1 g look like a bias to a level accelerometer triad
+        d[lay.index["ba"]] = (g.accel_bias_mps2**2 + g.accel_bi_mps2**2
+                              + (9.8 * g.accel_misalign_rad) ** 2 + (9.8 * g.accel_sf) ** 2)
+        d[lay.i("bb")] = nz.baro_bias_sigma_m**2
+        if lay.has("sb"):
+            d[lay.i("sb")] = self.sensors.baro.scale_factor_sigma**2
+        if lay.has("clk"):
+            c = self._clock()
+            d[lay.index["clk"]] = [c.bias0_sigma_m**2, c.drift0_sigma_mps**2]
+        if lay.has("gse"):
+            d[lay.index["gse"]] = np.broadcast_to(nz.gse_sigma_m, (lay.n_sv,)) ** 2
+            d[lay.index["gmp"]] = nz.gmp_sigma_m**2
+        if lay.has("pmp"):
+            p = self.sensors.pseudolite
+            d[lay.index["pmp"]] = p.multipath_m**2
+            d[lay.index["ptr"]] = (p.tropo_ppm_sigma * 1e-6) ** 2
+            if lay.has("pclk"):
+                d[lay.index["pclk"]] = np.tile([30.0**2, 0.03**2], lay.n_pl)
+        return np.diag(d)
+
+    # --- one pass ------------------------------------------------------------------------------------------
+
+    def start(self, truth: Truth, rngs: list[np.random.Generator], row: int = 0) -> tuple[ins.InsState, list[_Run]]:
+        """INS states of len(rngs) runs at truth row `row` with initial errors drawn from P0, and their filters."""
+        n = len(rngs)
+        c_true = ins.cbn_from_quaternion(truth.q_nb[row])
+        s = ins.init_state(np.full(n, truth.lat_rad[row]), truth.lon_rad[row], truth.h_m[row], truth.v_ned[row],
+                           c_true)
+        P0 = self.initial_covariance()
+        sd = np.sqrt(np.diag(P0)[:9])
+        e = np.stack([sd * g.standard_normal(9) for g in rngs])  # INS errors after alignment + cruise
+        s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
+        runs = [_Run(self.filter.init(np.zeros(self.layout.n), P0), [], np.zeros(3), np.zeros(3)) for _ in rngs]
+        return s, runs
+
+    def loop_gains(self) -> vl.LoopGains | None:
+        """The INS damping-loop gains (None without a loop)."""
+        return self.nav.loop_gains()
+
+    def aid(
+        self,
+        s: ins.InsState,
+        runs: list[_Run],
+        t: float,
+        dt_epoch: float,
+        f_ned_mean: Array,
+        obs: Mapping[str, Any],
+    ) -> ins.InsState:
+        """One aiding epoch for every run: predict over dt_epoch, then each available measurement in turn.
+
+        f_ned_mean (N, 3): mean specific force over the interval (NED, m/s^2). obs: per-run observation
+        dicts made by `observations` (values with a leading run axis). Returns the INS state (changed only
+        with feedback).
+        """
+        lay = self.layout
+        gains = self.loop_gains()
+        noise = self.noise(obs.get("gnss_el"))
+        r_ins = ins.position_ecef(s)
+        for i, run in enumerate(runs):
+            F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
+                                noise, gains)
+            phi, qd = em.discretize(F, Qc, dt_epoch)
+            fs = self.filter.predict(run.fs, phi, qd)
+            for m in self._measurements(s, i, r_ins[i], fs, obs, t):
+                fs, st = self.filter.update(fs, m(fs.x))
+                run.statuses.append(st)
+            run.fs = fs
+        if self.nav.feedback:
+            s = self._feedback(s, runs)
+        return s
+
+    def _measurements(self, s: ins.InsState, i: int, r_ins: Array, fs: FilterState, obs: Mapping[str, Any],
+                      t: float) -> list[Callable[[Array], Any]]:
+        """Row builders for run i at this epoch (each takes the current x_hat: sequential relinearization)."""
+        lay = self.layout
+        lat, lon, h = float(s.lat_rad[i]), float(s.lon_rad[i]), float(s.h_m[i])
+        out: list[Callable[[Array], Any]] = []
+        if "baro_h" in obs and np.isfinite(obs["baro_h"][i]):
+            hb, sb = float(obs["baro_h"][i]), float(obs["baro_sigma"])
+            out.append(lambda x: meas.baro(lay, h, hb, sb, t))
+        if "radalt_h" in obs and np.isfinite(obs["radalt_h"][i]):
+            hr = float(obs["radalt_h"][i])
+            sr = float(np.sqrt((self.sensors.radalt.percent_sigma * hr) ** 2 + self.sensors.radalt.floor_m**2))
+            out.append(lambda x: meas.radalt(lay, x, lat, lon, h, hr, sr, self.terrain_h, t))
+        c_en = geo.c_ecef_to_ned(lat, lon)
+        if "gnss_rho" in obs:
+            rho, r_sv = obs["gnss_rho"][i], obs["gnss_rsv"]
+            bud = CODE_PRESETS[self.sensors.gnss.code]
+            sig = bud.code_noise_m if lay.has("gse") else obs["gnss_sigma"]
+            for k in np.flatnonzero(np.isfinite(rho)):
+                sk = float(sig if np.isscalar(sig) else sig[k])
+                out.append(lambda x, k=k, sk=sk: meas.pseudorange(lay, x, r_ins, c_en, r_sv[k], float(rho[k]), sk, t,
+                                                                  f"gps{k:02d}", sv=int(k) if lay.has("gse") else None))
+        if "pl_rho" in obs:
+            rho, r_pl = obs["pl_rho"][i], obs["pl_r"]
+            p = self.sensors.pseudolite
+            for k in np.flatnonzero(np.isfinite(rho)):
+                if lay.has("pmp"):
+                    sk = float(np.sqrt(p.code_noise_m**2 + p.survey_sigma_m**2))
+                else:
+                    sk = float(obs["pl_sigma"][k])
+                out.append(lambda x, k=k, sk=sk: meas.pseudorange(lay, x, r_ins, c_en, r_pl[k], float(rho[k]), sk, t,
+                                                                  f"pl{k}", pl=int(k) if lay.has("pmp") else None))
+        return out
+
+    def _feedback(self, s: ins.InsState, runs: list[_Run]) -> ins.InsState:
+        """Closed-loop correction: INS -= estimated nav error; bias estimates go to the increments; reset."""
+        lay = self.layout
+        x = np.stack([r.fs.x for r in runs])
+        s = ins.perturb(s, -x[:, 0:3], -x[:, 3:6], -x[:, 6:9])
+        for i, r in enumerate(runs):
+            r.bg_fb = r.bg_fb + x[i, lay.index["bg"]]
+            r.ba_fb = r.ba_fb + x[i, lay.index["ba"]]
+            xn = x[i].copy()
+            for g in ("dp", "dv", "psi", "bg", "ba"):
+                xn[lay.index[g]] = 0.0
+            r.fs = replace(r.fs, x=xn)
+        return s
+
+    def output(self, s: ins.InsState, runs: list[_Run]) -> tuple[ins.InsState, Array, Array]:
+        """Corrected solution (feed-forward: INS - x_hat) and each run's P (n, n) and x_hat (N, n)."""
+        x = np.stack([r.fs.x for r in runs])
+        P = np.stack([self.filter.covariance(r.fs) for r in runs])
+        return ins.perturb(s, -x[:, 0:3], -x[:, 3:6], -x[:, 6:9]), P, x
+
+    # --- over whole records ----------------------------------------------------------------------------------
+
+    @staticmethod
+    def observations(records: Mapping[str, Any], t: float, tol: float, batched: bool) -> dict[str, Any]:
+        """The measurements available at time t from full records (values with a leading run axis)."""
+        obs: dict[str, Any] = {}
+
+        def per_run(a: Array) -> Array:
+            return a if batched else a[None]
+
+        b = records.get("baro")
+        if b is not None and (j := _epoch_index(b.t_s, t, tol)) is not None:
+            h = per_run(b.h_baro_m)[:, j]
+            obs["baro_h"] = np.where(per_run(b.valid)[:, j], h, np.nan)
+            obs["baro_sigma"] = float(b.sigma_m[j])
+        r = records.get("radalt")
+        if r is not None and (j := _epoch_index(r.t_s, t, tol)) is not None:
+            obs["radalt_h"] = np.where(per_run(r.valid)[:, j], per_run(r.h_agl_m)[:, j], np.nan)
+        g = records.get("gnss")
+        if g is not None and (j := _epoch_index(g.t_s, t, tol)) is not None:
+            obs["gnss_rho"] = np.where(per_run(g.valid)[:, j], per_run(g.pseudorange_m)[:, j], np.nan)
+            obs["gnss_rsv"] = g.r_sv_ecef[j]
+            obs["gnss_sigma"] = g.sigma_m[j]
+            obs["gnss_el"] = g.elevation_rad[j]
+        p = records.get("pseudolite")
+        if p is not None and (j := _epoch_index(p.t_s, t, tol)) is not None:
+            obs["pl_rho"] = np.where(per_run(p.valid)[:, j], per_run(p.pseudorange_m)[:, j], np.nan)
+            obs["pl_r"] = p.r_pl_ecef
+            obs["pl_sigma"] = p.sigma_m[j]
+        return obs
+
+    def run(self, truth: Truth, records: Mapping[str, Any], rngs: np.random.Generator | list[np.random.Generator]
+            ) -> NavRun | list[NavRun]:
+        """Navigate over whole records (open loop: the truth is only read at row 0 and for the error history).
+
+        records: {"imu": ImuSamples, "baro": ..., ...} of one run (rngs a Generator) or of len(rngs) runs
+        (run axis first, rngs a list). Returns one NavRun, or a list.
+        """
+        batched = isinstance(rngs, list)
+        gens = rngs if batched else [rngs]
+        imu = records["imu"]
+        dth = imu.dtheta_body if batched else imu.dtheta_body[None]
+        dvb = imu.dv_body if batched else imu.dv_body[None]
+        m = dth.shape[1]
+        dt = float(imu.dt_s)
+        rate = 1.0 / dt
+        epoch_rows = max(1, int(round(rate / self.nav.aiding_rate_hz)))
+        s, runs = self.start(truth, gens)
+        n_runs = len(gens)
+        gains = self.loop_gains()
+        baro = records.get("baro")
+        hb_full = None
+        if gains is not None and baro is not None:
+            hb = baro.h_baro_m if batched else baro.h_baro_m[None]
+            # zero-order hold of the latest baro sample at each IMU interval start (truth rows 0 .. m-1)
+            idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
+            hb_full = hb[:, idx]
+        n_out = m + 1
+        lat = np.empty((n_runs, n_out))
+        lon = np.empty((n_runs, n_out))
+        hh = np.empty((n_runs, n_out))
+        vel = np.empty((n_runs, n_out, 3))
+        cbn = np.empty((n_runs, n_out, 3, 3))
+        ppos = np.empty((n_runs, n_out, 3, 3))
+        clk = np.full((n_runs, n_out), np.nan)
+        clk_sd = np.full((n_runs, n_out), np.nan)
+        t_ep, xs, pds, pnav, terr = [], [], [], [], []
+        lay = self.layout
+
+        def record(k: int, s: ins.InsState) -> tuple[ins.InsState, Array, Array]:
+            o, P, x = self.output(s, runs)
+            lat[:, k], lon[:, k], hh[:, k] = o.lat_rad, o.lon_rad, o.h_m
+            vel[:, k], cbn[:, k] = o.v_ned, o.c_bn
+            ppos[:, k] = P[:, 0:3, 0:3]
+            if lay.has("clk"):
+                clk[:, k] = x[:, lay.i("clk")]
+                clk_sd[:, k] = np.sqrt(P[:, lay.i("clk"), lay.i("clk")])
+            return o, P, x
+
+        record(0, s)
+        f_sum = np.zeros((n_runs, 3))
+        t_last = float(truth.t_s[0])
+        for j in range(m):
+            bg = np.stack([r.bg_fb for r in runs]) if self.nav.feedback else 0.0
+            ba = np.stack([r.ba_fb for r in runs]) if self.nav.feedback else 0.0
+            dth_j = dth[:, j] - bg * dt
+            dv_j = dvb[:, j] - ba * dt
+            f_sum += np.einsum("nij,nj->ni", s.c_bn, dv_j)
+            s = ins.step(s, dth_j, dv_j, dt, h_baro_m=None if hb_full is None else hb_full[:, j], loop=gains)
+            row = j + 1
+            t = float(truth.t_s[row])
+            if row % epoch_rows == 0:
+                obs = self.observations(records, t, 0.25 * dt, batched)
+                s = self.aid(s, runs, t, t - t_last, f_sum / (t - t_last), obs)
+                f_sum[:] = 0.0
+                t_last = t
+                o, P, x = record(row, s)
+                t_ep.append(t)
+                xs.append(x)
+                pds.append(np.diagonal(P, axis1=1, axis2=2))
+                pnav.append(P[:, 0:9, 0:9])
+                terr.append(self._true_error(o, truth, row))
+            else:
+                record(row, s)
+        results = []
+        for i, r in enumerate(runs):
+            sol = NavSolution(
+                t_s=np.asarray(truth.t_s[:n_out], dtype=float),
+                r_ecef=geo.geodetic_to_ecef(lat[i], lon[i], hh[i]),
+                v_ned=vel[i],
+                euler_rad=ins.euler_from_cbn(cbn[i]),
+                P_pos_ned=ppos[i],
+                clock_bias_m=clk[i],
+                clock_bias_sigma_m=clk_sd[i],
+            )
+            results.append(NavRun(
+                solution=sol, status=StatusLog.from_records(r.statuses), t_epoch_s=np.array(t_ep),
+                x=np.array([x[i] for x in xs]), P_diag=np.array([p[i] for p in pds]),
+                P_nav=np.array([p[i] for p in pnav]), true_error_nav=np.array([e[i] for e in terr]),
+                layout=lay,
+            ))
+        return results if batched else results[0]
+
+    @staticmethod
+    def _true_error(o: ins.InsState, truth: Truth, row: int) -> Array:
+        """(N, 9) output error (dp NED, dv, psi) against truth row `row`."""
+        dp = ins.position_error_ned(o.lat_rad, o.lon_rad, o.h_m, truth.lat_rad[row], truth.lon_rad[row],
+                                    truth.h_m[row])
+        dv = o.v_ned - truth.v_ned[row]
+        psi = ins.attitude_error(o.c_bn, ins.cbn_from_quaternion(truth.q_nb[row]))
+        return np.concatenate([dp, dv, psi], axis=-1)

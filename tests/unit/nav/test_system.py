@@ -1,0 +1,68 @@
+"""NavSystem over sensor records: exact sensors and no initial error give centimetre navigation; the
+status log and the NavSolution have the documented shapes; feedback and feed-forward agree."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from approachsim import geo, synthetic
+from approachsim.nav import ins
+from approachsim.nav.config import InitialError
+from approachsim.nav.system import NavSystem
+from approachsim.profile import load_profile
+from approachsim.seeding import stream
+from approachsim.sensors.suite import SensorSuite
+
+PROFILE = load_profile("profiles/default.toml")
+
+
+def _truth(duration_s=60.0):
+    return synthetic.glidepath_descent(PROFILE.runway.frame, rate_hz=20.0, start_distance_m=70.0 * duration_s,
+                                       ground_speed_mps=70.0)
+
+
+def _system(**nav_kw):
+    nav = NavSystem.from_profile(PROFILE)
+    return NavSystem.build(replace(nav.nav, **nav_kw), PROFILE.sensors, PROFILE.runway.frame, PROFILE.terrain)
+
+
+@pytest.mark.parametrize("feedback", [False, True])
+def test_noiseless_sensors_and_no_initial_error_stay_within_1cm(feedback):
+    truth = _truth()
+    recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=3, runs=0, noise=False)
+    nav = _system(initial_error=InitialError(0.0, 0.0, 0.0, 0.0), feedback=feedback)
+    run = nav.run(truth, recs, stream(3, 0, "nav"))
+    sol = run.solution
+    lat, lon, h = geo.ecef_to_geodetic(sol.r_ecef)
+    dp = ins.position_error_ned(lat, lon, h, truth.lat_rad, truth.lon_rad, truth.h_m)
+    assert np.max(np.linalg.norm(dp, axis=1)) < 0.01
+    assert np.max(np.linalg.norm(sol.v_ned - truth.v_ned, axis=1)) < 0.001
+    assert np.all(run.status.accepted)
+    assert np.max(np.abs(run.status.innovation)) < 0.01  # exact sensors: the INS predicts every measurement
+
+
+def test_solution_and_status_shapes_and_names():
+    truth = _truth(20.0)
+    recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=3, runs=0)
+    run = _system().run(truth, recs, stream(3, 0, "nav"))
+    n = len(truth)
+    assert run.solution.r_ecef.shape == (n, 3) and run.solution.P_pos_ned.shape == (n, 3, 3)
+    assert run.t_epoch_s.shape == (20,) and run.x.shape == (20, run.layout.n)
+    names = set(run.status.name)
+    assert "baro" in names and "radalt" in names and any(s.startswith("gps") for s in names)
+    # every status: S > 0 and the test ratio is nu^2 / S (not nu^2 * S)
+    np.testing.assert_allclose(run.status.test_ratio, run.status.innovation**2 / run.status.variance)
+    assert np.all(run.status.variance > 0)
+
+
+def test_batched_runs_equal_single_runs():
+    truth = _truth(10.0)
+    suite = SensorSuite.from_profile(PROFILE)
+    nav = _system()
+    both = nav.run(truth, suite.measure(truth, seed=5, runs=[0, 1]), [stream(5, r, "nav") for r in (0, 1)])
+    one = nav.run(truth, suite.measure(truth, seed=5, runs=1), stream(5, 1, "nav"))
+    np.testing.assert_allclose(both[1].solution.r_ecef, one.solution.r_ecef, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(both[1].x, one.x, rtol=1e-9, atol=1e-12)
