@@ -27,18 +27,21 @@ from approachsim.campaign.result import RunResult
 
 STAGES = (
     ("approachsim.flight.run", "Approach", "flight (JSBSim truth)"),
-    ("approachsim.nav.system", None, "navigation system"),
+    ("approachsim.sensors.suite", "SensorSuite", "sensor suite"),
+    ("approachsim.nav.system", "NavSystem", "navigation system"),
 )
 """(module, required attribute, what) of every stage the pipeline needs."""
+CLOSED_LOOP_STAGE = ("approachsim.nav.closed_loop", "NavSource", "closed-loop navigation source")
+"""The extra stage closed-loop mode needs."""
 
 
 class PipelineUnavailable(RuntimeError):
     """A stage of the per-run pipeline is not available in this installation (exit 1, not a user error)."""
 
 
-def require_stages() -> None:
-    """Raise PipelineUnavailable naming the first stage that cannot be imported."""
-    for mod, attr, what in STAGES:
+def require_stages(mode: str = "open") -> None:
+    """Raise PipelineUnavailable naming the first stage (of `mode`) that cannot be imported."""
+    for mod, attr, what in STAGES + ((CLOSED_LOOP_STAGE,) if mode == "closed" else ()):
         try:
             m = importlib.import_module(mod)
         except ImportError as e:
@@ -46,7 +49,7 @@ def require_stages() -> None:
                 f"the {what} stage ({mod}) is not available: {e}; cannot evaluate without it"
             ) from None
         if attr is not None and not hasattr(m, attr):
-            raise PipelineUnavailable(f"the {what} stage ({mod}) has no {attr}; cannot run the pipeline")
+            raise PipelineUnavailable(f"the {what} stage ({mod}) has no {attr} yet; cannot evaluate without it")
 
 
 @dataclass(frozen=True)
@@ -60,7 +63,7 @@ class PipelineSpec:
 
 def spec_for(profile: Any, mode: str) -> PipelineSpec:
     """The campaign functions of `mode` ("closed" or "open") for this profile (after require_stages)."""
-    require_stages()
+    require_stages(mode)
     size = profile.evaluation.flight_group
     if mode == "open":
         return PipelineSpec(open_loop_group, size, False)
@@ -86,17 +89,50 @@ def _approach(profile: Any) -> Any:
     return Approach(profile, stop_height_m=max(lowest_dh_ft - 20.0, 5.0) * units.FT)
 
 
-def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunResult]:
-    """Fly the group's truth once (turbulence of its first run), then sense, navigate and score each run."""
-    from approachsim.nav import system
+def _clock_truth(records: dict, k: int, t_s: Any) -> Any:
+    """Run k's true receiver clock bias on the truth time base (linear between GNSS samples), or None."""
+    import numpy as np
 
-    first = (runs[0] // profile.evaluation.flight_group) * profile.evaluation.flight_group
+    g = records.get("gnss")
+    if g is None:
+        g = records.get("pseudolite")
+    if g is None:
+        return None
+    return np.interp(t_s, g.t_s, np.asarray(g.clock_bias_m)[k])
+
+
+def _reached_all(profile: Any, flight: Any) -> str | None:
+    """None when the flight descended through every decision height, else why not."""
+    low = min(profile.evaluation.dh_ft.values())
+    if flight.lowest_height_ft < low:
+        return None
+    return (f"flight ended above the {low:g} ft decision height ({flight.termination}, "
+            f"lowest {flight.lowest_height_ft:.0f} ft)")
+
+
+def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunResult]:
+    """Fly the group's truth once (turbulence of its first run), then sense, navigate and score each run.
+
+    Sensors and filters run batched over the group's runs (run axis first); every run's noise comes from its
+    own streams (seed, run, name), so a run's result does not depend on which runs share its batch.
+    """
+    from approachsim.nav.system import NavSystem
+    from approachsim.seeding import stream
+    from approachsim.sensors.suite import SensorSuite
+
+    size = profile.evaluation.flight_group
+    first = (runs[0] // size) * size
     flight = _approach(profile).fly(seed=seed, run=first)
+    why = _reached_all(profile, flight)
+    if why is not None:
+        return [RunResult.failed(i, f"shared flight of runs {first}-{first + size - 1}: {why}") for i in runs]
+    truth = flight.truth
+    records = SensorSuite.from_profile(profile).measure(truth, seed=seed, runs=list(runs))
+    navruns = NavSystem.from_profile(profile).run(truth, records, [stream(seed, i, "nav") for i in runs])
     out = []
-    for i in runs:
+    for k, (i, nr) in enumerate(zip(runs, navruns, strict=True)):
         try:
-            nav, clock_true = system.navigate(profile, flight.truth, seed=seed, run=i)
-            out.append(_score(profile, i, flight.truth, nav, clock_true))
+            out.append(_score(profile, i, truth, nr.solution, _clock_truth(records, k, truth.t_s)))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out
@@ -104,16 +140,19 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
 
 def closed_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunResult]:
     """Each run flies on its own navigation solution; the aircraft is parsed once for the group."""
-    from approachsim.nav import system
+    from approachsim.nav import closed_loop
 
     approach = _approach(profile)
     out = []
     for i in runs:
         try:
-            source = system.closed_loop_source(profile, seed=seed, run=i)
+            source = closed_loop.NavSource.from_profile(profile, seed=seed, run=i)
             flight = approach.fly(seed=seed, run=i, nav_source=source)
-            nav, clock_true = source.solution(flight.truth)
-            out.append(_score(profile, i, flight.truth, nav, clock_true))
+            why = _reached_all(profile, flight)
+            if why is not None:
+                raise RuntimeError(why)
+            nav, records = source.result(flight.truth)
+            out.append(_score(profile, i, flight.truth, nav, _clock_truth(records, 0, flight.truth.t_s)))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out
