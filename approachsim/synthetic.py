@@ -25,8 +25,9 @@ How each is consistent (the contract an INS test can rely on; Groves 2nd ed. eq.
   relative to inertial space: w_ib_body = C_nb' (w_ie + w_en) (stationary: C_nb' w_ie, Earth rate).
 
 Both w_ib_body and f_body therefore vary only through lat and h (micro-rad/s and micro-g over an approach),
-so IMU increments formed from them (sensors/imu.py: trapezoid of samples k-1 and k) differ from the exact
-integral over the interval by O(dt^3 d2f/dt2), far below a millimetre of position over a 10 nmi approach.
+so the IMU's increments (sensors/imu.py: the sample at the start of each interval held over it) differ from
+the exact integral by dt^2/2 df/dt per step, which telescopes to dt/2 (f_end - f_start), nanometres per
+second of velocity over a 10 nmi approach.
 
 The atmosphere fields use the ISA troposphere with the given ISA deviation and sea-level pressure
 (sensors/atmosphere.py); airspeed_mps is the equivalent airspeed of the ground speed (still air);

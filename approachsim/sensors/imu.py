@@ -1,13 +1,18 @@
 """Strapdown IMU: gyro and accelerometer triads delivering angle and velocity increments at the truth rate.
 
 Increment definition (the contract the INS matches): increment k (k = 1 .. n-1) covers (t_{k-1}, t_k] and is
-formed from truth samples k-1 and k by the trapezoid rule of the body-axis rate and specific force,
+the body-axis rate and specific force of truth sample k-1 held over the interval,
 
-    dtheta_true_k = dt/2 (w_ib_body[k-1] + w_ib_body[k]),   dv_true_k = dt/2 (f_body[k-1] + f_body[k]),
+    dtheta_true_k = dt w_ib_body[k-1],      dv_true_k = dt f_body[k-1],
 
-i.e. the exact integral of the piecewise-linear interpolation of the body-axis samples (no coning or
-sculling terms: the truth gives no information between samples). The record's sample j is increment
-k = j + 1 (t_s = truth.t_s[1:]).
+which is the Truth's own sampling convention (flight/truthfile.py: "f_body[k] and w_ib_body[k] are the
+specific force and inertial rate that carry the state from row k to row k+1, constant over the step"), so
+the increments are exact for the JSBSim truth: a body rate constant in body axes over the step rotates the
+body by exactly dtheta, and the INS's sculling term (1/2 dtheta x dv) accounts for the rotation of a
+constant body-axis specific force. (For the synthetic truth, whose rates are exact at each sample and vary
+by micro-units over an approach, the hold differs from the exact integral by dt^2/2 df/dt per step, which
+telescopes to dt/2 (f_end - f_start) in velocity: nanometres per second.) The record's sample j is
+increment k = j + 1 (t_s = truth.t_s[1:]).
 
 Error model per axis (gyro shown; accelerometer the same with its own parameters), 1-sigma from the grade:
 
@@ -37,15 +42,14 @@ Array = np.ndarray
 _OFFDIAG = [(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)]
 
 
-def trapezoid_increments(truth: Truth, rows: Array) -> tuple[Array, Array, float]:
-    """True (dtheta, dv) (m, 3) for the intervals ending at truth `rows` (each >= 1), and dt (s)."""
+def true_increments(truth: Truth, rows: Array) -> tuple[Array, Array, float]:
+    """Exact (dtheta, dv) (m, 3) of the intervals ending at truth `rows` (each >= 1), and dt (s).
+
+    dtheta = dt w_ib_body[row - 1], dv = dt f_body[row - 1] (the module docstring says why).
+    """
     rows = np.asarray(rows)
     dt = float(truth.t_s[1] - truth.t_s[0])
-    w = truth.w_ib_body
-    f = truth.f_body
-    dth = 0.5 * dt * (w[rows - 1] + w[rows])
-    dv = 0.5 * dt * (f[rows - 1] + f[rows])
-    return dth, dv, dt
+    return dt * truth.w_ib_body[rows - 1], dt * truth.f_body[rows - 1], dt
 
 
 def _matrix(diag: Array, off: Array) -> Array:
@@ -90,7 +94,7 @@ class Imu:
 
     def apply(self, truth: Truth, errors: base.SensorErrors) -> ImuSamples:
         """Increments for the samples in `errors` (truth rows errors.rows and the rows before them)."""
-        dth_t, dv_t, dt = trapezoid_increments(truth, errors.rows)
+        dth_t, dv_t, dt = true_increments(truth, errors.rows)
         s, k = errors.series, errors.constants
         lead = (slice(None),) if errors.batched else ()
         gm = k["gyro_m"][lead + (None,)] if errors.batched else k["gyro_m"]
@@ -110,7 +114,7 @@ class Imu:
         )
 
     def measure(self, truth: Truth, rng: base.RngLike, *, noise: bool = True) -> ImuSamples:
-        """apply(truth, draw(truth.t_s, rng)); noise=False gives the exact trapezoid increments."""
+        """apply(truth, draw(truth.t_s, rng)); noise=False gives the exact increments."""
         e = self.draw(truth.t_s, rng)
         return self.apply(truth, e if noise else e.zeroed())
 
