@@ -43,6 +43,9 @@ class MonitorConfig:
     p_chi2: float = 1e-4
     p_f: float = 1e-5
     window: int = 50
+    centered: bool = True
+    """True: the paper's sample variance about the window mean (sees variance growth); False: the mean square
+    of the normalized residuals, sum b_k^2 / n ~ chi^2(n) / n (also sees a slowly growing bias)."""
 
     def __post_init__(self) -> None:
         for name in ("p_chi2", "p_f"):
@@ -59,13 +62,14 @@ class MonitorConfig:
 
     @property
     def eta2(self) -> float:
-        """Tolerance eta^2 of F over a full window (chi^2(N-1)/(N-1) quantile)."""
-        n = self.window - 1
+        """Tolerance eta^2 of F over a full window (chi^2(N-1)/(N-1) quantile; chi^2(N)/N when not centered)."""
+        n = self.window - (1 if self.centered else 0)
         return float(stats.chi2.isf(self.p_f, n) / n)
 
     def eta2_for(self, n_valid: Array) -> Array:
-        """eta^2 for windows holding n_valid residuals (outliers left out): chi^2(n-1)/(n-1) quantiles."""
-        dof = np.maximum(np.asarray(n_valid) - 1, 1)
+        """eta^2 for windows holding n_valid residuals (outliers left out): chi^2(n-1)/(n-1) quantiles
+        (chi^2(n)/n when not centered)."""
+        dof = np.maximum(np.asarray(n_valid) - (1 if self.centered else 0), 1)
         return stats.chi2.isf(self.p_f, dof) / dof
 
 
@@ -73,9 +77,12 @@ def _f_ratio(win: Array, config: MonitorConfig) -> tuple[Array, Array]:
     """F (sample variance of the normalized residuals in each window, nan = left out) and its tolerance."""
     n_valid = np.sum(np.isfinite(win), axis=-1)
     with np.errstate(invalid="ignore", divide="ignore"):
-        mean = np.nansum(win, axis=-1) / n_valid
-        ss = np.nansum((win - mean[..., None]) ** 2, axis=-1)
-        f = np.where(n_valid >= 3, ss / np.maximum(n_valid - 1, 1), np.nan)  # F = sum (b_k - b_bar)^2 / (n - 1)
+        if config.centered:
+            mean = np.nansum(win, axis=-1) / n_valid
+            ss = np.nansum((win - mean[..., None]) ** 2, axis=-1)
+            f = np.where(n_valid >= 3, ss / np.maximum(n_valid - 1, 1), np.nan)  # F = sum (b_k - b_bar)^2 / (n-1)
+        else:
+            f = np.where(n_valid >= 3, np.nansum(win**2, axis=-1) / n_valid, np.nan)  # F = sum b_k^2 / n
     return f, config.eta2_for(n_valid)
 
 

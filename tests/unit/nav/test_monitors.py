@@ -83,3 +83,17 @@ def test_score_counts_detections_false_alarms_and_time_to_detect() -> None:
     np.testing.assert_allclose(sc.time_to_detect_s, [2.0])
     events = mon.failure_events(decision[0], t, "gyro-y")
     assert events == [mon.MonitorEvent("gyro-y", 6, 6.0, "failure")]
+
+
+def test_centered_f_misses_a_bias_that_the_mean_square_f_sees() -> None:
+    """The paper's F removes the window mean, so a constant bias of 1.5 sigma is invisible to it; the mean-square
+    variant (centered=False) flags it."""
+    rng = np.random.default_rng(5)
+    n = 400
+    S = np.ones(n)
+    v = rng.standard_normal(n) + np.where(np.arange(n) >= 200, 1.5, 0.0)
+    paper = mon.monitor(v, S, mon.MonitorConfig(centered=True))
+    square = mon.monitor(v, S, mon.MonitorConfig(centered=False))
+    assert not np.any(paper.decision[260:] == mon.FAILURE)
+    assert np.all(square.decision[260:] == mon.FAILURE)
+    assert not np.any(square.decision[:200] == mon.FAILURE)

@@ -65,3 +65,13 @@ def test_reproduce_writes_claims_numbers_and_figures(tmp_path: Path) -> None:
     assert "Finding" in (tmp_path / "chernodarov.md").read_text()
     for name in ("chernodarov_fig1.png", "chernodarov_fig2.png", "chernodarov_fig4.png", "chernodarov_nees.png"):
         assert (tmp_path / name).stat().st_size > 1000
+
+
+def test_bias_ramp_is_seen_only_by_the_mean_square_f() -> None:
+    """Finding of the note: with a bias ramp of 0.1 sigma/s the paper's centered F detects nothing, the
+    mean-square F detects it in every run."""
+    rows = {r["centered_F"]: r for r in ch.bias_ramp_study(ch.ChernodarovParams(), seed=3, runs=30)
+            if r["bias_rate_sigma_per_s"] == 0.1}
+    assert rows[True]["failure_detection_rate"] <= 0.1
+    assert rows[False]["failure_detection_rate"] >= 0.95
+    assert rows[False]["false_alarm_rate_per_epoch"] <= 1e-3
