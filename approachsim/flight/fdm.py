@@ -16,11 +16,10 @@ computes forces and accelerations at the new state). The sampled specific force 
 are therefore the ones that carry the state from row k to row k+1: an IMU model and a strapdown integrator
 see exactly what the aircraft did. Euler at 1/120 s is well inside the accuracy of the aerodynamic model.
 
-Turbulence: the profile's level maps to JSBSim's MIL-F-8785C (Dryden, `atmosphere/turb-type` 3) with the
-wind speed at 20 ft and the probability-of-exceedance index of FGWinds' documentation and MIL-F-8785C
-fig. 7 (low altitude: W20 = 15, 30, 45 kt for light, moderate, severe):
-
-    none: off; light: W20 25 ft/s, index 3 (1e-2); moderate: 50 ft/s, index 4 (1e-3); severe: 75 ft/s, index 6 (1e-5)
+Turbulence: JSBSim's own model is off (its MIL-F-8785C altitude dependence uses the altitude above sea
+level); approachsim.flight.turbulence computes it at the height above terrain and writes it every step to
+JSBSim's user gust atmosphere/gust-{north,east,down}-fps, which JSBSim adds to the wind (writes to
+atmosphere/turb-*-fps do not stick in 1.3.3 when its own model is off).
 """
 
 from __future__ import annotations
@@ -33,14 +32,6 @@ import numpy as np
 
 from approachsim import units
 from approachsim.flight.design import Linearization
-
-TURBULENCE_MILSPEC = {
-    "none": None,
-    "light": (25.0, 3),
-    "moderate": (50.0, 4),
-    "severe": (75.0, 6),
-}
-"""Profile turbulence level -> (MIL-F-8785C wind speed at 20 ft AGL, ft/s; probability-of-exceedance index)."""
 
 INTEGRATOR_RECT_EULER = 1
 """JSBSim's FGPropagate integrator code for rectangular Euler."""
@@ -117,17 +108,22 @@ class FDM:
         self._fdm["atmosphere/delta-T"] = isa_dev_k * RANKINE_PER_K
         self._fdm["atmosphere/P-sl-psf"] = sl_pressure_pa / units.PSF
 
-    def set_turbulence(self, level: str, seed: int) -> None:
-        """Milspec (Dryden) turbulence at the profile's level; seed the instance's random generator."""
+    def set_seed(self, seed: int) -> None:
+        """Seed this instance's random generator (simulation/randomseed), for any JSBSim-side randomness."""
         self._fdm["simulation/randomseed"] = int(seed)
-        spec = TURBULENCE_MILSPEC[level]
-        if spec is None:
-            self._fdm["atmosphere/turb-type"] = 0
-            return
-        w20_fps, index = spec
-        self._fdm["atmosphere/turb-type"] = 3
-        self._fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = w20_fps
-        self._fdm["atmosphere/turbulence/milspec/severity"] = index
+
+    def turbulence_setters(self):
+        """Setters (m/s) of the turbulence velocity JSBSim adds to the wind, NED (its user gust); JSBSim's own
+        turbulence model is switched off."""
+        self._fdm["atmosphere/turb-type"] = 0
+        nodes = [self.node(f"atmosphere/gust-{c}-fps") for c in ("north", "east", "down")]
+        fps = units.FPS
+
+        def setter(node):
+            set_value = node.set_double_value
+            return lambda v: set_value(v / fps)
+
+        return tuple(setter(n) for n in nodes)
 
     def initialize_and_trim(self, ic: InitialCondition) -> None:
         """Set the initial conditions, start the engines, trim (full, mode 1) and take the settling step.

@@ -37,9 +37,10 @@ from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import Linearization
 from approachsim.flight.fdm import FDM
 from approachsim.flight.trim import start_condition
+from approachsim.flight.turbulence import DrydenTurbulence
 from approachsim.profile import Profile
 from approachsim.records import NavigationSource, Truth
-from approachsim.seeding import stream_int
+from approachsim.seeding import stream, stream_int
 
 Array = np.ndarray
 
@@ -68,7 +69,7 @@ _READ = (
     "accelerations/pidot-rad_sec2", "accelerations/qidot-rad_sec2", "accelerations/ridot-rad_sec2",
     "forces/fbx-total-lbs", "forces/fby-total-lbs", "forces/fbz-total-lbs", "inertia/mass-slugs",
     "atmosphere/P-psf", "atmosphere/T-R", "velocities/vc-kts", "aero/beta-rad",
-    "gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW",
+    "gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW", "velocities/vtrue-fps",
 )
 
 
@@ -103,7 +104,7 @@ class FlightResult:
     seed: int
     run: int
     turbulence_seed: int
-    """The simulation/randomseed JSBSim used."""
+    """The simulation/randomseed JSBSim used (the turbulence itself comes from the run's "turbulence" stream)."""
 
     def reached(self, height_ft: float) -> bool:
         """True when the aircraft descended to height_ft above the threshold."""
@@ -145,12 +146,19 @@ class Approach:
         fdm = FDM(ac.jsbsim_model, dt)
         fdm.initialize_and_trim(ic)
         turb_seed = stream_int(seed, run, "turbulence")
-        fdm.set_turbulence(prof.environment.turbulence, turb_seed)
+        fdm.set_seed(turb_seed)
 
         # time budget: twice the still-air time to the threshold, at least 60 s
         if max_time_s is None:
             max_time_s = max(60.0, 2.0 * rw.start_distance_m / ac.approach_speed_mps)
         n_max = int(math.ceil(max_time_s / dt)) + 1
+        env = prof.environment
+        turb = None
+        if env.turbulence != "none":
+            turb = DrydenTurbulence(env.turbulence, stream(seed, run, "turbulence"), n_max, dt,
+                                    env.wind_from_rad + math.pi)
+            set_tn, set_te, set_td = fdm.turbulence_setters()
+            turb_step = turb.step
         buf = np.full((n_max, _NCOL), np.nan)
         gbuf = np.full((n_max, 6), np.nan)
         truth = _truth_views(buf, rw.frame)
@@ -204,7 +212,7 @@ class Approach:
             if k > 0:
                 run_step()
             (lat, lon, h_ft, vn_f, ve_f, vd_f, phi, th, psi, pi_, qi, ri, p, q, r, pid, qid, rid,
-             fx, fy, fz, m, p_psf, t_r, vc_kt, beta, w0, w1, w2) = [gv() for gv in getters]
+             fx, fy, fz, m, p_psf, t_r, vc_kt, beta, w0, w1, w2, vt_fps) = [gv() for gv in getters]
             h = h_ft * FT
             # body -> NED direction cosines from the Euler angles
             sf, cf, st, ct, sp, cp = sin(phi), cos(phi), sin(th), cos(th), sin(psi), cos(psi)
@@ -242,6 +250,11 @@ class Approach:
             else:
                 terr = float(np.interp(xr, terrain.along_m, terrain.height_m))
                 set_terrain(terr / FT)
+            if turb is not None:  # turbulence for the next step, at the CG's height above the terrain
+                tn, te, td = turb_step(k, h - terr, vt_fps * FPS)
+                set_tn(tn)
+                set_te(te)
+                set_td(td)
             # body -> NED quaternion (scalar first) from the Euler angles
             s1, c1 = sin(0.5 * phi), cos(0.5 * phi)
             s2, c2 = sin(0.5 * th), cos(0.5 * th)

@@ -70,8 +70,11 @@ def test_hot_high_crosswind_reaches_50_ft():
     assert s["lateral_rms_ft"] <= 20.0
     # 15 kt direct crosswind: the aircraft crabs (heading off the runway heading by ~6 deg into the wind)
     sel = r.truth.r_rwy[:, 2] < 1000 * units.FT
-    crab = np.degrees(np.mean(r.truth.euler_rad[sel, 2]))
-    assert -9.0 < crab < -3.0  # wind from the left (west) of a north runway: nose left
+    psi = r.truth.euler_rad[sel, 2] - profile.runway.heading_rad
+    crab = np.degrees(np.angle(np.mean(np.exp(1j * psi))))
+    tas = np.mean(r.truth.airspeed_mps[sel]) * 1.1  # 5434 ft, ISA +20: TAS about 1.1 CAS
+    # wind from the left (west) of a north runway: nose left by about asin(crosswind / TAS) = 5 deg
+    assert crab == pytest.approx(-np.degrees(np.arcsin(profile.environment.wind_speed_mps / tas)), abs=1.5)
 
 
 class _BiasedSource:

@@ -1,0 +1,110 @@
+"""MIL-F-8785C Dryden turbulence evaluated at the height above the terrain, stepped once per JSBSim step.
+
+Why not JSBSim's own milspec model: JSBSim 1.3.3 evaluates the MIL-F-8785C altitude dependence with the
+altitude above sea level (FGWinds::Run calls Turbulence(in.AltitudeASL)), so at a 5434 ft runway an aircraft
+700 ft above the ground gets the high-altitude intensities of the probability-of-exceedance table: measured
+std 4.7 / 6.0 / 4.5 ft/s (north, east, down) against 2.4 / 2.9 / 2.0 ft/s at a sea-level runway, same level,
+same height above ground. MIL-F-8785C defines the low-altitude model in height above ground. This module is
+JSBSim's milspec discretization (Yeager 1998, NASA CR-1998-206937, eqs. 30-32, the MIL-STD-1797A forms),
+with JSBSim's scale lengths and intensities (MIL-F-8785C sec. 3.7.2, figs. 7, 10, 11), evaluated at the
+height above the profile's terrain. The turbulence velocity is written to JSBSim's user gust atmosphere/gust-*-fps,
+which JSBSim adds to the wind (its own turbulence is switched off); JSBSim's experimental turbulence body rates (Yeager eqs. 33-35)
+are not reproduced (read-only in JSBSim), so gust rates act through the gust velocities only.
+
+Levels (MIL-F-8785C fig. 7 and FGWinds' documentation): wind speed at 20 ft and probability-of-exceedance
+index: light 25 ft/s (15 kt), index 3 (1e-2); moderate 50 ft/s (30 kt), index 4 (1e-3); severe 75 ft/s
+(45 kt), index 6 (1e-5).
+
+Heights, lengths and speeds are in feet and ft/s here, as in the standard's formulas; the module converts at
+its boundary (step() takes and returns SI).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from approachsim import units
+
+LEVELS = {
+    "none": None,
+    "light": (25.0, 3),
+    "moderate": (50.0, 4),
+    "severe": (75.0, 6),
+}
+"""Profile turbulence level -> (MIL-F-8785C wind speed at 20 ft, ft/s; probability-of-exceedance index)."""
+
+POE_ALT_FT = (500.0, 1750.0, 3750.0, 7500.0, 15000.0, 25000.0, 35000.0, 45000.0, 55000.0, 65000.0, 75000.0,
+              80000.0)
+"""Altitudes of the high-altitude intensity table, ft (MIL-F-8785C fig. 7)."""
+POE_SIGMA_FPS = (
+    (3.2, 2.2, 1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    (4.2, 3.6, 3.3, 1.6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    (6.6, 6.9, 7.4, 6.7, 4.6, 2.7, 0.4, 0.0, 0.0, 0.0, 0.0, 0.0),
+    (8.6, 9.6, 10.6, 10.1, 8.0, 6.6, 5.0, 4.2, 2.7, 0.0, 0.0, 0.0),
+    (11.8, 13.0, 16.0, 15.1, 11.6, 9.7, 8.1, 8.2, 7.9, 4.9, 3.2, 2.1),
+    (15.6, 17.6, 23.0, 23.6, 22.1, 20.0, 16.0, 15.1, 12.1, 7.9, 6.2, 5.1),
+    (18.7, 21.5, 28.4, 30.2, 30.7, 31.0, 25.2, 23.1, 17.5, 10.7, 8.4, 7.2),
+)
+"""High-altitude turbulence intensity sigma (ft/s) by probability-of-exceedance index 1..7 (rows) and altitude."""
+
+
+def scales(h_ft: float, w20_fps: float, index: int) -> tuple[float, float, float, float]:
+    """Scale lengths L_u, L_w (ft) and intensities sigma_u, sigma_w (ft/s) at height h_ft above ground.
+
+    Below 1000 ft: MIL-F-8785C low-altitude model (figs. 10, 11); above 2000 ft: L = 1750 ft and sigma from
+    the probability-of-exceedance table (fig. 7); linear in between (as JSBSim). Heights clipped at 10 ft.
+    """
+    h = max(h_ft, 10.0)
+    if h <= 1000.0:
+        den = 0.177 + 0.000823 * h
+        sig_w = 0.1 * w20_fps
+        return h / den**1.2, h, sig_w / den**0.4, sig_w
+    sig_hi = float(np.interp(h, POE_ALT_FT, POE_SIGMA_FPS[index - 1]))
+    if h <= 2000.0:
+        f = (h - 1000.0) / 1000.0
+        L = 1000.0 + f * 750.0
+        s = 0.1 * w20_fps + f * (sig_hi - 0.1 * w20_fps)
+        return L, L, s, s
+    return 1750.0, 1750.0, sig_hi, sig_hi
+
+
+class DrydenTurbulence:
+    """Turbulence velocity of one run, one step at a time (NED, m/s): u along the mean wind, v across it, w down.
+
+    The white-noise sequence is drawn up front from `rng` (the run's "turbulence" stream), so a run's
+    turbulence depends on nothing but its seed.
+    """
+
+    def __init__(self, level: str, rng: np.random.Generator, n_steps: int, dt_s: float, wind_to_rad: float) -> None:
+        spec = LEVELS[level]
+        if spec is None:
+            raise ValueError("DrydenTurbulence needs a turbulence level other than 'none'")
+        self.w20_fps, self.index = spec
+        self.dt = dt_s
+        self._nu = rng.standard_normal((n_steps, 3)).tolist()
+        self._c = math.cos(wind_to_rad)
+        self._s = math.sin(wind_to_rad)
+        self.xi_u = self.xi_v = self.xi_w = 0.0
+
+    def step(self, k: int, h_agl_m: float, v_true_mps: float) -> tuple[float, float, float]:
+        """Advance to step k at height h_agl_m above the terrain and true airspeed v_true_mps; NED m/s.
+
+        Yeager 1998 eqs. 30-32: xi_u' = (1 - T/tau_u) xi_u + sigma_u sqrt(2T/tau_u) nu_u, and the v, w
+        channels with 2T/tau, sqrt(4T/tau); tau = L / V.
+        """
+        L_u, L_w, sig_u, sig_w = scales(h_agl_m / units.FT, self.w20_fps, self.index)
+        V = max(v_true_mps / units.FPS, 1.0)
+        T = self.dt
+        tu = L_u / V
+        tw = L_w / V
+        nu_u, nu_v, nu_w = self._nu[k]
+        self.xi_u = (1.0 - T / tu) * self.xi_u + sig_u * math.sqrt(2.0 * T / tu) * nu_u
+        self.xi_v = (1.0 - 2.0 * T / tu) * self.xi_v + sig_u * math.sqrt(4.0 * T / tu) * nu_v
+        self.xi_w = (1.0 - 2.0 * T / tw) * self.xi_w + sig_w * math.sqrt(4.0 * T / tw) * nu_w
+        c, s = self._c, self._s
+        # rotate from wind axes (u along the direction the wind blows to) to NED, as JSBSim does
+        return ((c * self.xi_u - s * self.xi_v) * units.FPS,
+                (s * self.xi_u + c * self.xi_v) * units.FPS,
+                self.xi_w * units.FPS)
