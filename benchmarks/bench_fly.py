@@ -44,7 +44,8 @@ def main() -> None:
             step()
         raw_s.append(time.perf_counter() - t0)
     fly, raw = statistics.median(fly_s), statistics.median(raw_s)
-    print(f"profile {profile.name}: {n} steps at {profile.rates.imu_hz:g} Hz = {n / profile.rates.imu_hz:.1f} s of flight")
+    hz = profile.rates.imu_hz
+    print(f"profile {profile.name}: {n} steps at {hz:g} Hz = {n / hz:.1f} s of flight")
     print(f"approach (FDM build + trim + closed loop + truth): median {fly:.3f} s  ({fly / n * 1e6:.1f} us/step, "
           f"{n / profile.rates.imu_hz / fly:.0f}x real time)")
     print(f"raw JSBSim (trim + run() only):                     median {raw:.3f} s  ({raw / n * 1e6:.1f} us/step)")

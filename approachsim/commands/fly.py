@@ -65,5 +65,6 @@ def run(args: argparse.Namespace) -> int:
         f"  1000-200 ft: vertical RMS {stats['vertical_rms_ft']:.2f} ft, lateral RMS {stats['lateral_rms_ft']:.2f} ft, "
         f"CAS {stats['cas_min_kt']:.1f}-{stats['cas_max_kt']:.1f} kt"
     )
-    print(f"  wrote {args.out / 'truth.npz'} (+ truth.json schema, flight.json{'' if args.no_figures else ', figures'})")
+    extra = "" if args.no_figures else ", figures"
+    print(f"  wrote {args.out / 'truth.npz'} (+ truth.json schema, flight.json{extra})")
     return 0

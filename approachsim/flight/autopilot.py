@@ -12,7 +12,7 @@ linearization approachsim.flight.design checks loop at a time (gains from the ai
     y, y' = cross-track deviation (m, + right) and its rate
     phi_c = -(k_loc_p y + k_loc_d y' + k_loc_i int y)              limited to +- bank_limit
     da  = k_phi (phi_c - phi) - k_p p                              aileron
-    dr  = -k_beta beta                                             rudder (crab into the wind; the FCS adds its yaw damper)
+    dr  = -k_beta beta                                             rudder (crab into the wind; FCS adds a yaw damper)
 
 Sign conventions of the 737 FCS: + elevator = nose down, + aileron = roll right, + rudder = nose left.
 Everything is plain float arithmetic: it runs once per JSBSim step.

@@ -86,7 +86,8 @@ class Linearization:
     """The FGLinearization of the trimmed aircraft (JSBSim units, as JSBSim gives them) and its trim point."""
 
     A: Array
-    """(12, 12) system matrix, states Vt (ft/s), alpha, theta, q, beta, phi, p, psi, r (rad, rad/s), lat, lon, alt (ft)."""
+    """(12, 12) system matrix, states Vt (ft/s), alpha, theta, q, beta, phi, p, psi, r (rad, rad/s), lat, lon,
+    alt (ft)."""
     B: Array
     """(12, 4) input matrix, inputs throttle, aileron, elevator, rudder commands (normalized)."""
     vt_mps: float

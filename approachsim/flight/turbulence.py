@@ -7,9 +7,10 @@ std 4.7 / 6.0 / 4.5 ft/s (north, east, down) against 2.4 / 2.9 / 2.0 ft/s at a s
 same height above ground. MIL-F-8785C defines the low-altitude model in height above ground. This module is
 JSBSim's milspec discretization (Yeager 1998, NASA CR-1998-206937, eqs. 30-32, the MIL-STD-1797A forms),
 with JSBSim's scale lengths and intensities (MIL-F-8785C sec. 3.7.2, figs. 7, 10, 11), evaluated at the
-height above the profile's terrain. The turbulence velocity is written to JSBSim's user gust atmosphere/gust-*-fps,
-which JSBSim adds to the wind (its own turbulence is switched off); JSBSim's experimental turbulence body rates (Yeager eqs. 33-35)
-are not reproduced (read-only in JSBSim), so gust rates act through the gust velocities only.
+height above the profile's terrain. The turbulence velocity is written to JSBSim's user gust
+atmosphere/gust-*-fps, which JSBSim adds to the wind (its own turbulence is switched off); JSBSim's
+experimental turbulence body rates (Yeager eqs. 33-35) are not reproduced (read-only in JSBSim), so the
+gusts act through the gust velocities only.
 
 Levels (MIL-F-8785C fig. 7 and FGWinds' documentation): wind speed at 20 ft and probability-of-exceedance
 index: light 25 ft/s (15 kt), index 3 (1e-2); moderate 50 ft/s (30 kt), index 4 (1e-3); severe 75 ft/s

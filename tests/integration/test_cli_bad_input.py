@@ -24,7 +24,8 @@ CASES = [
     # (id, profile text, text the one-line message must contain)
     ("glidepath-zero", _edit("glidepath_deg = 3.0", "glidepath_deg = 0.0"), "runway.glidepath_deg"),
     ("glidepath-15", _edit("glidepath_deg = 3.0", "glidepath_deg = 15.0"), "runway.glidepath_deg"),
-    ("start-beyond-30nmi", _edit("start_distance_nmi = 10.0", "start_distance_nmi = 31.0"), "runway.start_distance_nmi"),
+    ("start-beyond-30nmi", _edit("start_distance_nmi = 10.0", "start_distance_nmi = 31.0"),
+     "runway.start_distance_nmi"),
     ("negative-speed", _edit('name = "737"', 'name = "737"\napproach_speed_kt = -140.0'), "aircraft.approach_speed_kt"),
     ("speed-string", _edit('name = "737"', 'name = "737"\napproach_speed_kt = "fast"'), "aircraft.approach_speed_kt"),
     ("latitude-string", _edit("threshold_lat_deg = 37.6117", 'threshold_lat_deg = "37N"'), "runway.threshold_lat_deg"),
