@@ -21,6 +21,7 @@ process robustly (influence function psi). `score` compares decisions with groun
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,6 +31,27 @@ Array = np.ndarray
 
 NONE, OUTLIER, FAILURE = 0, 1, 2
 """Decision / label codes per epoch."""
+
+FAULT_CLASS: dict[str, int] = {
+    "none": NONE, "outage": NONE,  # an outage gives no measurement: nothing to monitor
+    "spike": OUTLIER, "iam": OUTLIER,  # isolated abnormal samples
+    "cbm": FAILURE, "mni": FAILURE, "step": FAILURE, "ramp": FAILURE,  # persistent or gradual failures
+}
+"""What the monitors should decide for each sensor fault kind (sensors/faults.py kinds)."""
+
+
+def labels_from_fault_codes(codes: Array, fault_codes: Mapping[str, int]) -> Array:
+    """Ground-truth labels (NONE / OUTLIER / FAILURE) from a sensor record's `fault` codes, given the
+    kind -> code table of the sensor fault injector (sensors.faults.FAULT_CODES). Unknown codes: ValueError."""
+    codes = np.asarray(codes)
+    out = np.full(codes.shape, -1, dtype=int)
+    for kind, code in fault_codes.items():
+        if kind not in FAULT_CLASS:
+            raise ValueError(f"fault kind {kind!r}: no monitor class (known: {', '.join(FAULT_CLASS)})")
+        out[codes == code] = FAULT_CLASS[kind]
+    if np.any(out < 0):
+        raise ValueError(f"fault codes {sorted(set(codes[out < 0].tolist()))}: not in the fault table")
+    return out
 
 
 @dataclass(frozen=True)

@@ -97,3 +97,14 @@ def test_centered_f_misses_a_bias_that_the_mean_square_f_sees() -> None:
     assert not np.any(paper.decision[260:] == mon.FAILURE)
     assert np.all(square.decision[260:] == mon.FAILURE)
     assert not np.any(square.decision[:200] == mon.FAILURE)
+
+
+def test_labels_from_the_sensor_fault_codes() -> None:
+    from approachsim.sensors.faults import FAULT_CODES
+
+    codes = np.array([FAULT_CODES[k] for k in ("none", "spike", "iam", "ramp", "mni", "outage", "step", "cbm")])
+    labels = mon.labels_from_fault_codes(codes, FAULT_CODES)
+    N, O, F = mon.NONE, mon.OUTLIER, mon.FAILURE
+    np.testing.assert_array_equal(labels, [N, O, O, F, F, N, F, F])
+    with pytest.raises(ValueError, match="99"):
+        mon.labels_from_fault_codes(np.array([99]), FAULT_CODES)

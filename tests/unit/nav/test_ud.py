@@ -216,3 +216,29 @@ def test_batched_kernels_equal_the_single_filter(kind: str) -> None:
     for i, s in enumerate(states):
         np.testing.assert_allclose(x[i], s.x, rtol=1e-10, atol=1e-12)
         np.testing.assert_allclose((U[i] * d[i]) @ U[i].T, f.covariance(s), rtol=1e-10, atol=1e-12)
+
+
+def test_ud_variants_run_inside_the_navigation_system_named_in_the_profile() -> None:
+    """Drop-in: the nav system built with filter = 'ud' gives the EKF's solution and covariance (only the
+    covariance storage differs); the robust variant runs and stays close on clean data."""
+    from dataclasses import replace
+
+    from approachsim import synthetic
+    from approachsim.nav.system import NavSystem
+    from approachsim.profile import load_profile
+    from approachsim.seeding import stream
+    from approachsim.sensors.suite import SensorSuite
+
+    profile = load_profile("profiles/default.toml")
+    truth = synthetic.glidepath_descent(profile.runway.frame, rate_hz=20.0, start_distance_m=70.0 * 20,
+                                        ground_speed_mps=70.0)
+    recs = SensorSuite.from_profile(profile).measure(truth, seed=3, runs=0)
+    base = NavSystem.from_profile(profile).nav
+    sols = {}
+    for name in ("ekf", "ud", "robust-ud-gauss-laplace"):
+        system = NavSystem.build(replace(base, filter=name), profile.sensors, profile.runway.frame, profile.terrain)
+        sols[name] = system.run(truth, recs, stream(3, 0, "nav")).solution
+    scale = np.max(np.abs(sols["ekf"].P_pos_ned))
+    assert np.max(np.abs(sols["ud"].P_pos_ned - sols["ekf"].P_pos_ned)) < 1e-9 * scale
+    np.testing.assert_allclose(sols["ud"].r_ecef, sols["ekf"].r_ecef, rtol=0, atol=1e-6)
+    assert np.max(np.abs(sols["robust-ud-gauss-laplace"].r_ecef - sols["ekf"].r_ecef)) < 5.0
