@@ -62,3 +62,31 @@ def test_missing_navigation_stage_exits_1_with_one_line(tmp_path):
     assert p.stderr.count("\n") == 1 and "navigation system" in p.stderr, p.stderr
     assert p.stdout == ""
     assert not (tmp_path / "o" / "summary.json").exists()
+
+
+@pytest.mark.slow
+def test_open_loop_evaluation_end_to_end(tmp_path, capsys):
+    """The real pipeline (JSBSim truth, sensor suite, INS + filter, scoring) on 2 open-loop runs."""
+    import json
+
+    from approachsim.campaign.pipeline import PipelineUnavailable, require_stages
+
+    try:
+        require_stages("open")
+    except PipelineUnavailable as e:
+        pytest.skip(str(e))
+    out = tmp_path / "ev"
+    code = main(["evaluate", DEFAULT, "--runs", "2", "--seed", "3", "--mode", "open", "--workers", "1",
+                 "--out", str(out)])
+    assert code == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert set(s) == {"schema", "profile", "runs", "seed", "closed_loop", "decision_heights", "best_category",
+                      "failed_runs"}
+    assert (s["profile"], s["runs"], s["seed"], s["closed_loop"], s["failed_runs"]) == ("default", 2, 3, False, 0)
+    for cat, e in s["decision_heights"].items():
+        # a GPS-aided INS is good to tens of feet at worst: finite, positive, far below a nonsense scale
+        assert 0.0 < e["lateral_1sigma_ft"] < 200.0 and 0.0 < e["vertical_1sigma_ft"] < 200.0, (cat, e)
+    printed = capsys.readouterr().out
+    assert "best category:" in printed and "CAT III" in printed
+    assert (out / "report.html").is_file() and (out / "runs.parquet").is_file()
+    assert len(list((out / "series").glob("*.parquet"))) == 2
