@@ -56,6 +56,7 @@ def test_nees_bounds_are_the_chi2_quantiles() -> None:
     assert (lo, hi) == pytest.approx((1.627, 2.411), abs=1e-3)
 
 
+@pytest.mark.slow
 def test_reproduce_writes_claims_numbers_and_figures(tmp_path: Path) -> None:
     result = ch.reproduce(tmp_path, seed=5, runs=6)
     on_disk = json.loads((tmp_path / "chernodarov.json").read_text())

@@ -75,6 +75,7 @@ def test_printed_constant_gains_are_stable_but_not_eq5() -> None:
         assert np.all(vl.closed_loop_poles(p.gains(form)).real < 0)
 
 
+@pytest.mark.slow
 def test_reproduce_writes_the_tables_side_by_side(tmp_path: Path) -> None:
     result = sk.reproduce(tmp_path, seed=1, runs=4)
     on_disk = json.loads((tmp_path / "sokolovic.json").read_text())
