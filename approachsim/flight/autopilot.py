@@ -90,7 +90,14 @@ class Autopilot:
         body rates (rad/s), sideslip (rad), calibrated airspeed (m/s) -> elevator, aileron, rudder, throttle."""
         g = self.g
         dt = self.dt
-        d, d_dot, y, y_dot = self.deviations(x, y, z, vn, ve, vd)
+        # deviations (as deviations(), inlined: this runs every step)
+        ch, sh = self._ch, self._sh
+        conv = (x * sh + y * ch) * self._conv_per_east_m
+        x0 = vn * ch + ve * sh
+        y0 = -vn * sh + ve * ch
+        d = z - (self._tch - x * self._tan_gp)
+        d_dot = -vd + (x0 + conv * y0) * self._tan_gp
+        y_dot = y0 - conv * x0
         # glidepath -> pitch command (integral frozen while the command is limited)
         th_off = -(g.k_gs_p * d + g.k_gs_d * d_dot + g.k_gs_i * self.int_d)
         lim = g.pitch_limit_rad

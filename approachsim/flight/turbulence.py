@@ -22,6 +22,7 @@ its boundary (step() takes and returns SI).
 
 from __future__ import annotations
 
+import bisect
 import math
 
 import numpy as np
@@ -62,13 +63,28 @@ def scales(h_ft: float, w20_fps: float, index: int) -> tuple[float, float, float
         den = 0.177 + 0.000823 * h
         sig_w = 0.1 * w20_fps
         return h / den**1.2, h, sig_w / den**0.4, sig_w
-    sig_hi = float(np.interp(h, POE_ALT_FT, POE_SIGMA_FPS[index - 1]))
+    sig_hi = _interp(h, POE_ALT_FT, POE_SIGMA_FPS[index - 1])
     if h <= 2000.0:
         f = (h - 1000.0) / 1000.0
         L = 1000.0 + f * 750.0
         s = 0.1 * w20_fps + f * (sig_hi - 0.1 * w20_fps)
         return L, L, s, s
     return 1750.0, 1750.0, sig_hi, sig_hi
+
+
+def _interp(x: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> float:
+    """Piecewise-linear interpolation held at the ends (numpy.interp for one float, without its overhead)."""
+    if x <= xs[0]:
+        return ys[0]
+    i = bisect.bisect_right(xs, x)
+    if i >= len(xs):
+        return ys[-1]
+    x0, x1 = xs[i - 1], xs[i]
+    return ys[i - 1] + (x - x0) / (x1 - x0) * (ys[i] - ys[i - 1])
+
+
+COEFF_EVERY = 12
+"""Steps between re-evaluations of the scale lengths and intensities."""
 
 
 class DrydenTurbulence:
@@ -85,27 +101,32 @@ class DrydenTurbulence:
         self.w20_fps, self.index = spec
         self.dt = dt_s
         self._nu = rng.standard_normal((n_steps, 3)).tolist()
-        self._c = math.cos(wind_to_rad)
-        self._s = math.sin(wind_to_rad)
+        self._cf = math.cos(wind_to_rad) * units.FPS
+        self._sf = math.sin(wind_to_rad) * units.FPS
+        self._coef: tuple[float, ...] | None = None
         self.xi_u = self.xi_v = self.xi_w = 0.0
+        """Turbulence state in wind axes, ft/s."""
 
     def step(self, k: int, h_agl_m: float, v_true_mps: float) -> tuple[float, float, float]:
         """Advance to step k at height h_agl_m above the terrain and true airspeed v_true_mps; NED m/s.
 
         Yeager 1998 eqs. 30-32: xi_u' = (1 - T/tau_u) xi_u + sigma_u sqrt(2T/tau_u) nu_u, and the v, w
-        channels with 2T/tau, sqrt(4T/tau); tau = L / V.
+        channels with 2T/tau, sqrt(4T/tau); tau = L / V. The coefficients are re-evaluated every
+        COEFF_EVERY steps (0.1 s at 120 Hz: the height changes by well under a metre in between).
         """
-        L_u, L_w, sig_u, sig_w = scales(h_agl_m / units.FT, self.w20_fps, self.index)
-        V = max(v_true_mps / units.FPS, 1.0)
-        T = self.dt
-        tu = L_u / V
-        tw = L_w / V
+        if k % COEFF_EVERY == 0 or self._coef is None:
+            L_u, L_w, sig_u, sig_w = scales(h_agl_m / units.FT, self.w20_fps, self.index)
+            V = max(v_true_mps / units.FPS, 1.0)
+            T = self.dt
+            tu = L_u / V
+            tw = L_w / V
+            self._coef = (1.0 - T / tu, sig_u * math.sqrt(2.0 * T / tu), 1.0 - 2.0 * T / tu,
+                          sig_u * math.sqrt(4.0 * T / tu), 1.0 - 2.0 * T / tw, sig_w * math.sqrt(4.0 * T / tw))
+        au, bu, av, bv, aw, bw = self._coef
         nu_u, nu_v, nu_w = self._nu[k]
-        self.xi_u = (1.0 - T / tu) * self.xi_u + sig_u * math.sqrt(2.0 * T / tu) * nu_u
-        self.xi_v = (1.0 - 2.0 * T / tu) * self.xi_v + sig_u * math.sqrt(4.0 * T / tu) * nu_v
-        self.xi_w = (1.0 - 2.0 * T / tw) * self.xi_w + sig_w * math.sqrt(4.0 * T / tw) * nu_w
-        c, s = self._c, self._s
-        # rotate from wind axes (u along the direction the wind blows to) to NED, as JSBSim does
-        return ((c * self.xi_u - s * self.xi_v) * units.FPS,
-                (s * self.xi_u + c * self.xi_v) * units.FPS,
-                self.xi_w * units.FPS)
+        xu = self.xi_u = au * self.xi_u + bu * nu_u
+        xv = self.xi_v = av * self.xi_v + bv * nu_v
+        xw = self.xi_w = aw * self.xi_w + bw * nu_w
+        c, s = self._cf, self._sf
+        # rotate from wind axes (u along the direction the wind blows to, v to its right) to NED
+        return c * xu - s * xv, s * xu + c * xv, xw * units.FPS
