@@ -22,6 +22,8 @@ class Truth:
 
     Kinematic quantities (position, velocity, specific force, rates) are those of the IMU location,
     which is what an IMU at that point senses; the runway-frame deviations are of the same point.
+    Sampling (flight stage): f_body[k] and w_ib_body[k] are the specific force and rate that carry the
+    state from row k to row k+1, constant over that step (approachsim/flight/fdm.py, docs/truth.md).
     """
 
     t_s: Array
