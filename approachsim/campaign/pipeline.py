@@ -10,10 +10,13 @@ Stages are used through their public entry points only:
 A stage that is not importable makes `require_stages` raise PipelineUnavailable (the CLI prints it and
 exits 1): numbers are never invented for a missing stage.
 
-Work sharing: the campaign runs fixed groups of consecutive runs (evaluation.flight_group) per task, so
-the aircraft is parsed and linearized once per group. Open loop: the truth of a group is flown once (on
-truth navigation, with the turbulence of the group's first run) and shared by every run of the group, each
-with its own sensor and filter noise. Closed loop: each run flies on its own navigation solution.
+Work sharing: runs come in fixed groups of consecutive runs (evaluation.flight_group); a task holds some
+runs of one group, and the aircraft is parsed and linearized once per task. Open loop: every run of a group
+navigates over the same truth, flown on truth navigation with the turbulence of the group's first run (a
+task flies it once; tasks of the same group fly the identical, seeded flight), each run with its own sensor
+and filter noise, batched over the task's runs. A run's numbers depend only on (seed, run, group size),
+not on the executor or the batch it shared (checked: NavSystem.run gives bit-identical runs in a batch of
+1 and of 6). Closed loop: each run flies on its own navigation solution.
 """
 
 from __future__ import annotations

@@ -106,16 +106,25 @@ class Progress:
 
 
 def plan_chunks(todo: Sequence[int], *, workers: int, group_size: int | None, per_task: int | None = None) -> list:
-    """Split the runs to do into tasks: whole fixed groups (g*size .. (g+1)*size-1) or balanced chunks."""
+    """Split the runs to do into tasks of consecutive runs, never crossing a group (g*size .. (g+1)*size-1).
+
+    Tasks hold per_task runs (default: enough for about 4 tasks per worker, at most 32, at most a group), so a
+    small campaign still uses every worker while a large one keeps whole groups together.
+    """
     todo = sorted(todo)
-    if group_size:
-        groups: dict[int, list[int]] = {}
-        for i in todo:
-            groups.setdefault(i // group_size, []).append(i)
-        return [groups[g] for g in sorted(groups)]
     if per_task is None:
         per_task = max(1, min(32, math.ceil(len(todo) / (4 * max(workers, 1)))))
-    return [todo[k : k + per_task] for k in range(0, len(todo), per_task)]
+        if group_size:
+            per_task = max(per_task, math.ceil(len(todo) / max(workers, 1)))
+    if group_size:
+        per_task = min(per_task, group_size)
+    chunks: list[list[int]] = []
+    for i in todo:
+        if chunks and len(chunks[-1]) < per_task and (not group_size or chunks[-1][0] // group_size == i // group_size):
+            chunks[-1].append(i)
+        else:
+            chunks.append([i])
+    return chunks
 
 
 def _local(tasks: list, workers: int, args: tuple) -> Iterator[list[RunResult]]:
@@ -203,6 +212,7 @@ def run_campaign(
     done = {i: r for i, r in done.items() if i < runs}
     todo = [i for i in range(runs) if i not in done]
     tasks = plan_chunks(todo, workers=workers, group_size=group_size if group_fn else None, per_task=per_task)
+    # a group function gets some runs of one group: a run's result must not depend on which others it gets
     bar = Progress(total=runs, done=len(done), failed=sum(not r.ok for r in done.values()),
                    stream=progress_stream, enabled=progress)
     t0 = time.monotonic()

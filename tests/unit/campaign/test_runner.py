@@ -91,6 +91,10 @@ def test_a_raising_run_is_recorded_and_the_rest_complete(tmp_path):
 def test_groups_do_not_depend_on_what_is_left():
     assert plan_chunks([0, 1, 2, 3, 4, 5, 6], workers=2, group_size=3) == [[0, 1, 2], [3, 4, 5], [6]]
     assert plan_chunks([1, 4, 5, 9], workers=2, group_size=3) == [[1], [4, 5], [9]]
+    # a small campaign inside one group is split so that both workers get work
+    assert plan_chunks(list(range(20)), workers=2, group_size=25) == [list(range(10)), list(range(10, 20))]
+    big = plan_chunks(list(range(1000)), workers=2, group_size=25)
+    assert len(big) == 40 and all(c == list(range(c[0], c[0] + 25)) and c[0] % 25 == 0 for c in big)
     chunks = plan_chunks(list(range(100)), workers=2, group_size=None)
     assert sum(chunks, []) == list(range(100)) and len(chunks) == 8
 
