@@ -24,7 +24,10 @@ atmosphere/turb-*-fps do not stick in 1.3.3 when its own model is off).
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import sys
 from dataclasses import dataclass
 
 import jsbsim
@@ -37,6 +40,25 @@ INTEGRATOR_RECT_EULER = 1
 """JSBSim's FGPropagate integrator code for rectangular Euler."""
 
 RANKINE_PER_K = 1.8
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """Send the process's C-level stdout (file descriptor 1) to /dev/null for the duration."""
+    try:
+        sys.stdout.flush()
+        saved = os.dup(1)
+    except (OSError, ValueError, AttributeError):
+        yield
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
 
 
 @dataclass(frozen=True)
@@ -69,9 +91,11 @@ class FDM:
     """
 
     def __init__(self, model: str, dt_s: float) -> None:
-        fdm = jsbsim.FGFDMExec(None)
-        fdm.set_debug_level(0)
-        if not fdm.load_model(model):
+        with _quiet_stdout():  # JSBSim prints its banner from C++ on the first FGFDMExec of a process
+            fdm = jsbsim.FGFDMExec(None)
+            fdm.set_debug_level(0)
+            loaded = fdm.load_model(model)
+        if not loaded:
             raise ValueError(f"JSBSim could not load the aircraft model {model!r}")
         fdm.disable_input()  # 737.xml opens TCP/UDP input sockets at run_ic() otherwise
         fdm.disable_output()

@@ -63,8 +63,11 @@ def write_flight_figures(result, profile: Profile, out_dir: Path) -> list[Path]:
     paths.append(_save(fig, out_dir / "airspeed.png"))
 
     fig, axes = plt.subplots(3, 1, figsize=(9, 7), sharex=True)
-    for ax, col, name in zip(axes, range(3), ("roll", "pitch", "true heading"), strict=True):
-        ax.plot(t.t_s, np.degrees(t.euler_rad[:, col]), lw=1)
+    rel_heading = np.angle(np.exp(1j * (t.euler_rad[:, 2] - profile.runway.heading_rad)))
+    series = (t.euler_rad[:, 0], t.euler_rad[:, 1], rel_heading)
+    names = ("roll", "pitch", "heading - runway heading")
+    for ax, y, name in zip(axes, series, names, strict=True):
+        ax.plot(t.t_s, np.degrees(y), lw=1)
         ax.set_ylabel(f"{name} (deg)")
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("time (s)")
