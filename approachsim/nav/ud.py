@@ -100,24 +100,19 @@ def bierman_update(U: Array, d: Array, h: Array, r: float) -> tuple[Array, Array
     """Bierman's scalar measurement update of P = U diag(d) U' with z = h' x + v, var(v) = r > 0.
 
     Returns (U+, d+, K, S): the updated factors, the Kalman gain K = P h / S and S = h' P h + r.
+    Bierman's column recursion, with its running sums written as cumulative sums (same additions, same order):
+        f = U' h, v = D f, alpha_j = r + sum_{i<=j} f_i v_i, d+_j = d_j alpha_{j-1} / alpha_j,
+        b_j = sum_{i<=j} U[:, i] v_i, U+[:, j] = U[:, j] - f_j / alpha_{j-1} b_{j-1}, K = b_n / alpha_n.
     """
-    n = len(d)
     f = U.T @ h  # f = U' h
     v = d * f  # v = D f
-    U_new = U.copy()
-    d_new = d.copy()
-    b = np.zeros(n)
-    alpha = float(r)
-    for j in range(n):
-        alpha_prev = alpha
-        alpha = alpha_prev + f[j] * v[j]  # alpha_j = alpha_{j-1} + f_j v_j
-        d_new[j] = d[j] * alpha_prev / alpha
-        lam = -f[j] / alpha_prev
-        col = U[:j, j].copy()
-        U_new[:j, j] = col + lam * b[:j]
-        b[:j] += col * v[j]
-        b[j] = v[j]
-    return U_new, d_new, b / alpha, alpha
+    alpha = r + np.cumsum(f * v)  # alpha_j = alpha_{j-1} + f_j v_j
+    alpha_prev = np.concatenate([[r], alpha[:-1]])
+    B = np.cumsum(U * v, axis=1)  # b_j (column j); zero below row j since U is unit upper triangular
+    B_prev = np.concatenate([np.zeros((len(d), 1)), B[:, :-1]], axis=1)
+    U_new = U + B_prev * (-f / alpha_prev)  # U+_j = U_j + lambda_j b_{j-1}, lambda_j = -f_j / alpha_{j-1}
+    d_new = d * alpha_prev / alpha
+    return U_new, d_new, B[:, -1] / alpha[-1], float(alpha[-1])
 
 
 def mwgs_robust_update(U: Array, d: Array, h: Array, r: float, psi_prime: float) -> tuple[Array, Array, Array]:
@@ -213,24 +208,17 @@ def thornton_predict_batch(U: Array, d: Array, F: Array, Q: Array) -> tuple[Arra
 
 def bierman_update_batch(U: Array, d: Array, h: Array, r: Array) -> tuple[Array, Array]:
     """`bierman_update` over runs: h (n,) shared, r (runs,) > 0 (np.inf leaves that run's factors unchanged)."""
-    R, n = d.shape
     f = np.einsum("rji,j->ri", U, h)  # f = U' h
     v = d * f
-    U_new = U.copy()
-    d_new = d.copy()
-    b = np.zeros((R, n))
     keep = ~np.isfinite(r)
-    alpha = np.where(keep, 1.0, r)
-    for j in range(n):
-        alpha_prev = alpha
-        alpha = alpha_prev + f[:, j] * v[:, j]
-        d_new[:, j] = np.where(keep, d[:, j], d[:, j] * alpha_prev / alpha)
-        lam = -f[:, j] / alpha_prev
-        col = U[:, :j, j].copy()
-        U_new[:, :j, j] = np.where(keep[:, None], col, col + lam[:, None] * b[:, :j])
-        b[:, :j] += col * v[:, j, None]
-        b[:, j] = v[:, j]
-    return U_new, d_new
+    r0 = np.where(keep, 1.0, r)
+    alpha = r0[:, None] + np.cumsum(f * v, axis=1)
+    alpha_prev = np.concatenate([r0[:, None], alpha[:, :-1]], axis=1)
+    B = np.cumsum(U * v[:, None, :], axis=2)
+    B_prev = np.concatenate([np.zeros((*B.shape[:2], 1)), B[:, :, :-1]], axis=2)
+    U_new = U + B_prev * (-f / alpha_prev)[:, None, :]
+    d_new = d * alpha_prev / alpha
+    return np.where(keep[:, None, None], U, U_new), np.where(keep[:, None], d, d_new)
 
 
 def robust_update_batch(
