@@ -147,7 +147,7 @@ def run(args: argparse.Namespace) -> int:
         "streams": {name: f"approachsim.seeding.stream({seed}, {args.run}, {name!r})" for name in meas}
         | ({CLOCK_STREAM: f"approachsim.seeding.stream({seed}, {args.run}, {CLOCK_STREAM!r})"}
            if suite.clock is not None else {}),
-        "fault_codes": FAULT_CODES, "faults": [vars(f) | {"end_s": str(f.end_s)} for f in profile.faults],
+        "fault_codes": dict(FAULT_CODES), "faults": [vars(f) | {"end_s": str(f.end_s)} for f in profile.faults],
         "files": {},
     }
     for name, rec in meas.items():

@@ -9,7 +9,9 @@ profiles/default.toml.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 from approachsim import units
 from approachsim.config import ProfileError, Section
@@ -100,8 +102,10 @@ DEFAULT_SENSORS = SensorsConfig()
 """The suite of a profile with no [sensors] table (seed 002 without the pseudolite)."""
 
 
-FAULT_TARGETS = {"imu": ("dv", "dtheta"), "baro": ("h",), "radalt": ("h",), "gnss": ("pseudorange",),
-                 "pseudolite": ("pseudorange",)}
+FAULT_TARGETS: Mapping[str, tuple[str, ...]] = MappingProxyType(
+    {"imu": ("dv", "dtheta"), "baro": ("h",), "radalt": ("h",), "gnss": ("pseudorange",),
+     "pseudolite": ("pseudorange",)}
+)
 """Fault targets per sensor (the first is the default)."""
 
 

@@ -23,7 +23,9 @@ sensor's noise or this sensor's error draws.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -32,7 +34,9 @@ from approachsim.sensors import base
 
 Array = np.ndarray
 
-FAULT_CODES = {"none": 0, "outage": 1, "spike": 2, "iam": 3, "cbm": 4, "mni": 5, "step": 6, "ramp": 7}
+FAULT_CODES: Mapping[str, int] = MappingProxyType(
+    {"none": 0, "outage": 1, "spike": 2, "iam": 3, "cbm": 4, "mni": 5, "step": 6, "ramp": 7}
+)
 """Label code of each fault kind (records' `fault` field)."""
 FAULT_KINDS = tuple(k for k in FAULT_CODES if k != "none")
 

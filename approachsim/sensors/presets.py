@@ -36,7 +36,9 @@ and 10 mg (engineering choice, a few times the bias instability).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 
 from approachsim import units
 
@@ -114,7 +116,7 @@ _SEED002_COMMON = dict(
     a_bi_ug=3.6e-6 / MICRO_G, a_tau_s=600.0, vrw_mpssh=2.5e-5, a_sf_ppm=10.0, a_mis_mrad=0.02,
 )
 
-PRESETS: dict[str, ImuGrade] = {
+PRESETS: Mapping[str, ImuGrade] = MappingProxyType({
     "nav-0.4": _grade("nav-0.4", g_to_dph=0.0067, a_to_ug=10.0, **_SEED002_COMMON,
                       source="seed 002 0.4 nmi/h CEP (medium accuracy RLG); module docstring"),
     "nav-2.0": _grade("nav-2.0", g_to_dph=0.033, a_to_ug=50.0, **_SEED002_COMMON,
@@ -128,5 +130,5 @@ PRESETS: dict[str, ImuGrade] = {
                    g_sf_ppm=1e4, g_mis_mrad=20.0 / 3.0, a_to_ug=1e4, a_bi_ug=2e-4 / MICRO_G, a_tau_s=100.0,
                    vrw_mpssh=400e-6 * units.G0 * 60.0, a_sf_ppm=1e4, a_mis_mrad=20.0 / 3.0,
                    source="MPU-6000/6050 product specification rev 3.4 (seed 003); gnss-ins-sim low-accuracy"),
-}
+})
 """Grade presets by name (profile key sensors.imu.grade)."""

@@ -11,7 +11,9 @@ Bias in metres (c times seconds), drift in m/s. The initial bias and drift are r
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 
@@ -20,11 +22,11 @@ Array = np.ndarray
 C_LIGHT = 299792458.0
 """Speed of light, m/s."""
 
-OSCILLATORS: dict[str, tuple[float, float, float]] = {
+OSCILLATORS: Mapping[str, tuple[float, float, float]] = MappingProxyType({
     "tcxo": (2e-19, 7e-21, 2e-20),
     "ocxo": (8e-20, 2e-21, 4e-23),
     "rubidium": (2e-20, 7e-24, 4e-29),
-}
+})
 """(h0, h_-1, h_-2) Allan coefficients: Brown & Hwang 3rd ed. p. 430 via navtk (standards.md 2.4 Set A)."""
 
 

@@ -26,7 +26,9 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import ClassVar
 
 import numpy as np
@@ -58,12 +60,12 @@ class GnssErrorBudget:
     multipath_tau_s: float = 60.0
 
 
-CODE_PRESETS: dict[str, GnssErrorBudget] = {
+CODE_PRESETS: Mapping[str, GnssErrorBudget] = MappingProxyType({
     "P(Y)": GnssErrorBudget(clock_ephemeris_m=3.6, iono_zenith_m=0.3, tropo_zenith_m=0.2, multipath_m=1.8,
                             code_noise_m=0.6),
     "C/A": GnssErrorBudget(clock_ephemeris_m=3.6, iono_zenith_m=4.0, tropo_zenith_m=0.2, multipath_m=1.2,
                            code_noise_m=0.6),
-}
+})
 """Receiver code presets (module docstring gives the sources)."""
 
 
