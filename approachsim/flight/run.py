@@ -123,8 +123,8 @@ class Approach:
 
     @property
     def linearization(self) -> Linearization:
-        """FGLinearization in still air on a standard day, trimmed on the glidepath 1000 ft above the threshold
-        (the top of the scored segment), in the approach configuration (computed once)."""
+        """FGLinearization in still air (the profile's temperature and pressure), trimmed on the glidepath
+        1000 ft above the threshold (the top of the scored segment), approach configuration (computed once)."""
         if self._lin is None:
             rw = self.profile.runway
             along = -(LINEARIZATION_HEIGHT_M - rw.tch_m) / math.tan(rw.glidepath_rad)

@@ -16,7 +16,8 @@ from approachsim.profile import Profile
 def start_condition(profile: Profile, aircraft: Aircraft, *, still_air: bool = False,
                     along_m: float | None = None) -> InitialCondition:
     """The trimmed start of the profile's approach, on the glidepath at runway-frame x = along_m (default: the
-    start distance). still_air: no wind, standard day (for the linearization)."""
+    start distance). still_air: no wind (FGLinearization hangs with an IC wind); the day's temperature and
+    pressure are kept."""
     rw = profile.runway
     frame = rw.frame
     along = -rw.start_distance_m if along_m is None else along_m
@@ -35,6 +36,6 @@ def start_condition(profile: Profile, aircraft: Aircraft, *, still_air: bool = F
         terrain_m=float(profile.terrain.height_at(along)),
         wind_speed_mps=0.0 if still_air else env.wind_speed_mps,
         wind_from_rad=env.wind_from_rad,
-        isa_dev_k=0.0 if still_air else env.isa_dev_k,
-        sl_pressure_pa=101325.0 if still_air else env.true_qnh_pa,
+        isa_dev_k=env.isa_dev_k,
+        sl_pressure_pa=env.true_qnh_pa,
     )
