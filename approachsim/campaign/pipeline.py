@@ -73,14 +73,32 @@ def spec_for(profile: Any, mode: str) -> PipelineSpec:
     return PipelineSpec(closed_loop_group, size, True)
 
 
-def _score(profile: Any, run: int, truth: Any, nav: Any, clock_true: Any) -> RunResult:
+def _score(profile: Any, run: int, truth: Any, nav: Any, clock_true: Any, gnss: Any = None) -> RunResult:
     from approachsim.evaluate.score import score_run
 
     cfg = profile.evaluation
     scalars, arrays, series = score_run(
         truth, nav, cfg, clock_bias_true_m=clock_true, keep_series=run < cfg.series_runs
     )
+    if series is not None and gnss is not None:
+        series = {**series, **_geometry_series(gnss, series["t_s"])}
     return RunResult(run=run, ok=True, scalars=scalars, arrays=arrays, series=series)
+
+
+def _geometry_series(gnss: Any, t_s: Any) -> dict:
+    """GPS geometry at the series times (latest GNSS sample): PDOP, and elevation / azimuth (deg) of each
+    channel where it is above the mask (nan elsewhere), for the sky plot and DOP figure."""
+    import numpy as np
+
+    j = np.clip(np.searchsorted(gnss.t_s, t_s, side="right") - 1, 0, len(gnss.t_s) - 1)
+    vis = np.asarray(gnss.visible)[j]
+    out = {"pdop": np.asarray(gnss.pdop, dtype=float)[j]}
+    el = np.where(vis, np.degrees(np.asarray(gnss.elevation_rad)[j]), np.nan)
+    az = np.where(vis, np.degrees(np.asarray(gnss.azimuth_rad)[j]), np.nan)
+    for c, prn in enumerate(np.asarray(gnss.prn)):
+        out[f"el_deg_prn{int(prn):02d}"] = el[:, c]
+        out[f"az_deg_prn{int(prn):02d}"] = az[:, c]
+    return out
 
 
 def _approach(profile: Any) -> Any:
@@ -135,7 +153,7 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     out = []
     for k, (i, nr) in enumerate(zip(runs, navruns, strict=True)):
         try:
-            out.append(_score(profile, i, truth, nr.solution, _clock_truth(records, k, truth.t_s)))
+            out.append(_score(profile, i, truth, nr.solution, _clock_truth(records, k, truth.t_s), records.get("gnss")))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out
@@ -155,7 +173,8 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunR
             if why is not None:
                 raise RuntimeError(why)
             nav, records = source.result(flight.truth)
-            out.append(_score(profile, i, flight.truth, nav, _clock_truth(records, 0, flight.truth.t_s)))
+            out.append(_score(profile, i, flight.truth, nav, _clock_truth(records, 0, flight.truth.t_s),
+                              records.get("gnss")))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out

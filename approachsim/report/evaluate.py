@@ -9,7 +9,8 @@ Figures (PNG files in DIR and embedded as base64 in DIR/report.html):
 * stanford.png: vertical and horizontal Stanford diagrams (error against protection level, per epoch of
   the runs that kept time series) with the CAT I alert limit, and the all-run region counts;
 * availability.png: fraction of runs whose protection levels are within each category's alert limits,
-  against height.
+  against height;
+* sky_dop.png (when the series carry GPS geometry): sky plot of the satellites and PDOP of one run.
 
 Uses matplotlib's object API (Figure, no pyplot state), so it is safe in workers and threads.
 """
@@ -155,6 +156,33 @@ def fig_availability(results: list[RunResult]) -> Figure:
     return fig
 
 
+def fig_sky(series: dict[str, np.ndarray]) -> Figure:
+    """Sky plot of the GPS satellites above the mask during one run, and PDOP against time."""
+    fig = Figure(figsize=(11, 5), constrained_layout=True)
+    ax = fig.add_subplot(1, 2, 1, projection="polar")
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    for k in sorted(series):
+        if not k.startswith("el_deg_prn"):
+            continue
+        prn = k[len("el_deg_prn"):]
+        el, az = series[k], series[f"az_deg_prn{prn}"]
+        ok = np.isfinite(el)
+        if ok.any():
+            ax.plot(np.radians(az[ok]), 90.0 - el[ok], lw=2)
+            i = np.flatnonzero(ok)[-1]
+            ax.text(np.radians(az[i]), 90.0 - el[i], prn, fontsize=8)
+    ax.set_rmax(90.0)
+    ax.set_rticks([0, 30, 60, 90], labels=["90", "60", "30", "0"])
+    ax.set_title("GPS sky (elevation deg, azimuth from north)", fontsize=9)
+    ax2 = fig.add_subplot(1, 2, 2)
+    ax2.plot(series["t_s"], series["pdop"])
+    ax2.set_xlabel("time, s")
+    ax2.set_ylabel("PDOP of the satellites used")
+    ax2.grid(True, alpha=0.3)
+    return fig
+
+
 def _png(fig: Figure, path: Path) -> str:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
@@ -189,6 +217,9 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
         "stanford": fig_stanford(_series(out_dir), det),
         "availability": fig_availability(results),
     }
+    sky = next((x for x in _series(out_dir) if "pdop" in x), None)
+    if sky is not None:
+        imgs["sky_dop"] = fig_sky(sky)
     b64 = {k: _png(f, out_dir / f"{k}.png") for k, f in imgs.items()}
     verdict_rows = []
     for cat, e in summary["decision_heights"].items():

@@ -46,3 +46,11 @@ def test_outputs_and_report(tmp_path):
     assert "never descended" in page
     for name in ("errors_vs_height", "histograms_dh", "stanford", "availability"):
         assert (tmp_path / f"{name}.png").stat().st_size > 1000
+    # series that carry GPS geometry add the sky plot / DOP figure
+    ser = dict(results[0].series)
+    t = ser["t_s"]
+    ser |= {"pdop": 2.0 + 0.001 * t, "el_deg_prn01": np.where(t < 50, 30.0 + 0.1 * t, np.nan),
+            "az_deg_prn01": 120.0 + 0.05 * t}
+    store.write_series(RunResult(run=0, ok=True, series=ser))
+    page = write_report(tmp_path, results, summary, det).read_text()
+    assert page.count("data:image/png;base64,") == 5 and (tmp_path / "sky_dop.png").is_file()
