@@ -138,6 +138,18 @@ def monitor(v: Array, S: Array, config: MonitorConfig = MonitorConfig()) -> Moni
     return MonitorResult(beta2, f_ratio, decision)
 
 
+def redundancy_monitor(z_a: Array, z_b: Array, var_a: float | Array, var_b: float | Array,
+                       config: MonitorConfig = MonitorConfig()) -> MonitorResult:
+    """The combined test on the difference of two redundant channels measuring the same quantity, d = z_a - z_b
+    with variance var_a + var_b (hardware redundancy, Chernodarov sec. 1-2). It does not depend on any filter, so
+    a slow bias that a filter would absorb into a state still shows; the F-ratio is the mean square (a bias is
+    what it must see). With two channels it says that one has failed, not which."""
+    d = np.asarray(z_a, dtype=float) - np.asarray(z_b, dtype=float)
+    S = np.broadcast_to(np.asarray(var_a, dtype=float) + np.asarray(var_b, dtype=float), d.shape)
+    cfg = MonitorConfig(config.p_chi2, config.p_f, config.window, centered=False)
+    return monitor(d, S, cfg)
+
+
 @dataclass(frozen=True)
 class MonitorWindow:
     """Streaming state of `monitor_step`: the last N (clipped) residuals and predicted variances, shape

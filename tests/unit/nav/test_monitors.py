@@ -108,3 +108,16 @@ def test_labels_from_the_sensor_fault_codes() -> None:
     np.testing.assert_array_equal(labels, [N, O, O, F, F, N, F, F])
     with pytest.raises(ValueError, match="99"):
         mon.labels_from_fault_codes(np.array([99]), FAULT_CODES)
+
+
+def test_redundancy_monitor_sees_a_slow_bias_between_two_channels() -> None:
+    rng = np.random.default_rng(8)
+    n = 600
+    truth = np.cumsum(rng.standard_normal(n))  # any common signal cancels in the difference
+    ramp = 0.03 * np.clip(np.arange(n) - 300.0, 0, None)  # sigma units per epoch
+    a = truth + rng.standard_normal(n) + ramp
+    b = truth + rng.standard_normal(n)
+    res = mon.redundancy_monitor(a, b, 1.0, 1.0)
+    assert not np.any(res.decision[:300] == mon.FAILURE)
+    first = np.flatnonzero(res.decision == mon.FAILURE)[0]
+    assert 300 < first < 450
