@@ -7,6 +7,8 @@ from fractions import Fraction
 import numpy as np
 import pytest
 import scipy.linalg
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from approachsim.config import ProfileError
 from approachsim.nav.base import KalmanFilter, ScalarMeasurement
@@ -17,6 +19,7 @@ from approachsim.nav.ud import (
     bierman_update,
     mwgs,
     mwgs_robust_update,
+    thornton_predict,
     ud_factor,
 )
 
@@ -37,6 +40,25 @@ def test_ud_factor_and_mwgs_round_trip(seed: int) -> None:
     dw = rng.random(9)
     U2, d2 = mwgs(W, dw)
     np.testing.assert_allclose((U2 * d2) @ U2.T, (W * dw) @ W.T, rtol=1e-12, atol=1e-12)
+
+
+@settings(derandomize=True, max_examples=100, deadline=None)
+@given(st.integers(1, 8), st.integers(0, 2**32 - 1), st.floats(-6.0, 6.0))
+def test_update_then_factors_are_a_valid_covariance(n: int, seed: int, log_r: float) -> None:
+    """Invariant (any size, any noise level over 12 decades): after a Thornton predict and a Bierman update the
+    factors are unit upper triangular with d >= 0, and U D U' equals the covariance-form result."""
+    rng = np.random.default_rng(seed)
+    U, d = ud_factor(_spd(rng, n))
+    F = np.eye(n) + 0.3 * rng.normal(size=(n, n))
+    Q = np.diag(rng.random(n))
+    U, d = thornton_predict(U, d, F, Q)
+    P = (U * d) @ U.T
+    h, r = rng.normal(size=n), 10.0**log_r
+    U2, d2, K, S = bierman_update(U, d, h, r)
+    assert np.all(d2 >= 0.0) and np.allclose(np.diag(U2), 1.0) and np.all(np.tril(U2, -1) == 0.0)
+    P_ref = P - np.outer(P @ h, P @ h) / (h @ P @ h + r)
+    np.testing.assert_allclose((U2 * d2) @ U2.T, P_ref, rtol=1e-8, atol=1e-10 * np.max(np.abs(P)))
+    np.testing.assert_allclose(K, P @ h / S, rtol=1e-8, atol=1e-12)
 
 
 def test_ud_factor_of_a_singular_matrix_gives_zero_pivots() -> None:
