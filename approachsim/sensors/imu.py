@@ -28,7 +28,7 @@ The errors depend only on time, so `draw` makes them once and `apply` combines t
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 import numpy as np
@@ -114,9 +114,12 @@ class Imu:
         )
 
     def measure(self, truth: Truth, rng: base.RngLike, *, noise: bool = True) -> ImuSamples:
-        """apply(truth, draw(truth.t_s, rng)); noise=False gives the exact increments."""
+        """apply(truth, draw(truth.t_s, rng)); noise=False gives the exact increments (no quantization)."""
         e = self.draw(truth.t_s, rng)
-        return self.apply(truth, e if noise else e.zeroed())
+        if noise:
+            return self.apply(truth, e)
+        exact = replace(self, grade=replace(self.grade, gyro_quant_rad=0.0, accel_quant_mps=0.0))
+        return exact.apply(truth, e.zeroed())
 
     fault_targets: ClassVar[tuple[tuple[str, str, str], ...]] = (
         ("dv", "dv_body", "accel_noise"),

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from approachsim import synthetic, units
 from approachsim.sensors import atmosphere
@@ -65,3 +67,13 @@ def test_bias_scale_factor_noise_statistics():
     err = rec.h_baro_m - exact
     expect = e.constants["scale_factor"][:, None] * exact + e.series["bias"] + e.series["noise"]
     assert np.allclose(err, expect, atol=1e-9)
+
+
+@settings(derandomize=True, max_examples=200, deadline=None)
+@given(h=st.floats(-400.0, 11000.0), dt_k=st.floats(-40.0, 30.0), p_sl=st.floats(95000.0, 105000.0))
+def test_indicated_altitude_inverts_the_atmosphere_when_set_to_its_sea_level_pressure(h, dt_k, p_sl):
+    """Round trip: on a standard-temperature day with the right QNH the indication is H exactly; with a
+    temperature deviation it is H T0 / (T0 + dT) (the module docstring's closed form)."""
+    p = atmosphere.static_pressure_pa(h, dt_k, p_sl)
+    ind = atmosphere.indicated_altitude_m(p, p_sl)
+    assert ind == pytest.approx(h * atmosphere.T0_K / (atmosphere.T0_K + dt_k), abs=1e-6)

@@ -114,3 +114,16 @@ def test_allan_deviation_recovers_arw_and_bias_instability(grade):
         assert n_fit == pytest.approx(n_true, rel=0.10)
         assert s_fit == pytest.approx(s_true, rel=0.10)
         assert tc_fit == pytest.approx(tc_true, rel=0.5)  # loosely: the bump sits at the right time scale
+
+
+def test_quantization_rounds_each_increment(descent):
+    from dataclasses import replace
+
+    q_th, q_v = 1e-6, 1e-4
+    imu = Imu(replace(PRESETS["mems"], gyro_quant_rad=q_th, accel_quant_mps=q_v))
+    rec = imu.measure(descent, np.random.default_rng(2))
+    raw = Imu(PRESETS["mems"]).measure(descent, np.random.default_rng(2))
+    assert np.allclose(rec.dtheta_body / q_th, np.round(rec.dtheta_body / q_th), rtol=0, atol=1e-6)
+    assert np.max(np.abs(rec.dv_body - raw.dv_body)) <= 0.5 * q_v * (1 + 1e-9)
+    exact = imu.measure(descent, np.random.default_rng(2), noise=False)
+    assert np.array_equal(exact.dv_body, (descent.t_s[1] - descent.t_s[0]) * descent.f_body[:-1])
