@@ -334,6 +334,10 @@ def reproduce(out_dir: Path, *, seed: int, runs: int) -> dict:
         },
         "tolerances": {"gamma2": cfg.gamma2, "eta2": cfg.eta2, "window": cfg.window,
                        "paper_3sigma_rule_false_alarm_per_epoch": float(2 * stats.norm.sf(3.0))},
+        "failure_events": [
+            {**asdict(ev), "run": i, "onset_s": float(s.onset_s[i]), "action": "switched to the twin channel"}
+            for i in range(runs) for ev in mon.failure_events(results[gl].decision[i], s.t_s, "gyro primary")
+        ],
         "bias_ramp_study": bias_ramp_study(p, seed=seed, runs=runs),
         "params": asdict(p),
         "verdict": verdict,

@@ -64,6 +64,8 @@ def test_reproduce_writes_claims_numbers_and_figures(tmp_path: Path) -> None:
     assert set(on_disk["claims"]["ours"]["nees_consistency"]) == {"ekf"} | {f"robust-ud-{k}" for k in
                                                                             ch.INFLUENCE_KINDS}
     assert "Finding" in (tmp_path / "chernodarov.md").read_text()
+    for ev in on_disk["failure_events"]:  # logged: channel, time of detection, after the true onset
+        assert ev["kind"] == "failure" and ev["channel"] == "gyro primary" and ev["t_s"] >= ev["onset_s"]
     for name in ("chernodarov_fig1.png", "chernodarov_fig2.png", "chernodarov_fig4.png", "chernodarov_nees.png"):
         assert (tmp_path / name).stat().st_size > 1000
 
