@@ -8,12 +8,21 @@ truth's p_static and the profile's QNH setting here, a cold day or a wrong setti
 error (cold-is-low, 8.3 m per hPa at sea level). S is a random-constant scale factor, B a first-order
 Gauss-Markov bias (sigma, tau; exact discretization of seed 001 eq. 2), v white noise. Defaults are seed 001
 Table 1 (sigma_B = 1 m, beta = 0.01 1/s so tau = 100 s) and seed 003 Table 1 (noise 1 m). No static-source
-(position) error and no lag: a first-order lag would make the output depend on the past trajectory, which
-the stateless draw/apply split excludes (left out, see the issue report).
+(position) error.
+
+Optional first-order lag (lag_s > 0, the pneumatic / filter lag of the static system) on the indicated
+altitude, computed statelessly so that stepwise and batch application agree: each sample is a weighted
+sum of the indicated altitude over the truth rows up to its own, the exact response of
+tau y' = u - y to the linearly interpolated input (first-order-hold discretization, impulse response
+w_0 = b0, w_i = a^(i-1) (a b0 + b1); a = exp(-dt / tau), b0 = 1 - tau (1 - a) / dt, b1 = tau (1 - a) / dt - a),
+truncated at M = ceil(10 tau / dt) rows (the dropped tail weighs e^-10; weights renormalized to sum 1) with
+rows before the first repeated (the lag starts in steady state). On a steady descent at rate v it reads high
+by exactly v tau.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -35,6 +44,7 @@ class Baro:
     bias_tau_s: float = 100.0
     scale_factor_sigma: float = 0.0
     noise_sigma_m: float = 1.0
+    lag_s: float = 0.0
     name: str = "baro"
 
     fault_targets: ClassVar[tuple[tuple[str, str, str], ...]] = (("h", "h_baro_m", "noise"),)
@@ -55,7 +65,18 @@ class Baro:
 
     def apply(self, truth: Truth, errors: base.SensorErrors) -> BaroSamples:
         """Measurements at the truth rows of `errors`."""
-        h_ind = atmosphere.indicated_altitude_m(truth.p_static_pa[errors.rows], self.setting_pa)
+        if self.lag_s > 0.0:
+            dt = float(truth.t_s[1] - truth.t_s[0])
+            a = math.exp(-dt / self.lag_s)
+            m = int(math.ceil(10.0 * self.lag_s / dt))
+            b0 = 1.0 - self.lag_s * (1.0 - a) / dt
+            b1 = self.lag_s * (1.0 - a) / dt - a
+            w = np.concatenate([[b0], (a * b0 + b1) * a ** np.arange(m)])
+            w = w / w.sum()
+            idx = np.maximum(errors.rows[:, None] - np.arange(m + 1)[None, :], 0)
+            h_ind = atmosphere.indicated_altitude_m(truth.p_static_pa[idx], self.setting_pa) @ w
+        else:
+            h_ind = atmosphere.indicated_altitude_m(truth.p_static_pa[errors.rows], self.setting_pa)
         sf = errors.constants["scale_factor"]
         sf = sf[:, None] if errors.batched else sf
         h = h_ind * (1.0 + sf) + errors.series["bias"] + errors.series["noise"]

@@ -43,6 +43,7 @@ class BaroConfig:
     bias_tau_s: float = 100.0
     scale_factor_sigma: float = 0.0
     noise_sigma_m: float = 1.0
+    lag_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -134,6 +135,7 @@ def parse_sensors(s: Section) -> SensorsConfig:
             bias_tau_s=b.number("bias_tau_s", 100.0, lo=0.0, lo_open=True, unit="s"),
             scale_factor_sigma=b.number("scale_factor_sigma", 0.0, lo=0.0, hi=0.5),
             noise_sigma_m=b.number("noise_sigma_m", 1.0, lo=0.0, unit="m"),
+            lag_s=b.number("lag_s", 0.0, lo=0.0, hi=10.0, unit="s"),
         )
     b.done()
 

@@ -48,7 +48,7 @@ def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterab
         b = cfg.baro
         out["baro"] = Baro(setting_pa=qnh_pa, rate_hz=b.rate_hz, bias_sigma_m=b.bias_sigma_m,
                            bias_tau_s=b.bias_tau_s, scale_factor_sigma=b.scale_factor_sigma,
-                           noise_sigma_m=b.noise_sigma_m)
+                           noise_sigma_m=b.noise_sigma_m, lag_s=b.lag_s)
     if cfg.radalt is not None:
         r = cfg.radalt
         out["radalt"] = RadarAltimeter(rate_hz=r.rate_hz, max_range_m=r.max_range_m, percent_sigma=r.percent_sigma,

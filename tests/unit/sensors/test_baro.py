@@ -77,3 +77,18 @@ def test_indicated_altitude_inverts_the_atmosphere_when_set_to_its_sea_level_pre
     p = atmosphere.static_pressure_pa(h, dt_k, p_sl)
     ind = atmosphere.indicated_altitude_m(p, p_sl)
     assert ind == pytest.approx(h * atmosphere.T0_K / (atmosphere.T0_K + dt_k), abs=1e-6)
+
+
+def test_first_order_lag_reads_high_by_rate_times_lag_and_is_stateless(descent):
+    lag = 1.5
+    b = Baro(rate_hz=10.0, lag_s=lag)
+    rec = b.measure(descent, np.random.default_rng(0), noise=False)
+    plain = Baro(rate_hz=10.0).measure(descent, np.random.default_rng(0), noise=False)
+    v_down = descent.v_ned[0, 2]
+    settled = rec.t_s > 10 * lag
+    assert np.allclose(rec.h_baro_m[settled] - plain.h_baro_m[settled], v_down * lag, rtol=2e-3)  # geopotential rate
+    assert rec.h_baro_m[0] == pytest.approx(plain.h_baro_m[0], abs=1e-9)  # starts in steady state
+    e = b.draw(descent.t_s, np.random.default_rng(4))
+    batch = b.apply(descent, e)
+    for j in (0, 3, 500):
+        assert b.apply(descent, e.take(slice(j, j + 1))).h_baro_m[0] == batch.h_baro_m[j]
