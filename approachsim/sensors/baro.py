@@ -74,7 +74,8 @@ class Baro:
             w = np.concatenate([[b0], (a * b0 + b1) * a ** np.arange(m)])
             w = w / w.sum()
             idx = np.maximum(errors.rows[:, None] - np.arange(m + 1)[None, :], 0)
-            h_ind = atmosphere.indicated_altitude_m(truth.p_static_pa[idx], self.setting_pa) @ w
+            # row-wise sum (not a matrix product: BLAS blocking would make one row differ from the batch)
+            h_ind = np.sum(atmosphere.indicated_altitude_m(truth.p_static_pa[idx], self.setting_pa) * w, axis=-1)
         else:
             h_ind = atmosphere.indicated_altitude_m(truth.p_static_pa[errors.rows], self.setting_pa)
         sf = errors.constants["scale_factor"]
