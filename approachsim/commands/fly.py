@@ -1,4 +1,4 @@
-"""`approachsim fly PROFILE --out DIR [--seed S] [--run I]`: fly one approach, write its truth and figures.
+"""`approachsim fly PROFILE --out DIR [--seed S] [--run I] [--land]`: fly one approach, write truth and figures.
 
 Writes DIR/truth.npz + DIR/truth.json (the truth record and its schema, see docs/truth.md and
 approachsim.flight.truthfile), DIR/flight.json (termination, tracking statistics) and the figures
@@ -22,6 +22,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=None, help="campaign seed (default: the profile's run.seed)")
     p.add_argument("--run", type=int, default=0, help="run index within the campaign (default 0)")
     p.add_argument("--no-figures", action="store_true", help="write the truth files only")
+    p.add_argument("--land", action="store_true", help="fly on through the flare to touchdown (default: stop 50 ft)")
     p.set_defaults(func=run)
 
 
@@ -39,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
         raise ProfileError(f"--run: must be >= 0, got {args.run}")
     if args.out.exists() and not args.out.is_dir():
         raise ProfileError(f"--out: {str(args.out)!r} exists and is not a directory")
-    result = Approach(profile).fly(seed=seed, run=args.run)
+    result = Approach(profile, land=args.land).fly(seed=seed, run=args.run)
     args.out.mkdir(parents=True, exist_ok=True)
     save_truth(args.out / "truth.npz", result.truth, meta={"profile": profile.name, "seed": seed, "run": args.run})
     stats = tracking_stats(result, profile)
@@ -50,6 +51,8 @@ def run(args: argparse.Namespace) -> int:
         "termination": result.termination,
         "duration_s": float(result.truth.t_s[-1]),
         "lowest_height_ft": result.lowest_height_ft,
+        "touchdown_past_threshold_ft": result.touchdown_x_m / 0.3048 if args.land else None,
+        "touchdown_sink_fps": result.touchdown_sink_mps / 0.3048 if args.land else None,
         **stats,
     }
     (args.out / "flight.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
@@ -65,6 +68,9 @@ def run(args: argparse.Namespace) -> int:
         f"  1000-200 ft: vertical RMS {stats['vertical_rms_ft']:.2f} ft, lateral RMS {stats['lateral_rms_ft']:.2f} ft, "
         f"CAS {stats['cas_min_kt']:.1f}-{stats['cas_max_kt']:.1f} kt"
     )
+    if args.land:
+        print(f"  touchdown {summary['touchdown_past_threshold_ft']:.0f} ft past the threshold, "
+              f"sink {summary['touchdown_sink_fps']:.1f} ft/s")
     extra = "" if args.no_figures else ", figures"
     print(f"  wrote {args.out / 'truth.npz'} (+ truth.json schema, flight.json{extra})")
     return 0

@@ -81,6 +81,12 @@ def _gains(s: Section) -> AutopilotGains:
         k_loc_i=pos("k_loc_i"),
         bank_limit_rad=math.radians(s.number("bank_limit_deg", lo=0.0, hi=35.0, lo_open=True, unit="deg")),
         pitch_limit_rad=math.radians(s.number("pitch_limit_deg", lo=0.0, hi=20.0, lo_open=True, unit="deg")),
+        flare_height_m=s.number("flare_height_ft", lo=10.0, hi=200.0, unit="ft") * units.FT,
+        flare_tau_s=s.number("flare_tau_s", lo=0.5, hi=20.0, unit="s"),
+        touchdown_sink_mps=s.number("touchdown_sink_fps", lo=0.0, hi=10.0, unit="ft/s") * units.FPS,
+        k_flare=pos("k_flare"),
+        k_flare_i=pos("k_flare_i"),
+        retard_height_m=s.number("retard_height_ft", lo=0.0, hi=200.0, unit="ft") * units.FT,
     )
     s.done()
     return g

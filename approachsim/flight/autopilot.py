@@ -14,6 +14,9 @@ linearization approachsim.flight.design checks loop at a time (gains from the ai
     da  = k_phi (phi_c - phi) - k_p p                              aileron
     dr  = -k_beta beta                                             rudder (crab into the wind; FCS adds a yaw damper)
 
+Landing runs add a flare below flare_height (main-gear height h_g): theta_c = theta_entry + k_flare e +
+k_flare_i int e, e = -(h_g / tau_flare + sink_td) - h', and the throttle to idle below retard_height.
+
 Sign conventions of the 737 FCS: + elevator = nose down, + aileron = roll right, + rudder = nose left.
 Everything is plain float arithmetic: it runs once per JSBSim step.
 """
@@ -68,6 +71,10 @@ class Autopilot:
         self.int_y = 0.0
         self.e_f = 0.0
         self.int_e = 0.0
+        self.flaring = False
+        self._theta_flare0 = 0.0
+        self._int_flare = 0.0
+        self._theta_c = trim.theta_rad
 
     def deviations(self, x: float, y: float, z: float, vn: float, ve: float, vd: float) -> tuple[float, ...]:
         """Glidepath deviation d (m, + above), its rate (m/s), cross-track y (m, + right) and its rate (m/s)."""
@@ -84,10 +91,11 @@ class Autopilot:
     def step(
         self,
         x: float, y: float, z: float, vn: float, ve: float, vd: float,
-        phi: float, theta: float, p: float, q: float, beta: float, cas: float,
+        phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float | None = None,
     ) -> tuple[float, float, float, float]:
         """One control step: guidance position (runway frame, m) and NED velocity (m/s), attitude (rad),
-        body rates (rad/s), sideslip (rad), calibrated airspeed (m/s) -> elevator, aileron, rudder, throttle."""
+        body rates (rad/s), sideslip (rad), calibrated airspeed (m/s) -> elevator, aileron, rudder, throttle.
+        h_gear: main-gear height above the terrain (m) on landing runs (the radio altitude; None: no flare)."""
         g = self.g
         dt = self.dt
         # deviations (as deviations(), inlined: this runs every step)
@@ -106,6 +114,11 @@ class Autopilot:
         else:
             th_off = lim if th_off > 0.0 else -lim
         theta_c = self.trim.theta_rad + th_off
+        if h_gear is not None and (self.flaring or h_gear <= g.flare_height_m):
+            theta_c, thr_flare = self._flare(h_gear, -vd, theta_c)
+        else:
+            thr_flare = None
+        self._theta_c = theta_c
         de = -g.k_theta * (theta_c - theta) + g.k_q * q
         # autothrottle on the filtered speed error
         self.e_f += dt / g.tau_v_s * (self.trim.cas_mps - cas - self.e_f)
@@ -114,6 +127,8 @@ class Autopilot:
             self.int_e += self.e_f * dt
         else:
             thr = 1.0 if thr >= 1.0 else 0.0
+        if thr_flare is not None:
+            thr = min(thr, thr_flare)
         # localizer -> bank command
         phi_c = -(g.k_loc_p * y + g.k_loc_d * y_dot + g.k_loc_i * self.int_y)
         blim = g.bank_limit_rad
@@ -124,6 +139,20 @@ class Autopilot:
         da = g.k_phi * (phi_c - phi) - g.k_p * p
         dr = -g.k_beta * beta
         return _clip1(de), _clip1(da), _clip1(dr), thr
+
+
+    def _flare(self, h_gear: float, h_dot: float, theta_c_path: float) -> tuple[float, float]:
+        """Flare: pitch command from the sink-rate error to h'_c = -(h_gear / tau + sink_td), starting from
+        the pitch command at flare entry; throttle limit (1 above the retard height, then idle)."""
+        g = self.g
+        if not self.flaring:
+            self.flaring = True
+            self._theta_flare0 = self._theta_c
+        e = -(max(h_gear, 0.0) / g.flare_tau_s + g.touchdown_sink_mps) - h_dot  # > 0: sinking too fast
+        self._int_flare += e * self.dt
+        theta_c = self._theta_flare0 + g.k_flare * e + g.k_flare_i * self._int_flare
+        thr_limit = 1.0 if h_gear > g.retard_height_m else 0.0
+        return theta_c, thr_limit
 
 
 def _clip1(u: float) -> float:

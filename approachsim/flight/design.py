@@ -79,6 +79,18 @@ class AutopilotGains:
     """Bank command limit, rad."""
     pitch_limit_rad: float
     """Limit of the pitch command's departure from the trim pitch, rad."""
+    flare_height_m: float = 50.0 * units.FT
+    """Main-gear height above the terrain where the flare starts (landing runs only), m."""
+    flare_tau_s: float = 5.0
+    """Flare time constant: sink-rate command h' = -(h_gear / tau + touchdown sink), s."""
+    touchdown_sink_mps: float = 2.0 * units.FPS
+    """Sink rate the flare aims to touch down with, m/s."""
+    k_flare: float = 0.05
+    """Pitch command per sink-rate error in the flare, rad s/m."""
+    k_flare_i: float = 0.02
+    """Pitch command per integrated sink-rate error in the flare, rad/m."""
+    retard_height_m: float = 25.0 * units.FT
+    """Main-gear height where the throttle goes to idle in the flare, m."""
 
 
 @dataclass(frozen=True)

@@ -14,8 +14,9 @@ FlightResult, so that
     flight technical error = guidance estimate - desired path,  navigation error = estimate - truth,
     total system error = truth - desired path.
 
-The run ends when the IMU descends to `stop_height_m` above the threshold ("reached stop height"), or on
-ground contact, divergence or timeout (each a termination reason). The Truth arrays are preallocated for
+The run ends when the IMU descends to `stop_height_m` above the threshold ("reached stop height"), or, with
+`land=True`, after a flare when the main gear touches ("touchdown"), or on ground contact, divergence or
+timeout (each a termination reason). The Truth arrays are preallocated for
 the longest permitted run and trimmed at the end; a navigation source sees the preallocated record and may
 read rows <= k only.
 
@@ -70,6 +71,7 @@ _READ = (
     "forces/fbx-total-lbs", "forces/fby-total-lbs", "forces/fbz-total-lbs", "inertia/mass-slugs",
     "atmosphere/P-psf", "atmosphere/T-R", "velocities/vc-kts", "aero/beta-rad",
     "gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW", "velocities/vtrue-fps",
+    "gear/unit[1]/AGL-ft", "gear/unit[2]/AGL-ft",
 )
 
 
@@ -98,13 +100,19 @@ class FlightResult:
     guidance_v_ned: Array
     """(n, 3) the NED velocity guidance flew on, m/s."""
     termination: str
-    """Why the run ended: "reached stop height", "ground contact", "diverged", "timeout"."""
+    """Why the run ended: "reached stop height", "touchdown" (landing runs), "ground contact" (anything else
+    touching: a failure), "diverged", "timeout"."""
     lowest_height_ft: float
     """Lowest true IMU height above the threshold reached, ft."""
     seed: int
     run: int
     turbulence_seed: int
     """The simulation/randomseed JSBSim used (the turbulence itself comes from the run's "turbulence" stream)."""
+
+    touchdown_x_m: float = math.nan
+    """Landing runs: IMU runway-frame x when the main gear touched down, m past the threshold (nan: none)."""
+    touchdown_sink_mps: float = math.nan
+    """Landing runs: sink rate at touchdown (IMU, positive down), m/s (nan: none)."""
 
     def reached(self, height_ft: float) -> bool:
         """True when the aircraft descended to height_ft above the threshold."""
@@ -114,11 +122,13 @@ class FlightResult:
 class Approach:
     """A profile's approach, ready to fly many times: the aircraft is parsed and linearized once."""
 
-    def __init__(self, profile: Profile, *, stop_height_m: float = STOP_HEIGHT_M) -> None:
+    def __init__(self, profile: Profile, *, stop_height_m: float = STOP_HEIGHT_M, land: bool = False) -> None:
         self.profile = profile
         self.aircraft: Aircraft = load_aircraft(profile)
         self.dt_s = 1.0 / profile.rates.imu_hz
-        self.stop_height_m = stop_height_m
+        self.stop_height_m = -math.inf if land else stop_height_m
+        self.land = land
+        """Fly on through a flare to touchdown (main gear on the ground) instead of stopping at stop_height_m."""
         self._lin: Linearization | None = None
 
     @property
@@ -202,6 +212,8 @@ class Approach:
         ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m, rw.threshold_lat_rad), dt)
         ap_step = ap.step
         stop_h = self.stop_height_m
+        land = self.land
+        touchdown = (math.nan, math.nan)
         run_step = fdm.run
         termination = "timeout"
         lowest = math.inf
@@ -212,7 +224,7 @@ class Approach:
             if k > 0:
                 run_step()
             (lat, lon, h_ft, vn_f, ve_f, vd_f, phi, th, psi, pi_, qi, ri, p, q, r, pid, qid, rid,
-             fx, fy, fz, m, p_psf, t_r, vc_kt, beta, w0, w1, w2, vt_fps) = [gv() for gv in getters]
+             fx, fy, fz, m, p_psf, t_r, vc_kt, beta, w0, w1, w2, vt_fps, g1_ft, g2_ft) = [gv() for gv in getters]
             h = h_ft * FT
             # body -> NED direction cosines from the Euler angles
             sf, cf, st, ct, sp, cp = sin(phi), cos(phi), sin(th), cos(th), sin(psi), cos(psi)
@@ -279,6 +291,10 @@ class Approach:
             if zr <= stop_h:
                 termination = "reached stop height"
                 break
+            if land and (w1 > 0.0 or w2 > 0.0) and w0 == 0.0:
+                termination = "touchdown"
+                touchdown = (xr, vd)
+                break
             if w0 > 0.0 or w1 > 0.0 or w2 > 0.0 or h_i - terr <= 0.0:
                 termination = "ground contact"
                 break
@@ -286,7 +302,8 @@ class Approach:
                 termination = "diverged"
                 break
             # the controls for the next step
-            de, da, dr, thr = ap_step(gx, gy, gz, gvn, gve, gvd, phi, th, p, q, beta, vc_kt * KT)
+            h_gear = min(g1_ft, g2_ft) * FT if land else None
+            de, da, dr, thr = ap_step(gx, gy, gz, gvn, gve, gvd, phi, th, p, q, beta, vc_kt * KT, h_gear)
             buf[k, _CTRL:_CTRL + 4] = (de + pitch_trim, da, dr, thr)
             set_de(de)
             set_da(da)
@@ -307,6 +324,8 @@ class Approach:
             guidance_v_ned=np.ascontiguousarray(gbuf[:n, 3:]),
             termination=termination,
             lowest_height_ft=lowest / FT,
+            touchdown_x_m=touchdown[0],
+            touchdown_sink_mps=touchdown[1],
             seed=seed,
             run=run,
             turbulence_seed=turb_seed,

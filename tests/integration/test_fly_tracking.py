@@ -98,3 +98,16 @@ def test_guidance_flies_on_the_navigation_source():
     fte = biased.guidance_r_rwy[sel, 2] - np.asarray(profile.runway.glidepath_height_m(biased.guidance_r_rwy[sel, 0]))
     assert np.sqrt(np.mean(fte**2)) < 1.0
     np.testing.assert_allclose(biased.guidance_r_rwy[:, 2] - t.r_rwy[:, 2], 10.0)
+
+
+def test_calm_landing_flares_to_a_touchdown_in_the_zone():
+    """Landing run: the flare brings the main gear down in the touchdown zone with a normal sink rate."""
+    profile = _calm_default()
+    r = Approach(profile, land=True).fly(seed=1)
+    print(r.termination, r.touchdown_x_m / units.FT, r.touchdown_sink_mps / units.FPS)
+    assert r.termination == "touchdown"  # main gear first (nose-gear contact is "ground contact")
+    assert 1000.0 <= r.touchdown_x_m / units.FT <= 3000.0  # FAA touchdown zone: the first 3000 ft
+    assert 0.5 <= r.touchdown_sink_mps / units.FPS <= 6.0  # ft/s; 10 ft/s is a hard landing
+    # the flare raised the nose above the approach attitude
+    t = r.truth
+    assert t.euler_rad[-1, 1] > np.median(t.euler_rad[:, 1]) + np.radians(1.0)
