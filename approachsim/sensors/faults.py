@@ -94,6 +94,12 @@ class Faulted:
         """The wrapped sensor's name (its random stream and record name)."""
         return self.sensor.name
 
+    def __getattr__(self, item: str) -> Any:
+        """Every other attribute (rate_hz, grade, constellation, fault_targets, ...) is the wrapped sensor's."""
+        if item == "sensor" or item.startswith("__"):
+            raise AttributeError(item)
+        return getattr(self.sensor, item)
+
     def _target(self, spec: FaultSpec) -> tuple[str, str]:
         targets = self.sensor.fault_targets
         if spec.target is None:

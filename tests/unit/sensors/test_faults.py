@@ -124,3 +124,14 @@ def test_bad_kind_is_rejected():
     with pytest.raises(ValueError, match="kind must be one of"):
         FaultSpec("baro", "glitch")
     assert math.isinf(FaultSpec("baro", "cbm").end_s)
+
+
+def test_wrapper_exposes_the_sensor_and_pickles(descent):
+    import pickle
+
+    f = Faulted(Baro(rate_hz=2.0), (FaultSpec("baro", "cbm", start_s=1.0, magnitude=1.0),))
+    assert f.rate_hz == 2.0 and f.name == "baro" and f.fault_targets == Baro.fault_targets
+    g = pickle.loads(pickle.dumps(f))
+    assert g == f
+    with pytest.raises(AttributeError):
+        _ = f.no_such_attribute
