@@ -46,9 +46,25 @@ def test_robust_ud_nees_inside_bounds_where_the_ekf_is_not(experiment) -> None:
     c_rob = ch.consistency(robust, s.t_s, p.fail_onset_s[0])
     c_ekf = ch.consistency(ekf, s.t_s, p.fail_onset_s[0])
     assert c_rob["inside_fraction_outlier_phase"] >= 0.9
-    assert c_ekf["inside_fraction_outlier_phase"] < 0.5
+    assert c_ekf["inside_fraction_outlier_phase"] < 0.1
     assert c_rob["inside_fraction"] > c_ekf["inside_fraction"] + 0.5
     assert ch._inside_after(robust, s) >= 0.9  # consistent again once the twin is connected
+
+
+@pytest.mark.slow
+def test_nees_claim_over_several_campaign_seeds() -> None:
+    """The per-epoch 'inside the bounds' fraction is a noisy statistic (the NEES is correlated in time; on clean
+    data the optimal KF itself scores 0.94-1.0 across seeds), so the claim is checked over five campaign seeds:
+    median >= 0.9 and none below 0.8 for the robust U-D, every one below 0.1 for the EKF."""
+    p = ch.ChernodarovParams()
+    rob, ekf = [], []
+    for seed in (2026, 1, 2, 3, 4):
+        s = ch.make_stream(p, seed=seed, runs=100)
+        rob.append(ch.consistency(ch.run_robust_ud(s, p, InfluenceFunction("gauss-laplace")), s.t_s,
+                                  p.fail_onset_s[0])["inside_fraction_outlier_phase"])
+        ekf.append(ch.consistency(ch.run_ekf(s, p), s.t_s, p.fail_onset_s[0])["inside_fraction_outlier_phase"])
+    assert np.median(rob) >= 0.9 and min(rob) >= 0.8
+    assert max(ekf) < 0.1
 
 
 def test_nees_bounds_are_the_chi2_quantiles() -> None:
