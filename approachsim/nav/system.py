@@ -198,11 +198,12 @@ class NavSystem:
             **kw,
         )
 
-    def initial_covariance(self) -> Array:
-        """P0: the profile's initial INS errors, the IMU grade's biases, the sensors' error budgets."""
+    def initial_covariance(self, elevation_rad: Array | None = None) -> Array:
+        """P0: the profile's initial INS errors, the IMU grade's biases, the sensors' error budgets (the GPS
+        channels' slow errors at their elevations elevation_rad (24,), rad, when given)."""
         lay, ie = self.layout, self.nav.initial_error
         g = PRESETS[self.sensors.imu.grade]
-        nz = self.noise()
+        nz = self.noise(elevation_rad)
         d = np.zeros(lay.n)
         d[lay.index["dp"]] = ie.position_m**2
         d[lay.index["dv"]] = ie.velocity_mps**2
@@ -230,13 +231,15 @@ class NavSystem:
 
     # --- one pass ------------------------------------------------------------------------------------------
 
-    def start(self, truth: Truth, rngs: list[np.random.Generator], row: int = 0) -> tuple[ins.InsState, list[_Run]]:
-        """INS states of len(rngs) runs at truth row `row` with initial errors drawn from P0, and their filters."""
+    def start(self, truth: Truth, rngs: list[np.random.Generator], row: int = 0,
+              elevation_rad: Array | None = None) -> tuple[ins.InsState, list[_Run]]:
+        """INS states of len(rngs) runs at truth row `row` with initial errors drawn from P0, and their filters
+        (elevation_rad: the GPS channels' elevations at the start, for their P0)."""
         n = len(rngs)
         c_true = ins.cbn_from_quaternion(truth.q_nb[row])
         s = ins.init_state(np.full(n, truth.lat_rad[row]), truth.lon_rad[row], truth.h_m[row], truth.v_ned[row],
                            c_true)
-        P0 = self.initial_covariance()
+        P0 = self.initial_covariance(elevation_rad)
         sd = np.sqrt(np.diag(P0)[:9])
         e = np.stack([sd * g.standard_normal(9) for g in rngs])  # INS errors after alignment + cruise
         s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
@@ -299,8 +302,8 @@ class NavSystem:
             sig = bud.code_noise_m if lay.has("gse") else obs["gnss_sigma"]
             for k in np.flatnonzero(np.isfinite(rho)):
                 sk = float(sig if np.isscalar(sig) else sig[k])
-                out.append(lambda x, k=k, sk=sk: meas.pseudorange(lay, x, r_ins, c_en, r_sv[k], float(rho[k]), sk, t,
-                                                                  f"gps{k:02d}", sv=int(k) if lay.has("gse") else None))
+                out.append(lambda x, k=k, sk=sk, rk=float(rho[k]), rs=r_sv[k]: meas.pseudorange(
+                    lay, x, r_ins, c_en, rs, rk, sk, t, f"gps{k:02d}", sv=int(k) if lay.has("gse") else None))
         if "pl_rho" in obs:
             rho, r_pl = obs["pl_rho"][i], obs["pl_r"]
             p = self.sensors.pseudolite
@@ -309,8 +312,8 @@ class NavSystem:
                     sk = float(np.sqrt(p.code_noise_m**2 + p.survey_sigma_m**2))
                 else:
                     sk = float(obs["pl_sigma"][k])
-                out.append(lambda x, k=k, sk=sk: meas.pseudorange(lay, x, r_ins, c_en, r_pl[k], float(rho[k]), sk, t,
-                                                                  f"pl{k}", pl=int(k) if lay.has("pmp") else None))
+                out.append(lambda x, k=k, sk=sk, rk=float(rho[k]), rp=r_pl[k]: meas.pseudorange(
+                    lay, x, r_ins, c_en, rp, rk, sk, t, f"pl{k}", pl=int(k) if lay.has("pmp") else None))
         return out
 
     def _feedback(self, s: ins.InsState, runs: list[_Run]) -> ins.InsState:
@@ -380,7 +383,8 @@ class NavSystem:
         dt = float(imu.dt_s)
         rate = 1.0 / dt
         epoch_rows = max(1, int(round(rate / self.nav.aiding_rate_hz)))
-        s, runs = self.start(truth, gens)
+        gnss = records.get("gnss")
+        s, runs = self.start(truth, gens, elevation_rad=None if gnss is None else gnss.elevation_rad[0])
         n_runs = len(gens)
         gains = self.loop_gains()
         baro = records.get("baro")

@@ -1,0 +1,55 @@
+"""Filter consistency (issue 4 acceptance): default profile sensors, 100 seeded runs on one shared synthetic
+glidepath truth (open loop). At each aiding epoch the run-averaged NEES of the 9 navigation errors and the
+run-averaged NIS of each measurement group must lie inside their two-sided 95 % chi-square bounds for at
+least 90 % of the epochs (Bar-Shalom, Li & Kirubarajan sec. 5.4). A filter that claims a sigma it does not
+have fails here."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.stats import chi2
+
+from approachsim import synthetic
+from approachsim.nav.system import NavSystem
+from approachsim.profile import load_profile
+from approachsim.seeding import stream
+from approachsim.sensors.suite import SensorSuite
+
+RUNS = 100
+SEED = 1
+
+
+@pytest.fixture(scope="module")
+def runs():
+    prof = load_profile("profiles/default.toml")
+    truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 90.0,
+                                        ground_speed_mps=70.0)
+    recs = SensorSuite.from_profile(prof).measure(truth, seed=SEED, runs=range(RUNS))
+    return NavSystem.from_profile(prof).run(truth, recs, [stream(SEED, r, "nav") for r in range(RUNS)])
+
+
+@pytest.mark.slow
+def test_average_nees_inside_95_percent_bounds(runs):
+    e = np.stack([r.true_error_nav for r in runs])  # (runs, epochs, 9): output - truth = -(x_hat - x)
+    P = np.stack([r.P_nav for r in runs])
+    nees = np.einsum("rki,rki->rk", e, np.linalg.solve(P, e[..., None])[..., 0]).mean(axis=0)
+    lo, hi = chi2.ppf([0.025, 0.975], 9 * RUNS) / RUNS
+    inside = (nees >= lo) & (nees <= hi)
+    assert inside.mean() >= 0.9, (nees.mean(), inside.mean())
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("group", ["baro", "radalt", "gps"])
+def test_average_nis_inside_95_percent_bounds(runs, group):
+    by_epoch: dict[float, list[float]] = {}
+    for r in runs:
+        m = np.char.startswith(r.status.name, group)
+        for t, q in zip(r.status.t_s[m], r.status.test_ratio[m], strict=True):
+            by_epoch.setdefault(round(float(t), 6), []).append(float(q))
+    assert len(by_epoch) >= 80  # the group really was used at (almost) every 1 s epoch
+    inside = []
+    for v in by_epoch.values():
+        lo, hi = chi2.ppf([0.025, 0.975], len(v)) / len(v)
+        inside.append(lo <= np.mean(v) <= hi)
+    assert np.mean(inside) >= 0.9, np.mean(inside)
