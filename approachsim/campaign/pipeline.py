@@ -73,12 +73,18 @@ def spec_for(profile: Any, mode: str) -> PipelineSpec:
     return PipelineSpec(closed_loop_group, size, True)
 
 
-def _score(profile: Any, run: int, truth: Any, nav: Any, clock_true: Any, gnss: Any = None) -> RunResult:
+def _score(
+    profile: Any, run: int, truth: Any, nav: Any, clock_true: Any, gnss: Any = None, flight: Any = None
+) -> RunResult:
     from approachsim.evaluate.score import score_run
 
     cfg = profile.evaluation
+    fte = {}
+    if flight is not None:  # closed loop: FTE is the deviation of the position guidance flew on
+        g = flight.guidance_r_rwy
+        fte = {"fte_lat_m": g[:, 1], "fte_vert_m": g[:, 2] - profile.runway.glidepath_height_m(g[:, 0])}
     scalars, arrays, series = score_run(
-        truth, nav, cfg, clock_bias_true_m=clock_true, keep_series=run < cfg.series_runs
+        truth, nav, cfg, clock_bias_true_m=clock_true, keep_series=run < cfg.series_runs, **fte
     )
     if series is not None and gnss is not None:
         series = {**series, **_geometry_series(gnss, series["t_s"])}
@@ -174,7 +180,7 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunR
                 raise RuntimeError(why)
             nav, records = source.result(flight.truth)
             out.append(_score(profile, i, flight.truth, nav, _clock_truth(records, 0, flight.truth.t_s),
-                              records.get("gnss")))
+                              records.get("gnss"), flight))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out

@@ -8,7 +8,8 @@ errors (ft^2). Arrays: lateral / vertical error and VPL / HPL on a fixed height 
 for the error-against-height figures. Series (kept for a few runs): decimated per-epoch errors.
 
 TSE, FTE, NSE (ICAO PBN, without path definition error): TSE = true deviation from the desired path
-(truth loc_dev_m / gs_dev_m); NSE = estimate - truth; FTE = estimated deviation = TSE + NSE.
+(truth loc_dev_m / gs_dev_m); NSE = estimate - truth; FTE = the deviation guidance flew on. When the flight
+gives what guidance flew on (fte_lat_m / fte_vert_m series) that is used; otherwise FTE = TSE + NSE.
 """
 
 from __future__ import annotations
@@ -44,6 +45,8 @@ def score_run(
     *,
     clock_bias_true_m: np.ndarray | None = None,
     keep_series: bool = False,
+    fte_lat_m: np.ndarray | None = None,
+    fte_vert_m: np.ndarray | None = None,
 ) -> tuple[dict[str, float], dict[str, np.ndarray], dict[str, np.ndarray] | None]:
     """(scalars, arrays, series or None) of one run; RunScoreError when it cannot be scored."""
     err = runway_errors(truth, nav)
@@ -70,8 +73,12 @@ def score_run(
         }
         if not (np.isfinite(vals["lateral_m"]) and np.isfinite(vals["vertical_m"])):
             raise RunScoreError(f"navigation solution is not finite at the {cat} decision height (diverged)")
-        vals["fte_lat_m"] = vals["tse_lat_m"] + vals["lateral_m"]
-        vals["fte_vert_m"] = vals["tse_vert_m"] + vals["vertical_m"]
+        vals["fte_lat_m"] = (
+            vals["tse_lat_m"] + vals["lateral_m"] if fte_lat_m is None else at_crossing(fte_lat_m[:n], cr)
+        )
+        vals["fte_vert_m"] = (
+            vals["tse_vert_m"] + vals["vertical_m"] if fte_vert_m is None else at_crossing(fte_vert_m[:n], cr)
+        )
         for k, v in vals.items():
             scalars[f"{key}_{k}"] = float(v)
         # integrity over the approach down to this decision height

@@ -113,6 +113,11 @@ def test_fte_tse_identity():
     assert sc["cat1_tse_lat_m"] == pytest.approx(10.0)
     assert sc["cat1_lateral_m"] == pytest.approx(2.0, abs=1e-3)
     assert sc["cat1_fte_lat_m"] == pytest.approx(sc["cat1_tse_lat_m"] + sc["cat1_lateral_m"])
+    # when the flight reports the deviation guidance flew on, that is the FTE (interpolated at the DH)
+    fte = 12.0 + 0.01 * truth.t_s
+    sc2, _, _ = score_run(truth, make_nav(truth, 2.0 * cross_axis_ned()), CFG, fte_lat_m=fte,
+                          fte_vert_m=np.zeros(len(truth)))
+    assert sc2["cat1_fte_lat_m"] == pytest.approx(12.0 + 0.01 * sc2["cat1_t_s"], abs=1e-9)
 
 
 def test_time_averaged_rms_in_feet():
