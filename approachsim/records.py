@@ -199,6 +199,8 @@ class GnssSamples:
     """(m,) per run: true receiver clock drift, m/s."""
     fault: Array
     """(m, 24) per run: fault label (int8)."""
+    pseudorange_rate_mps: Array | None = None
+    """(m, 24) per run: pseudorange rate (carrier Doppler), m/s (nan where not valid); None if not modelled."""
 
 
 @dataclass(frozen=True)
@@ -221,3 +223,20 @@ class PseudoliteSamples:
     """(m,) per run: true receiver clock bias included (same clock as the GNSS channels in a suite), m."""
     fault: Array
     """(m, p) per run: fault label (int8)."""
+
+
+@dataclass(frozen=True)
+class ApproachErrors:
+    """Error split of one flown approach (nav/closed_loop.py), RNP convention: TSE = FTE + NSE.
+
+    Components on the last axis: (lateral = cross-track, vertical = height above the ideal glidepath), m.
+    """
+
+    t_s: Array
+    """(n,) time, s (the Truth's time base)."""
+    fte_m: Array
+    """(n, 2) flight technical error: deviation from the desired path of the position guidance flew on, m."""
+    nse_m: Array
+    """(n, 2) navigation system error in path terms: deviation of the truth minus that of the estimate, m."""
+    tse_m: Array
+    """(n, 2) total system error: deviation of the true position from the desired path, m."""
