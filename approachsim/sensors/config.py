@@ -70,6 +70,8 @@ class GnssConfig:
     oscillator: str = "tcxo"
     clock_bias0_sigma_m: float = 300.0
     clock_drift0_sigma_mps: float = 3.0
+    doppler: bool = False
+    doppler_noise_mps: float = 0.05
 
 
 @dataclass(frozen=True)
@@ -104,7 +106,7 @@ DEFAULT_SENSORS = SensorsConfig()
 
 
 FAULT_TARGETS: Mapping[str, tuple[str, ...]] = MappingProxyType(
-    {"imu": ("dv", "dtheta"), "baro": ("h",), "radalt": ("h",), "gnss": ("pseudorange",),
+    {"imu": ("dv", "dtheta"), "baro": ("h",), "radalt": ("h",), "gnss": ("pseudorange", "pseudorange_rate"),
      "pseudolite": ("pseudorange",)}
 )
 """Fault targets per sensor (the first is the default)."""
@@ -169,6 +171,8 @@ def parse_sensors(s: Section) -> SensorsConfig:
             oscillator=g.string("oscillator", "tcxo", choices=tuple(OSCILLATORS)),
             clock_bias0_sigma_m=g.number("clock_bias0_sigma_m", 300.0, lo=0.0, unit="m"),
             clock_drift0_sigma_mps=g.number("clock_drift0_sigma_mps", 3.0, lo=0.0, unit="m/s"),
+            doppler=g.boolean("doppler", False),
+            doppler_noise_mps=g.number("doppler_noise_mps", 0.05, lo=0.0, unit="m/s"),
         )
     g.done()
 

@@ -164,6 +164,8 @@ class Faulted:
         if any(f.kind == "outage" for f in self.faults):
             for _, fld, _ in self.sensor.fault_targets:
                 val = updates.get(fld, getattr(rec, fld))
+                if val is None:  # an optional output the sensor does not produce
+                    continue
                 vmask = valid.reshape(valid.shape + (1,) * (val.ndim - valid.ndim))
                 updates[fld] = np.where(vmask, val, np.nan)
         return replace(rec, fault=fault, valid=valid, **updates)

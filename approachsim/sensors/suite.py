@@ -61,7 +61,8 @@ def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterab
         out["gnss"] = GnssReceiver(
             constellation=Constellation.nominal(g.epoch_utc), budget=CODE_PRESETS[g.code],
             clock=ClockModel.named(g.oscillator, g.clock_bias0_sigma_m, g.clock_drift0_sigma_mps),
-            mask_rad=g.mask_rad, selection=g.selection, rate_hz=g.rate_hz,
+            mask_rad=g.mask_rad, selection=g.selection, rate_hz=g.rate_hz, doppler=g.doppler,
+            doppler_noise_mps=g.doppler_noise_mps,
         )
     if cfg.pseudolite is not None:
         p = cfg.pseudolite

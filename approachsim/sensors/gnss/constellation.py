@@ -66,7 +66,7 @@ class Constellation:
     inclination_rad: float = INCLINATION_RAD
 
     @classmethod
-    def nominal(cls, epoch_utc: datetime | str = "2026-01-01T00:00:00Z") -> Constellation:
+    def nominal(cls, epoch_utc: datetime | str = "2026-01-01T12:00:00Z") -> Constellation:
         """The 24 nominal slots at the given simulation epoch (UTC)."""
         ep = parse_epoch(epoch_utc) if isinstance(epoch_utc, str) else epoch_utc
         return cls(
@@ -76,8 +76,7 @@ class Constellation:
             prn=np.array([s[3] for s in SLOTS]),
         )
 
-    def positions_ecef(self, t_s: Array) -> Array:
-        """Satellite positions (n, 24, 3), ECEF, m, at run times t_s (n,)."""
+    def _angles(self, t_s: Array) -> tuple[Array, Array, float]:
         t = np.asarray(t_s, dtype=float)
         n_mot = math.sqrt(MU_GPS / self.a_m**3)
         # phases reduced mod 2 pi at the epoch first, so decades of propagation keep full precision
@@ -85,6 +84,24 @@ class Constellation:
         g_ep = math.fmod(GHA_AT_REFERENCE_RAD + geo.OMEGA_E * self.epoch_s, 2.0 * math.pi)
         u = self.u0_rad[None, :] + u_ep + n_mot * t[:, None]
         lam = self.raan_rad[None, :] - (g_ep + geo.OMEGA_E * t[:, None])  # node longitude in ECEF
+        return u, lam, n_mot
+
+    def velocities_ecef(self, t_s: Array) -> Array:
+        """Satellite velocities relative to the rotating Earth (n, 24, 3), ECEF axes, m/s (d/dt of positions)."""
+        u, lam, n_mot = self._angles(t_s)
+        ci = math.cos(self.inclination_rad)
+        si = math.sin(self.inclination_rad)
+        cu, su = np.cos(u), np.sin(u)
+        cl, sl = np.cos(lam), np.sin(lam)
+        ld = -geo.OMEGA_E
+        vx = self.a_m * (-su * n_mot * cl - cu * sl * ld - cu * n_mot * ci * sl - su * ci * cl * ld)
+        vy = self.a_m * (-su * n_mot * sl + cu * cl * ld + cu * n_mot * ci * cl - su * ci * sl * ld)
+        vz = self.a_m * (cu * n_mot * si)
+        return np.stack([vx, vy, vz], axis=-1)
+
+    def positions_ecef(self, t_s: Array) -> Array:
+        """Satellite positions (n, 24, 3), ECEF, m, at run times t_s (n,)."""
+        u, lam, _ = self._angles(t_s)
         ci = math.cos(self.inclination_rad)
         si = math.sin(self.inclination_rad)
         cu, su = np.cos(u), np.sin(u)

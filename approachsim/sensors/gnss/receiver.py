@@ -18,6 +18,12 @@ Presets (1-sigma, m; NRC 1995 Table C-1 [S11]):
 
 Satellite positions are those at the receive time (no light-time or Sagnac terms): the record carries them,
 so a navigation filter that uses the record's r_sv_ecef sees exactly the modelled geometry.
+Pseudorange rate (optional, doppler=True): rho_dot_i = u_i . (v_sv,i - v_rx) + d_rx + e_i, the geometric
+range rate (SV velocity relative to the rotating Earth, receiver velocity from the truth's v_ned) plus the
+receiver clock drift and white noise e (doppler_noise_mps, default 0.05 m/s: carrier-derived Doppler of a
+typical receiver, engineering choice); the slow range errors' rates are neglected. Off by default; its noise
+columns are drawn only when on, so receivers without it keep their exact draws (switching it on reshuffles
+that receiver's pseudorange noise, reproducibly).
 Selection: "all" (every SV above the mask) or "best4" (the four of lowest PDOP, seed 002, chosen afresh at
 each epoch). Channels are the 24 slots, in SLOTS order; invisible or unselected channels are nan and invalid.
 """
@@ -118,22 +124,28 @@ class GnssReceiver:
     mask_rad: float = math.radians(5.0)
     selection: str = "best4"
     rate_hz: float = 1.0
+    doppler: bool = False
+    doppler_noise_mps: float = 0.05
     name: str = "gnss"
 
-    fault_targets: ClassVar[tuple[tuple[str, str, str], ...]] = (("pseudorange", "pseudorange_m", "noise"),)
+    fault_targets: ClassVar[tuple[tuple[str, str, str], ...]] = (
+        ("pseudorange", "pseudorange_m", "noise"),
+        ("pseudorange_rate", "pseudorange_rate_mps", "rate_noise"),
+    )
 
     def __post_init__(self) -> None:
         if self.selection not in ("all", "best4"):
             raise ValueError(f"selection must be 'all' or 'best4', got {self.selection!r}")
 
     def draw(self, t_s: Array, rng: base.RngLike) -> base.SensorErrors:
-        """series (m, 24) m: clock_ephemeris, iono_zenith, tropo_zenith, multipath, noise."""
+        """series (m, 24) m: clock_ephemeris, iono_zenith, tropo_zenith, multipath, noise (+ rate_noise m/s)."""
         b = self.budget
         k = self.constellation.prn.shape[0]
 
         def one(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
-            z = g.standard_normal((m, 5 * k))
-            return {
+            z = g.standard_normal((m, (6 if self.doppler else 5) * k))
+            extra = {"rate_noise": self.doppler_noise_mps * z[:, 5 * k : 6 * k]} if self.doppler else {}
+            return extra | {
                 "clock_ephemeris": base.gauss_markov(z[:, 0:k], b.clock_ephemeris_m, b.clock_ephemeris_tau_s, dt),
                 "iono_zenith": base.gauss_markov(z[:, k : 2 * k], b.iono_zenith_m, b.iono_tau_s, dt),
                 "tropo_zenith": base.gauss_markov(z[:, 2 * k : 3 * k], b.tropo_zenith_m, b.tropo_tau_s, dt),
@@ -188,11 +200,21 @@ class GnssReceiver:
             cd = np.broadcast_to(clock.series["drift"], shape_t)
         pr = pr + cb[..., None]
         valid = np.broadcast_to(geo_["sel"], pr.shape).copy()
+        prr = None
+        if self.doppler:
+            r = errors.rows
+            lat, lon = truth.lat_rad[r], truth.lon_rad[r]
+            v_rx = np.einsum("nji,nj->ni", geo.c_ecef_to_ned(lat, lon), truth.v_ned[r])  # NED -> ECEF
+            v_sv = self.constellation.velocities_ecef(errors.t_s)
+            rr = np.einsum("nki,nki->nk", geo_["u"], v_sv - v_rx[:, None, :])
+            cd_ = np.zeros(shape_t) if clock is None else np.broadcast_to(clock.series["drift"], shape_t)
+            prr = np.where(valid, rr + cd_[..., None] + s["rate_noise"], np.nan)
         return GnssSamples(
             t_s=errors.t_s, prn=self.constellation.prn, r_sv_ecef=geo_["r_sv"],
             pseudorange_m=np.where(valid, pr, np.nan), sigma_m=self.sigma_m(el), elevation_rad=el,
             azimuth_rad=geo_["az"], visible=geo_["visible"], valid=valid, pdop=geo_["pdop"],
             clock_bias_m=np.array(cb), clock_drift_mps=np.array(cd), fault=np.zeros(pr.shape, dtype=np.int8),
+            pseudorange_rate_mps=prr,
         )
 
     def measure(

@@ -99,3 +99,23 @@ def test_pseudorange_error_matches_the_budget(runway):
         assert abs(np.nanmean(err[:, ok])) < 0.05 * rec.sigma_m[ok].min()
         # the NRC 1995 UERE the preset is built from, at 30 deg elevation
         assert rx.sigma_m(np.array(math.radians(30.0))) == pytest.approx(uere_30deg, rel=0.03)
+
+
+def test_pseudorange_rate_is_the_range_derivative_plus_clock_drift(descent):
+    rx = GnssReceiver(selection="all", doppler=True)
+    exact = rx.measure(descent, np.random.default_rng(0), noise=False)
+    rows = np.arange(0, len(descent), 20)
+    # central difference of the geometric range between neighbouring 20 Hz truth rows (independent check)
+    dt = descent.t_s[1] - descent.t_s[0]
+    mid = rows[1:-1]
+    c = rx.constellation
+    r_p = np.linalg.norm(c.positions_ecef(descent.t_s[mid + 1]) - descent.r_ecef[mid + 1][:, None], axis=-1)
+    r_m = np.linalg.norm(c.positions_ecef(descent.t_s[mid - 1]) - descent.r_ecef[mid - 1][:, None], axis=-1)
+    fd = (r_p - r_m) / (2 * dt)
+    ok = exact.valid[1:-1]
+    assert np.max(np.abs(exact.pseudorange_rate_mps[1:-1][ok] - fd[ok])) < 1e-3
+    noisy = rx.measure(descent, [np.random.default_rng(i) for i in range(200)],
+                       clock_rng=[np.random.default_rng(1000 + i) for i in range(200)])
+    resid = noisy.pseudorange_rate_mps - exact.pseudorange_rate_mps - noisy.clock_drift_mps[..., None]
+    assert np.nanstd(resid) == pytest.approx(0.05, rel=0.05)
+    assert GnssReceiver().measure(descent, np.random.default_rng(0)).pseudorange_rate_mps is None
