@@ -16,9 +16,10 @@ FlightResult, so that
 
 The run ends when the IMU descends to `stop_height_m` above the threshold ("reached stop height"), or, with
 `land=True`, after a flare when the main gear touches ("touchdown"), or on ground contact, divergence or
-timeout (each a termination reason). The Truth arrays are preallocated for
-the longest permitted run and trimmed at the end; a navigation source sees the preallocated record and may
-read rows <= k only.
+timeout (each a termination reason). With a navigation source, the Truth arrays are preallocated for the
+longest permitted run (NaN until written) and trimmed at the end; the source sees that record and may read
+rows <= k only. On truth navigation (the default) nothing reads the record during the run, so the rows are
+collected in a list and stacked at the end (same values; tested).
 
 Truth is of the IMU point (aircraft file [imu]): position, velocity and specific force are moved from the
 CG with the rigid-body lever-arm terms (f_imu = f_cg + w_ib' x l + w_ib x (w_ib x l), v_imu = v_cg +
@@ -169,9 +170,13 @@ class Approach:
                                     env.wind_from_rad + math.pi)
             set_tn, set_te, set_td = fdm.turbulence_setters()
             turb_step = turb.step
-        buf = np.full((n_max, _NCOL), np.nan)
-        gbuf = np.full((n_max, 6), np.nan)
-        truth = _truth_views(buf, rw.frame)
+        if on_truth:
+            rows: list[tuple[float, ...]] = []
+            rows_append = rows.append
+        else:
+            buf = np.full((n_max, _NCOL), np.nan)
+            gbuf = np.full((n_max, 6), np.nan)
+            truth = _truth_views(buf, rw.frame)
 
         nodes = [fdm.node(n) for n in _READ]
         getters = [n.get_double_value for n in nodes]
@@ -271,52 +276,60 @@ class Approach:
             s1, c1 = sin(0.5 * phi), cos(0.5 * phi)
             s2, c2 = sin(0.5 * th), cos(0.5 * th)
             s3, c3 = sin(0.5 * psi), cos(0.5 * psi)
-            buf[k] = (
+            head = (
                 k * dt, lat_i, lon_i, h_i, x_e, y_e, z_e, vn, ve, vd,
                 c1 * c2 * c3 + s1 * s2 * s3, s1 * c2 * c3 - c1 * s2 * s3,
                 c1 * s2 * c3 + s1 * c2 * s3, c1 * c2 * s3 - s1 * s2 * c3,
                 phi, th, psi, pi_, qi, ri, fbx, fby, fbz, p_psf * PSF, t_r / 1.8, h_i - terr,
-                xr, yr, zr, zr - (tch - xr * tan_gp), yr, de, da, dr, thr, vc_kt * KT,
+                xr, yr, zr, zr - (tch - xr * tan_gp), yr,
             )
-            # the navigation source sees row k, then the termination checks on the true state
-            if on_truth:  # TruthSource.step would return exactly these values: skip the array round trip
-                gx, gy, gz, gvn, gve, gvd = xr, yr, zr, vn, ve, vd
+            # termination checks on the true state
+            if zr < lowest:
+                lowest = zr
+            term = None
+            if zr <= stop_h:
+                term = "reached stop height"
+            elif land and (w1 > 0.0 or w2 > 0.0) and w0 == 0.0:
+                term = "touchdown"
+                touchdown = (xr, vd)
+            elif w0 > 0.0 or w1 > 0.0 or w2 > 0.0 or h_i - terr <= 0.0:
+                term = "ground contact"
+            elif abs(phi) > 1.0 or abs(zr - (tch - xr * tan_gp)) > 300.0 or abs(yr) > 1500.0:
+                term = "diverged"
+            if on_truth:
+                # TruthSource.step would return this row's r_rwy and v_ned: fly on them directly, and keep the
+                # rows in a list (no one reads the arrays during the run)
+                if term is not None:  # the controls of the previous step still act on the last row
+                    rows_append(head + (de + pitch_trim, da, dr, thr, vc_kt * KT))
+                    termination = term
+                    break
+                h_gear = min(g1_ft, g2_ft) * FT if land else None
+                de, da, dr, thr = ap_step(xr, yr, zr, vn, ve, vd, phi, th, p, q, beta, vc_kt * KT, h_gear)
+                rows_append(head + (de + pitch_trim, da, dr, thr, vc_kt * KT))
             else:
+                # the navigation source sees row k (controls: those of the previous step until replaced below)
+                buf[k] = head + (de + pitch_trim, da, dr, thr, vc_kt * KT)
                 gr, gv = src.step(k, truth)
                 gx, gy, gz = float(gr[0]), float(gr[1]), float(gr[2])
                 gvn, gve, gvd = float(gv[0]), float(gv[1]), float(gv[2])
                 gbuf[k] = (gx, gy, gz, gvn, gve, gvd)
-            if zr < lowest:
-                lowest = zr
-            if zr <= stop_h:
-                termination = "reached stop height"
-                break
-            if land and (w1 > 0.0 or w2 > 0.0) and w0 == 0.0:
-                termination = "touchdown"
-                touchdown = (xr, vd)
-                break
-            if w0 > 0.0 or w1 > 0.0 or w2 > 0.0 or h_i - terr <= 0.0:
-                termination = "ground contact"
-                break
-            if abs(phi) > 1.0 or abs(zr - (tch - xr * tan_gp)) > 300.0 or abs(yr) > 1500.0:
-                termination = "diverged"
-                break
+                if term is not None:
+                    termination = term
+                    break
+                h_gear = min(g1_ft, g2_ft) * FT if land else None
+                de, da, dr, thr = ap_step(gx, gy, gz, gvn, gve, gvd, phi, th, p, q, beta, vc_kt * KT, h_gear)
+                buf[k, _CTRL:_CTRL + 4] = (de + pitch_trim, da, dr, thr)
             # the controls for the next step
-            h_gear = min(g1_ft, g2_ft) * FT if land else None
-            de, da, dr, thr = ap_step(gx, gy, gz, gvn, gve, gvd, phi, th, p, q, beta, vc_kt * KT, h_gear)
-            buf[k, _CTRL:_CTRL + 4] = (de + pitch_trim, da, dr, thr)
             set_de(de)
             set_da(da)
             set_dr(dr)
             set_thr[0](thr)
             set_thr[1](thr)
         n = k + 1
-        if termination != "timeout":
-            # the autopilot did not run on the last row: the controls of the previous step still act
-            buf[k, _CTRL:_CTRL + 4] = (de + pitch_trim, da, dr, thr)
         if on_truth:
-            gbuf[:n, :3] = buf[:n, _COLS["r_rwy"][0]:_COLS["r_rwy"][0] + 3]
-            gbuf[:n, 3:] = buf[:n, _COLS["v_ned"][0]:_COLS["v_ned"][0] + 3]
+            buf = np.array(rows, dtype=float).reshape(n, _NCOL)
+            truth = _truth_views(buf, rw.frame)
+            gbuf = np.concatenate([truth.r_rwy, truth.v_ned], axis=1)
         final = Truth(**{name: np.ascontiguousarray(v[:n]) for name, v in truth.arrays().items()}, runway=rw.frame)
         return FlightResult(
             truth=final,

@@ -77,3 +77,7 @@ def test_navigation_source_is_called_once_per_row_in_order():
     r = Approach(load_profile(DEFAULT)).fly(seed=1, nav_source=src, max_time_s=5.0)
     assert src.seen == list(range(len(r.truth)))
     np.testing.assert_array_equal(r.guidance_r_rwy, r.truth.r_rwy)
+    # the default (truth) path keeps its rows in a list: it must give the very same record
+    default = Approach(load_profile(DEFAULT)).fly(seed=1, max_time_s=5.0)
+    for name, arr in default.truth.arrays().items():
+        np.testing.assert_array_equal(arr, getattr(r.truth, name), err_msg=name)
