@@ -48,9 +48,9 @@ def main() -> None:
     print(f"profile {profile.name}: {n} steps at {hz:g} Hz = {n / hz:.1f} s of flight; {args.repeat} interleaved pairs")
     for label, pick in (("min", min), ("median", statistics.median)):
         fly, raw = pick(fly_s), pick(raw_s)
-        print(f"{label:6s}: approach (FDM build + trim + closed loop + truth) {fly:.3f} s ({fly / n * 1e6:.1f} us/step, "
-              f"{n / hz / fly:.0f}x real time); raw JSBSim (trim + run()) {raw:.3f} s ({raw / n * 1e6:.1f} us/step); "
-              f"ratio {fly / raw:.2f} (target <= 3)")
+        print(f"{label:6s}: approach (FDM build + trim + closed loop + truth) {fly:.3f} s "
+              f"({fly / n * 1e6:.1f} us/step, {n / hz / fly:.0f}x real time); raw JSBSim (trim + run()) "
+              f"{raw:.3f} s ({raw / n * 1e6:.1f} us/step); ratio {fly / raw:.2f} (target <= 3)")
     print(f"pairwise ratios: {', '.join(f'{f / r:.2f}' for f, r in zip(fly_s, raw_s, strict=True))}")
 
 if __name__ == "__main__":
