@@ -34,7 +34,7 @@ STAGES = (
     ("approachsim.nav.system", "NavSystem", "navigation system"),
 )
 """(module, required attribute, what) of every stage the pipeline needs."""
-CLOSED_LOOP_STAGE = ("approachsim.nav.closed_loop", "NavSource", "closed-loop navigation source")
+CLOSED_LOOP_STAGE = ("approachsim.nav.closed_loop", "NavInTheLoop", "closed-loop navigation source")
 """The extra stage closed-loop mode needs."""
 
 
@@ -166,21 +166,26 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
 
 
 def closed_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunResult]:
-    """Each run flies on its own navigation solution; the aircraft is parsed once for the group."""
-    from approachsim.nav import closed_loop
+    """Each run flies on its own navigation solution (nav.closed_loop.NavInTheLoop as the flight's navigation
+    source); the aircraft is parsed and linearized once per task."""
+    import numpy as np
+
+    from approachsim.nav.closed_loop import NavInTheLoop
 
     approach = _approach(profile)
     out = []
     for i in runs:
         try:
-            source = closed_loop.NavSource.from_profile(profile, seed=seed, run=i)
+            source = NavInTheLoop(profile, seed, i)
             flight = approach.fly(seed=seed, run=i, nav_source=source)
             why = _reached_all(profile, flight)
             if why is not None:
                 raise RuntimeError(why)
-            nav, records = source.result(flight.truth)
-            out.append(_score(profile, i, flight.truth, nav, _clock_truth(records, 0, flight.truth.t_s),
-                              records.get("gnss"), flight))
+            truth = flight.truth
+            nav = source.result(truth).solution
+            clk = source.errors.clock
+            clock_true = None if clk is None else np.interp(truth.t_s, clk.t_s, np.asarray(clk.series["bias"]))
+            out.append(_score(profile, i, truth, nav, clock_true, None, flight))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out
