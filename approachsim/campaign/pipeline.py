@@ -16,7 +16,7 @@ navigates over the same truth, flown on truth navigation with the turbulence of 
 task flies it once; tasks of the same group fly the identical, seeded flight), each run with its own sensor
 and filter noise, batched over the task's runs. A run's numbers depend only on (seed, run, group size),
 not on the executor or the batch it shared (checked: NavSystem.run gives bit-identical runs in a batch of
-1 and of 6). Closed loop: each run flies on its own navigation solution.
+1 and of 6). Closed loop: each run flies on its own navigation solution, one run per task.
 """
 
 from __future__ import annotations
@@ -70,7 +70,8 @@ def spec_for(profile: Any, mode: str) -> PipelineSpec:
     size = profile.evaluation.flight_group
     if mode == "open":
         return PipelineSpec(open_loop_group, size, False)
-    return PipelineSpec(closed_loop_group, size, True)
+    # closed loop shares no flight: one run per task, so each run is stored (and resumable) as it finishes
+    return PipelineSpec(closed_loop_group, 1, True)
 
 
 def _score(
