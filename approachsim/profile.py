@@ -22,6 +22,7 @@ from approachsim import units
 from approachsim.config import ProfileError, Section
 from approachsim.evaluate.config import EvaluationConfig, parse_evaluation
 from approachsim.geo import RunwayFrame
+from approachsim.nav.config import NavConfig, parse_nav
 from approachsim.sensors.config import SensorsConfig, parse_faults, parse_sensors
 
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
@@ -129,6 +130,9 @@ class Profile:
     """The sensor suite ([sensors]; sensors/config.py). Default: seed 002's suite without the pseudolite."""
     faults: tuple = ()
     """Declared sensor faults ([[faults]]; sensors/faults.py FaultSpec), in profile order."""
+    nav: NavConfig = field(default_factory=NavConfig)
+    """The navigation system ([nav]: filter by name and its tuning, aiding rate, feedback, baro loop, initial
+    INS errors; nav/config.py)."""
 
 
 def _runway(s: Section) -> Runway:
@@ -231,6 +235,7 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
     evaluation = parse_evaluation(top.section("evaluation"))
     sensors = parse_sensors(top.section("sensors"))
     faults = parse_faults(top.sections("faults"), sensors)
+    nav = parse_nav(top.section("nav"))
     top.done()
     return Profile(
         name=name,
@@ -245,6 +250,7 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
         evaluation=evaluation,
         sensors=sensors,
         faults=faults,
+        nav=nav,
     )
 
 
