@@ -4,8 +4,9 @@ Scalars (SI, names carry the unit): for each category key (cat1, cat2, cat3) at 
 along / lateral / vertical navigation error, VPL / HPL, the time of the crossing, and (always computed;
 meaningful in closed loop) flight technical and total system error; Stanford counts (vertical and
 horizontal) and availability over the approach down to that height; seed 002's time-averaged squared
-errors (ft^2). Arrays: lateral / vertical error and VPL / HPL on a fixed height grid (HEIGHT_GRID_FT),
-for the error-against-height figures. Series (kept for a few runs): decimated per-epoch errors.
+errors (ft^2) from evaluation.timeavg_settle_s on. Arrays: lateral / vertical error and VPL / HPL on a
+fixed height grid (HEIGHT_GRID_FT), for the error-against-height figures. Series (kept for a few runs):
+decimated per-epoch errors.
 
 TSE, FTE, NSE (ICAO PBN, without path definition error): TSE = true deviation from the desired path
 (truth loc_dev_m / gs_dev_m); NSE = estimate - truth; FTE = the deviation guidance flew on. When the flight
@@ -92,7 +93,11 @@ def score_run(
                 scalars[f"{key}_{axis}_{region}"] = float(count)
         avail = availability(integ.vpl_m[win], integ.hpl_m[win], lim.vertical_al_m, lim.horizontal_al_m)
         scalars[f"{key}_availability"] = float(np.mean(avail))
-    for state, ms in mean_square_ft2(state_errors_m(truth, nav, clock_bias_true_m, e_ned=err.e_ned)).items():
+    settled = err.t_s >= err.t_s[0] + cfg.timeavg_settle_s
+    if not settled.any():
+        raise RunScoreError(f"run shorter than evaluation.timeavg_settle_s ({cfg.timeavg_settle_s:g} s)")
+    ta = mean_square_ft2(state_errors_m(truth, nav, clock_bias_true_m, e_ned=err.e_ned), settled)
+    for state, ms in ta.items():
         scalars[f"ta_{state}_ft2"] = ms
     grid_m = HEIGHT_GRID_FT * units.FT
     arrays = {

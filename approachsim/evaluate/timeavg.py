@@ -39,9 +39,9 @@ def state_errors_m(
     return out
 
 
-def mean_square_ft2(errors_m: dict[str, np.ndarray]) -> dict[str, float]:
-    """One run's time-averaged squared error per state, ft^2 (nan where the state has no error series)."""
-    return {k: float(np.mean((errors_m[k] / units.FT) ** 2)) for k in STATES}
+def mean_square_ft2(errors_m: dict[str, np.ndarray], window: np.ndarray | slice = slice(None)) -> dict[str, float]:
+    """One run's time-averaged squared error per state over the samples `window`, ft^2 (nan: no series)."""
+    return {k: float(np.mean((errors_m[k][window] / units.FT) ** 2)) for k in STATES}
 
 
 def campaign_rms_ft(per_run_ms_ft2: dict[str, np.ndarray]) -> dict[str, float]:

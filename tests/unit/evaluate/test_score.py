@@ -128,6 +128,11 @@ def test_time_averaged_rms_in_feet():
     assert sc["ta_longitude_ft2"] == pytest.approx((4.0 / units.FT) ** 2, rel=1e-4)
     assert sc["ta_altitude_ft2"] == pytest.approx((1.0 / units.FT) ** 2, rel=1e-4)
     assert sc["ta_clock_bias_ft2"] == pytest.approx((2.0 / units.FT) ** 2)
+    # the filter's start-up (here a 400 m clock error for the first second) is left out of the average
+    clock = np.full(len(truth), -2.0)
+    clock[truth.t_s < 1.0] = 400.0
+    sc, _, _ = score_run(truth, make_nav(truth, e), CFG, clock_bias_true_m=clock)
+    assert sc["ta_clock_bias_ft2"] == pytest.approx((2.0 / units.FT) ** 2)
 
 
 def test_unscorable_runs_raise_with_a_reason():
@@ -151,6 +156,8 @@ def test_evaluation_section_parsing():
         ({"verdict": "icao"}, "evaluation.verdict"),
         ({"k_v": 0}, "evaluation.k_v"),
         ({"series_runs": -1}, "evaluation.series_runs"),
+        ({"timeavg_settle_s": -1}, "evaluation.timeavg_settle_s"),
+        ({"flight_group": 0}, "evaluation.flight_group"),
         ({"bogus": 1}, "evaluation.bogus"),
     ):
         with pytest.raises(ProfileError, match=field.replace(".", r"\.")):
