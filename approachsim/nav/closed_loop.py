@@ -14,7 +14,8 @@ errors to row k and runs the filter (system.NavSystem.aid). Guidance gets the na
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -24,7 +25,7 @@ from approachsim.nav import ins
 from approachsim.nav.system import NavRun, NavSystem, StatusLog
 from approachsim.records import ApproachErrors, NavSolution, Truth
 from approachsim.seeding import stream
-from approachsim.sensors.suite import SensorSuite
+from approachsim.sensors.suite import SensorSuite, SuiteErrors
 
 Array = np.ndarray
 
@@ -60,7 +61,7 @@ class NavInTheLoop:
         self.h_baro_hold = math.nan
         self.f_sum = np.zeros((1, 3))
         self.t_last = 0.0
-        self.out: dict[str, list] = {"lat": [], "lon": [], "h": [], "v": [], "c": [], "ppos": [], "clk": [], "clk_sd": []}
+        self.out: dict[str, list] = {k: [] for k in ("lat", "lon", "h", "v", "c", "ppos", "clk", "clk_sd")}
         self.epochs: dict[str, list] = {"t": [], "x": [], "pd": [], "pnav": [], "err": []}
 
     def _apply(self, name: str, k: int, truth: Truth) -> Any:
@@ -68,8 +69,11 @@ class NavInTheLoop:
         j = self.sample_at.get(name, {}).get(k)
         if j is None:
             return None
-        one = SensorSuite.take(self.errors, name, slice(j, j + 1))
-        return self.suite.apply(truth, one, names=[name])[name]
+        e = self.errors.sensors[name]
+        one = replace(e, index=e.index[j:j + 1], rows=e.rows[j:j + 1], t_s=e.t_s[j:j + 1],
+                      series={k: v[j:j + 1] for k, v in e.series.items()})  # a view: no copy of the long draw
+        sub = SuiteErrors(MappingProxyType({name: one}), self.errors.clock)
+        return self.suite.apply(truth, sub, names=[name])[name]
 
     def step(self, k: int, truth: Truth) -> tuple[Array, Array]:
         """Runway-frame position (m) and NED velocity (m/s) of the navigation output at truth row k."""
