@@ -18,7 +18,7 @@ from approachsim.config import ProfileError, Section
 from approachsim.sensors.faults import FAULT_KINDS, FaultSpec
 from approachsim.sensors.gnss.clock import OSCILLATORS
 from approachsim.sensors.gnss.constellation import parse_epoch
-from approachsim.sensors.gnss.receiver import CODE_PRESETS
+from approachsim.sensors.gnss.receiver import CODE_PRESETS, SELECTIONS
 from approachsim.sensors.presets import PRESETS
 
 SENSOR_NAMES = ("imu", "baro", "radalt", "gnss", "pseudolite")
@@ -164,7 +164,7 @@ def parse_sensors(s: Section) -> SensorsConfig:
             raise ProfileError(f"{g.path}.epoch_utc: {e}") from None
         gnss = GnssConfig(
             code=g.string("code", "P(Y)", choices=tuple(CODE_PRESETS)),
-            selection=g.string("selection", "best4", choices=("best4", "all")),
+            selection=g.string("selection", "best4", choices=SELECTIONS),
             mask_rad=math.radians(g.number("mask_deg", 5.0, lo=0.0, hi=45.0, unit="deg")),
             rate_hz=g.number("rate_hz", 1.0, lo=0.1, hi=100.0, unit="Hz"),
             epoch_utc=epoch,

@@ -47,6 +47,11 @@ from approachsim.sensors.gnss.constellation import Constellation, dops, look_ang
 
 Array = np.ndarray
 
+SELECTIONS = ("best4", "best4-fixed", "all")
+"""Satellite selection. best4: the best-PDOP four at every epoch. best4-fixed: seed 002's one planned set for
+the approach, the best-PDOP four (at the run start) among the satellites that stay above the mask for
+fixed_hold_s seen from the start position (truth row 0 only: stateless), kept while all four are in view,
+with per-epoch best4 at any epoch where one is not. all: every satellite in view."""
 IONO_SHELL_M = 350e3
 """Thin-shell ionosphere height, m (Klobuchar / DO-229)."""
 
@@ -126,6 +131,7 @@ class GnssReceiver:
     rate_hz: float = 1.0
     doppler: bool = False
     doppler_noise_mps: float = 0.05
+    fixed_hold_s: float = 1800.0
     name: str = "gnss"
 
     fault_targets: ClassVar[tuple[tuple[str, str, str], ...]] = (
@@ -134,8 +140,8 @@ class GnssReceiver:
     )
 
     def __post_init__(self) -> None:
-        if self.selection not in ("all", "best4"):
-            raise ValueError(f"selection must be 'all' or 'best4', got {self.selection!r}")
+        if self.selection not in SELECTIONS:
+            raise ValueError(f"selection must be one of {', '.join(SELECTIONS)}; got {self.selection!r}")
 
     def draw(self, t_s: Array, rng: base.RngLike) -> base.SensorErrors:
         """series (m, 24) m: clock_ephemeris, iono_zenith, tropo_zenith, multipath, noise (+ rate_noise m/s)."""
@@ -167,7 +173,20 @@ class GnssReceiver:
         visible = el >= self.mask_rad
         lat, lon, _ = geo.ecef_to_geodetic(r_rx)
         c_ned = geo.c_ecef_to_ned(lat, lon)
-        sel = visible if self.selection == "all" else best_pdop_four(u, visible)
+        if self.selection == "all":
+            sel = visible
+        elif self.selection == "best4":
+            sel = best_pdop_four(u, visible)
+        else:  # best4-fixed: planned at the run start (truth row 0) for the next fixed_hold_s
+            t_plan = truth.t_s[0] + np.arange(0.0, self.fixed_hold_s + 1.0, 60.0)
+            r0 = np.repeat(truth.r_ecef[:1], t_plan.shape[0], axis=0)
+            _, u0, el0, _ = look_angles(r0, self.constellation.positions_ecef(t_plan))
+            stays = np.all(el0 >= self.mask_rad, axis=0, keepdims=True)
+            first = best_pdop_four(u0[:1], stays)[0]
+            keep = np.all(visible[:, first], axis=1)
+            sel = np.where(keep[:, None], first[None, :] & visible, False)
+            if not np.all(keep):
+                sel[~keep] = best_pdop_four(u[~keep], visible[~keep])
         _, pdop, _, _ = dops(u, sel, c_ned)
         return {"r_sv": r_sv, "range": rng_m, "u": u, "el": el, "az": az, "visible": visible, "sel": sel,
                 "pdop": pdop}

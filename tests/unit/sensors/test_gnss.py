@@ -119,3 +119,19 @@ def test_pseudorange_rate_is_the_range_derivative_plus_clock_drift(descent):
     resid = noisy.pseudorange_rate_mps - exact.pseudorange_rate_mps - noisy.clock_drift_mps[..., None]
     assert np.nanstd(resid) == pytest.approx(0.05, rel=0.05)
     assert GnssReceiver().measure(descent, np.random.default_rng(0)).pseudorange_rate_mps is None
+
+
+def test_best4_fixed_keeps_the_start_set_and_is_stateless(descent):
+    fixed = GnssReceiver(selection="best4-fixed")
+    e = fixed.draw(descent.t_s, np.random.default_rng(0))
+    rec = fixed.apply(descent, e)
+    every = GnssReceiver(selection="best4").measure(descent, np.random.default_rng(0), noise=False)
+    assert np.all(rec.valid.sum(axis=1) == 4)
+    assert np.all(rec.valid == rec.valid[0])  # one planned set for the whole approach
+    assert np.all(rec.elevation_rad[0][rec.valid[0]] >= fixed.mask_rad)
+    # re-selecting every epoch switches sets (here PRN 14 sets through the 5 deg mask at t = 115 s)
+    assert not np.all(every.valid == every.valid[0])
+    assert rec.pdop[0] >= every.pdop[0]  # the planned set trades a little PDOP for continuity
+    for j in (0, 100, len(e) - 1):
+        one = fixed.apply(descent, e.take(slice(j, j + 1)))
+        assert np.array_equal(one.pseudorange_m[0], rec.pseudorange_m[j], equal_nan=True)
