@@ -130,3 +130,9 @@ def test_run_study_writes_the_comparison(tmp_path):
     table = comparison_table(rows)
     assert table.splitlines()[1].startswith("wind_speed_kt=0") and "CAT III" in table
     assert math.isfinite(windy["CATIII_vertical_1sigma_ft"])
+
+
+def test_the_example_study_file_is_valid():
+    s = load_study(ROOT / "studies" / "ins-grade-x-aids.toml")
+    assert [v.profile.sensors.imu.grade for v in s.variants] == ["nav-0.4", "nav-2.0", "nav-4.0", "nav-2.0"]
+    assert [v.profile.sensors.pseudolite is not None for v in s.variants] == [False, False, False, True]
