@@ -16,6 +16,7 @@ from approachsim.config import ProfileError
 COMMAND_MODULES = (
     "approachsim.commands.fly",
     "approachsim.commands.sense",
+    "approachsim.commands.navigate",
     "approachsim.commands.reproduce",
     "approachsim.commands.evaluate",
     "approachsim.commands.study",
