@@ -118,8 +118,9 @@ class ClosedLoop:
     C: Array
 
 
-def _si_plant(lin: Linearization) -> tuple[Array, Array]:
-    """The 9 rigid-body states (Vt m/s, alpha, theta, q, beta, phi, p, psi, r) plus altitude rate row, SI."""
+def _si_plant(lin: Linearization) -> tuple[Array, Array, list[int]]:
+    """The linearization in SI (Vt m/s, alt m) and the indices of the 9 rigid-body states kept
+    (Vt, alpha, theta, q, beta, phi, p, psi, r); the altitude row gives h' for the glidepath deviation."""
     keep = [_VT, _ALPHA, _THETA, _Q, _BETA, _PHI, _P, _PSI, _R]
     scale = np.ones(12)
     scale[_VT] = units.FPS

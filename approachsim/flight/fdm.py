@@ -42,6 +42,10 @@ INTEGRATOR_RECT_EULER = 1
 RANKINE_PER_K = 1.8
 
 
+class TrimError(RuntimeError):
+    """JSBSim could not trim the aircraft at the requested condition."""
+
+
 @contextlib.contextmanager
 def _quiet_stdout():
     """Send the process's C-level stdout (file descriptor 1) to /dev/null for the duration."""
@@ -175,9 +179,10 @@ class FDM:
             raise RuntimeError("JSBSim run_ic failed")
         f["propulsion/set-running"] = -1
         try:
-            f.do_trim(1)
+            with _quiet_stdout():  # a failing trim explains itself on stdout; the exception says it in one line
+                f.do_trim(1)
         except jsbsim.TrimFailureError as e:
-            raise RuntimeError(
+            raise TrimError(
                 f"JSBSim could not trim at {ic.cas_mps / units.KT:.0f} KCAS, flaps {ic.flaps_norm}, "
                 f"gamma {math.degrees(ic.gamma_rad):.1f} deg: {e}"
             ) from None

@@ -34,10 +34,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from approachsim import geo, units
+from approachsim.config import ProfileError
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import Linearization
-from approachsim.flight.fdm import FDM
+from approachsim.flight.fdm import FDM, TrimError
 from approachsim.flight.trim import start_condition
 from approachsim.flight.turbulence import DrydenTurbulence
 from approachsim.profile import Profile
@@ -140,9 +141,19 @@ class Approach:
             rw = self.profile.runway
             along = -(LINEARIZATION_HEIGHT_M - rw.tch_m) / math.tan(rw.glidepath_rad)
             fdm = FDM(self.aircraft.jsbsim_model, self.dt_s)
-            fdm.initialize_and_trim(start_condition(self.profile, self.aircraft, still_air=True, along_m=along))
+            self._trim(fdm, start_condition(self.profile, self.aircraft, still_air=True, along_m=along))
             self._lin = fdm.linearize(-self.profile.runway.glidepath_rad)
         return self._lin
+
+    def _trim(self, fdm: FDM, ic) -> None:
+        """Trim; a condition the aircraft cannot trim at is a profile error naming the approach speed."""
+        try:
+            fdm.initialize_and_trim(ic)
+        except TrimError as e:
+            raise ProfileError(
+                f"aircraft.approach_speed_kt: {e}; choose a speed the {self.aircraft.name} trims at with these "
+                f"flaps (the 737 with flaps 1: about 130-160 kt)"
+            ) from None
 
     def fly(self, seed: int, run: int = 0, nav_source: NavigationSource | None = None,
             max_time_s: float | None = None) -> FlightResult:
@@ -155,7 +166,7 @@ class Approach:
         on_truth = type(src) is TruthSource
         ic = start_condition(prof, ac)
         fdm = FDM(ac.jsbsim_model, dt)
-        fdm.initialize_and_trim(ic)
+        self._trim(fdm, ic)
         turb_seed = stream_int(seed, run, "turbulence")
         fdm.set_seed(turb_seed)
 
