@@ -19,6 +19,7 @@ import sys
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO
@@ -127,6 +128,24 @@ def plan_chunks(todo: Sequence[int], *, workers: int, group_size: int | None, pe
     return chunks
 
 
+CRASH = "worker process died while running this run's task (a crash or out of memory)"
+
+
+def _pool_round(tasks: list, workers: int, args: tuple, ctx) -> Iterator[tuple[list, list[RunResult] | None]]:
+    """Run tasks on a fresh pool; yields (task, results) or (task, None) for tasks lost to a dead worker."""
+    run_fn, group_fn, profile, seed = args
+    with ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=ctx) as pool:
+        futures = {pool.submit(run_task, run_fn, group_fn, profile, seed, t): t for t in tasks}
+        while futures:
+            finished, _ = wait(futures, return_when=FIRST_COMPLETED)
+            for f in finished:
+                t = futures.pop(f)
+                try:
+                    yield t, f.result()
+                except BrokenProcessPool:
+                    yield t, None
+
+
 def _local(tasks: list, workers: int, args: tuple) -> Iterator[list[RunResult]]:
     run_fn, group_fn, profile, seed = args
     if workers <= 1 or len(tasks) <= 1:
@@ -134,12 +153,24 @@ def _local(tasks: list, workers: int, args: tuple) -> Iterator[list[RunResult]]:
             yield run_task(run_fn, group_fn, profile, seed, t)
         return
     ctx = multiprocessing.get_context("fork") if sys.platform.startswith("linux") else None
-    with ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=ctx) as pool:
-        pending = {pool.submit(run_task, run_fn, group_fn, profile, seed, t) for t in tasks}
-        while pending:
-            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for f in finished:
-                yield f.result()
+    # a worker that dies (segfault, OOM kill) breaks the pool and every task in flight: rerun those on a new
+    # pool, and what breaks it again alone, one task at a time, so only the culprit's runs are lost
+    lost: list = []
+    for t, res in _pool_round(tasks, workers, args, ctx):
+        if res is None:
+            lost.append(t)
+        else:
+            yield res
+    again: list = []
+    if lost:
+        for t, res in _pool_round(lost, workers, args, ctx):
+            if res is None:
+                again.append(t)
+            else:
+                yield res
+    for t in again:
+        for _, res in _pool_round([t], 1, args, ctx):
+            yield res if res is not None else [RunResult.failed(i, CRASH) for i in t]
 
 
 def _dask(tasks: list, address: str, args: tuple, timeout_s: float) -> Iterator[list[RunResult]]:

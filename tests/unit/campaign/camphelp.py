@@ -5,6 +5,7 @@ Its "profile" is a plain dict: sleep_s (per run), fail_runs (indices that raise)
 
 from __future__ import annotations
 
+import os
 import time
 
 import numpy as np
@@ -19,6 +20,8 @@ def synth_run(profile: dict, seed: int, run: int) -> RunResult:
     x = rng.normal(1.0, 2.0, 200)
     if run in profile.get("fail_runs", ()):
         raise RuntimeError(f"synthetic failure in run {run}\n(second line)")
+    if run in profile.get("crash_runs", ()):
+        os._exit(3)  # a worker process that dies (as a segfault or an OOM kill would)
     time.sleep(profile.get("sleep_s", 0.0))
     keep = run < profile.get("series_runs", 0)
     return RunResult(

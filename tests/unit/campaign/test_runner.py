@@ -88,6 +88,15 @@ def test_a_raising_run_is_recorded_and_the_rest_complete(tmp_path):
     assert all(r.error == "RuntimeError: shared flight failed" for r in g.failed)
 
 
+def test_a_dying_worker_loses_only_its_own_run():
+    res = run_campaign({"crash_runs": (5,)}, seed=1, runs=12, run_fn=synth_run, workers=2, per_task=1,
+                       progress=False)
+    assert [r.run for r in res.failed] == [5]
+    assert "worker process died" in res.failed[0].error
+    fresh = _run({}, run_fn=synth_run, seed=1, runs=12, workers=1)
+    assert all(a.same_as(b) for a, b in zip(res.results, fresh.results, strict=True) if a.run != 5)
+
+
 def test_groups_do_not_depend_on_what_is_left():
     assert plan_chunks([0, 1, 2, 3, 4, 5, 6], workers=2, group_size=3) == [[0, 1, 2], [3, 4, 5], [6]]
     assert plan_chunks([1, 4, 5, 9], workers=2, group_size=3) == [[1], [4, 5], [9]]
