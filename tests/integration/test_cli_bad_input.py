@@ -45,7 +45,8 @@ CASES = [
     ("terrain-mismatch", GOOD + "\n[terrain]\ndistance_nmi = [10.0, 5.0, 0.0]\nheight_ft = [100.0, 13.0]\n",
      "terrain.height_ft"),
     ("flaps-above-one", _edit('name = "737"', 'name = "737"\nflaps_norm = 1.5'), "aircraft.flaps_norm"),
-    ("untrimmable-speed", _edit('name = "737"', 'name = "737"\napproach_speed_kt = 90.0'), "aircraft.approach_speed_kt"),
+    ("untrimmable-speed", _edit('name = "737"', 'name = "737"\napproach_speed_kt = 90.0'),
+     "aircraft.approach_speed_kt"),
     ("not-toml", "this is [not toml\n", "not valid TOML"),
     ("not-utf8", None, "not a UTF-8"),
 ]
