@@ -113,12 +113,17 @@ def pseudorange(
     if pl is not None and layout.has("pmp"):
         h[layout.i("pmp", pl)] = -1.0
         h[layout.i("ptr", pl)] = -rng_hat
+        h[layout.index["dp"]] = e_ned * (1.0 + x_hat[layout.i("ptr", pl)])  # range (1 + T): its gradient
         if layout.has("pclk"):
             h[layout.i("pclk", 2 * pl)] = -1.0
     z = rng_ins - rho_m
     lin = h.copy()
     lin[layout.index["dp"]] = 0.0
-    g_hat = rng_ins - rng_hat + float(lin @ x_hat)  # exact in dp, linear in the rest
+    if pl is not None and layout.has("ptr"):
+        lin[layout.i("ptr", pl)] = 0.0
+        g_hat = rng_ins - rng_hat * (1.0 + x_hat[layout.i("ptr", pl)]) + float(lin @ x_hat)
+    else:
+        g_hat = rng_ins - rng_hat + float(lin @ x_hat)  # exact in dp, linear in the rest
     return ScalarMeasurement(z=float(z - g_hat + h @ x_hat), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
 
 
