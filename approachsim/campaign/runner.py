@@ -12,6 +12,7 @@ the store as each task finishes, so `resume=True` after an interruption reruns o
 
 from __future__ import annotations
 
+import copyreg
 import math
 import multiprocessing
 import os
@@ -22,6 +23,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any, TextIO
 
 from approachsim.campaign.result import RunResult
@@ -34,6 +36,24 @@ GroupFn = Callable[[Any, int, Sequence[int]], list[RunResult]]
 
 class SchedulerError(ProfileError):
     """The Dask scheduler address cannot be reached (a user mistake: exit 2)."""
+
+
+def make_mappingproxy(d: dict) -> MappingProxyType:
+    """Rebuild a read-only mapping after unpickling."""
+    return MappingProxyType(d)
+
+
+def _reduce_mappingproxy(m: MappingProxyType) -> tuple:
+    return make_mappingproxy, (dict(m),)
+
+
+def register_pickling() -> None:
+    """Let read-only mappings (types.MappingProxyType, used in frozen configs) be pickled to workers.
+
+    Profiles travel to worker processes and Dask workers by pickle; the standard library cannot pickle a
+    mappingproxy. This registers the obvious reduction (rebuild from a dict copy) with copyreg; idempotent.
+    """
+    copyreg.pickle(MappingProxyType, _reduce_mappingproxy)
 
 
 def _one_line(e: BaseException) -> str:
@@ -236,6 +256,7 @@ def run_campaign(
     if group_fn is not None and not group_size:
         raise ValueError("group_fn needs group_size")
     workers = workers or os.cpu_count() or 1
+    register_pickling()
     store = CampaignStore(out_dir) if out_dir is not None else None
     done: dict[int, RunResult] = {}
     if store is not None:

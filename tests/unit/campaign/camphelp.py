@@ -38,3 +38,9 @@ def synth_group(profile: dict, seed: int, runs: list[int]) -> list[RunResult]:
     if profile.get("fail_group") in runs:
         raise RuntimeError("shared flight failed")
     return [synth_run(profile, seed, i) for i in runs]
+
+
+def profile_run(profile, seed: int, run: int) -> RunResult:
+    """A run that reads the (real) profile it was sent: the evaluation decision height and a nav field."""
+    return RunResult(run=run, ok=True, scalars={"dh_cat1_ft": profile.evaluation.dh_cat1_ft,
+                                                 "n_tuning": float(len(getattr(profile, "nav", {}).__dict__))})

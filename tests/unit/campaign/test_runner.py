@@ -23,6 +23,7 @@ from approachsim.campaign.store import CampaignStore
 from approachsim.config import ProfileError
 
 HERE = Path(__file__).parent
+ROOT = HERE.parents[2]
 
 
 def _same(a: list[RunResult], b: list[RunResult]) -> bool:
@@ -95,6 +96,16 @@ def test_a_dying_worker_loses_only_its_own_run():
     assert "worker process died" in res.failed[0].error
     fresh = _run({}, run_fn=synth_run, seed=1, runs=12, workers=1)
     assert all(a.same_as(b) for a, b in zip(res.results, fresh.results, strict=True) if a.run != 5)
+
+
+def test_a_real_profile_travels_to_worker_processes():
+    from camphelp import profile_run
+
+    from approachsim.profile import load_profile
+
+    prof = load_profile(ROOT / "profiles" / "default.toml")
+    res = run_campaign(prof, seed=1, runs=4, run_fn=profile_run, workers=2, per_task=1, progress=False)
+    assert not res.failed and all(r.scalars["dh_cat1_ft"] == 200.0 for r in res.results)
 
 
 def test_groups_do_not_depend_on_what_is_left():
