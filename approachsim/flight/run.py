@@ -72,9 +72,12 @@ _READ = (
     "accelerations/pidot-rad_sec2", "accelerations/qidot-rad_sec2", "accelerations/ridot-rad_sec2",
     "forces/fbx-total-lbs", "forces/fby-total-lbs", "forces/fbz-total-lbs", "inertia/mass-slugs",
     "atmosphere/P-psf", "atmosphere/T-R", "velocities/vc-kts", "aero/beta-rad",
-    "gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW", "velocities/vtrue-fps",
-    "gear/unit[1]/AGL-ft", "gear/unit[2]/AGL-ft",
+    "velocities/vtrue-fps",
 )
+_READ_LOW = ("gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW", "gear/unit[1]/AGL-ft", "gear/unit[2]/AGL-ft")
+"""Read only below LOW_READ_HEIGHT_M: the gear (nose, left main, right main)."""
+LOW_READ_HEIGHT_M = 100.0
+"""IMU height above the terrain below which the gear state is read (the gear hangs about 4 m below it)."""
 
 
 def _truth_views(buf: Array, runway) -> Truth:
@@ -191,6 +194,9 @@ class Approach:
 
         nodes = [fdm.node(n) for n in _READ]
         getters = [n.get_double_value for n in nodes]
+        getters_low = [fdm.node(n).get_double_value for n in _READ_LOW]
+        w0 = w1 = w2 = 0.0
+        g1_ft = g2_ft = math.inf
         set_de = fdm.node("fcs/elevator-cmd-norm").set_double_value
         set_da = fdm.node("fcs/aileron-cmd-norm").set_double_value
         set_dr = fdm.node("fcs/rudder-cmd-norm").set_double_value
@@ -198,6 +204,7 @@ class Approach:
         pitch_trim = fdm["fcs/pitch-trim-cmd-norm"]
         terrain = prof.terrain
         flat_terrain = len(terrain.along_m) == 1
+        terr0 = terrain.height_m[0]
         set_terrain = fdm.node("position/terrain-elevation-asl-ft").set_double_value
 
         # constants: lever arm (body axes, m), geodesy, runway frame
@@ -240,7 +247,7 @@ class Approach:
             if k > 0:
                 run_step()
             (lat, lon, h_ft, vn_f, ve_f, vd_f, phi, th, psi, pi_, qi, ri, p, q, r, pid, qid, rid,
-             fx, fy, fz, m, p_psf, t_r, vc_kt, beta, w0, w1, w2, vt_fps, g1_ft, g2_ft) = [gv() for gv in getters]
+             fx, fy, fz, m, p_psf, t_r, vc_kt, beta, vt_fps) = [gv() for gv in getters]
             h = h_ft * FT
             # body -> NED direction cosines from the Euler angles
             sf, cf, st, ct, sp, cp = sin(phi), cos(phi), sin(th), cos(th), sin(psi), cos(psi)
@@ -274,10 +281,12 @@ class Approach:
             yr = c10 * dx + c11 * dy + c12 * dz
             zr = h_i - h_thr
             if flat_terrain:
-                terr = terrain.height_m[0]
+                terr = terr0
             else:
                 terr = float(np.interp(xr, terrain.along_m, terrain.height_m))
                 set_terrain(terr / FT)
+            if h_i - terr < LOW_READ_HEIGHT_M:
+                w0, w1, w2, g1_ft, g2_ft = [gv() for gv in getters_low]
             if turb is not None:  # turbulence for the next step, at the CG's height above the terrain
                 tn, te, td = turb_step(k, h - terr, vt_fps * FPS)
                 set_tn(tn)
