@@ -66,6 +66,13 @@ def verdict_table(summary: dict, det: dict) -> str:
             f"{_f(e['lateral_95_ft'], '7.2f')} {lim['lateral_95_ft']:6.1f} | "
             f"{_f(e['vertical_95_ft'], '8.2f')} {lim['vertical_95_ft']:6.1f} | {'YES' if e['meets'] else 'no'}"
         )
+    if summary["closed_loop"]:
+        for cat, c in det["categories"].items():
+            lines.append(
+                f"{cat:9} {summary['decision_heights'][cat]['height_ft']:>6} | RMS ft: FTE lat "
+                f"{_f(c['fte_lat_ft']['rms'], '.2f')} vert {_f(c['fte_vert_ft']['rms'], '.2f')}, TSE lat "
+                f"{_f(c['tse_lat_ft']['rms'], '.2f')} vert {_f(c['tse_vert_ft']['rms'], '.2f')}"
+            )
     best = summary["best_category"] or "none"
     lines.append(f"best category: {best} (FAA 1-sigma = RMS over runs, bias included; all values ft)")
     return "\n".join(lines)

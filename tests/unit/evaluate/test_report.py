@@ -38,7 +38,9 @@ def test_outputs_and_report(tmp_path):
     assert back["decision_heights"]["CAT I"]["lateral_1sigma_ft"] == np.sqrt(np.mean(lat**2))
     table = verdict_table(summary, det)
     assert table.splitlines()[0] == "synthetic: 13 runs (1 failed), seed 1, open loop"
-    assert "CAT III" in table and "best category:" in table
+    assert "CAT III" in table and "best category:" in table and "FTE" not in table
+    closed, det_c = evaluate_results(results, cfg, profile="synthetic", seed=1, closed_loop=True)
+    assert "CAT II       100 | RMS ft: FTE lat" in verdict_table(closed, det_c)
     page = write_report(tmp_path, results, summary, det).read_text()
     # the verdict table comes before any figure, and the figures are embedded
     assert page.index("<table>") < page.index("<img")
