@@ -13,6 +13,8 @@ from approachsim import units
 from approachsim.flight.run import Approach
 from approachsim.profile import load_profile, parse_profile
 
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT = ROOT / "profiles" / "default.toml"
 

@@ -18,6 +18,8 @@ from approachsim import geo
 from approachsim.flight.run import Approach
 from approachsim.profile import load_profile
 
+pytestmark = pytest.mark.slow
+
 DURATION_S = 60.0
 
 
