@@ -137,3 +137,23 @@ def gps_position(layout: StateLayout, dp_ins_minus_gps_ned: Array, sigma_ned_m: 
         out.append(ScalarMeasurement(z=float(dp_ins_minus_gps_ned[k]), h=h, r=float(sigma_ned_m[k] ** 2),
                                      name=f"gps_{axis}", t_s=t_s))
     return out
+
+
+def gps_fix(r_guess_ecef: Array, r_sv_ecef: Array, rho_m: Array, sigma_m: Array, iterations: int = 6
+            ) -> tuple[Array, Array] | None:
+    """Least-squares GPS position (ECEF, m) and its covariance (3, 3) from k >= 4 pseudoranges (weighted by
+    1 / sigma^2), Gauss-Newton from r_guess; None with fewer than 4. The receiver clock is solved and dropped."""
+    ok = np.isfinite(rho_m)
+    if ok.sum() < 4:
+        return None
+    rsv, rho, w = r_sv_ecef[ok], rho_m[ok], 1.0 / np.asarray(sigma_m, dtype=float)[ok] ** 2
+    x = np.append(np.asarray(r_guess_ecef, dtype=float), 0.0)
+    for _ in range(iterations):
+        d = x[:3] - rsv
+        rng = np.linalg.norm(d, axis=1)
+        G = np.column_stack([d / rng[:, None], np.ones(len(rho))])
+        res = rho - (rng + x[3])
+        N = G.T @ (w[:, None] * G)
+        x = x + np.linalg.solve(N, G.T @ (w * res))
+    cov = np.linalg.inv(N)
+    return x[:3], cov[:3, :3]

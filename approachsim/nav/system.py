@@ -137,7 +137,7 @@ class NavSystem:
         n_pl = len(sensors.pseudolite.positions_rwy) if sensors.pseudolite is not None and nav.channel_states else 0
         layout = em.StateLayout(
             baro_scale=sensors.baro is not None and sensors.baro.scale_factor_sigma > 0.0,
-            clock=sensors.gnss is not None or sensors.pseudolite is not None,
+            clock=(sensors.gnss is not None and nav.gps_coupling == "tight") or sensors.pseudolite is not None,
             loop=nav.baro_loop != "none",
             n_sv=n_sv,
             n_pl=n_pl,
@@ -296,7 +296,16 @@ class NavSystem:
             sr = float(np.sqrt((self.sensors.radalt.percent_sigma * hr) ** 2 + self.sensors.radalt.floor_m**2))
             out.append(lambda x: meas.radalt(lay, x, lat, lon, h, hr, sr, self.terrain_h, t))
         c_en = geo.c_ecef_to_ned(lat, lon)
-        if "gnss_rho" in obs:
+        if "gnss_rho" in obs and self.nav.gps_coupling == "loose":
+            fix = meas.gps_fix(r_ins, obs["gnss_rsv"], obs["gnss_rho"][i], obs["gnss_sigma"])
+            if fix is not None:
+                r_fix, cov = fix
+                glat, glon, gh = geo.ecef_to_geodetic(r_fix)
+                dz = ins.position_error_ned(lat, lon, h, glat, glon, gh)  # INS - GPS, NED
+                sd = np.sqrt(np.diag(c_en @ cov @ c_en.T))
+                for m in meas.gps_position(lay, dz, sd, t):
+                    out.append(lambda x, m=m: m)
+        elif "gnss_rho" in obs:
             rho, r_sv = obs["gnss_rho"][i], obs["gnss_rsv"]
             bud = CODE_PRESETS[self.sensors.gnss.code]
             sig = bud.code_noise_m if lay.has("gse") else obs["gnss_sigma"]

@@ -66,3 +66,17 @@ def test_batched_runs_equal_single_runs():
     one = nav.run(truth, suite.measure(truth, seed=5, runs=1), stream(5, 1, "nav"))
     np.testing.assert_allclose(both[1].solution.r_ecef, one.solution.r_ecef, rtol=0, atol=1e-6)
     np.testing.assert_allclose(both[1].x, one.x, rtol=1e-9, atol=1e-12)
+
+
+def test_loose_coupling_uses_position_fixes():
+    """gps_coupling = "loose": three position scalars per epoch from a least-squares fix, no clock state, and
+    exact sensors give an exact fix (innovations at the centimetre level)."""
+    truth = _truth(10.0)
+    recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=3, runs=0, noise=False)
+    nav = _system(gps_coupling="loose", initial_error=InitialError(0.0, 0.0, 0.0, 0.0))
+    assert not nav.layout.has("clk") and not nav.layout.has("gse")
+    run = nav.run(truth, recs, stream(3, 0, "nav"))
+    names = list(run.status.name)
+    assert names.count("gps_N") == 10 and not any(n.startswith("gps0") for n in names)
+    m = np.char.startswith(run.status.name, "gps_")
+    assert np.max(np.abs(run.status.innovation[m])) < 0.01
