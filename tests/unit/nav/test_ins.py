@@ -106,3 +106,17 @@ def test_perturb_and_error_functions_invert():
     np.testing.assert_allclose(
         ins.position_error_ned(p.lat_rad, p.lon_rad, p.h_m, s.lat_rad, s.lon_rad, s.h_m), dp, atol=1e-6)
     np.testing.assert_allclose(ins.attitude_error(p.c_bn, s.c_bn), psi, atol=1e-10)
+
+
+def test_scalar_single_run_step_equals_the_vector_step():
+    rng = np.random.default_rng(1)
+    a = b = ins.init_state(0.6, -2.1, 1000.0, [60.0, 40.0, 4.0], ins.cbn_from_euler([0.1, 0.05, 1.0]))
+    for _ in range(300):
+        dth = rng.normal(size=(1, 3)) * 1e-3
+        dv = rng.normal(size=(1, 3)) * 0.05 + [[0.0, 0.0, -0.08]]
+        a = ins.step(a, dth, dv, 1 / 120)
+        b = ins.step_one(b, dth, dv, 1 / 120)
+    np.testing.assert_allclose(b.lat_rad, a.lat_rad, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(b.h_m, a.h_m, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(b.v_ned, a.v_ned, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(b.c_bn, a.c_bn, rtol=0, atol=1e-13)
