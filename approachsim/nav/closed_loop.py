@@ -59,9 +59,13 @@ class NavInTheLoop:
         self.s: ins.InsState | None = None
         self.runs: list = []
         self.h_baro_hold = math.nan
-        self.f_sum = np.zeros((1, 3))
+        self.f_sum = np.zeros(3)
         self.t_last = 0.0
-        self.out: dict[str, list] = {k: [] for k in ("lat", "lon", "h", "v", "c", "ppos", "clk", "clk_sd")}
+        self.out: dict[str, list] = {k: [] for k in ("lat", "lon", "h", "v", "c", "snap")}
+        self.snaps: list[tuple[Array, Array]] = []
+        self.x_nav = np.zeros(9)
+        self._c_rwy = self.profile.runway.frame.c_ecef_to_rwy
+        self._o_rwy = self.profile.runway.frame.origin_ecef
         self.epochs: dict[str, list] = {"t": [], "x": [], "pd": [], "pnav": [], "err": []}
 
     def _apply(self, name: str, k: int, truth: Truth) -> Any:
@@ -85,6 +89,7 @@ class NavInTheLoop:
                 rec = self._apply("gnss", 0, truth)
                 el = rec.elevation_rad[0] if rec is not None else None
             self.s, self.runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el)
+            self._snapshot()
         else:
             imu = self._apply("imu", k, truth)
             dth = imu.dtheta_body.reshape(1, 3)
@@ -92,46 +97,56 @@ class NavInTheLoop:
             if nav.nav.feedback:
                 dth = dth - self.runs[0].bg_fb * self.dt
                 dv = dv - self.runs[0].ba_fb * self.dt
-            self.f_sum += np.einsum("nij,nj->ni", self.s.c_bn, dv)
-            hb = None
-            if self.gains is not None:
-                hb = np.array([self.h_baro_hold])
-            self.s = ins.step(self.s, dth, dv, self.dt, h_baro_m=hb, loop=self.gains if hb is not None else None)
+            self.f_sum += self.s.c_bn[0] @ dv[0]
+            if self.gains is None:
+                self.s = ins.step_one(self.s, dth, dv, self.dt)
+            else:
+                self.s = ins.step(self.s, dth, dv, self.dt, h_baro_m=np.array([self.h_baro_hold]), loop=self.gains)
             if k % self.epoch_rows == 0:
                 t = float(truth.t_s[k])
                 recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite")
                         if (r := self._apply(name, k, truth)) is not None}
                 obs = nav.observations(recs, t, 0.25 * self.dt, False)
-                self.s = nav.aid(self.s, self.runs, t, t - self.t_last, self.f_sum / (t - self.t_last), obs)
+                self.s = nav.aid(self.s, self.runs, t, t - self.t_last, (self.f_sum / (t - self.t_last))[None], obs)
                 self.f_sum[:] = 0.0
                 self.t_last = t
+                self._snapshot()
                 self._epoch(k, truth)
         if self.gains is not None and (b := self._apply("baro", k, truth)) is not None:
             self.h_baro_hold = float(np.ravel(b.h_baro_m)[0])
             if k == 0:
                 self.s = ins.replace(self.s, h_m=np.array([self.h_baro_hold]))
-        o, P, x = nav.output(self.s, self.runs)
-        self._record(o, P, x)
-        r_ecef = ins.position_ecef(o)[0]
-        r_rwy = self.profile.runway.frame.from_ecef(r_ecef)
-        r_rwy[2] = float(o.h_m[0]) - self.profile.runway.elevation_m  # height above threshold, as truth.r_rwy
-        return r_rwy, o.v_ned[0]
-
-    def _record(self, o: ins.InsState, P: Array, x: Array) -> None:
-        lay = self.nav.layout
+        s = self.s
+        lat, lon, h = float(s.lat_rad[0]), float(s.lon_rad[0]), float(s.h_m[0])
         d = self.out
-        d["lat"].append(o.lat_rad[0])
-        d["lon"].append(o.lon_rad[0])
-        d["h"].append(o.h_m[0])
-        d["v"].append(o.v_ned[0])
-        d["c"].append(o.c_bn[0])
-        d["ppos"].append(P[0, 0:3, 0:3])
-        if lay.has("clk"):
-            d["clk"].append(x[0, lay.i("clk")])
-            d["clk_sd"].append(math.sqrt(P[0, lay.i("clk"), lay.i("clk")]))
-        else:
-            d["clk"].append(math.nan)
-            d["clk_sd"].append(math.nan)
+        d["lat"].append(lat)
+        d["lon"].append(lon)
+        d["h"].append(h)
+        d["v"].append(s.v_ned[0])
+        d["c"].append(s.c_bn[0])
+        d["snap"].append(len(self.snaps) - 1)
+        # guidance: feed-forward output INS - x_hat (position and velocity only; attitude in result())
+        dp, dvel = self.x_nav[0:3], self.x_nav[3:6]
+        r_n, r_e = self.radii(lat)
+        lat_c = lat - dp[0] / (r_n + h)
+        lon_c = lon - dp[1] / ((r_e + h) * math.cos(lat))
+        h_c = h + dp[2]
+        r_rwy = self._c_rwy @ (geo.geodetic_to_ecef(lat_c, lon_c, h_c) - self._o_rwy)  # RunwayFrame.from_ecef
+        r_rwy[2] = h_c - self.profile.runway.elevation_m  # height above threshold, as truth.r_rwy
+        return r_rwy, s.v_ned[0] - dvel
+
+    @staticmethod
+    def radii(lat: float) -> tuple[float, float]:
+        """Meridian and prime-vertical radii (m) at latitude lat (rad), scalar."""
+        w = math.sqrt(1.0 - geo.E2_WGS84 * math.sin(lat) ** 2)
+        return geo.A_WGS84 * (1.0 - geo.E2_WGS84) / w**3, geo.A_WGS84 / w
+
+    def _snapshot(self) -> None:
+        """Keep the filter's x and P (the estimate in force until the next epoch)."""
+        fs = self.runs[0].fs
+        x = np.array(fs.x, dtype=float)
+        self.snaps.append((x, np.array(self.nav.filter.covariance(fs), dtype=float)))
+        self.x_nav = x[0:9]
 
     def _epoch(self, k: int, truth: Truth) -> None:
         o, P, x = self.nav.output(self.s, self.runs)
@@ -146,15 +161,23 @@ class NavInTheLoop:
         """The navigation run over the flown truth (call after the flight)."""
         n = len(truth)
         d = self.out
-        lat, lon, h = (np.array(d[k][:n]) for k in ("lat", "lon", "h"))
+        raw = ins.InsState(np.array(d["lat"][:n]), np.array(d["lon"][:n]), np.array(d["h"][:n]),
+                           np.array(d["v"][:n]), np.array(d["c"][:n]), np.zeros(n))
+        snap = np.array(d["snap"][:n])
+        X = np.stack([x for x, _ in self.snaps])[snap]
+        P = np.stack([p for _, p in self.snaps])[snap]
+        o = ins.perturb(raw, -X[:, 0:3], -X[:, 3:6], -X[:, 6:9])
+        lay = self.nav.layout
+        clk = X[:, lay.i("clk")] if lay.has("clk") else np.full(n, np.nan)
+        clk_sd = np.sqrt(P[:, lay.i("clk"), lay.i("clk")]) if lay.has("clk") else np.full(n, np.nan)
         sol = NavSolution(
             t_s=np.asarray(truth.t_s[:n], dtype=float),
-            r_ecef=geo.geodetic_to_ecef(lat, lon, h),
-            v_ned=np.array(d["v"][:n]),
-            euler_rad=ins.euler_from_cbn(np.array(d["c"][:n])),
-            P_pos_ned=np.array(d["ppos"][:n]),
-            clock_bias_m=np.array(d["clk"][:n]),
-            clock_bias_sigma_m=np.array(d["clk_sd"][:n]),
+            r_ecef=geo.geodetic_to_ecef(o.lat_rad, o.lon_rad, o.h_m),
+            v_ned=o.v_ned,
+            euler_rad=ins.euler_from_cbn(o.c_bn),
+            P_pos_ned=P[:, 0:3, 0:3],
+            clock_bias_m=clk,
+            clock_bias_sigma_m=clk_sd,
         )
         e = self.epochs
         return NavRun(
