@@ -90,3 +90,13 @@ def test_open_loop_evaluation_end_to_end(tmp_path, capsys):
     assert "best category:" in printed and "CAT III" in printed
     assert (out / "report.html").is_file() and (out / "runs.parquet").is_file()
     assert len(list((out / "series").glob("*.parquet"))) == 2
+    # the same campaign on a Dask cluster (loopback) gives bit-identical per-run results
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, protocol="tcp://",
+                                  host="127.0.0.1", dashboard_address=":0") as cluster:
+        out2 = tmp_path / "ev-dask"
+        assert main(["evaluate", DEFAULT, "--runs", "2", "--seed", "3", "--mode", "open", "--scheduler",
+                     cluster.scheduler_address, "--out", str(out2), "--no-report"]) == 0
+    lines = sorted((out / "runs.jsonl").read_text().splitlines())
+    assert lines == sorted((out2 / "runs.jsonl").read_text().splitlines()) and len(lines) == 2
+    assert json.loads((out2 / "summary.json").read_text()) == s
