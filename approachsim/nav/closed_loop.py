@@ -165,17 +165,17 @@ class NavInTheLoop:
                            np.array(d["v"][:n]), np.array(d["c"][:n]), np.zeros(n))
         snap = np.array(d["snap"][:n])
         X = np.stack([x for x, _ in self.snaps])[snap]
-        P = np.stack([p for _, p in self.snaps])[snap]
+        PP = np.stack([p for _, p in self.snaps])  # per snapshot; index the small blocks per row only
         o = ins.perturb(raw, -X[:, 0:3], -X[:, 3:6], -X[:, 6:9])
         lay = self.nav.layout
         clk = X[:, lay.i("clk")] if lay.has("clk") else np.full(n, np.nan)
-        clk_sd = np.sqrt(P[:, lay.i("clk"), lay.i("clk")]) if lay.has("clk") else np.full(n, np.nan)
+        clk_sd = np.sqrt(PP[:, lay.i("clk"), lay.i("clk")][snap]) if lay.has("clk") else np.full(n, np.nan)
         sol = NavSolution(
             t_s=np.asarray(truth.t_s[:n], dtype=float),
             r_ecef=geo.geodetic_to_ecef(o.lat_rad, o.lon_rad, o.h_m),
             v_ned=o.v_ned,
             euler_rad=ins.euler_from_cbn(o.c_bn),
-            P_pos_ned=P[:, 0:3, 0:3],
+            P_pos_ned=PP[:, 0:3, 0:3][snap],
             clock_bias_m=clk,
             clock_bias_sigma_m=clk_sd,
         )

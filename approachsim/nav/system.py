@@ -404,37 +404,40 @@ class NavSystem:
             idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
             hb_full = hb[:, idx]
         n_out = m + 1
+        # raw INS rows and, per row, the filter snapshot in force; corrected (INS - x_hat) after the pass
         lat = np.empty((n_runs, n_out))
         lon = np.empty((n_runs, n_out))
         hh = np.empty((n_runs, n_out))
         vel = np.empty((n_runs, n_out, 3))
         cbn = np.empty((n_runs, n_out, 3, 3))
-        ppos = np.empty((n_runs, n_out, 3, 3))
-        clk = np.full((n_runs, n_out), np.nan)
-        clk_sd = np.full((n_runs, n_out), np.nan)
+        snap = np.zeros(n_out, dtype=int)
+        snaps: list[tuple[Array, Array]] = []
         t_ep, xs, pds, pnav, terr = [], [], [], [], []
         lay = self.layout
 
-        def record(k: int, s: ins.InsState) -> tuple[ins.InsState, Array, Array]:
-            o, P, x = self.output(s, runs)
-            lat[:, k], lon[:, k], hh[:, k] = o.lat_rad, o.lon_rad, o.h_m
-            vel[:, k], cbn[:, k] = o.v_ned, o.c_bn
-            ppos[:, k] = P[:, 0:3, 0:3]
-            if lay.has("clk"):
-                clk[:, k] = x[:, lay.i("clk")]
-                clk_sd[:, k] = np.sqrt(P[:, lay.i("clk"), lay.i("clk")])
-            return o, P, x
+        def keep(k: int, s: ins.InsState) -> None:
+            lat[:, k], lon[:, k], hh[:, k] = s.lat_rad, s.lon_rad, s.h_m
+            vel[:, k], cbn[:, k] = s.v_ned, s.c_bn
+            snap[k] = len(snaps) - 1
 
-        record(0, s)
+        def snapshot() -> None:
+            snaps.append((np.stack([r.fs.x for r in runs]), np.stack([self.filter.covariance(r.fs) for r in runs])))
+
+        snapshot()
+        keep(0, s)
         f_sum = np.zeros((n_runs, 3))
         t_last = float(truth.t_s[0])
+        fast = n_runs == 1 and gains is None
         for j in range(m):
             bg = np.stack([r.bg_fb for r in runs]) if self.nav.feedback else 0.0
             ba = np.stack([r.ba_fb for r in runs]) if self.nav.feedback else 0.0
             dth_j = dth[:, j] - bg * dt
             dv_j = dvb[:, j] - ba * dt
             f_sum += np.einsum("nij,nj->ni", s.c_bn, dv_j)
-            s = ins.step(s, dth_j, dv_j, dt, h_baro_m=None if hb_full is None else hb_full[:, j], loop=gains)
+            if fast:
+                s = ins.step_one(s, dth_j, dv_j, dt)
+            else:
+                s = ins.step(s, dth_j, dv_j, dt, h_baro_m=None if hb_full is None else hb_full[:, j], loop=gains)
             row = j + 1
             t = float(truth.t_s[row])
             if row % epoch_rows == 0:
@@ -442,24 +445,33 @@ class NavSystem:
                 s = self.aid(s, runs, t, t - t_last, f_sum / (t - t_last), obs)
                 f_sum[:] = 0.0
                 t_last = t
-                o, P, x = record(row, s)
+                snapshot()
+                o, P, x = self.output(s, runs)
                 t_ep.append(t)
                 xs.append(x)
                 pds.append(np.diagonal(P, axis1=1, axis2=2))
                 pnav.append(P[:, 0:9, 0:9])
                 terr.append(self._true_error(o, truth, row))
-            else:
-                record(row, s)
+            keep(row, s)
+        X = np.stack([x for x, _ in snaps])[snap]  # (n_out, runs, n)
+        PP = np.stack([p for _, p in snaps])  # (snaps, runs, n, n)
         results = []
         for i, r in enumerate(runs):
+            xi = X[:, i]
+            o = ins.perturb(ins.InsState(lat[i], lon[i], hh[i], vel[i], cbn[i], np.zeros(n_out)),
+                            -xi[:, 0:3], -xi[:, 3:6], -xi[:, 6:9])
+            p_pos = PP[:, i, 0:3, 0:3][snap]  # index the small blocks only: (rows, n, n) would be GBs at 120 Hz
+            has_clk = lay.has("clk")
+            ic = lay.i("clk") if has_clk else 0
+            clk_sd = np.sqrt(PP[:, i, ic, ic][snap]) if has_clk else np.full(n_out, np.nan)
             sol = NavSolution(
                 t_s=np.asarray(truth.t_s[:n_out], dtype=float),
-                r_ecef=geo.geodetic_to_ecef(lat[i], lon[i], hh[i]),
-                v_ned=vel[i],
-                euler_rad=ins.euler_from_cbn(cbn[i]),
-                P_pos_ned=ppos[i],
-                clock_bias_m=clk[i],
-                clock_bias_sigma_m=clk_sd[i],
+                r_ecef=geo.geodetic_to_ecef(o.lat_rad, o.lon_rad, o.h_m),
+                v_ned=o.v_ned,
+                euler_rad=ins.euler_from_cbn(o.c_bn),
+                P_pos_ned=p_pos,
+                clock_bias_m=xi[:, ic] if has_clk else np.full(n_out, np.nan),
+                clock_bias_sigma_m=clk_sd,
             )
             results.append(NavRun(
                 solution=sol, status=StatusLog.from_records(r.statuses), t_epoch_s=np.array(t_ep),
