@@ -131,7 +131,12 @@ class NavInTheLoop:
         lat_c = lat - dp[0] / (r_n + h)
         lon_c = lon - dp[1] / ((r_e + h) * math.cos(lat))
         h_c = h + dp[2]
-        r_rwy = self._c_rwy @ (geo.geodetic_to_ecef(lat_c, lon_c, h_c) - self._o_rwy)  # RunwayFrame.from_ecef
+        # geo.geodetic_to_ecef in scalar arithmetic, then RunwayFrame.from_ecef
+        sl, cl = math.sin(lat_c), math.cos(lat_c)
+        re = geo.A_WGS84 / math.sqrt(1.0 - geo.E2_WGS84 * sl * sl)
+        r_e = ((re + h_c) * cl * math.cos(lon_c), (re + h_c) * cl * math.sin(lon_c),
+               (re * (1.0 - geo.E2_WGS84) + h_c) * sl)
+        r_rwy = self._c_rwy @ (np.array(r_e) - self._o_rwy)
         r_rwy[2] = h_c - self.profile.runway.elevation_m  # height above threshold, as truth.r_rwy
         return r_rwy, s.v_ned[0] - dvel
 
