@@ -86,3 +86,20 @@ def test_empty_and_malformed_baselines_exit_2(tmp_path, capsys):
     assert main(["regress", "--baselines", str(tmp_path)]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 2 and "no baseline files" in err[0] and "not an approachsim.baseline/1" in err[1]
+
+
+def test_committed_baselines_are_valid():
+    from pathlib import Path
+
+    from approachsim.campaign.regress import read_baseline
+    from approachsim.profile import load_profile
+
+    root = Path(__file__).resolve().parents[3]
+    files = sorted((root / "baselines").glob("*.json"))
+    assert files, "no committed baselines"
+    for f in files:
+        doc = read_baseline(f)
+        prof = load_profile(root / doc["profile"])
+        assert doc["summary"]["profile"] == prof.name == f.stem
+        assert (doc["summary"]["runs"], doc["summary"]["seed"]) == (doc["runs"], doc["seed"])
+        assert set(doc["summary"]["decision_heights"]) == {"CAT I", "CAT II", "CAT III"}
