@@ -80,3 +80,22 @@ def test_loose_coupling_uses_position_fixes():
     assert names.count("gps_N") == 10 and not any(n.startswith("gps0") for n in names)
     m = np.char.startswith(run.status.name, "gps_")
     assert np.max(np.abs(run.status.innovation[m])) < 0.01
+
+
+def test_shared_covariance_matches_per_run_filters():
+    """Open-loop runs on one truth: one shared covariance/gain (run 0's linearization) gives the per-run
+    estimates to a small fraction of their sigma, the same status records, and is refused for robust filters."""
+    truth = _truth(20.0)
+    suite = SensorSuite.from_profile(PROFILE)
+    recs = suite.measure(truth, seed=6, runs=[0, 1, 2])
+    nav = _system()
+    rngs = [stream(6, r, "nav") for r in range(3)]
+    per = nav.run(truth, recs, rngs)
+    shared = nav.run(truth, recs, [stream(6, r, "nav") for r in range(3)], shared_covariance=True)
+    for a, b in zip(per, shared, strict=True):
+        sd = np.sqrt(a.P_diag)
+        assert np.max(np.abs(a.x - b.x) / sd) < 0.2  # the approximation: gains from run 0 (measured 0.1)
+        assert list(a.status.name) == list(b.status.name)
+        np.testing.assert_allclose(b.status.variance, a.status.variance, rtol=1e-3)
+    with pytest.raises(ValueError, match="optimal"):
+        _system(filter="rkf-gate").run(truth, recs, rngs, shared_covariance=True)
