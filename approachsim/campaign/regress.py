@@ -39,7 +39,7 @@ class Diff:
 
     def line(self) -> str:
         """A readable diff line."""
-        mark = "REGRESSION" if self.regression else "ok"
+        mark = "REGRESSION" if self.regression else ("changed" if self.old != self.new else "ok")
         band = f"  allowed [{self.band[0]:.4g}, {self.band[1]:.4g}]" if self.band else ""
         return f"{mark:10} {self.field}: {self.old!r} -> {self.new!r}{band}"
 

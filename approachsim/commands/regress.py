@@ -103,7 +103,9 @@ def run(args: argparse.Namespace) -> int:
             diffs = compare(doc["summary"], ev.summary)
             bad = [d for d in diffs if d.regression]
             failed += bool(bad)
-            print(f"{path.stem}: {'REGRESSION' if bad else 'ok'} ({runs} runs, seed {seed}, {mode} loop)")
-            for d in diffs if bad else []:
+            changed = [d for d in diffs if d.old != d.new]
+            state = "REGRESSION" if bad else ("ok, changed within tolerance" if changed else "ok, identical")
+            print(f"{path.stem}: {state} ({runs} runs, seed {seed}, {mode} loop)")
+            for d in diffs if bad else changed:
                 print("  " + d.line())
     return 1 if failed else 0

@@ -39,7 +39,9 @@ def test_shift_inside_and_outside_tolerance():
     lo, hi = f_band(8)
     new = copy.deepcopy(SUMMARY)
     new["decision_heights"]["CAT I"]["lateral_1sigma_ft"] = 5.0 * (1 + hi) / 2  # inside the band
-    assert not any(d.regression for d in compare(SUMMARY, new))
+    inside = compare(SUMMARY, new)
+    assert not any(d.regression for d in inside)
+    assert [d.line().split()[0] for d in inside if d.old != d.new] == ["changed"]
     new["decision_heights"]["CAT I"]["lateral_1sigma_ft"] = 5.0 * hi * 1.01
     bad = [d for d in compare(SUMMARY, new) if d.regression]
     assert [d.field for d in bad] == ["CAT I.lateral_1sigma_ft"]
