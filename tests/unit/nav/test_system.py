@@ -11,6 +11,7 @@ import pytest
 from approachsim import geo, synthetic
 from approachsim.nav import ins
 from approachsim.nav.config import InitialError
+from approachsim.nav.registry import FILTERS
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream
@@ -99,3 +100,14 @@ def test_shared_covariance_matches_per_run_filters():
         np.testing.assert_allclose(b.status.variance, a.status.variance, rtol=0.1)  # measured: within 4.6 %
     with pytest.raises(ValueError, match="optimal"):
         _system(filter="rkf-gate").run(truth, recs, rngs, shared_covariance=True)
+
+
+@pytest.mark.parametrize("name", sorted(FILTERS))
+def test_every_registered_filter_is_drop_in(name):
+    """Each filter of the registry runs the navigation (U-D ones store no P: the system asks covariance())."""
+    truth = _truth(8.0)
+    recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=2, runs=0)
+    run = _system(filter=name).run(truth, recs, stream(2, 0, "nav"))
+    assert run.x.shape == (8, run.layout.n) and np.all(np.isfinite(run.P_nav))
+    e, P = run.true_error_nav, run.P_nav
+    assert np.mean([x @ np.linalg.solve(p, x) for x, p in zip(e, P, strict=True)]) < 30.0  # 9 dof, not diverged
