@@ -22,7 +22,6 @@ A bad key or value raises ProfileError naming the field; an unknown filter fails
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from types import MappingProxyType
 from typing import Any
 
 from approachsim.config import ProfileError, Section
@@ -47,7 +46,8 @@ class NavConfig:
     """The navigation system of a profile (module docstring lists the keys)."""
 
     filter: str = "ekf"
-    filter_tuning: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
+    filter_tuning: tuple[tuple[str, Any], ...] = ()
+    """The filter's tuning keywords as (key, value) pairs (a tuple: the profile stays hashable and picklable)."""
     aiding_rate_hz: float = 1.0
     feedback: bool = False
     gps_coupling: str = "tight"
@@ -99,7 +99,7 @@ def parse_nav(s: Section) -> NavConfig:
     ie.done()
     s.done()
     cfg = NavConfig(
-        filter=name, filter_tuning=MappingProxyType(tuning), aiding_rate_hz=rate, feedback=feedback,
+        filter=name, filter_tuning=tuple(sorted(tuning.items())), aiding_rate_hz=rate, feedback=feedback,
         gps_coupling=coupling, channel_states=channel, baro_loop=loop, baro_loop_tau_s=tau,
         baro_loop_b_per_m=b, initial_error=init,
     )
