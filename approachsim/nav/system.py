@@ -107,6 +107,20 @@ def _epoch_index(t_rec: Array, t: float, tol: float) -> int | None:
 
 
 @dataclass(frozen=True)
+class TerrainDatabase:
+    """The filter's terrain: ellipsoid height (m) at ECEF points (..., 3) from the profile's Terrain along the
+    runway x axis (flat at the threshold height when terrain is None). A picklable callable."""
+
+    runway: geo.RunwayFrame
+    terrain: Any = None
+
+    def __call__(self, r_ecef: Array) -> Array:
+        if self.terrain is None:
+            return np.full(np.shape(r_ecef)[:-1], self.runway.threshold_h_m)
+        return self.terrain.height_at(self.runway.from_ecef(r_ecef)[..., 0])
+
+
+@dataclass(frozen=True)
 class NavSystem:
     """INS + filter configured from a profile's [nav] and [sensors] (+ the runway and terrain)."""
 
@@ -124,12 +138,7 @@ class NavSystem:
         """From configs; runway defaults to a frame at SFO 28R, terrain to flat at the threshold height."""
         rwy = runway or geo.RunwayFrame(np.radians(37.6117), np.radians(-122.3581), 4.0, np.radians(298.0))
 
-        if terrain is None:
-            def terrain_h(r: Array) -> Array:
-                return np.full(np.shape(r)[:-1], rwy.threshold_h_m)
-        else:
-            def terrain_h(r: Array) -> Array:
-                return terrain.height_at(rwy.from_ecef(r)[..., 0])
+        terrain_h = TerrainDatabase(rwy, terrain)
 
         n_sv = 0
         if sensors.gnss is not None and nav.channel_states and nav.gps_coupling == "tight":
