@@ -11,9 +11,10 @@ each pseudolite range), each giving an UpdateStatus. Output (seed 002 feed-forwa
 with `feedback` the estimate is fed back into the INS (and the IMU bias estimates into the increments) and
 the corresponding error states reset to zero.
 
-The same epoch machinery serves the closed loop (closed_loop.py): `start`, `imu_step`, `aid`, `output`.
-Several Monte Carlo runs can share one call: the INS is stepped for all of them at once (run axis first);
-each run has its own filter state.
+The same epoch machinery serves the closed loop (closed_loop.py): `start`, `aid`, `output`, with the INS
+stepped by the caller (nav/ins.py). Several Monte Carlo runs can share one call: the INS is stepped for all of
+them at once (run axis first); each run has its own filter state, or with `shared_covariance` one covariance
+and gain for all (open-loop runs on one truth, optimal filter).
 """
 
 from __future__ import annotations
