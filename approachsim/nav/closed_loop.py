@@ -14,7 +14,7 @@ errors to row k and runs the filter (system.NavSystem.aid). Guidance gets the na
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from types import MappingProxyType
 from typing import Any
 
@@ -28,6 +28,8 @@ from approachsim.seeding import stream
 from approachsim.sensors.suite import SensorSuite, SuiteErrors
 
 Array = np.ndarray
+
+_VEC3 = ("r_ecef", "v_ned", "euler_rad", "w_ib_body", "f_body", "r_rwy")
 
 
 @dataclass
@@ -56,6 +58,7 @@ class NavInTheLoop:
         self.sample_at = {name: {int(r): j for j, r in enumerate(e.rows)} for name, e in self.errors.sensors.items()}
         self.epoch_rows = max(1, int(round(self.profile.rates.imu_hz / self.nav.nav.aiding_rate_hz)))
         self.gains = self.nav.loop_gains()
+        self._imu_affine = self._imu_error_terms()
         self.s: ins.InsState | None = None
         self.runs: list = []
         self.h_baro_hold = math.nan
@@ -67,6 +70,39 @@ class NavInTheLoop:
         self._c_rwy = self.profile.runway.frame.c_ecef_to_rwy
         self._o_rwy = self.profile.runway.frame.origin_ecef
         self.epochs: dict[str, list] = {"t": [], "x": [], "pd": [], "pnav": [], "err": []}
+
+    def _imu_error_terms(self) -> tuple[Array, Array, Array, Array] | None:
+        """The IMU error model is affine in the true increments (sensors/imu.py):
+            dtheta_k = (I + S_g + M_g) dtheta_true_k + c_g,k ,   dv_k = (I + S_a + M_a) dv_true_k + c_a,k
+        so the error terms c_k of every sample come from one `apply` of the pre-drawn errors to a motionless
+        (all-zero) truth, and the matrices from the drawn constants. Returns (A_g, A_a, c_g, c_a), or None when
+        the IMU is quantized or fault-wrapped (not affine): then every sample goes through `apply`."""
+        imu = self.suite.sensors.get("imu")
+        e = self.errors.sensors.get("imu")
+        if imu is None or e is None or type(imu).__name__ == "Faulted":
+            return None
+        if getattr(imu.grade, "gyro_quant_rad", 0.0) > 0.0 or getattr(imu.grade, "accel_quant_mps", 0.0) > 0.0:
+            return None
+        n = self.t_s.shape[0]
+        zeros = {f.name: np.zeros((n,) + (3,) * (f.name in _VEC3) + (4,) * (f.name in ("q_nb", "controls")))
+                 for f in fields(Truth) if f.name != "runway"}
+        zeros["t_s"] = self.t_s
+        zero_truth = Truth(**zeros, runway=self.profile.runway.frame)
+        rec = imu.apply(zero_truth, e)
+        eye = np.eye(3)
+        return (eye + e.constants["gyro_m"], eye + e.constants["accel_m"], np.asarray(rec.dtheta_body),
+                np.asarray(rec.dv_body))
+
+    def _imu(self, k: int, truth: Truth) -> tuple[Array, Array]:
+        """Increments (rad, m/s) of the IMU interval (k-1, k], body axes."""
+        if self._imu_affine is None:
+            imu = self._apply("imu", k, truth)
+            return imu.dtheta_body.reshape(3), imu.dv_body.reshape(3)
+        a_g, a_a, c_g, c_a = self._imu_affine
+        h = 0.5 * self.dt  # the trapezoid of samples k-1, k (sensors/imu.py increment definition)
+        dth = a_g @ (h * (truth.w_ib_body[k - 1] + truth.w_ib_body[k])) + c_g[k - 1]
+        dv = a_a @ (h * (truth.f_body[k - 1] + truth.f_body[k])) + c_a[k - 1]
+        return dth, dv
 
     def _apply(self, name: str, k: int, truth: Truth) -> Any:
         """The record of sensor `name` at truth row k (one sample), or None when it has no sample there."""
@@ -91,9 +127,8 @@ class NavInTheLoop:
             self.s, self.runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el)
             self._snapshot()
         else:
-            imu = self._apply("imu", k, truth)
-            dth = imu.dtheta_body.reshape(1, 3)
-            dv = imu.dv_body.reshape(1, 3)
+            dth, dv = self._imu(k, truth)
+            dth, dv = dth.reshape(1, 3), dv.reshape(1, 3)
             if nav.nav.feedback:
                 dth = dth - self.runs[0].bg_fb * self.dt
                 dv = dv - self.runs[0].ba_fb * self.dt
