@@ -118,6 +118,7 @@ class NavInTheLoop:
     def step(self, k: int, truth: Truth) -> tuple[Array, Array]:
         """Runway-frame position (m) and NED velocity (m/s) of the navigation output at truth row k."""
         nav = self.nav
+        scalar = self.gains is None  # single run without a loop: the INS state lives in a 15-tuple
         if k == 0:
             g = self.errors.sensors.get("gnss")
             el = None
@@ -125,24 +126,32 @@ class NavInTheLoop:
                 rec = self._apply("gnss", 0, truth)
                 el = rec.elevation_rad[0] if rec is not None else None
             self.s, self.runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el)
+            self.st = ins.to_scalar(self.s)
             self._snapshot()
         else:
             dth, dv = self._imu(k, truth)
-            dth, dv = dth.reshape(1, 3), dv.reshape(1, 3)
             if nav.nav.feedback:
                 dth = dth - self.runs[0].bg_fb * self.dt
                 dv = dv - self.runs[0].ba_fb * self.dt
-            self.f_sum += self.s.c_bn[0] @ dv[0]
-            if self.gains is None:
-                self.s = ins.step_one(self.s, dth, dv, self.dt)
+            if scalar:
+                c = self.st[6:15]
+                self.f_sum += (c[0] * dv[0] + c[1] * dv[1] + c[2] * dv[2], c[3] * dv[0] + c[4] * dv[1] + c[5] * dv[2],
+                               c[6] * dv[0] + c[7] * dv[1] + c[8] * dv[2])
+                self.st = ins.step_scalar(self.st, (float(dth[0]), float(dth[1]), float(dth[2])),
+                                          (float(dv[0]), float(dv[1]), float(dv[2])), self.dt)
             else:
-                self.s = ins.step(self.s, dth, dv, self.dt, h_baro_m=np.array([self.h_baro_hold]), loop=self.gains)
+                self.f_sum += self.s.c_bn[0] @ dv
+                self.s = ins.step(self.s, dth.reshape(1, 3), dv.reshape(1, 3), self.dt,
+                                  h_baro_m=np.array([self.h_baro_hold]), loop=self.gains)
             if k % self.epoch_rows == 0:
+                if scalar:
+                    self.s = ins.from_scalar(self.st)
                 t = float(truth.t_s[k])
                 recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite")
                         if (r := self._apply(name, k, truth)) is not None}
                 obs = nav.observations(recs, t, 0.25 * self.dt, False)
                 self.s = nav.aid(self.s, self.runs, t, t - self.t_last, (self.f_sum / (t - self.t_last))[None], obs)
+                self.st = ins.to_scalar(self.s)  # feedback may have corrected it
                 self.f_sum[:] = 0.0
                 self.t_last = t
                 self._snapshot()
@@ -151,14 +160,14 @@ class NavInTheLoop:
             self.h_baro_hold = float(np.ravel(b.h_baro_m)[0])
             if k == 0:
                 self.s = ins.replace(self.s, h_m=np.array([self.h_baro_hold]))
-        s = self.s
-        lat, lon, h = float(s.lat_rad[0]), float(s.lon_rad[0]), float(s.h_m[0])
+        st = self.st if scalar else ins.to_scalar(self.s)
+        lat, lon, h = st[0], st[1], st[2]
         d = self.out
         d["lat"].append(lat)
         d["lon"].append(lon)
         d["h"].append(h)
-        d["v"].append(s.v_ned[0])
-        d["c"].append(s.c_bn[0])
+        d["v"].append(st[3:6])
+        d["c"].append(st[6:15])
         d["snap"].append(len(self.snaps) - 1)
         # guidance: feed-forward output INS - x_hat (position and velocity only; attitude in result())
         dp, dvel = self.x_nav[0:3], self.x_nav[3:6]
@@ -173,7 +182,7 @@ class NavInTheLoop:
                (re * (1.0 - geo.E2_WGS84) + h_c) * sl)
         r_rwy = self._c_rwy @ (np.array(r_e) - self._o_rwy)
         r_rwy[2] = h_c - self.profile.runway.elevation_m  # height above threshold, as truth.r_rwy
-        return r_rwy, s.v_ned[0] - dvel
+        return r_rwy, np.array(st[3:6]) - dvel
 
     @staticmethod
     def radii(lat: float) -> tuple[float, float]:
@@ -202,7 +211,7 @@ class NavInTheLoop:
         n = len(truth)
         d = self.out
         raw = ins.InsState(np.array(d["lat"][:n]), np.array(d["lon"][:n]), np.array(d["h"][:n]),
-                           np.array(d["v"][:n]), np.array(d["c"][:n]), np.zeros(n))
+                           np.array(d["v"][:n]), np.array(d["c"][:n]).reshape(n, 3, 3), np.zeros(n))
         snap = np.array(d["snap"][:n])
         X = np.stack([x for x, _ in self.snaps])[snap]
         PP = np.stack([p for _, p in self.snaps])  # per snapshot; index the small blocks per row only

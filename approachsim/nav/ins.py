@@ -331,18 +331,41 @@ def _rot_exp_scalar(x: float, y: float, z: float) -> tuple[float, ...]:
 
 def _mm(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, ...]:
     """Product of two row-major 3x3 9-tuples."""
-    return tuple(a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j]
-                 for i in range(3) for j in range(3))
+    a0, a1, a2, a3, a4, a5, a6, a7, a8 = a
+    b0, b1, b2, b3, b4, b5, b6, b7, b8 = b
+    return (a0 * b0 + a1 * b3 + a2 * b6, a0 * b1 + a1 * b4 + a2 * b7, a0 * b2 + a1 * b5 + a2 * b8,
+            a3 * b0 + a4 * b3 + a5 * b6, a3 * b1 + a4 * b4 + a5 * b7, a3 * b2 + a4 * b5 + a5 * b8,
+            a6 * b0 + a7 * b3 + a8 * b6, a6 * b1 + a7 * b4 + a8 * b7, a6 * b2 + a7 * b5 + a8 * b8)
 
 
 def step_one(s: InsState, dtheta_body: Array, dv_body: Array, dt_s: float) -> InsState:
     """`step` for a single run (N = 1) without a damping loop, in scalar arithmetic: the same equations and
-    the same result to rounding (tests/unit/nav/test_ins.py), ten times cheaper for the closed loop."""
-    lat0, lon0, h0 = float(s.lat_rad[0]), float(s.lon_rad[0]), float(s.h_m[0])
-    vn, ve, vd = (float(u) for u in s.v_ned[0])
-    c0 = tuple(float(u) for u in s.c_bn[0].ravel())
-    tx, ty, tz = (float(u) for u in np.ravel(dtheta_body))
-    ux, uy, uz = (float(u) for u in np.ravel(dv_body))
+    the same result to rounding (tests/unit/nav/test_ins.py), several times cheaper for the closed loop."""
+    st = to_scalar(s)
+    out = step_scalar(st, tuple(float(u) for u in np.ravel(dtheta_body)), tuple(float(u) for u in np.ravel(dv_body)),
+                      dt_s)
+    return from_scalar(out, s.a_comp_mps2)
+
+
+def to_scalar(s: InsState) -> tuple[float, ...]:
+    """Run 0 of a state as a 15-tuple (lat, lon, h, vN, vE, vD, C row-major) for step_scalar."""
+    return (float(s.lat_rad[0]), float(s.lon_rad[0]), float(s.h_m[0]), *(float(u) for u in s.v_ned[0]),
+            *(float(u) for u in s.c_bn[0].ravel()))
+
+
+def from_scalar(st: tuple[float, ...], a_comp_mps2: Array | None = None) -> InsState:
+    """An N = 1 InsState from a step_scalar 15-tuple."""
+    return InsState(np.array([st[0]]), np.array([st[1]]), np.array([st[2]]), np.array([st[3:6]]),
+                    np.array(st[6:15]).reshape(1, 3, 3), np.zeros(1) if a_comp_mps2 is None else a_comp_mps2)
+
+
+def step_scalar(st: tuple[float, ...], dtheta_body: tuple[float, float, float],
+                dv_body: tuple[float, float, float], dt_s: float) -> tuple[float, ...]:
+    """The mechanization of `step` on one state held as a 15-tuple (to_scalar), increments as 3-tuples."""
+    lat0, lon0, h0, vn, ve, vd = st[0:6]
+    c0 = st[6:15]
+    tx, ty, tz = dtheta_body
+    ux, uy, uz = dv_body
     om, a, e2 = geo.OMEGA_E, geo.A_WGS84, geo.E2_WGS84
     sin, cos, tan, sqrt = math.sin, math.cos, math.tan, math.sqrt
 
@@ -393,5 +416,4 @@ def step_one(s: InsState, dtheta_body: Array, dv_body: Array, dt_s: float) -> In
     wenm2 = w_en(lat_m2, hm, vmn, vme)
     wi = (om * cos(lat_m2) + wenm2[0], wenm2[1], -om * sin(lat_m2) + wenm2[2])
     c1 = _mm(_mm(_rot_exp_scalar(-wi[0] * dt_s, -wi[1] * dt_s, -wi[2] * dt_s), c0), _rot_exp_scalar(tx, ty, tz))
-    return InsState(np.array([lat1]), np.array([lon1]), np.array([h1]), np.array([v1]),
-                    np.array(c1).reshape(1, 3, 3), s.a_comp_mps2)
+    return (lat1, lon1, h1, v1[0], v1[1], v1[2], *c1)
