@@ -17,13 +17,15 @@ from approachsim.seeding import stream
 from approachsim.sensors.suite import SensorSuite
 
 
-@pytest.mark.parametrize("quantized", [False, True])
-def test_step_by_step_equals_open_loop_pass(quantized):
-    """quantized: the IMU is not affine in the truth, so the source applies every sample (the other path)."""
+@pytest.mark.parametrize(("quantized", "feedback"), [(False, False), (True, False), (False, True)])
+def test_step_by_step_equals_open_loop_pass(quantized, feedback):
+    """quantized: the IMU is not affine in the truth, so the source applies every sample (the other path);
+    feedback: the estimate is fed back into the INS and the bias estimates into the increments."""
     path = Path("profiles/gray-maybeck.toml")  # baro, radalt, GPS and a pseudolite
     data = tomllib.loads(path.read_text(encoding="utf-8"))
     if quantized:
         data.setdefault("sensors", {}).setdefault("imu", {})["gyro_quant_rad"] = 1e-7
+    data.setdefault("nav", {})["feedback"] = feedback
     prof = parse_profile(data, source=path.resolve())
     truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=prof.rates.imu_hz, start_distance_m=70.0 * 6.0,
                                         ground_speed_mps=70.0)
