@@ -256,6 +256,34 @@ class NavSystem:
         runs = [_Run(self.filter.init(np.zeros(self.layout.n), P0), [], np.zeros(3), np.zeros(3)) for _ in rngs]
         return s, runs
 
+    def loop_slopes(self, fs: FilterState, h_m: float, noise: em.ErrorNoise) -> vl.LoopGains | None:
+        """The damping loop as the error model sees it: constant gains as they are; for the adaptive tanh /
+        sinh forms the *statistical linearization* E[dk/de] of each branch over the loop error
+        e ~ N(e_hat, var), e_hat = -dp_D - bb - S h from the estimate, var = its variance + the baro noise
+        (5-point Gauss-Hermite). The small-signal slope alone makes the filter claim a sigma it does not have
+        once |b e| ~ 1 (tanh saturates, sinh grows)."""
+        g = self.loop_gains()
+        if g is None or g.form == "constant":
+            return g
+        lay = self.layout
+        row = np.zeros(lay.n)
+        row[lay.i("dp", 2)] = -1.0
+        row[lay.i("bb")] = -1.0
+        if lay.has("sb"):
+            row[lay.i("sb")] = -h_m
+        P = self.filter.covariance(fs)
+        e_hat = float(row @ fs.x)
+        sd = float(np.sqrt(row @ P @ row + noise.baro_noise_sigma_m**2))
+        z, w = np.polynomial.hermite_e.hermegauss(5)
+        e = e_hat + sd * z
+        w = w / w.sum()
+
+        def slope(c: float, b: float) -> float:
+            d = 1.0 / np.cosh(b * e) ** 2 if g.form == "tanh" else np.cosh(b * e)  # d/de f(b e) / b
+            return float(c * b * (w @ d))
+
+        return vl.LoopGains(slope(g.c1, g.b1_per_m), slope(g.c2, g.b2_per_m), g.c3)
+
     def loop_gains(self) -> vl.LoopGains | None:
         """The INS damping-loop gains (None without a loop)."""
         return self.nav.loop_gains()
@@ -276,10 +304,10 @@ class NavSystem:
         with feedback).
         """
         lay = self.layout
-        gains = self.loop_gains()
         noise = self.noise(obs.get("gnss_el"))
         r_ins = ins.position_ecef(s)
         for i, run in enumerate(runs):
+            gains = self.loop_slopes(run.fs, float(s.h_m[i]), noise)
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
                                 noise, gains)
             phi, qd = em.discretize(F, Qc, dt_epoch)
@@ -312,9 +340,10 @@ class NavSystem:
         builders = [self._measurements(s, i, r_ins[i], runs[i].fs, obs, t) for i in range(len(runs))]
         if len({len(b) for b in builders}) != 1:
             return None
-        gains = self.loop_gains()
+        noise = self.noise(obs.get("gnss_el"))
+        gains = self.loop_slopes(runs[0].fs, float(s.h_m[0]), noise)
         F, Qc = em.dynamics(lay, float(s.lat_rad[0]), float(s.h_m[0]), s.v_ned[0], f_ned_mean[0], s.c_bn[0],
-                            self.noise(obs.get("gnss_el")), gains)
+                            noise, gains)
         phi, qd = em.discretize(F, Qc, dt_epoch)
         X = np.stack([r.fs.x for r in runs]) @ phi.T  # x- = Phi x+ (each run)
         P = phi @ runs[0].fs.P @ phi.T + qd  # P- = Phi P+ Phi' + Qd (shared)

@@ -1,0 +1,46 @@
+"""The INS with the 3rd-order baro damping loop inside the filtered system (seed 003 eq. 3, 7): the error
+model carries the loop (linearized; adaptive forms by statistical linearization over the loop error), and the
+filter must stay consistent: run-averaged NEES of the 9 navigation errors inside the 95 % chi-square bounds
+for >= 90 % of the epochs (20 runs, default sensors, shared synthetic glidepath)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from scipy.stats import chi2
+
+from approachsim import synthetic
+from approachsim.nav.system import NavSystem
+from approachsim.profile import load_profile
+from approachsim.seeding import stream
+from approachsim.sensors.suite import SensorSuite
+
+RUNS = 20
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "form",
+    [
+        "constant",
+        "sinh",
+        pytest.param("tanh", marks=pytest.mark.xfail(
+            strict=True, reason="finding: with the tanh loop the filter under-claims the vertical velocity error "
+                                "(normalized 2.9 instead of 1; NEES ~12.7 of 9) even with statistical "
+                                "linearization; see the issue report")),
+    ],
+)
+def test_filter_with_damping_loop_is_consistent(form):
+    prof = load_profile("profiles/default.toml")
+    truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 90.0,
+                                        ground_speed_mps=70.0)
+    recs = SensorSuite.from_profile(prof).measure(truth, seed=1, runs=range(RUNS))
+    nav = NavSystem.build(replace(prof.nav, baro_loop=form), prof.sensors, prof.runway.frame, prof.terrain)
+    out = nav.run(truth, recs, [stream(1, r, "nav") for r in range(RUNS)])
+    e = np.stack([o.true_error_nav for o in out])
+    P = np.stack([o.P_nav for o in out])
+    nees = np.einsum("rki,rki->rk", e, np.linalg.solve(P, e[..., None])[..., 0]).mean(axis=0)
+    lo, hi = chi2.ppf([0.025, 0.975], 9 * RUNS) / RUNS
+    assert np.mean((nees >= lo) & (nees <= hi)) >= 0.9, nees.mean()
