@@ -73,6 +73,20 @@ def verdict_table(summary: dict, det: dict) -> str:
                 f"{_f(c['fte_lat_ft']['rms'], '.2f')} vert {_f(c['fte_vert_ft']['rms'], '.2f')}, TSE lat "
                 f"{_f(c['tse_lat_ft']['rms'], '.2f')} vert {_f(c['tse_vert_ft']['rms'], '.2f')}"
             )
+    for cat, e in summary["decision_heights"].items():
+        c = det["categories"][cat]
+        if not e["meets"]:
+            continue
+        lim = c["limits_ft"]
+        hi = (
+            (c["lateral_ft"]["rms_hi"], lim["lateral_1sigma_ft"]),
+            (c["vertical_ft"]["rms_hi"], lim["vertical_1sigma_ft"]),
+        )
+        if any(h is None or h > limit for h, limit in hi):
+            lines.append(
+                f"note: {cat} is met on the RMS of {c['lateral_ft']['n']} runs, but its 95 % upper bound (lat "
+                f"{_f(hi[0][0], '.2f')}, vert {_f(hi[1][0], '.2f')} ft) exceeds a limit: run more to confirm"
+            )
     best = summary["best_category"] or "none"
     lines.append(f"best category: {best} (FAA 1-sigma = RMS over runs, bias included; all values ft)")
     return "\n".join(lines)

@@ -39,6 +39,11 @@ def test_outputs_and_report(tmp_path):
     table = verdict_table(summary, det)
     assert table.splitlines()[0] == "synthetic: 13 runs (1 failed), seed 1, open loop"
     assert "CAT III" in table and "best category:" in table and "FTE" not in table
+    # 12 runs of ~3 ft lateral, ~3.3 ft vertical: CAT I is met with room (upper bounds below 28.1 / 6.8 ft)
+    assert summary["decision_heights"]["CAT I"]["meets"] and "note:" not in table
+    tight = json.loads(json.dumps(summary))
+    tight["decision_heights"]["CAT II"]["meets"] = True  # as if the point estimate had passed CAT II
+    assert "note: CAT II is met on the RMS of 12 runs" in verdict_table(tight, det)
     closed, det_c = evaluate_results(results, cfg, profile="synthetic", seed=1, closed_loop=True)
     assert "CAT II       100 | RMS ft: FTE lat" in verdict_table(closed, det_c)
     page = write_report(tmp_path, results, summary, det).read_text()
