@@ -521,17 +521,15 @@ class NavSystem:
         keep(0, s)
         f_sum = np.zeros((n_runs, 3))
         t_last = float(truth.t_s[0])
-        fast = n_runs == 1 and gains is None
+        # one code path for every batch size: a run's numbers must not depend on the batch it shares (the
+        # campaign relies on it); the scalar single-run step (ins.step_scalar) serves the closed loop only
         for j in range(m):
             bg = np.stack([r.bg_fb for r in runs]) if self.nav.feedback else 0.0
             ba = np.stack([r.ba_fb for r in runs]) if self.nav.feedback else 0.0
             dth_j = dth[:, j] - bg * dt
             dv_j = dvb[:, j] - ba * dt
             f_sum += np.einsum("nij,nj->ni", s.c_bn, dv_j)
-            if fast:
-                s = ins.step_one(s, dth_j, dv_j, dt)
-            else:
-                s = ins.step(s, dth_j, dv_j, dt, h_baro_m=None if hb_full is None else hb_full[:, j], loop=gains)
+            s = ins.step(s, dth_j, dv_j, dt, h_baro_m=None if hb_full is None else hb_full[:, j], loop=gains)
             row = j + 1
             t = float(truth.t_s[row])
             if row % epoch_rows == 0:
