@@ -27,6 +27,7 @@ from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
 from approachsim import units
+from approachsim.campaign.outputs import verdict_table
 from approachsim.campaign.result import RunResult
 from approachsim.evaluate.limits import CATEGORIES, LIMITS
 from approachsim.evaluate.score import CATEGORY_KEYS, HEIGHT_GRID_FT
@@ -255,6 +256,7 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
         f"Verdict uses: {html.escape(det['verdict_limits'])}.</p>",
         _table(["category", "DH ft", "lateral 1σ ft", "FAA limit", "vertical 1σ ft", "FAA limit", "lateral 95% ft",
                 "ICAO 95%", "vertical 95% ft", "ICAO 95%", "meets"], verdict_rows),
+        *(f"<p><b>{html.escape(n)}</b></p>" for n in verdict_table(summary, det).splitlines() if n.startswith("note:")),
         "<h2>Statistics at decision height (ft; 95 % intervals for the number of runs)</h2>",
         _table(["category", "error", "n", "RMS", "RMS lo", "RMS hi", "mean", "std", "95%", "95% lo", "95% hi"],
                detail_rows),
