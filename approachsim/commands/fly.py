@@ -9,19 +9,14 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
-from approachsim.config import ProfileError
+from approachsim.commands._single_run import add_single_run_arguments, load_single_run
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `fly` sub-command."""
     p = sub.add_parser("fly", help="fly one closed-loop approach (truth navigation) and write the truth record")
-    p.add_argument("profile", type=Path, help="approach profile (TOML)")
-    p.add_argument("--out", required=True, type=Path, help="output directory")
-    p.add_argument("--seed", type=int, default=None, help="campaign seed (default: the profile's run.seed)")
-    p.add_argument("--run", type=int, default=0, help="run index within the campaign (default 0)")
-    p.add_argument("--no-figures", action="store_true", help="write the truth files only")
+    add_single_run_arguments(p)
     p.add_argument("--land", action="store_true", help="fly on through the flare to touchdown (default: stop 50 ft)")
     p.set_defaults(func=run)
 
@@ -30,16 +25,8 @@ def run(args: argparse.Namespace) -> int:
     """Fly, write the truth, the figures and flight.json; print a summary."""
     from approachsim.flight.run import Approach, tracking_stats
     from approachsim.flight.truthfile import save_truth
-    from approachsim.profile import load_profile
 
-    profile = load_profile(args.profile)
-    seed = profile.run.seed if args.seed is None else args.seed
-    if seed < 0:
-        raise ProfileError(f"--seed: must be >= 0, got {seed}")
-    if args.run < 0:
-        raise ProfileError(f"--run: must be >= 0, got {args.run}")
-    if args.out.exists() and not args.out.is_dir():
-        raise ProfileError(f"--out: {str(args.out)!r} exists and is not a directory")
+    profile, seed = load_single_run(args)
     result = Approach(profile, land=args.land).fly(seed=seed, run=args.run)
     args.out.mkdir(parents=True, exist_ok=True)
     save_truth(args.out / "truth.npz", result.truth, meta={"profile": profile.name, "seed": seed, "run": args.run})

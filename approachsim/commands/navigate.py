@@ -13,22 +13,17 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
 import numpy as np
 
-from approachsim.config import ProfileError
+from approachsim.commands._single_run import add_single_run_arguments, load_single_run
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `navigate` sub-command."""
     p = sub.add_parser("navigate", help="fly one approach and navigate it (INS + filter): solution, status, figures")
-    p.add_argument("profile", type=Path, help="approach profile (TOML)")
-    p.add_argument("--out", required=True, type=Path, help="output directory")
-    p.add_argument("--seed", type=int, default=None, help="campaign seed (default: the profile's run.seed)")
-    p.add_argument("--run", type=int, default=0, help="run index within the campaign (default 0)")
+    add_single_run_arguments(p)
     p.add_argument("--mode", choices=("closed", "open"), default=None, help="default: the profile's run.mode")
-    p.add_argument("--no-figures", action="store_true", help="write the data files only")
     p.set_defaults(func=run)
 
 
@@ -70,18 +65,10 @@ def run(args: argparse.Namespace) -> int:
     from approachsim.flight.truthfile import save_truth
     from approachsim.nav.closed_loop import NavInTheLoop, approach_errors
     from approachsim.nav.system import NavSystem
-    from approachsim.profile import load_profile
     from approachsim.seeding import stream
     from approachsim.sensors.suite import SensorSuite
 
-    profile = load_profile(args.profile)
-    seed = profile.run.seed if args.seed is None else args.seed
-    if seed < 0:
-        raise ProfileError(f"--seed: must be >= 0, got {seed}")
-    if args.run < 0:
-        raise ProfileError(f"--run: must be >= 0, got {args.run}")
-    if args.out.exists() and not args.out.is_dir():
-        raise ProfileError(f"--out: {str(args.out)!r} exists and is not a directory")
+    profile, seed = load_single_run(args)
     mode = args.mode or profile.run.mode
     approach = Approach(profile)
     if mode == "closed":

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from approachsim.config import ProfileError
+from approachsim.commands._single_run import add_single_run_arguments, load_single_run
 
 UNITS = {
     "t_s": "s", "dt_s": "s", "dtheta_body": "rad", "dv_body": "m/s", "valid": "bool", "fault": "code",
@@ -39,13 +39,9 @@ VALUE_FIELDS = {"imu": ("dtheta_body", "dv_body"), "baro": ("h_baro_m",), "radal
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `sense` sub-command."""
     p = sub.add_parser("sense", help="fly one approach and write its sensor streams (with faults) and figures")
-    p.add_argument("profile", type=Path, help="approach profile (TOML)")
-    p.add_argument("--out", required=True, type=Path, help="output directory")
-    p.add_argument("--seed", type=int, default=None, help="campaign seed (default: the profile's run.seed)")
-    p.add_argument("--run", type=int, default=0, help="run index within the campaign (default 0)")
+    add_single_run_arguments(p)
     p.add_argument("--synthetic", action="store_true",
                    help="use the synthetic constant-velocity test truth instead of flying JSBSim")
-    p.add_argument("--no-figures", action="store_true", help="write the data files only")
     p.set_defaults(func=run)
 
 
@@ -111,18 +107,10 @@ def _day_sky(gnss: Any, profile: Any, path: Path) -> Path:
 def run(args: argparse.Namespace) -> int:
     """Fly (or build the synthetic truth), measure, write data, schema and figures; print a summary."""
     from approachsim.flight.truthfile import save_truth
-    from approachsim.profile import load_profile
     from approachsim.sensors.faults import FAULT_CODES
     from approachsim.sensors.suite import CLOCK_STREAM, SensorSuite
 
-    profile = load_profile(args.profile)
-    seed = profile.run.seed if args.seed is None else args.seed
-    if seed < 0:
-        raise ProfileError(f"--seed: must be >= 0, got {seed}")
-    if args.run < 0:
-        raise ProfileError(f"--run: must be >= 0, got {args.run}")
-    if args.out.exists() and not args.out.is_dir():
-        raise ProfileError(f"--out: {str(args.out)!r} exists and is not a directory")
+    profile, seed = load_single_run(args)
     if args.synthetic:
         from approachsim import synthetic
 
