@@ -87,6 +87,12 @@ def verdict_table(summary: dict, det: dict) -> str:
                 f"note: {cat} is met on the RMS of {c['lateral_ft']['n']} runs, but its 95 % upper bound (lat "
                 f"{_f(hi[0][0], '.2f')}, vert {_f(hi[1][0], '.2f')} ft) exceeds a limit: run more to confirm"
             )
+    ta = det.get("time_averaged_rms_ft", {})
+    if ta:
+        lines.append(
+            "time-averaged RMS over the approach (seed 002 Tables 3-6), ft: "
+            + ", ".join(f"{k.replace('_', ' ')} {_f(v, '.2f').strip()}" for k, v in ta.items())
+        )
     best = summary["best_category"] or "none"
     lines.append(f"best category: {best} (FAA 1-sigma = RMS over runs, bias included; all values ft)")
     return "\n".join(lines)

@@ -39,6 +39,7 @@ def test_outputs_and_report(tmp_path):
     table = verdict_table(summary, det)
     assert table.splitlines()[0] == "synthetic: 13 runs (1 failed), seed 1, open loop"
     assert "CAT III" in table and "best category:" in table and "FTE" not in table
+    assert "time-averaged RMS over the approach (seed 002 Tables 3-6), ft: latitude " in table
     # 12 runs of ~3 ft lateral, ~3.3 ft vertical: CAT I is met with room (upper bounds below 28.1 / 6.8 ft)
     assert summary["decision_heights"]["CAT I"]["meets"] and "note:" not in table
     tight = json.loads(json.dumps(summary))
