@@ -193,15 +193,21 @@ def _local(tasks: list, workers: int, args: tuple) -> Iterator[list[RunResult]]:
             yield res if res is not None else [RunResult.failed(i, CRASH) for i in t]
 
 
-def _dask(tasks: list, address: str, args: tuple, timeout_s: float) -> Iterator[list[RunResult]]:
+def _connect(address: str, timeout_s: float):
+    """A dask.distributed Client on an existing scheduler; SchedulerError (exit 2) when it cannot connect."""
     try:
-        from distributed import Client, as_completed
+        from distributed import Client
     except ImportError as e:  # pragma: no cover - distributed is a declared dependency
         raise SchedulerError(f"--scheduler: dask.distributed is not installed ({e})") from None
     try:
-        client = Client(address, timeout=f"{timeout_s}s")
+        return Client(address, timeout=f"{timeout_s}s")
     except (OSError, TimeoutError, ValueError) as e:
         raise SchedulerError(f"--scheduler: cannot connect to {address!r} ({_one_line(e)})") from None
+
+
+def _dask(client, tasks: list, args: tuple) -> Iterator[list[RunResult]]:
+    from distributed import as_completed
+
     try:
         run_fn, group_fn, profile, seed = args
         futures = [client.submit(run_task, run_fn, group_fn, profile, seed, t, pure=False) for t in tasks]
@@ -257,6 +263,8 @@ def run_campaign(
         raise ValueError("group_fn needs group_size")
     workers = workers or os.cpu_count() or 1
     register_pickling()
+    # connect first: a bad address fails before any output is written or an existing store is touched
+    client = _connect(scheduler, scheduler_timeout_s) if scheduler else None
     store = CampaignStore(out_dir) if out_dir is not None else None
     done: dict[int, RunResult] = {}
     if store is not None:
@@ -270,7 +278,7 @@ def run_campaign(
     t0 = time.monotonic()
     bar.start()
     args = (run_fn, group_fn, profile, seed)
-    source = _dask(tasks, scheduler, args, scheduler_timeout_s) if scheduler else _local(tasks, workers, args)
+    source = _dask(client, tasks, args) if client is not None else _local(tasks, workers, args)
     newly = 0
     for chunk in source:
         if store is not None:

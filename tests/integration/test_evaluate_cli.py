@@ -51,6 +51,21 @@ def test_bad_out_and_profile_exit_2(tmp_path, capsys):
     assert len(err) == 3 and "--out" in err[0] and "missing.toml" in err[1] and "evaluation.dh_cat1_ft" in err[2]
 
 
+def test_unreachable_scheduler_exits_2_with_one_line_and_writes_nothing(tmp_path, capsys):
+    from approachsim.campaign.pipeline import PipelineUnavailable, require_stages
+
+    try:
+        require_stages("open")
+    except PipelineUnavailable as e:
+        pytest.skip(str(e))
+    out = tmp_path / "o"
+    assert main(["evaluate", DEFAULT, "--runs", "1", "--mode", "open", "--scheduler", "tcp://127.0.0.1:9",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--scheduler: cannot connect to 'tcp://127.0.0.1:9'" in err, err
+    assert not out.exists()
+
+
 def test_missing_navigation_stage_exits_1_with_one_line(tmp_path):
     code = (
         "import sys; sys.modules['approachsim.nav.system'] = None\n"
