@@ -35,6 +35,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler (tcp://host:port)")
     p.add_argument("--resume", action="store_true", help="continue the campaign in --out, keeping finished runs")
+    p.add_argument("--overwrite", action="store_true", help="start afresh in --out, discarding a campaign there")
     p.add_argument("--no-report", action="store_true", help="skip figures and report.html")
     p.set_defaults(func=run)
 
@@ -58,6 +59,14 @@ def check_options(args: argparse.Namespace, profile) -> tuple[int, int, str, Pat
     out = args.out if args.out is not None else Path(f"evaluate-{profile.name}")
     if out.exists() and not out.is_dir():
         raise ProfileError(f"--out: {str(out)!r} exists and is not a directory")
+    if args.resume and args.overwrite:
+        raise ProfileError("--overwrite: cannot be combined with --resume")
+    jl = out / "runs.jsonl"
+    if not args.resume and not args.overwrite and jl.is_file() and jl.stat().st_size > 0:
+        raise ProfileError(
+            f"--out: {str(out)!r} already holds a campaign; add --resume to continue it, --overwrite to discard it, "
+            "or choose another --out"
+        )
     return runs, seed, mode, out
 
 

@@ -39,6 +39,17 @@ def test_bad_option_exits_2_with_one_line(argv, needle, capsys, tmp_path):
     assert err.count("\n") == 1 and needle in err, err
 
 
+def test_an_existing_campaign_is_not_discarded_silently(tmp_path, capsys):
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "runs.jsonl").write_text('{"run": 0}\n')
+    assert main(["evaluate", DEFAULT, "--out", str(out)]) == 2
+    assert main(["evaluate", DEFAULT, "--out", str(out), "--resume", "--overwrite"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 2 and "already holds a campaign; add --resume" in err[0] and "--overwrite" in err[1]
+    assert (out / "runs.jsonl").read_text() == '{"run": 0}\n'
+
+
 def test_bad_out_and_profile_exit_2(tmp_path, capsys):
     f = tmp_path / "file"
     f.write_text("x")
