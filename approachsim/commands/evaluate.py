@@ -1,5 +1,6 @@
 """`approachsim evaluate PROFILE [--runs N] [--seed S] [--out DIR] [--mode closed|open] [--workers K]
-[--scheduler ADDR] [--resume]`: the Monte Carlo evaluation of a profile against CAT I / II / III.
+[--scheduler ADDR] [--resume | --overwrite] [--no-report]`: the Monte Carlo evaluation of a profile
+against CAT I / II / III.
 
 Writes DIR/summary.json (design.md's output contract), DIR/details.json (intervals, ICAO columns,
 integrity, FTE / TSE, time-averaged RMS), DIR/runs.parquet (one row per run), DIR/heights.parquet (per-run
