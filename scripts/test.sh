@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The README's test command: install the package with its test extras, lint, check layering, run pytest.
+# The README's test command: install the package with its test extras, lint, check layering, run pytest,
+# then the profile regression baselines.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 python -m pip install --quiet -e ".[test]"
@@ -13,4 +14,8 @@ if [ "$status" -eq 5 ]; then
   echo "pytest collected no tests: failing" >&2
   exit 1
 fi
-exit "$status"
+if [ "$status" -ne 0 ]; then
+  exit "$status"
+fi
+# Regression: the committed profile baselines (small N, fixed seeds) against their stored results.
+approachsim regress
