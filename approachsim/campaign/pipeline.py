@@ -142,7 +142,9 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     """Fly the group's truth once (turbulence of its first run), then sense, navigate and score each run.
 
     Sensors and filters run batched over the group's runs (run axis first); every run's noise comes from its
-    own streams (seed, run, name), so a run's result does not depend on which runs share its batch.
+    own streams (seed, run, name), so a run's result does not depend on which runs share its batch. With the
+    optimal filter the runs share their covariance and gains (NavSystem.shares_covariance; a run's covariance
+    depends only on the truth and its own measurement schedule, so this holds there too).
     """
     from approachsim.nav.system import NavSystem
     from approachsim.seeding import stream
@@ -156,7 +158,11 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
         return [RunResult.failed(i, f"shared flight of runs {first}-{first + size - 1}: {why}") for i in runs]
     truth = flight.truth
     records = SensorSuite.from_profile(profile).measure(truth, seed=seed, runs=list(runs))
-    navruns = NavSystem.from_profile(profile).run(truth, records, [stream(seed, i, "nav") for i in runs])
+    nav = NavSystem.from_profile(profile)
+    # optimal filter: one covariance per measurement schedule for all runs (linearized along the shared truth);
+    # robust / adaptive configurations filter each run on its own
+    navruns = nav.run(truth, records, [stream(seed, i, "nav") for i in runs],
+                      shared_covariance=nav.shares_covariance())
     out = []
     for k, (i, nr) in enumerate(zip(runs, navruns, strict=True)):
         try:

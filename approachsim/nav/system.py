@@ -99,6 +99,40 @@ class _Run:
     ba_fb: Array
 
 
+@dataclass
+class _SharedCov:
+    """Shared covariances of one `NavSystem.run(..., shared_covariance=True)` pass: one P per measurement
+    schedule history (never leaves this module)."""
+
+    P: list
+    """(n, n) covariance of each class."""
+    of_run: Array
+    """(N,) class of each run."""
+
+    def predict(self, phi: Array, qd: Array) -> None:
+        """P- = Phi P+ Phi' + Qd for every class."""
+        for c, P in enumerate(self.P):
+            P = phi @ P @ phi.T + qd
+            self.P[c] = 0.5 * (P + P.T)
+
+    def split(self, schedule: Array) -> None:
+        """Runs of one class whose schedules (rows of (N, k) bool) differ go to new classes (copies of P)."""
+        keys: dict[tuple[int, bytes], int] = {}
+        new_P: list = []
+        of_run = np.empty_like(self.of_run)
+        for i, c in enumerate(self.of_run):
+            k = (int(c), schedule[i].tobytes())
+            if k not in keys:
+                keys[k] = len(new_P)
+                new_P.append(self.P[int(c)])
+            of_run[i] = keys[k]
+        self.P, self.of_run = new_P, of_run
+
+    def classes(self) -> list[tuple[int, list[int]]]:
+        """(class, its runs) for every class."""
+        return [(c, [int(i) for i in np.flatnonzero(self.of_run == c)]) for c in range(len(self.P))]
+
+
 def _epoch_index(t_rec: Array, t: float, tol: float) -> int | None:
     """Index of the record sample at time t (within tol), or None."""
     i = int(np.searchsorted(t_rec, t - tol))
@@ -320,57 +354,99 @@ class NavSystem:
             s = self._feedback(s, runs)
         return s
 
+    def shares_covariance(self) -> bool:
+        """Whether runs on one truth can share one covariance (`run(..., shared_covariance=True)`): the optimal
+        'ekf' filter, tightly coupled GPS (the loose fix's covariance depends on each run's ranges), and a baro
+        loop the error model sees with constant gains (the adaptive forms linearize about each run's
+        estimate). Decided from the configuration alone, so a campaign picks it once per profile."""
+        g = self.loop_gains()
+        return (self.nav.filter == "ekf" and self.nav.gps_coupling == "tight"
+                and (g is None or g.form == "constant"))
+
     def aid_shared(
         self,
         s: ins.InsState,
         runs: list[_Run],
         t: float,
         dt_epoch: float,
-        f_ned_mean: Array,
+        ref: ins.InsState,
+        f_ned_ref: Array,
         obs: Mapping[str, Any],
-    ) -> ins.InsState | None:
-        """`aid` for runs that share one trajectory and measurement schedule (open-loop Monte Carlo): one
-        covariance and one gain per scalar measurement for all runs (computed along run 0's linearization),
-        each run's own state and innovation (issue 5 speed notes). Only for the optimal filter (no gating:
-        every run takes every measurement). Returns None (nothing done) when the runs' available measurement
-        sets differ at this epoch; the caller then uses `aid`.
+        cov: _SharedCov,
+    ) -> ins.InsState:
+        """`aid` for open-loop runs on one truth with the optimal filter: the covariance and the gains are
+        propagated along the reference trajectory `ref` (the truth, one row; f_ned_ref (3,) its mean
+        specific force over the interval, NED m/s^2) once per *measurement schedule* instead of once per run,
+        and each run's state takes its own innovation nu_i = z_i - g(x_hat_i) (issue 5 speed notes).
+
+        Runs whose available measurements have been the same at every epoch share one covariance; a run
+        whose schedule departs (a fault, an outage, a lost channel) gets its own copy from then on. A run's
+        covariance is thus a function of the truth and its own schedule only, and its numbers do not depend
+        on the runs it shares a batch with. Phi and Qd are built once per epoch.
         """
         lay = self.layout
-        r_ins = ins.position_ecef(s)
-        builders = [self._measurements(s, i, r_ins[i], runs[i].fs, obs, t) for i in range(len(runs))]
-        if len({len(b) for b in builders}) != 1:
-            return None
         noise = self.noise(obs.get("gnss_el"))
-        gains = self.loop_slopes(runs[0].fs, float(s.h_m[0]), noise)
-        F, Qc = em.dynamics(lay, float(s.lat_rad[0]), float(s.h_m[0]), s.v_ned[0], f_ned_mean[0], s.c_bn[0],
-                            noise, gains)
+        F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ned_ref, ref.c_bn[0],
+                            noise, self.loop_gains())
         phi, qd = em.discretize(F, Qc, dt_epoch)
-        X = np.stack([r.fs.x for r in runs]) @ phi.T  # x- = Phi x+ (each run)
-        P = phi @ runs[0].fs.P @ phi.T + qd  # P- = Phi P+ Phi' + Qd (shared)
-        P = 0.5 * (P + P.T)
-        eye = np.eye(lay.n)
-        stats: list[list[UpdateStatus]] = [[] for _ in runs]
-        for j in range(len(builders[0])):
-            ms = [b[j](X[i]) for i, b in enumerate(builders)]
-            if len({m.name for m in ms}) != 1:
-                return None
-            h0, r = ms[0].h, ms[0].r
-            Ph = P @ h0
-            S = float(h0 @ Ph + r)  # S = h' P h + r
-            K = Ph / S  # K = P h S^-1
-            nu = np.array([m.z - m.h @ X[i] for i, m in enumerate(ms)])  # each run's innovation
-            X = X + nu[:, None] * K[None, :]  # x+ = x- + K nu
-            A = eye - np.outer(K, h0)
-            P = A @ P @ A.T + r * np.outer(K, K)  # Joseph form
-            P = 0.5 * (P + P.T)
-            for i in range(len(runs)):
-                stats[i].append(UpdateStatus(ms[i].name, t, float(nu[i]), S, float(nu[i] ** 2 / S), 1.0, True))
-        for i, run in enumerate(runs):  # commit only when every measurement went through
-            run.fs = FilterState(x=X[i], P=P, memory=run.fs.memory)
-            run.statuses.extend(stats[i])
+        X = np.stack([phi @ r.fs.x for r in runs])  # x- = Phi x+ (row by row: no batch-size-dependent BLAS path)
+        cov.predict(phi, qd)
+        cov.split(self._schedule(obs, len(runs)))
+        r_ins = ins.position_ecef(s)
+        r_ref = ins.position_ecef(ref)[0]
+        x0 = np.zeros(lay.n)
+        for c, members in cov.classes():
+            i0 = members[0]
+            ref_obs = self._reference_obs(obs, i0, ref, r_ref)
+            rows = [b(x0) for b in self._measurements(ref, 0, r_ref, runs[i0].fs, ref_obs, t)]
+            builders = {i: self._measurements(s, i, r_ins[i], runs[i].fs, obs, t) for i in members}
+            P = cov.P[c]
+            for j, m0 in enumerate(rows):
+                h0, r = m0.h, m0.r
+                Ph = P @ h0
+                S = float(h0 @ Ph + r)  # S = h' P h + r (shared)
+                K = Ph / S  # K = P h S^-1 (shared)
+                for i in members:
+                    m = builders[i][j](X[i])
+                    nu = float(m.z - m.h @ X[i])  # run i's innovation z - g(x_hat_i)
+                    X[i] = X[i] + K * nu  # x+ = x- + K nu
+                    runs[i].statuses.append(UpdateStatus(m.name, t, nu, S, nu * nu / S, 1.0, True))
+                A = np.eye(lay.n) - np.outer(K, h0)
+                P = A @ P @ A.T + r * np.outer(K, K)  # Joseph form
+                P = 0.5 * (P + P.T)
+            cov.P[c] = P
+        for i, run in enumerate(runs):
+            run.fs = FilterState(x=X[i], P=cov.P[cov.of_run[i]], memory=run.fs.memory)
         if self.nav.feedback:
             s = self._feedback(s, runs)
         return s
+
+    @staticmethod
+    def _schedule(obs: Mapping[str, Any], n_runs: int) -> Array:
+        """(N, k) which measurements each run has at this epoch (baro, radalt, each GPS channel, each
+        pseudolite): runs with equal rows take the same scalar updates in the same order."""
+        cols = [np.zeros((n_runs, 0), dtype=bool)]
+        for key in ("baro_h", "radalt_h", "gnss_rho", "pl_rho"):
+            if key in obs:
+                cols.append(np.isfinite(np.asarray(obs[key], dtype=float)).reshape(n_runs, -1))
+        return np.concatenate(cols, axis=1)
+
+    def _reference_obs(self, obs: Mapping[str, Any], i: int, ref: ins.InsState, r_ref: Array) -> dict[str, Any]:
+        """Observations of run i's schedule as seen from the reference trajectory (one row): the values that
+        only decide which rows exist are kept, the radar altimeter's sigma is taken at the reference height
+        above the terrain database (the measured height would make it differ by run)."""
+        out: dict[str, Any] = dict(obs)
+        if "baro_h" in obs:
+            out["baro_h"] = np.asarray(obs["baro_h"])[i:i + 1]
+        if "radalt_h" in obs:
+            ok = np.isfinite(obs["radalt_h"][i])
+            agl = float(ref.h_m[0] - self.terrain_h(r_ref))
+            out["radalt_h"] = np.array([agl if ok else np.nan])
+        if "gnss_rho" in obs:
+            out["gnss_rho"] = np.asarray(obs["gnss_rho"])[i:i + 1]
+        if "pl_rho" in obs:
+            out["pl_rho"] = np.asarray(obs["pl_rho"])[i:i + 1]
+        return out
 
     def _measurements(self, s: ins.InsState, i: int, r_ins: Array, fs: FilterState, obs: Mapping[str, Any],
                       t: float) -> list[Callable[[Array], Any]]:
@@ -475,8 +551,9 @@ class NavSystem:
         'ekf' only): one covariance and gain for all runs at each epoch (`aid_shared`), several times faster;
         epochs where the runs' measurement sets differ fall back to per-run filtering.
         """
-        if shared_covariance and self.nav.filter != "ekf":
-            raise ValueError("shared_covariance needs the optimal 'ekf' filter (robust filters gate per run)")
+        if shared_covariance and not self.shares_covariance():
+            raise ValueError("shared_covariance needs the optimal 'ekf' filter (robust filters gate per run), "
+                             "tight GPS coupling and a constant-gain or no baro loop")
         batched = isinstance(rngs, list)
         gens = rngs if batched else [rngs]
         imu = records["imu"]
@@ -489,6 +566,10 @@ class NavSystem:
         gnss = records.get("gnss")
         s, runs = self.start(truth, gens, elevation_rad=None if gnss is None else gnss.elevation_rad[0])
         n_runs = len(gens)
+        cov = None
+        if shared_covariance:  # the reference trajectory (truth) and its specific force in NED, per row
+            cov = _SharedCov([runs[0].fs.P], np.zeros(n_runs, dtype=int))
+            f_ned_ref = np.einsum("nij,nj->ni", ins.cbn_from_quaternion(truth.q_nb[:m]), truth.f_body[:m])
         gains = self.loop_gains()
         baro = records.get("baro")
         hb_full = None
@@ -534,10 +615,14 @@ class NavSystem:
             t = float(truth.t_s[row])
             if row % epoch_rows == 0:
                 obs = self.observations(records, t, 0.25 * dt, batched)
-                s_new = None
-                if shared_covariance and n_runs > 1:
-                    s_new = self.aid_shared(s, runs, t, t - t_last, f_sum / (t - t_last), obs)
-                s = s_new if s_new is not None else self.aid(s, runs, t, t - t_last, f_sum / (t - t_last), obs)
+                if cov is not None:
+                    ref = ins.InsState(truth.lat_rad[row:row + 1], truth.lon_rad[row:row + 1],
+                                       truth.h_m[row:row + 1], truth.v_ned[row:row + 1],
+                                       ins.cbn_from_quaternion(truth.q_nb[row:row + 1]), np.zeros(1))
+                    f_ref = f_ned_ref[row - epoch_rows:row].mean(axis=0)
+                    s = self.aid_shared(s, runs, t, t - t_last, ref, f_ref, obs, cov)
+                else:
+                    s = self.aid(s, runs, t, t - t_last, f_sum / (t - t_last), obs)
                 f_sum[:] = 0.0
                 t_last = t
                 snapshot()
