@@ -1,15 +1,21 @@
 """Free-inertial INS performance (issue 4 acceptance): stationary for 1 h after an 8-minute analytic
-alignment, 30 seeded runs per seed-002 grade (sensors/presets.py), vertical channel on the 3rd-order baro loop.
+alignment, 200 seeded runs per seed-002 grade (sensors/presets.py), vertical channel on the 3rd-order baro loop.
 
-* horizontal radial drift rate (CEP at 1 h / 1 h) within +-30 % of the grade's 0.4 / 2.0 / 4.0 nmi/h
-  (judged with the confidence interval of a 30-run median; measured with campaign seed 1: 0.61, 1.93,
-  2.46 nmi/h, i.e. the nav-0.4 preset drifts high and nav-4.0 low on this draw);
+* horizontal radial drift rate, CEP at 1 h (median radial error over the runs) / 1 h, within +-30 % of the
+  grade's 0.4 / 2.0 / 4.0 nmi/h. With 200 runs the median scatters by about 8 % (1-sigma; the error is nearly
+  one-dimensional, the east error of the north gyro bias); with the issue's 30 runs it scatters by 21 %, so
+  30 runs could not decide +-30 %. Measured (campaign seeds 1-5): see the report in presets.py's history
+  and the assertion messages; the presets are derived from the grades by tools/calibrate_ins_grades.py,
+  which test_presets_follow_the_grade_derivation re-runs;
 * the unaided vertical channel diverges with the time constant sqrt(R / 2 g);
 * with the baro loop (seed 003 eq. 5 gains, tau = 100 s) the height error stays bounded: its RMS over the
   runs stays within 3x the baro 1-sigma for the whole hour.
 """
 
 from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,29 +26,29 @@ from approachsim.nav import vertical_loop as vl
 from approachsim.seeding import stream
 from approachsim.sensors.baro import Baro
 from approachsim.sensors.imu import Imu
-from approachsim.sensors.presets import PRESETS
+from approachsim.sensors.presets import DEG_PER_H, PRESETS
 
 LAT, LON, H = np.radians(37.6), np.radians(-122.36), 100.0
-RATE_HZ = 10.0  # stationary: the mechanization is exact at any rate; 10 Hz keeps the test short
+RATE_HZ = 1.0  # stationary: the mechanization is exact at any rate; 1 Hz keeps 600 runs under ~30 s
 T_ALIGN, T_NAV = 480.0, 3600.0
-RUNS = 30
+RUNS = 200
 GRADES = {"nav-0.4": 0.4, "nav-2.0": 2.0, "nav-4.0": 4.0}
 SEED = 1
 
 
-@pytest.fixture(scope="module")
-def free_inertial():
-    """All 90 runs stepped together: final horizontal errors per grade and the height-error history."""
+def free_inertial_runs(seed: int, runs: int = RUNS) -> tuple[np.ndarray, np.ndarray, float]:
+    """All grades' runs stepped together: radial horizontal error at 1 h (grades, runs), m; the height
+    error each minute (minutes, grades * runs), m; the baro 1-sigma, m."""
     truth = synthetic.stationary(LAT, LON, H, T_ALIGN + T_NAV, RATE_HZ, euler_rad=(0.0, 0.0, np.radians(30.0)))
     dth, dv = [], []
     for gi, grade in enumerate(GRADES):
-        rec = Imu(PRESETS[grade]).measure(truth, [stream(SEED, gi * RUNS + r, "imu") for r in range(RUNS)])
+        rec = Imu(PRESETS[grade]).measure(truth, [stream(seed, gi * runs + r, "imu") for r in range(runs)])
         dth.append(rec.dtheta_body)
         dv.append(rec.dv_body)
     dth, dv = np.concatenate(dth), np.concatenate(dv)
     n = dth.shape[0]
     baro = Baro(rate_hz=RATE_HZ)
-    hb = baro.measure(truth, [stream(SEED, r, "baro") for r in range(n)]).h_baro_m
+    hb = baro.measure(truth, [stream(seed, r, "baro") for r in range(n)]).h_baro_m
     m_al = int(T_ALIGN * RATE_HZ)
     c = ins.align_stationary(dth[:, :m_al], dv[:, :m_al], np.full(n, LAT))
     s = ins.init_state(np.full(n, LAT), LON, H, np.zeros(3), c)
@@ -54,23 +60,40 @@ def free_inertial():
         if (k + 1 - m_al) % int(60 * RATE_HZ) == 0:
             dh.append(s.h_m - H)
     dp = ins.position_error_ned(s.lat_rad, s.lon_rad, s.h_m, LAT, LON, H)
-    radial = np.hypot(dp[:, 0], dp[:, 1]).reshape(len(GRADES), RUNS)
+    radial = np.hypot(dp[:, 0], dp[:, 1]).reshape(len(GRADES), runs)
     return radial, np.array(dh), float(np.hypot(baro.bias_sigma_m, baro.noise_sigma_m))
+
+
+@pytest.fixture(scope="module")
+def free_inertial():
+    return free_inertial_runs(SEED)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("grade", list(GRADES))
 def test_horizontal_cep_drift_rate(free_inertial, grade):
-    """The 30-run CEP rate must be consistent with the grade +-30 %: its distribution-free 93 % confidence
-    interval (order statistics 10 and 20 of 30, binomial) must overlap [0.7, 1.3] x grade. With 30 runs the
-    median radial error itself scatters by about +-20 % (1-sigma), so the point estimate alone cannot decide;
-    the measured point estimates are in the assertion message and in the issue report."""
+    """The grade's CEP rate (median radial error at 1 h over 200 runs, per hour) is within +-30 % of nominal."""
     radial, _, _ = free_inertial
     gi = list(GRADES).index(grade)
-    r = np.sort(radial[gi]) / units.NMI / (T_NAV / 3600.0)
-    lo_ci, cep, hi_ci = r[9], float(np.median(r)), r[19]
-    lo_ok, hi_ok = 0.7 * GRADES[grade], 1.3 * GRADES[grade]
-    assert hi_ci >= lo_ok and lo_ci <= hi_ok, (grade, cep, lo_ci, hi_ci)
+    cep_rate = float(np.median(radial[gi])) / units.NMI / (T_NAV / 3600.0)
+    assert cep_rate == pytest.approx(GRADES[grade], rel=0.30), (grade, cep_rate)
+
+
+@pytest.mark.slow
+def test_presets_follow_the_grade_derivation():
+    """The seed-002 presets' gyro turn-on biases are those tools/calibrate_ins_grades.py derives from the
+    grades' CEP rates with the presets' grade-common terms (rounded in presets.py to 4 decimals of deg/h)."""
+    path = Path(__file__).resolve().parents[2] / "tools" / "calibrate_ins_grades.py"
+    spec = importlib.util.spec_from_file_location("calibrate_ins_grades", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    eps = mod.derive()
+    for grade in GRADES:
+        assert PRESETS[grade].gyro_bias_radps / DEG_PER_H == pytest.approx(eps[grade], rel=0.02), (grade, eps)
+    # the grades differ only in random constants (seed 002): the Gauss-Markov and noise terms are shared
+    common = {(g.gyro_bi_radps, g.gyro_bi_tau_s, g.gyro_arw_rad_sqrts, g.accel_bi_mps2, g.accel_vrw_mps_sqrts)
+              for g in (PRESETS[k] for k in GRADES)}
+    assert len(common) == 1
 
 
 @pytest.mark.slow
