@@ -399,18 +399,18 @@ class NavSystem:
             i0 = members[0]
             ref_obs = self._reference_obs(obs, i0, ref, r_ref)
             rows = [b(x0) for b in self._measurements(ref, 0, r_ref, runs[i0].fs, ref_obs, t)]
-            builders = {i: self._measurements(s, i, r_ins[i], runs[i].fs, obs, t) for i in members}
+            idx = np.array(members)
+            c_en = geo.c_ecef_to_ned(s.lat_rad[idx], s.lon_rad[idx])
             P = cov.P[c]
-            for j, m0 in enumerate(rows):
+            for m0 in rows:
                 h0, r = m0.h, m0.r
                 Ph = P @ h0
                 S = float(h0 @ Ph + r)  # S = h' P h + r (shared)
                 K = Ph / S  # K = P h S^-1 (shared)
-                for i in members:
-                    m = builders[i][j](X[i])
-                    nu = float(m.z - m.h @ X[i])  # run i's innovation z - g(x_hat_i)
-                    X[i] = X[i] + K * nu  # x+ = x- + K nu
-                    runs[i].statuses.append(UpdateStatus(m.name, t, nu, S, nu * nu / S, 1.0, True))
+                nu = self._innovations(m0.name, X[idx], idx, s, r_ins[idx], c_en, obs)  # z - g(x_hat_i)
+                X[idx] = X[idx] + nu[:, None] * K[None, :]  # x+ = x- + K nu (row by row)
+                for i, v in zip(members, nu.tolist(), strict=True):
+                    runs[i].statuses.append(UpdateStatus(m0.name, t, v, S, v * v / S, 1.0, True))
                 A = np.eye(lay.n) - np.outer(K, h0)
                 P = A @ P @ A.T + r * np.outer(K, K)  # Joseph form
                 P = 0.5 * (P + P.T)
@@ -420,6 +420,49 @@ class NavSystem:
         if self.nav.feedback:
             s = self._feedback(s, runs)
         return s
+
+    def _innovations(self, name: str, X: Array, idx: Array, s: ins.InsState, r_ins: Array, c_en: Array,
+                     obs: Mapping[str, Any]) -> Array:
+        """Innovations nu = z - g(x_hat) (m) of measurement `name` for runs idx at once, X (M, n) their
+        estimates: the exact differences of nav.measurements (baro, radalt, pseudorange) evaluated at each
+        run's x_hat, elementwise (a run's value does not depend on the others')."""
+        lay = self.layout
+        h_ins = s.h_m[idx]
+        if name == "baro":
+            pred = -X[:, lay.i("dp", 2)] - X[:, lay.i("bb")]  # h' x: -dp_D - bb - h sb
+            if lay.has("sb"):
+                pred = pred - h_ins * X[:, lay.i("sb")]
+            return (h_ins - obs["baro_h"][idx]) - pred
+        dp = X[:, lay.index["dp"]]
+        # corrected position r_hat = r_ins - C_ne dp_hat, written out (C_ne = C_en'): no batch-size-dependent path
+        r_hat = r_ins - (c_en[:, 0, :] * dp[:, 0:1] + c_en[:, 1, :] * dp[:, 1:2] + c_en[:, 2, :] * dp[:, 2:3])
+        if name == "radalt":  # (h_ins - T(ins) - h_R) - g(x_hat) = (h_ins + dp_D) - T(r_hat) - h_R
+            return (h_ins + dp[:, 2]) - self.terrain_h(r_hat) - obs["radalt_h"][idx]
+        if name.startswith("gps"):
+            k = int(name[3:])
+            d = r_hat - obs["gnss_rsv"][k]
+            rng_hat = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + d[:, 2] ** 2)
+            nu = rng_hat - obs["gnss_rho"][idx, k]  # |r_hat - r_sv| - rho + clk + gse + gmp
+            if lay.has("clk"):
+                nu = nu + X[:, lay.i("clk")]
+            if lay.has("gse"):
+                nu = nu + X[:, lay.i("gse", k)] + X[:, lay.i("gmp", k)]
+            return nu
+        if name.startswith("pl"):
+            k = int(name[2:])
+            d = r_hat - obs["pl_r"][k]
+            rng_hat = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + d[:, 2] ** 2)
+            if lay.has("ptr"):
+                rng_hat = rng_hat * (1.0 + X[:, lay.i("ptr", k)])
+            nu = rng_hat - obs["pl_rho"][idx, k]  # range (1 + T) - rho + clk + pmp + pclk
+            if lay.has("clk"):
+                nu = nu + X[:, lay.i("clk")]
+            if lay.has("pmp"):
+                nu = nu + X[:, lay.i("pmp", k)]
+            if lay.has("pclk"):
+                nu = nu + X[:, lay.i("pclk", 2 * k)]
+            return nu
+        raise ValueError(f"no shared-covariance innovation for measurement {name!r}")
 
     @staticmethod
     def _schedule(obs: Mapping[str, Any], n_runs: int) -> Array:
