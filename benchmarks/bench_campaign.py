@@ -107,6 +107,8 @@ def bench_pipeline(n_open: int, n_closed: int) -> None:
     prof = load_profile(ROOT / "profiles" / "default.toml")
     closed_core_s = None
     for mode, n in (("open", n_open), ("closed", n_closed)):
+        if n <= 0:
+            continue
         try:
             require_stages(mode)
         except PipelineUnavailable as e:
@@ -140,10 +142,12 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="runner N up to 100 only")
     ap.add_argument("--open-runs", type=int, default=1000, help="open-loop pipeline runs (default 1000)")
-    ap.add_argument("--closed-runs", type=int, default=20, help="closed-loop pipeline runs (default 20)")
+    ap.add_argument("--closed-runs", type=int, default=20, help="closed-loop pipeline runs (default 20; 0: skip)")
+    ap.add_argument("--pipeline-only", action="store_true", help="skip the runner (A) and scoring (B) parts")
     args = ap.parse_args()
-    bench_runner([10, 100] if args.quick else [10, 100, 1000])
-    bench_scoring()
+    if not args.pipeline_only:
+        bench_runner([10, 100] if args.quick else [10, 100, 1000])
+        bench_scoring()
     bench_pipeline(args.open_runs, args.closed_runs)
 
 

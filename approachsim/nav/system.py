@@ -638,8 +638,12 @@ class NavSystem:
             vel[:, k], cbn[:, k] = s.v_ned, s.c_bn
             snap[k] = len(snaps) - 1
 
-        def snapshot() -> None:
-            snaps.append((np.stack([r.fs.x for r in runs]), np.stack([self.filter.covariance(r.fs) for r in runs])))
+        has_clk = lay.has("clk")
+        ic = lay.i("clk") if has_clk else 0
+
+        def snapshot() -> None:  # x, the position block of P and the clock variance: what the output needs
+            P = np.stack([self.filter.covariance(r.fs) for r in runs])
+            snaps.append((np.stack([r.fs.x for r in runs]), P[:, 0:3, 0:3].copy(), P[:, ic, ic].copy()))
 
         snapshot()
         keep(0, s)
@@ -652,7 +656,8 @@ class NavSystem:
             ba = np.stack([r.ba_fb for r in runs]) if self.nav.feedback else 0.0
             dth_j = dth[:, j] - bg * dt
             dv_j = dvb[:, j] - ba * dt
-            f_sum += np.einsum("nij,nj->ni", s.c_bn, dv_j)
+            if cov is None:  # the per-run filters linearize about each run's INS (shared: about the truth)
+                f_sum += np.einsum("nij,nj->ni", s.c_bn, dv_j)
             s = ins.step(s, dth_j, dv_j, dt, h_baro_m=None if hb_full is None else hb_full[:, j], loop=gains)
             row = j + 1
             t = float(truth.t_s[row])
@@ -676,17 +681,16 @@ class NavSystem:
                 pnav.append(P[:, 0:9, 0:9])
                 terr.append(self._true_error(o, truth, row))
             keep(row, s)
-        X = np.stack([x for x, _ in snaps])[snap]  # (n_out, runs, n)
-        PP = np.stack([p for _, p in snaps])  # (snaps, runs, n, n)
+        X = np.stack([x for x, _, _ in snaps])[snap]  # (n_out, runs, n)
+        PP = np.stack([p for _, p, _ in snaps])  # (snaps, runs, 3, 3)
+        PC = np.stack([c for _, _, c in snaps])  # (snaps, runs)
         results = []
         for i, r in enumerate(runs):
             xi = X[:, i]
             o = ins.perturb(ins.InsState(lat[i], lon[i], hh[i], vel[i], cbn[i], np.zeros(n_out)),
                             -xi[:, 0:3], -xi[:, 3:6], -xi[:, 6:9])
-            p_pos = PP[:, i, 0:3, 0:3][snap]  # index the small blocks only: (rows, n, n) would be GBs at 120 Hz
-            has_clk = lay.has("clk")
-            ic = lay.i("clk") if has_clk else 0
-            clk_sd = np.sqrt(PP[:, i, ic, ic][snap]) if has_clk else np.full(n_out, np.nan)
+            p_pos = PP[:, i][snap]  # the small blocks only: (rows, n, n) would be GBs at 120 Hz
+            clk_sd = np.sqrt(PC[:, i][snap]) if has_clk else np.full(n_out, np.nan)
             sol = NavSolution(
                 t_s=np.asarray(truth.t_s[:n_out], dtype=float),
                 r_ecef=geo.geodetic_to_ecef(o.lat_rad, o.lon_rad, o.h_m),
