@@ -7,6 +7,7 @@ frame (origin at the threshold, x along the landing direction, y to the right, z
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -115,6 +116,89 @@ def normal_gravity(lat_rad: ArrayLike, h_m: ArrayLike) -> Array:
     return g0 * (
         1.0 - 2.0 / A_WGS84 * (1.0 + F_WGS84 + _M_WGS84 - 2.0 * F_WGS84 * s2) * h + 3.0 / A_WGS84**2 * h**2
     )
+
+
+# JSBSim's Earth (src/models/FGInertial.cpp, FGInertial::FGInertial, JSBSim 1.3.x), converted from feet
+_FT = 0.3048
+GM_JSBSIM = 14.0764417572e15 * _FT**3
+"""JSBSim's Earth gravitational constant (14.0764417572e15 ft^3/s^2), m^3/s^2."""
+J2_JSBSIM = 1.08262982e-3
+"""JSBSim's Earth J2 (dimensionless)."""
+A_JSBSIM = 20925646.32546 * _FT
+"""JSBSim's Earth semi-major axis (20925646.32546 ft), m: the WGS-84 value."""
+OMEGA_JSBSIM = 7.292115e-5
+"""JSBSim's Earth rotation rate, rad/s (0.00007292115; differs from OMEGA_E by 1.5e-14 rad/s)."""
+
+
+def gravitation_j2_ecef(r_ecef: ArrayLike) -> Array:
+    """J2 gravitation (mass attraction only, no centrifugal term) at ECEF positions (..., 3), m/s^2, ECEF axes.
+
+    JSBSim's WGS-84 gravity model (simulation/gravity-model = 1, FGInertial::GetGravityJ2, Stevens & Lewis
+    eq. 1.4-16) with its constants GM_JSBSIM, J2_JSBSIM, A_JSBSIM; sin(lat) there is the *geocentric*
+    latitude's, z / r:
+        g_xy = -GM/r^2 (1 + 3/2 J2 (a/r)^2 (1 - 5 s^2)) (x, y)/r,
+        g_z  = -GM/r^2 (1 + 3/2 J2 (a/r)^2 (3 - 5 s^2)) z/r,   s = z / r.
+    JSBSim integrates the inertial velocity with exactly this plus the body forces / mass (FGAccelerations).
+    """
+    r_vec = np.asarray(r_ecef, dtype=float)
+    r2 = np.einsum("...i,...i->...", r_vec, r_vec)
+    r = np.sqrt(r2)
+    s2 = r_vec[..., 2] ** 2 / r2
+    pre = 1.5 * J2_JSBSIM * A_JSBSIM**2 / r2
+    k = -GM_JSBSIM / (r2 * r)
+    out = np.empty(r_vec.shape)
+    kxy = k * (1.0 + pre * (1.0 - 5.0 * s2))
+    out[..., 0] = kxy * r_vec[..., 0]
+    out[..., 1] = kxy * r_vec[..., 1]
+    out[..., 2] = k * (1.0 + pre * (3.0 - 5.0 * s2)) * r_vec[..., 2]
+    return out
+
+
+def gravity_ned(lat_rad: ArrayLike, h_m: ArrayLike) -> Array:
+    """Gravity (J2 gravitation + centrifugal) as a full NED vector (..., 3), m/s^2, at geodetic lat and height.
+
+    The plumb-bob gravity of JSBSim's Earth (gravitation_j2_ecef minus W x (W x r), W = OMEGA_JSBSIM: the
+    centrifugal term JSBSim's FGAccelerations::CalculateUVWdot subtracts), resolved on the local geodetic NED
+    axes. It is not exactly along the ellipsoid normal: the J2-only field's level surfaces are not the WGS-84
+    ellipsoid, so it has a north component of a few 1e-5 m/s^2. This is the one gravity model of the
+    simulated world (JSBSim) and of the navigation computer (nav/ins.py, synthetic.py). It differs from
+    normal_gravity (Somigliana, the full normal field) by ~1e-5 m/s^2 (the neglected J4... terms; tests/unit/
+    test_geo.py states the measured difference). Gravity is axisymmetric: longitude does not enter.
+    """
+    lat = np.asarray(lat_rad, dtype=float)
+    h = np.asarray(h_m, dtype=float)
+    sl, cl = np.sin(lat), np.cos(lat)
+    _, r_e = radii(lat)
+    p = (r_e + h) * cl  # distance from the spin axis (meridian plane at longitude 0)
+    z = (r_e * (1.0 - E2_WGS84) + h) * sl
+    r2 = p * p + z * z
+    r = np.sqrt(r2)
+    s2 = z * z / r2
+    pre = 1.5 * J2_JSBSIM * A_JSBSIM**2 / r2
+    k = -GM_JSBSIM / (r2 * r)
+    gp = k * (1.0 + pre * (1.0 - 5.0 * s2)) * p + OMEGA_JSBSIM**2 * p
+    gz = k * (1.0 + pre * (3.0 - 5.0 * s2)) * z
+    out = np.empty(np.broadcast(lat, h).shape + (3,))
+    out[..., 0] = -sl * gp + cl * gz
+    out[..., 1] = 0.0
+    out[..., 2] = -cl * gp - sl * gz
+    return out
+
+
+def gravity_nd_scalar(lat_rad: float, h_m: float) -> tuple[float, float]:
+    """gravity_ned's north and down components (m/s^2) for one point in plain float arithmetic (fast path
+    for the scalar INS step; the same equations, equal to rounding)."""
+    sl, cl = math.sin(lat_rad), math.cos(lat_rad)
+    r_e = A_WGS84 / math.sqrt(1.0 - E2_WGS84 * sl * sl)
+    p = (r_e + h_m) * cl
+    z = (r_e * (1.0 - E2_WGS84) + h_m) * sl
+    r2 = p * p + z * z
+    s2 = z * z / r2
+    pre = 1.5 * J2_JSBSIM * A_JSBSIM**2 / r2
+    k = -GM_JSBSIM / (r2 * math.sqrt(r2))
+    gp = k * (1.0 + pre * (1.0 - 5.0 * s2)) * p + OMEGA_JSBSIM**2 * p
+    gz = k * (1.0 + pre * (3.0 - 5.0 * s2)) * z
+    return -sl * gp + cl * gz, -cl * gp - sl * gz
 
 
 @dataclass(frozen=True)

@@ -11,8 +11,9 @@ WGS-84 NED mechanization equations that a strapdown INS integrates. Two trajecto
 
 How each is consistent (the contract an INS test can rely on; Groves 2nd ed. eq. 5.44-5.56, NED frame):
 
-* Gravity is the normal-gravity vector g_ned = (0, 0, geo.normal_gravity(lat, h)) (gravitation plus
-  centrifugal, along the local vertical), evaluated at each sample's own lat and h.
+* Gravity is the vector g_ned = geo.gravity_ned(lat, h) (JSBSim's J2 gravitation plus centrifugal, the
+  one model of the simulated world and the INS; a few 1e-5 m/s^2 off the local vertical), evaluated at
+  each sample's own lat and h.
 * Earth rate w_ie_ned = OMEGA_E (cos lat, 0, -sin lat); transport rate
   w_en_ned = (vE / (R_E + h), -vN / (R_N + h), -vE tan(lat) / (R_E + h)) with geo.radii at the sample's lat.
 * Position is the solution of lat' = vN / (R_N + h), lon' = vE / ((R_E + h) cos lat), h' = -vD for the
@@ -104,10 +105,8 @@ def transport_rate_ned(lat_rad: Array, h_m: Array, v_ned: Array) -> Array:
 
 
 def gravity_ned(lat_rad: Array, h_m: Array) -> Array:
-    """Normal-gravity vector in NED (..., 3), m/s^2: (0, 0, geo.normal_gravity(lat, h))."""
-    g = np.asarray(geo.normal_gravity(lat_rad, h_m), dtype=float)
-    z = np.zeros_like(g)
-    return np.stack([z, z, g], axis=-1)
+    """Gravity vector in NED (..., 3), m/s^2: geo.gravity_ned (JSBSim's J2 gravitation + centrifugal)."""
+    return geo.gravity_ned(lat_rad, h_m)
 
 
 def _time_base(duration_s: float, rate_hz: float) -> Array:

@@ -208,7 +208,7 @@ def dynamics(
     F[V, A] = ins.skew(np.asarray(f_ned, dtype=float))
     F[V, V] = -ins.skew(2.0 * w_ie + w_en) + vx @ d_dv
     F[V, P] = vx @ (2.0 * d_ie_dp + d_en_dp)
-    dg_dh = float((geo.normal_gravity(lat_rad, h_m + 10.0) - geo.normal_gravity(lat_rad, h_m - 10.0)) / 20.0)
+    dg_dh = float((geo.gravity_ned(lat_rad, h_m + 10.0)[2] - geo.gravity_ned(lat_rad, h_m - 10.0)[2]) / 20.0)
     F[V.start + 2, P.start + 2] += -dg_dh  # dg_D = (dg/dh) dh = -(dg/dh) dp_D  (about +2 g / R)
     F[V, ix["ba"]] = c_bn
     # attitude error: -w_in x psi + dw_in - C bg

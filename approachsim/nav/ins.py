@@ -2,9 +2,10 @@
 
 The INS integrates gyro and accelerometer increments (delta-theta, delta-v over one IMU interval, body
 axes) into geodetic position (lat, lon, ellipsoid height), NED velocity relative to the Earth and the
-body-to-NED attitude matrix. Earth rate, transport rate, Coriolis and normal gravity varying with latitude
-and height (geo.normal_gravity) are all modelled (Groves, *Principles of GNSS, Inertial and Multisensor
-Integrated Navigation Systems*, 2nd ed., sec. 5.4-5.5; Titterton & Weston ch. 3).
+body-to-NED attitude matrix. Earth rate, transport rate, Coriolis and gravity varying with latitude
+and height (geo.gravity_ned: JSBSim's J2 gravitation + centrifugal, the simulated world's own model, so
+that exact increments of JSBSim truth integrate back to that truth) are all modelled (Groves, *Principles
+of GNSS, Inertial and Multisensor Integrated Navigation Systems*, 2nd ed., sec. 5.4-5.5; Titterton & Weston ch. 3).
 
 Integration is second-order accurate in the step (the global error falls as dt^2):
     attitude  C(+) = Exp(-w_in^n dt) C(-) Exp(dtheta)                     (Groves eq. 5.47 exact form)
@@ -124,11 +125,9 @@ def transport_rate_ned(lat_rad: Array, h_m: Array, v_ned: Array) -> Array:
 
 
 def gravity_ned(lat_rad: Array, h_m: Array) -> Array:
-    """Normal gravity vector (gravitation + centrifugal) in NED (..., 3), m/s^2: (0, 0, g(L, h))."""
-    g = geo.normal_gravity(lat_rad, h_m)
-    out = np.zeros(np.shape(g) + (3,))
-    out[..., 2] = g
-    return out
+    """Gravity vector (J2 gravitation + centrifugal) in NED (..., 3), m/s^2: geo.gravity_ned, the model of
+    the simulated world (JSBSim's), with its small north component."""
+    return geo.gravity_ned(lat_rad, h_m)
 
 
 def euler_from_cbn(c_bn: Array) -> Array:
@@ -394,16 +393,16 @@ def step_scalar(st: tuple[float, ...], dtheta_body: tuple[float, float, float],
     h_mid = h0 - k * vd
     rn0, _ = radii(lat0)
     lat_mid = lat0 + k * vn / (rn0 + h0)
-    g_mid = float(geo.normal_gravity(lat_mid, h_mid))
+    gn_mid, g_mid = geo.gravity_nd_scalar(lat_mid, h_mid)
     w2 = (wie0[0] + win0[0], wie0[1] + win0[1], wie0[2] + win0[2])  # 2 w_ie + w_en at the start
     cor0 = (w2[1] * vd - w2[2] * ve, w2[2] * vn - w2[0] * vd, w2[0] * ve - w2[1] * vn)
-    vm = (vn + 0.5 * (dvf[0] - cor0[0] * dt_s), ve + 0.5 * (dvf[1] - cor0[1] * dt_s),
+    vm = (vn + 0.5 * (dvf[0] + (gn_mid - cor0[0]) * dt_s), ve + 0.5 * (dvf[1] - cor0[1] * dt_s),
           vd + 0.5 * (dvf[2] + (g_mid - cor0[2]) * dt_s))
     clm, slm = cos(lat_mid), sin(lat_mid)
     wenm = w_en(lat_mid, h_mid, vm[0], vm[1])
     wc = (2.0 * om * clm + wenm[0], wenm[1], -2.0 * om * slm + wenm[2])
     cor = (wc[1] * vm[2] - wc[2] * vm[1], wc[2] * vm[0] - wc[0] * vm[2], wc[0] * vm[1] - wc[1] * vm[0])
-    v1 = (vn + dvf[0] - cor[0] * dt_s, ve + dvf[1] - cor[1] * dt_s, vd + dvf[2] + (g_mid - cor[2]) * dt_s)
+    v1 = (vn + dvf[0] + (gn_mid - cor[0]) * dt_s, ve + dvf[1] - cor[1] * dt_s, vd + dvf[2] + (g_mid - cor[2]) * dt_s)
     # position: trapezoid, radii at the midpoint
     vmn, vme, vmd = 0.5 * (vn + v1[0]), 0.5 * (ve + v1[1]), 0.5 * (vd + v1[2])
     h1 = h0 - dt_s * vmd

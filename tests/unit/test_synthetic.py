@@ -24,7 +24,7 @@ def _log_so3(c):
 
 
 def _check_ecef_consistency(truth, tol_acc, tol_rate):
-    """r'' = C_en (f + g) - 2 W x r' - W x (W x r) + W x (W x r) ... in ECEF with g the normal gravity (plumb)."""
+    """r'' = C_en (f + g) - 2 W x r' - W x (W x r) + W x (W x r) ... in ECEF with g = geo.gravity_ned (plumb)."""
     t = truth.t_s
     dt = t[1] - t[0]
     r = truth.r_ecef
@@ -59,12 +59,12 @@ def _check_ecef_consistency(truth, tol_acc, tol_rate):
 def test_stationary_reads_one_g_up_and_earth_rate():
     tr = synthetic.stationary(RWY.threshold_lat_rad, RWY.threshold_lon_rad, 4.0, 10.0, 10.0,
                               euler_rad=(0.1, -0.05, 1.0))
-    g = geo.normal_gravity(RWY.threshold_lat_rad, 4.0)
+    g = np.linalg.norm(geo.gravity_ned(RWY.threshold_lat_rad, 4.0))
     assert np.allclose(np.linalg.norm(tr.f_body, axis=1), g, rtol=0, atol=1e-12)
     assert np.allclose(np.linalg.norm(tr.w_ib_body, axis=1), geo.OMEGA_E, rtol=1e-12)
     # level attitude: f_body = (0, 0, -g), gyros see Earth rate north and up components
     lv = synthetic.stationary(RWY.threshold_lat_rad, 0.0, 0.0, 1.0, 10.0)
-    assert np.allclose(lv.f_body[0], [0, 0, -geo.normal_gravity(RWY.threshold_lat_rad, 0.0)], atol=1e-12)
+    assert np.allclose(lv.f_body[0], -geo.gravity_ned(RWY.threshold_lat_rad, 0.0), atol=1e-12)
     lat = RWY.threshold_lat_rad
     assert np.allclose(lv.w_ib_body[0], geo.OMEGA_E * np.array([math.cos(lat), 0, -math.sin(lat)]), atol=1e-18)
     assert np.all(tr.v_ned == 0.0)
@@ -90,7 +90,7 @@ def test_descent_follows_glidepath_and_reaches_threshold():
     assert np.max(np.abs(tr.loc_dev_m)) < 25.0  # rhumb line vs great circle, zero at the end
     assert abs(tr.loc_dev_m[-1]) < 1e-6
     # constant velocity: the specific force differs from -g only by Coriolis/transport terms (< 0.02 m/s^2)
-    g = geo.normal_gravity(tr.lat_rad, tr.h_m)
+    g = np.linalg.norm(geo.gravity_ned(tr.lat_rad, tr.h_m), axis=-1)
     assert np.max(np.abs(np.linalg.norm(tr.f_body, axis=1) - g)) < 0.02
     # and those terms are present (2 W x v ~ 2 * 7.29e-5 * 70 = 0.01 m/s^2)
     f_ned = np.einsum("nij,nj->ni", synthetic.euler_to_c_nb(tr.euler_rad), tr.f_body)

@@ -82,8 +82,8 @@ def test_loop_closes_with_the_seed003_poles():
     idx = [2, 5, lay.i("ac")]
     ev = np.sort_complex(np.linalg.eigvals(F[np.ix_(idx, idx)]))
     # python-control's poles of seed 003 eq. 3 with this point's gravity gradient in place of 2 g0 / R0
-    g = float(geo.normal_gravity(np.radians(45.0), 0.0))
-    dg_dh = float(geo.normal_gravity(np.radians(45.0), 10.0) - geo.normal_gravity(np.radians(45.0), -10.0)) / 20.0
+    g = float(geo.gravity_ned(np.radians(45.0), 0.0)[2])
+    dg_dh = float(geo.gravity_ned(np.radians(45.0), 10.0)[2] - geo.gravity_ned(np.radians(45.0), -10.0)[2]) / 20.0
     want = np.sort_complex(vl.closed_loop_poles(gains, g0_mps2=g, r0_m=-2.0 * g / dg_dh))
     np.testing.assert_allclose(ev, want, rtol=1e-6)
     np.testing.assert_allclose(ev.real, -1.0 / tau, rtol=0.05)  # near the triple pole at -1/tau
