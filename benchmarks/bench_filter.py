@@ -18,7 +18,9 @@ Methods (all Joseph-form covariance updates, the same numbers to rounding: check
              filter on a shared truth and measurement schedule), the N states as one (N, n) matrix
 FLOP floor: the arithmetic of the per-run-covariance filter (predict 4 n^3 + 2 n^2, update ~10 n^2) at the
 machine's measured dgemm rate on 2 threads; for `shared` its own floor (the covariance once, states per run).
-Prints times per run and ratios; no pass/fail. Results go in benchmarks/RESULTS.md.
+Prints times per run and ratios; no pass/fail. Results go in benchmarks/RESULTS.md. The batched column's
+products have an inner dimension of 18: on a shared machine run with OPENBLAS_NUM_THREADS=1 (two BLAS threads
+fighting other jobs made it 10x slower here); everything runs in one process (one core).
 """
 
 from __future__ import annotations
@@ -200,7 +202,8 @@ def main() -> None:
     ap.add_argument("--batched-runs", type=int, default=200, help="runs of the batched per-run-covariance filter")
     ap.add_argument("--loop-runs", type=int, default=4, help="runs of the per-run Python loops")
     a = ap.parse_args()
-    print(f"OPENBLAS_CORETYPE={os.environ.get('OPENBLAS_CORETYPE', '(unset)')}; building the problem ...")
+    env = {k: os.environ.get(k, "(unset)") for k in ("OPENBLAS_CORETYPE", "OPENBLAS_NUM_THREADS")}
+    print(f"{env}; building the problem ...")
     pb = build_problem()
     n, n_pred, n_upd = pb["n"], pb["n_sec"] * pb["steps_per_s"], pb["n_sec"] * N_UPDATES
     z = measurements(pb, max(a.runs, a.batched_runs, a.loop_runs))
