@@ -138,13 +138,37 @@ def bench_pipeline(n_open: int, n_closed: int) -> None:
           f"{closed_core_s:.2f} core-s/run: ratio {closed_core_s / raw:.1f} (goal <= 2)")
 
 
+def profile_group(n: int) -> None:
+    """cProfile of one open-loop group (n runs sharing one flight of the default profile), in this process."""
+    import cProfile
+    import pstats
+
+    from approachsim.campaign.pipeline import open_loop_group
+    from approachsim.profile import load_profile
+
+    prof = load_profile(ROOT / "profiles" / "default.toml")
+    pr = cProfile.Profile()
+    t = time.perf_counter()
+    pr.enable()
+    res = open_loop_group(prof, 1, list(range(n)))
+    pr.disable()
+    print(f"D. one open-loop group of {n} runs in one process: {time.perf_counter() - t:.1f} s (under cProfile), "
+          f"{sum(r.ok for r in res)} ok")
+    pstats.Stats(pr).sort_stats("cumulative").print_stats(30)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="runner N up to 100 only")
     ap.add_argument("--open-runs", type=int, default=1000, help="open-loop pipeline runs (default 1000)")
     ap.add_argument("--closed-runs", type=int, default=20, help="closed-loop pipeline runs (default 20; 0: skip)")
     ap.add_argument("--pipeline-only", action="store_true", help="skip the runner (A) and scoring (B) parts")
+    ap.add_argument("--profile-group", type=int, default=0, metavar="N",
+                    help="only profile one open-loop group of N runs (cProfile, cumulative) and exit")
     args = ap.parse_args()
+    if args.profile_group:
+        profile_group(args.profile_group)
+        return
     if not args.pipeline_only:
         bench_runner([10, 100] if args.quick else [10, 100, 1000])
         bench_scoring()
