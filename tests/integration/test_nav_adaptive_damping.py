@@ -42,8 +42,9 @@ orders tanh > constant > sinh. tanh is the worst in both, sinh beats constant on
 tanh(b e) / (b e) = 0.92 at 1 m, 0.76 at 2 m, 0.48 at 4 m), and its C2 branch cannot push more than C2 / b
 = 6.1e-4 m/s^2 (62 micro-g, barely above the nav-2.0 accelerometer turn-on bias, 50 micro-g 1 sigma), so
 the unstable channel wanders until the slow C3 integral catches up (5 m rms, 57 m max);
-sinh(x) >= x makes the sinh loop stiffer (1.04 at 1 m, 1.18 at 2 m, 1.81 at 4 m), which halves the large
-excursions. The EKF then estimates the residual from the same baro (and GPS outside the gaps); the constant
+sinh(x) >= x makes the sinh loop stiffer (1.04 at 1 m, 1.18 at 2 m, 1.81 at 4 m), which cuts the large
+excursions (max 12.2 -> 8.9 m). The EKF then estimates the residual from the same baro (and GPS outside the
+gaps); the constant
 loop is the one the filter's linear model describes exactly, while the adaptive ones enter by statistical
 linearization (tanh is known over-confident: tests/integration/test_nav_loop_consistency.py strict xfail), so
 after the filter sinh's advantage is gone and tanh's loss remains. The paper's gains double the loop in the
