@@ -35,22 +35,20 @@ the adaptive loops' filters are per run, as NavSystem requires for their statist
     d(constant - sinh)                                         +0.82 +- 0.10       +0.92 +- 0.16 m^2
     (max |error|: constant 12.2 m, tanh 56.5 m, sinh 8.9 m over 100 runs)
 
-Finding: the navigation output orders tanh > sinh > constant (paper: constant > tanh > sinh); the loop alone
-orders tanh > constant > sinh. tanh is the worst in both, sinh beats constant only before the EKF. Why (seed
-003 eq. 3, 7, 16): with C_KF = C / b the adaptive correction C_KF f(b e) has the constant loop's slope at e = 0;
-|tanh x| <= |x| makes the tanh loop *weaker* than the constant one at every loop error (effective gain
-tanh(b e) / (b e) = 0.92 at 1 m, 0.76 at 2 m, 0.48 at 4 m), and its C2 branch cannot push more than C2 / b
-= 6.1e-4 m/s^2 (62 micro-g, barely above the nav-2.0 accelerometer turn-on bias, 50 micro-g 1 sigma), so
-the unstable channel wanders until the slow C3 integral catches up (5 m rms, 57 m max);
-sinh(x) >= x makes the sinh loop stiffer (1.04 at 1 m, 1.18 at 2 m, 1.81 at 4 m), which cuts the large
-excursions (max 12.2 -> 8.9 m). The EKF then estimates the residual from the same baro (and GPS outside the
-gaps); the constant
-loop is the one the filter's linear model describes exactly, while the adaptive ones enter by statistical
-linearization (tanh is known over-confident: tests/integration/test_nav_loop_consistency.py strict xfail), so
-after the filter sinh's advantage is gone and tanh's loss remains. The paper's gains double the loop in the
-gaps (tanh C1KF = 0.06 = 2 C1 at an unprinted b), a different bandwidth rather than the nonlinearity;
-approachsim/papers/sokolovic.py finds tanh behind constant on the paper's own model too. Never tuned: tau and
-b are the profile's [nav] defaults.
+Finding: the navigation output orders tanh > sinh > constant (paper: constant > tanh > sinh); the loop alone orders
+tanh > constant > sinh. tanh is the worst in both, sinh beats constant only before the EKF. Why (seed 003 eq. 3, 7,
+16): with C_KF = C / b the adaptive correction C_KF f(b e) has the constant loop's slope at e = 0; |tanh x| <= |x|
+makes the tanh loop *weaker* than the constant one at every loop error (effective gain tanh(b e) / (b e) = 0.92 at
+1 m, 0.76 at 2 m, 0.48 at 4 m), and its C2 branch cannot push more than C2 / b = 6.1e-4 m/s^2 (62 micro-g, barely
+above the nav-2.0 accelerometer turn-on bias, 50 micro-g 1 sigma), so the unstable channel wanders until the slow
+C3 integral catches up (5 m rms, 57 m max); sinh(x) >= x makes the sinh loop stiffer (1.04 at 1 m, 1.18 at 2 m,
+1.81 at 4 m), which cuts the large excursions (max 12.2 -> 8.9 m). The EKF then estimates the residual from the
+same baro (and GPS outside the gaps); the constant loop is the one the filter's linear model describes exactly,
+while the adaptive ones enter by statistical linearization (tanh is known over-confident: the strict xfail in
+tests/integration/test_nav_loop_consistency.py), so after the filter sinh's advantage is gone and tanh's loss
+remains. The paper's gains double the loop in the gaps (tanh C1KF = 0.06 = 2 C1 at an unprinted b), a different
+bandwidth rather than the nonlinearity; approachsim/papers/sokolovic.py finds tanh behind constant on the paper's
+own model too. Never tuned: tau and b are the profile's [nav] defaults.
 """
 
 from __future__ import annotations
