@@ -23,7 +23,8 @@ class Truth:
     Kinematic quantities (position, velocity, specific force, rates) are those of the IMU location,
     which is what an IMU at that point senses; the runway-frame deviations are of the same point.
     Sampling (flight stage): f_body[k] and w_ib_body[k] are the specific force and rate that carry the
-    state from row k to row k+1, constant over that step (approachsim/flight/fdm.py, docs/truth.md).
+    state from row k to row k+1, constant over that step in body axes (f_body[k] is the body-axis mean over
+    the step), with gravity geo.gravity_ned (approachsim/flight/fdm.py, flight/run.py, docs/truth.md).
     """
 
     t_s: Array
@@ -47,7 +48,7 @@ class Truth:
     f_body: Array
     """(n, 3) specific force at the IMU, body axes (what an accelerometer senses), m/s^2."""
     p_static_pa: Array
-    """(n,) ambient static pressure at the aircraft, Pa."""
+    """(n,) ambient static pressure at the IMU point (JSBSim's at the CG, moved hydrostatically), Pa."""
     t_air_k: Array
     """(n,) ambient (static) air temperature, K."""
     h_agl_m: Array

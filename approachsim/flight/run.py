@@ -22,8 +22,10 @@ rows <= k only. On truth navigation (the default) nothing reads the record durin
 collected in a list and stacked at the end (same values; tested).
 
 Truth is of the IMU point (aircraft file [imu]): position, velocity and specific force are moved from the
-CG with the rigid-body lever-arm terms (f_imu = f_cg + w_ib' x l + w_ib x (w_ib x l), v_imu = v_cg +
-C_nb (w_eb x l)); the lever arm l is fixed at trim (the CG moves by well under a millimetre as fuel burns).
+CG with the rigid-body lever-arm terms (f_imu = f_cg + w_ib' x l + w_ib x (w_ib x l), in the exact form of
+JSBSim's Euler step, plus the gravitation gradient; v_imu = v_cg + C_nb (w_eb x l), resolved on the IMU's own
+NED axes), and the static pressure is moved hydrostatically to the IMU height; the lever arm l is fixed at
+trim (the CG moves by well under a millimetre as fuel burns). docs/truth.md says why each term is there.
 """
 
 from __future__ import annotations
@@ -49,6 +51,10 @@ Array = np.ndarray
 
 STOP_HEIGHT_M = 50.0 * units.FT
 """Default end of the run: the IMU 50 ft above the threshold (the CAT III decision height)."""
+
+R_AIR = 287.05287
+"""Specific gas constant of dry air, J/(kg K) (US Standard Atmosphere 1976, as JSBSim's Rdry), for the
+hydrostatic move of JSBSim's static pressure from the CG to the IMU point."""
 
 LINEARIZATION_HEIGHT_M = 1000.0 * units.FT
 """Height above the threshold of the design linearization (the top of the 1000-200 ft scored segment)."""
@@ -228,6 +234,11 @@ class Approach:
         FT, FPS, KT = units.FT, units.FPS, units.KT
         LBF_PER_SLUG = units.LBF / units.SLUG  # (lbf/slug) -> m/s^2
         PSF = units.PSF
+        gm = geo.GM_JSBSIM
+        hdt = 0.5 * dt
+        omega = geo.OMEGA_JSBSIM
+        RANKINE = 1.8  # Rankine per kelvin
+        g0_over_r = units.G0 / R_AIR
         sin, cos, sqrt = math.sin, math.cos, math.sqrt
 
         trim = Trim(theta_rad=fdm["attitude/theta-rad"], throttle=fdm["fcs/throttle-cmd-norm[0]"],
@@ -258,9 +269,17 @@ class Approach:
             ux, uy, uz = q * lz - r * ly, r * lx - p * lz, p * ly - q * lx
             wx, wy, wz = qi * lz - ri * ly, ri * lx - pi_ * lz, pi_ * ly - qi * lx
             s = LBF_PER_SLUG / m
-            fbx = fx * s + (qid * lz - rid * ly) + (qi * wz - ri * wy)
-            fby = fy * s + (rid * lx - pid * lz) + (ri * wx - pi_ * wz)
-            fbz = fz * s + (pid * ly - qid * lx) + (pi_ * wy - qi * wx)
+            # lever-arm acceleration over the step, exactly as JSBSim's rectangular-Euler step moves the IMU point:
+            # (R (w1 x l) - w x l) / dt, w1 = w + dt w' the next inertial rate, R the body rotation of the step
+            # (q(+) = normalize(q (1, dt w / 2))): w' x l + w x (w x l) + O(dt)
+            ex, ey, ez = hdt * pi_, hdt * qi, hdt * ri
+            ux1, uy1, uz1 = pi_ + dt * pid, qi + dt * qid, ri + dt * rid
+            ax, ay, az = uy1 * lz - uz1 * ly, uz1 * lx - ux1 * lz, ux1 * ly - uy1 * lx  # w1 x l
+            bx, by, bz = ey * az - ez * ay, ez * ax - ex * az, ex * ay - ey * ax  # e x (w1 x l)
+            k2 = 2.0 / (1.0 + ex * ex + ey * ey + ez * ez)
+            fbx = fx * s + (ax + k2 * (bx + ey * bz - ez * by) - wx) / dt
+            fby = fy * s + (ay + k2 * (by + ez * bx - ex * bz) - wy) / dt
+            fbz = fz * s + (az + k2 * (bz + ex * by - ey * bx) - wz) / dt
             vn = vn_f * FPS + n00 * ux + n01 * uy + n02 * uz
             ve = ve_f * FPS + n10 * ux + n11 * uy + n12 * uz
             vd = vd_f * FPS + n20 * ux + n21 * uy + n22 * uz
@@ -276,6 +295,45 @@ class Approach:
             x_e = (re_i + h_i) * clat * cos(lon_i)
             y_e = (re_i + h_i) * clat * sin(lon_i)
             z_e = (re_i * (1.0 - e2) + h_i) * slat
+            # gravitation at the IMU differs from the CG's (JSBSim's, in f_cg) by the gradient GM/r^3 (3 uu' - I) d,
+            # d = C_nb l: the accelerometer there feels f_imu = ... - (G_imu - G_cg), in body axes
+            # GM/r^3 (l - 3 d_D C_nb' e_D)  (J2 part of the gradient: < 1e-8 m/s^2)
+            kg = gm / (x_e * x_e + y_e * y_e + z_e * z_e) ** 1.5
+            fbx += kg * (lx - 3.0 * dd * n20)
+            fby += kg * (ly - 3.0 * dd * n21)
+            fbz += kg * (lz - 3.0 * dd * n22)
+            # JSBSim's Euler step applies the gravitation of the step's start, G(r_i[k]), while the point moves at
+            # its inertial velocity v_i = v + W x r (~300 m/s east): the recorded trajectory is that of gravitation
+            # at the step's midpoint plus the specific force f + G(r_i[k]) - G(r_i[k] + v_i dt/2)
+            # = f + GM/r^3 dt/2 (v_i - 3 u (u . v_i)) (u up; <= 3e-6 m/s^2, JSBSim's O(dt) error put where an
+            # accelerometer on this trajectory would see it)
+            kv = kg * hdt
+            gn_, ge_, gd_ = kv * vn, kv * (ve + omega * sqrt(x_e * x_e + y_e * y_e)), -2.0 * kv * vd
+            fbx += n00 * gn_ + n10 * ge_ + n20 * gd_
+            fby += n01 * gn_ + n11 * ge_ + n21 * gd_
+            fbz += n02 * gn_ + n12 * ge_ + n22 * gd_
+            # JSBSim holds that specific force fixed in inertial axes over the step while the body turns at w: the
+            # record holds its body-axis mean, (1/dt) int_0^dt Exp(-[w x] t) dt f = f - c1 phi x f + c2 phi x (phi x f)
+            # (phi = w dt; c1 = (1 - cos a)/a^2, c2 = (a - sin a)/a^3, a = |phi|, series), so that dt f_body is the
+            # exact velocity increment of the step in body axes
+            px, py, pz = 2.0 * ex, 2.0 * ey, 2.0 * ez
+            a2 = px * px + py * py + pz * pz
+            c1, c2 = 0.5 - a2 / 24.0, 1.0 / 6.0 - a2 / 120.0
+            qx, qy, qz = py * fbz - pz * fby, pz * fbx - px * fbz, px * fby - py * fbx  # phi x f
+            fbx, fby, fbz = (fbx - c1 * qx + c2 * (py * qz - pz * qy), fby - c1 * qy + c2 * (pz * qx - px * qz),
+                             fbz - c1 * qz + c2 * (px * qy - py * qx))
+            # the IMU's own NED axes are turned from the CG's by t = (dE/(R_E+h), -dN/(R_N+h), -dE tan L/(R_E+h))
+            # (l/R ~ 1.4e-6 rad): velocity and attitude are resolved on them, x_imu = (I - [t x]) x_cg
+            ta, tb, tc = dE / (r_e + h), -dn / (r_n + h), -dE * math.tan(lat) / (r_e + h)
+            vn, ve, vd = vn - tb * vd + tc * ve, ve - tc * vn + ta * vd, vd - ta * ve + tb * vn
+            m00, m10, m20 = n00 - tb * n20 + tc * n10, n10 - tc * n00 + ta * n20, n20 - ta * n10 + tb * n00
+            m21, m22 = n21 - ta * n11 + tb * n01, n22 - ta * n12 + tb * n02
+            phi_i = math.atan2(m21, m22)
+            th_i = -math.asin(m20)
+            psi_i = psi + math.remainder(math.atan2(m10, m00) - psi, 2.0 * math.pi)
+            # static pressure at the IMU point: hydrostatic over the CG-to-IMU height difference (JSBSim gives it
+            # at the CG), dp = -p g0 / (R_air T) dz  (ISA hydrostatics in geopotential height, dH = dz here)
+            p_imu = p_psf * PSF * math.exp(dd * g0_over_r / (t_r / RANKINE))
             dx, dy, dz = x_e - ox, y_e - oy, z_e - oz
             xr = c00 * dx + c01 * dy + c02 * dz
             yr = c10 * dx + c11 * dy + c12 * dz
@@ -292,15 +350,15 @@ class Approach:
                 set_tn(tn)
                 set_te(te)
                 set_td(td)
-            # body -> NED quaternion (scalar first) from the Euler angles
-            s1, c1 = sin(0.5 * phi), cos(0.5 * phi)
-            s2, c2 = sin(0.5 * th), cos(0.5 * th)
-            s3, c3 = sin(0.5 * psi), cos(0.5 * psi)
+            # body -> NED quaternion (scalar first) from the IMU point's Euler angles
+            s1, c1 = sin(0.5 * phi_i), cos(0.5 * phi_i)
+            s2, c2 = sin(0.5 * th_i), cos(0.5 * th_i)
+            s3, c3 = sin(0.5 * psi_i), cos(0.5 * psi_i)
             head = (
                 k * dt, lat_i, lon_i, h_i, x_e, y_e, z_e, vn, ve, vd,
                 c1 * c2 * c3 + s1 * s2 * s3, s1 * c2 * c3 - c1 * s2 * s3,
                 c1 * s2 * c3 + s1 * c2 * s3, c1 * c2 * s3 - s1 * s2 * c3,
-                phi, th, psi, pi_, qi, ri, fbx, fby, fbz, p_psf * PSF, t_r / 1.8, h_i - terr,
+                phi_i, th_i, psi_i, pi_, qi, ri, fbx, fby, fbz, p_imu, t_r / 1.8, h_i - terr,
                 xr, yr, zr, zr - (tch - xr * tan_gp), yr,
             )
             # termination checks on the true state
