@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from approachsim.cli import main
@@ -21,7 +19,9 @@ from approachsim.cli import main
     ],
 )
 def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, needle):
-    base = Path("profiles/default.toml").read_text(encoding="utf-8")
+    # a minimal valid profile (every other section takes its defaults) plus one bad [nav] table
+    base = ('[runway]\nthreshold_lat_deg = 37.6\nthreshold_lon_deg = -122.4\nelevation_ft = 13.0\n'
+            'heading_true_deg = 298.0\n')
     bad = {"BAD": '\n[nav]\nfilter = "nope"\n', "TUNE": '\n[nav]\nfilter = "ekf"\nfilter_tuning = { gate = 3 }\n',
            "RATE": "\n[nav]\naiding_rate_hz = 0.0\n"}
     argv = list(argv)
