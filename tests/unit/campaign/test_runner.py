@@ -53,7 +53,7 @@ def test_local_pool_matches_in_process_and_disk(tmp_path):
 
 
 def test_dask_local_cluster_is_bit_identical(tmp_path):
-    distributed = pytest.importorskip("distributed")
+    import distributed  # in the test extra
     prof = {"series_runs": 1}
     local = _run(prof, run_fn=synth_run, workers=2)
     with distributed.LocalCluster(
