@@ -188,6 +188,13 @@ class FDM:
             ) from None
         f.run()  # the first step after trim snaps the engines to the trimmed throttle; controls move after it
 
+    def cas_and_path(self) -> tuple[float, float]:
+        """JSBSim's own calibrated airspeed (m/s) and earth-frame flight-path angle (rad, + climbing) of the CG:
+        velocities/vc-kts and atan2(-v_down, |v_north, v_east|) of the ground-relative NED velocity."""
+        f = self._fdm
+        vn, ve, vd = f["velocities/v-north-fps"], f["velocities/v-east-fps"], f["velocities/v-down-fps"]
+        return float(f["velocities/vc-kts"]) * units.KT, math.atan2(-vd, math.hypot(vn, ve))
+
     def linearize(self, gamma_rad: float) -> Linearization:
         """JSBSim's FGLinearization at the current (trimmed, still-air) state."""
         lin = jsbsim.FGLinearization(self._fdm)

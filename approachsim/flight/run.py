@@ -40,8 +40,14 @@ from approachsim.config import ProfileError
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import Linearization
-from approachsim.flight.fdm import FDM, TrimError
-from approachsim.flight.trim import start_condition
+from approachsim.flight.fdm import FDM, InitialCondition, TrimError
+from approachsim.flight.trim import (
+    CAS_TOLERANCE_MPS,
+    PATH_TOLERANCE_RAD,
+    StartError,
+    solve_start,
+    start_condition,
+)
 from approachsim.flight.turbulence import DrydenTurbulence
 from approachsim.profile import Profile
 from approachsim.records import NavigationSource, Truth
@@ -141,6 +147,28 @@ class Approach:
         self.land = land
         """Fly on through a flare to touchdown (main gear on the ground) instead of stopping at stop_height_m."""
         self._lin: Linearization | None = None
+        self._start: InitialCondition | None = None
+
+    def start(self) -> InitialCondition:
+        """The initial-condition command that JSBSim trims at the approach CAS on the glidepath in the profile's
+        wind (trim.solve_start; solved once per Approach: it depends only on the profile). ProfileError when the
+        aircraft cannot be trimmed there at all."""
+        if self._start is None:
+            ic = start_condition(self.profile, self.aircraft)
+            try:
+                self._start, _, _ = solve_start(lambda: FDM(self.aircraft.jsbsim_model, self.dt_s), ic)
+            except (TrimError, StartError) as e:
+                raise ProfileError(self._trim_message(e)) from None
+        return self._start
+
+    def _trim_message(self, e: Exception) -> str:
+        env = self.profile.environment
+        return (
+            f"aircraft.approach_speed_kt: {e} (wind {env.wind_speed_mps / units.KT:.0f} kt from "
+            f"{math.degrees(env.wind_from_rad):.0f} deg, ISA{env.isa_dev_k:+.0f} C, field "
+            f"{self.profile.runway.elevation_m / units.FT:.0f} ft); choose a speed the {self.aircraft.name} trims at "
+            f"with these flaps (the 737 with flaps 1: about 130-160 kt)"
+        )
 
     @property
     def linearization(self) -> Linearization:
@@ -159,10 +187,7 @@ class Approach:
         try:
             fdm.initialize_and_trim(ic)
         except TrimError as e:
-            raise ProfileError(
-                f"aircraft.approach_speed_kt: {e}; choose a speed the {self.aircraft.name} trims at with these "
-                f"flaps (the 737 with flaps 1: about 130-160 kt)"
-            ) from None
+            raise ProfileError(self._trim_message(e)) from None
 
     def fly(self, seed: int, run: int = 0, nav_source: NavigationSource | None = None,
             max_time_s: float | None = None) -> FlightResult:
@@ -173,9 +198,17 @@ class Approach:
         dt = self.dt_s
         src = TruthSource() if nav_source is None else nav_source
         on_truth = type(src) is TruthSource
-        ic = start_condition(prof, ac)
+        ic = self.start()
         fdm = FDM(ac.jsbsim_model, dt)
         self._trim(fdm, ic)
+        cas0, gamma0 = fdm.cas_and_path()  # JSBSim's own state after initialisation, checked against the targets
+        if (abs(cas0 - ac.approach_speed_mps) > CAS_TOLERANCE_MPS
+                or abs(gamma0 + rw.glidepath_rad) > PATH_TOLERANCE_RAD):
+            raise StartError(
+                f"start not trimmed: JSBSim flies {cas0 / units.KT:.1f} KCAS on a {-math.degrees(gamma0):.2f} deg "
+                f"path, the profile asks {ac.approach_speed_mps / units.KT:.1f} KCAS on "
+                f"{math.degrees(rw.glidepath_rad):.2f} deg"
+            )
         turb_seed = stream_int(seed, run, "turbulence")
         fdm.set_seed(turb_seed)
 
