@@ -15,6 +15,7 @@ from pathlib import Path
 from approachsim import units
 from approachsim.config import ProfileError, Section
 from approachsim.flight.design import AutopilotGains
+from approachsim.flight.envelope import TURBULENCE_ORDER, ApproachLimits
 from approachsim.profile import Profile
 
 IN = 0.0254
@@ -37,6 +38,8 @@ class Aircraft:
     """IMU location in JSBSim's structural frame (x aft, y right, z up), m."""
     gains: AutopilotGains
     source: Path
+    limits: ApproachLimits
+    """The approach limits of the aircraft file's [envelope] table (flight.envelope)."""
 
 
 def aircraft_dirs(profile: Profile | None) -> list[Path]:
@@ -73,6 +76,7 @@ def _gains(s: Section) -> AutopilotGains:
         k_v_p=pos("k_v_p"),
         k_v_i=pos("k_v_i"),
         tau_v_s=s.number("tau_v_s", lo=0.0, lo_open=True, unit="s"),
+        tau_wind_s=s.number("tau_wind_s", 20.0, lo=0.0, hi=600.0, lo_open=True, unit="s"),
         k_phi=pos("k_phi"),
         k_p=pos("k_p"),
         k_beta=pos("k_beta"),
@@ -90,6 +94,26 @@ def _gains(s: Section) -> AutopilotGains:
     )
     s.done()
     return g
+
+
+def _limits(s: Section) -> ApproachLimits:
+    kt, ft = units.KT, units.FT
+    lim = ApproachLimits(
+        max_headwind_mps=s.number("max_headwind_kt", lo=0.0, hi=60.0, unit="kt") * kt,
+        max_tailwind_mps=s.number("max_tailwind_kt", lo=0.0, hi=30.0, unit="kt") * kt,
+        max_crosswind_mps=s.number("max_crosswind_kt", lo=0.0, hi=60.0, unit="kt") * kt,
+        min_glidepath_rad=math.radians(s.number("min_glidepath_deg", lo=1.0, hi=10.0, unit="deg")),
+        max_glidepath_rad=math.radians(s.number("max_glidepath_deg", lo=1.0, hi=10.0, unit="deg")),
+        min_field_elevation_m=s.number("min_field_elevation_ft", lo=-2000.0, hi=15000.0, unit="ft") * ft,
+        max_field_elevation_m=s.number("max_field_elevation_ft", lo=-2000.0, hi=15000.0, unit="ft") * ft,
+        max_turbulence=s.string("max_turbulence", choices=TURBULENCE_ORDER),
+    )
+    s.done()
+    if lim.min_glidepath_rad > lim.max_glidepath_rad:
+        raise ProfileError(f"{s.path}.min_glidepath_deg: must not exceed max_glidepath_deg")
+    if lim.min_field_elevation_m > lim.max_field_elevation_m:
+        raise ProfileError(f"{s.path}.min_field_elevation_ft: must not exceed max_field_elevation_ft")
+    return lim
 
 
 def parse_aircraft(data: dict, source: Path) -> Aircraft:
@@ -110,6 +134,7 @@ def parse_aircraft(data: dict, source: Path) -> Aircraft:
     loc = tuple(imu.number(f"location_{c}_in", unit="in") * IN for c in "xyz")
     imu.done()
     gains = _gains(top.section("autopilot", default_empty=False))
+    limits = _limits(top.section("envelope", default_empty=False))
     top.done()
     return Aircraft(
         name=name,
@@ -121,6 +146,7 @@ def parse_aircraft(data: dict, source: Path) -> Aircraft:
         imu_location_struct_m=loc,  # type: ignore[arg-type]
         gains=gains,
         source=source,
+        limits=limits,
     )
 
 
@@ -146,4 +172,5 @@ def load_aircraft(profile: Profile) -> Aircraft:
         imu_location_struct_m=ac.imu_location_struct_m,
         gains=ac.gains,
         source=ac.source,
+        limits=ac.limits,
     )

@@ -7,7 +7,9 @@ linearization approachsim.flight.design checks loop at a time (gains from the ai
     d   = h - h_gp(x),  d' = -v_down + x' tan(gp)                  glidepath deviation (m, + above) and rate
     theta_c = theta_0 - (k_gs_p d + k_gs_d d' + k_gs_i int d)      limited to theta_0 +- pitch_limit
     de  = -k_theta (theta_c - theta) + k_q q                       elevator, added to the trimmed pitch trim
-    e_f <- e_f + dt/tau_v (V_c - V_cas - e_f)                      filtered speed error (turbulence)
+    w   <- w + dt/tau_w (V_tas - |v_ground| - w)                   wind along the path (complementary filter)
+    V   = V_cas (|v_ground| + w) / V_tas                           inertially smoothed CAS (= V_cas in still air)
+    e_f <- e_f + dt/tau_v (V_c - V - e_f)                          filtered speed error (turbulence)
     thr = thr_0 + k_v_p e_f + k_v_i int e_f                        autothrottle (integral frozen at saturation)
     y, y' = cross-track deviation (m, + right) and its rate
     phi_c = -(k_loc_p y + k_loc_d y' + k_loc_i int y)              limited to +- bank_limit
@@ -70,6 +72,7 @@ class Autopilot:
         self.int_d = 0.0
         self.int_y = 0.0
         self.e_f = 0.0
+        self._w = math.nan  # wind along the path, m/s (initialised at the first step)
         self.int_e = 0.0
         self.flaring = False
         self._theta_flare0 = 0.0
@@ -92,12 +95,20 @@ class Autopilot:
         self,
         x: float, y: float, z: float, vn: float, ve: float, vd: float,
         phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float | None = None,
+        tas: float | None = None,
     ) -> tuple[float, float, float, float]:
         """One control step: guidance position (runway frame, m) and NED velocity (m/s), attitude (rad),
         body rates (rad/s), sideslip (rad), calibrated airspeed (m/s) -> elevator, aileron, rudder, throttle.
-        h_gear: main-gear height above the terrain (m) on landing runs (the radio altitude; None: no flare)."""
+        h_gear: main-gear height above the terrain (m) on landing runs (the radio altitude; None: no flare).
+        tas: true airspeed (m/s) for the speed complement (None: the autothrottle holds the raw CAS)."""
         g = self.g
         dt = self.dt
+        if tas is not None and tas > 1.0:  # inertially smoothed speed (module docstring)
+            gs = math.sqrt(vn * vn + ve * ve + vd * vd)
+            if self._w != self._w:
+                self._w = tas - gs
+            self._w += dt / g.tau_wind_s * (tas - gs - self._w)
+            cas = cas * (gs + self._w) / tas
         # deviations (as deviations(), inlined: this runs every step)
         ch, sh = self._ch, self._sh
         conv = (x * sh + y * ch) * self._conv_per_east_m

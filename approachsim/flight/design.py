@@ -79,6 +79,10 @@ class AutopilotGains:
     """Bank command limit, rad."""
     pitch_limit_rad: float
     """Limit of the pitch command's departure from the trim pitch, rad."""
+    tau_wind_s: float = 20.0
+    """Autothrottle speed complement: time constant of the low-pass on TAS - ground speed (the wind along the
+    path); the speed fed back is ground speed + that wind, so gusts shorter than this do not move the throttle
+    (inertially smoothed speed, as transport autothrottles use). In still air it equals the airspeed."""
     flare_height_m: float = 50.0 * units.FT
     """Main-gear height above the terrain where the flare starts (landing runs only), m."""
     flare_tau_s: float = 5.0

@@ -40,6 +40,7 @@ from approachsim.config import ProfileError
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import Linearization
+from approachsim.flight.envelope import StabilityMonitor, check_envelope
 from approachsim.flight.fdm import FDM, InitialCondition, TrimError
 from approachsim.flight.trim import (
     CAS_TOLERANCE_MPS,
@@ -61,6 +62,9 @@ STOP_HEIGHT_M = 50.0 * units.FT
 R_AIR = 287.05287
 """Specific gas constant of dry air, J/(kg K) (US Standard Atmosphere 1976, as JSBSim's Rdry), for the
 hydrostatic move of JSBSim's static pressure from the CG to the IMU point."""
+
+SUCCESS = ("reached stop height", "touchdown")
+"""Terminations of a successful approach; every other one is a failed approach."""
 
 LINEARIZATION_HEIGHT_M = 1000.0 * units.FT
 """Height above the threshold of the design linearization (the top of the 1000-200 ft scored segment)."""
@@ -117,8 +121,9 @@ class FlightResult:
     guidance_v_ned: Array
     """(n, 3) the NED velocity guidance flew on, m/s."""
     termination: str
-    """Why the run ended: "reached stop height", "touchdown" (landing runs), "ground contact" (anything else
-    touching: a failure), "diverged", "timeout"."""
+    """Why the run ended: "reached stop height" or "touchdown" (landing runs) when it succeeded; otherwise the
+    failure: "unstabilized at <h> ft: <what>" (flight.envelope's stabilized-approach criterion), "touchdown short
+    of the threshold ...", "ground contact" (anything else touching), "diverged", "timeout"."""
     lowest_height_ft: float
     """Lowest true IMU height above the threshold reached, ft."""
     seed: int
@@ -131,6 +136,16 @@ class FlightResult:
     touchdown_sink_mps: float = math.nan
     """Landing runs: sink rate at touchdown (IMU, positive down), m/s (nan: none)."""
 
+    @property
+    def ok(self) -> bool:
+        """True when the approach ended where it should: at the stop height, or (landing runs) on the runway."""
+        return self.termination in SUCCESS
+
+    @property
+    def failure(self) -> str | None:
+        """None for a successful approach, else why it failed (the termination reason)."""
+        return None if self.ok else self.termination
+
     def reached(self, height_ft: float) -> bool:
         """True when the aircraft descended to height_ft above the threshold."""
         return self.lowest_height_ft <= height_ft
@@ -142,6 +157,7 @@ class Approach:
     def __init__(self, profile: Profile, *, stop_height_m: float = STOP_HEIGHT_M, land: bool = False) -> None:
         self.profile = profile
         self.aircraft: Aircraft = load_aircraft(profile)
+        check_envelope(profile, self.aircraft.limits, self.aircraft.name, self.aircraft.approach_speed_mps)
         self.dt_s = 1.0 / profile.rates.imu_hz
         self.stop_height_m = -math.inf if land else stop_height_m
         self.land = land
@@ -278,6 +294,11 @@ class Approach:
                     cas_mps=ac.approach_speed_mps)
         ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m, rw.threshold_lat_rad), dt)
         ap_step = ap.step
+        monitor = StabilityMonitor(rw.glidepath_rad, rw.tch_m, ac.approach_speed_mps, dt)
+        mon_step = monitor.step
+        monitor_floor = ac.gains.flare_height_m if self.land else -math.inf  # the flare leaves the glidepath
+        w_n = -env.wind_speed_mps * math.cos(env.wind_from_rad)  # the steady wind (blowing towards from + pi), m/s
+        w_e = -env.wind_speed_mps * math.sin(env.wind_from_rad)
         stop_h = self.stop_height_m
         land = self.land
         touchdown = (math.nan, math.nan)
@@ -401,12 +422,16 @@ class Approach:
             if zr <= stop_h:
                 term = "reached stop height"
             elif land and (w1 > 0.0 or w2 > 0.0) and w0 == 0.0:
-                term = "touchdown"
+                term = "touchdown" if xr >= 0.0 else f"touchdown short of the threshold ({-xr / FT:.0f} ft)"
                 touchdown = (xr, vd)
             elif w0 > 0.0 or w1 > 0.0 or w2 > 0.0 or h_i - terr <= 0.0:
                 term = "ground contact"
             elif abs(phi) > 1.0 or abs(zr - (tch - xr * tan_gp)) > 300.0 or abs(yr) > 1500.0:
                 term = "diverged"
+            elif zr > monitor_floor:  # speed through the mean air mass (gusts removed), as CAS
+                an, ae = vn_f * FPS - w_n, ve_f * FPS - w_e
+                v_air = sqrt(an * an + ae * ae + (vd_f * FPS) ** 2)
+                term = mon_step(xr, yr, zr, v_air * (vc_kt * KT) / (vt_fps * FPS), vd, sqrt(vn * vn + ve * ve))
             if on_truth:
                 # TruthSource.step would return this row's r_rwy and v_ned: fly on them directly, and keep the
                 # rows in a list (no one reads the arrays during the run)
@@ -415,7 +440,8 @@ class Approach:
                     termination = term
                     break
                 h_gear = min(g1_ft, g2_ft) * FT if land else None
-                de, da, dr, thr = ap_step(xr, yr, zr, vn, ve, vd, phi, th, p, q, beta, vc_kt * KT, h_gear)
+                de, da, dr, thr = ap_step(xr, yr, zr, vn, ve, vd, phi, th, p, q, beta, vc_kt * KT, h_gear,
+                                          vt_fps * FPS)
                 rows_append(head + (de + pitch_trim, da, dr, thr, vc_kt * KT))
             else:
                 # the navigation source sees row k (controls: those of the previous step until replaced below)
@@ -428,7 +454,8 @@ class Approach:
                     termination = term
                     break
                 h_gear = min(g1_ft, g2_ft) * FT if land else None
-                de, da, dr, thr = ap_step(gx, gy, gz, gvn, gve, gvd, phi, th, p, q, beta, vc_kt * KT, h_gear)
+                de, da, dr, thr = ap_step(gx, gy, gz, gvn, gve, gvd, phi, th, p, q, beta, vc_kt * KT, h_gear,
+                                          vt_fps * FPS)
                 buf[k, _CTRL:_CTRL + 4] = (de + pitch_trim, da, dr, thr)
             # the controls for the next step
             set_de(de)
