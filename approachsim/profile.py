@@ -23,6 +23,7 @@ from approachsim.config import ProfileError, Section
 from approachsim.evaluate.config import EvaluationConfig, parse_evaluation
 from approachsim.geo import RunwayFrame
 from approachsim.nav.config import NavConfig, parse_nav
+from approachsim.sensors import atmosphere
 from approachsim.sensors.config import SensorsConfig, parse_faults, parse_sensors
 
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
@@ -73,9 +74,18 @@ class Environment:
     """One of TURBULENCE_LEVELS."""
     isa_dev_k: float
     qnh_pa: float
-    """The QNH set on the baro altimeter, Pa."""
-    true_qnh_pa: float
-    """The actual sea-level pressure of the day, Pa (differs from qnh_pa for a QNH-error study)."""
+    """The day's QNH at the field, Pa: the setting with which an altimeter reads the field elevation at the
+    threshold (ISA inverse), whatever the temperature."""
+    setting_pa: float = 101325.0
+    """What is set on the baro altimeter: QNH + the profile's qnh_setting_error_hPa, Pa."""
+    sea_level_pa: float = 101325.0
+    """The day's true sea-level pressure of the ISA+dT atmosphere that has the QNH's pressure at the field
+    (sensors.atmosphere.sea_level_pressure_pa): what JSBSim's atmosphere is set to, Pa."""
+
+    @property
+    def true_qnh_pa(self) -> float:
+        """Former name of sea_level_pa (the day's true sea-level pressure), Pa."""
+        return self.sea_level_pa
 
 
 @dataclass(frozen=True)
@@ -170,21 +180,28 @@ def _aircraft(s: Section) -> AircraftChoice:
     return AircraftChoice(name=name, approach_speed_mps=speed, flaps_norm=flaps, gear_down=gear)
 
 
-def _environment(s: Section) -> Environment:
+def _environment(s: Section, runway: Runway) -> Environment:
     ws = s.number("wind_speed_kt", 0.0, lo=0.0, hi=60.0, unit="kt")
     wd = s.number("wind_from_deg", 0.0, lo=0.0, hi=360.0, unit="deg")
     turb = s.string("turbulence", "none", choices=TURBULENCE_LEVELS)
     dt = s.number("isa_dev_C", 0.0, lo=-60.0, hi=40.0, unit="C")
     qnh = s.number("qnh_hPa", 1013.25, lo=900.0, hi=1100.0, unit="hPa")
-    true_qnh = s.number("true_qnh_hPa", qnh, lo=900.0, hi=1100.0, unit="hPa")
+    if s.has("true_qnh_hPa"):
+        raise ProfileError(
+            f"{s.path}.true_qnh_hPa: no longer used: the sea-level pressure follows from qnh_hPa, the field "
+            "elevation and isa_dev_C; for a mis-set altimeter give qnh_setting_error_hPa"
+        )
+    err = s.number("qnh_setting_error_hPa", 0.0, lo=-50.0, hi=50.0, unit="hPa")
     s.done()
+    h_field = float(atmosphere.geopotential_m(runway.elevation_m))
     return Environment(
         wind_speed_mps=ws * units.KT,
         wind_from_rad=math.radians(wd % 360.0),
         turbulence=turb,
         isa_dev_k=dt,
         qnh_pa=qnh * units.HPA,
-        true_qnh_pa=true_qnh * units.HPA,
+        setting_pa=(qnh + err) * units.HPA,
+        sea_level_pa=atmosphere.sea_level_pressure_pa(qnh * units.HPA, h_field, dt),
     )
 
 
@@ -228,7 +245,7 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
     description = top.string("description", "")
     runway = _runway(top.section("runway", default_empty=False))
     aircraft = _aircraft(top.section("aircraft"))
-    env = _environment(top.section("environment"))
+    env = _environment(top.section("environment"), runway)
     terrain = _terrain(top.section("terrain"), runway)
     rates = _rates(top.section("rates"))
     run = _run(top.section("run"))

@@ -309,5 +309,5 @@ def profile_descent(profile, *, rate_hz: float | None = None, ground_speed_mps: 
         terrain_h_m=np.asarray(profile.terrain.height_m),
         terrain_along_m=np.asarray(profile.terrain.along_m),
         isa_dev_k=profile.environment.isa_dev_k,
-        sea_level_pa=profile.environment.true_qnh_pa,
+        sea_level_pa=profile.environment.sea_level_pa,
     )

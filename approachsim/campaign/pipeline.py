@@ -130,7 +130,10 @@ def _clock_truth(records: dict, k: int, t_s: Any) -> Any:
 
 
 def _reached_all(profile: Any, flight: Any) -> str | None:
-    """None when the flight descended through every decision height, else why not."""
+    """None when the flight was a successful approach through every decision height, else why not (a failed
+    approach, flight.envelope's criteria, counts as a failed run with its reason)."""
+    if not flight.ok:
+        return f"failed approach: {flight.termination} (lowest {flight.lowest_height_ft:.0f} ft)"
     low = min(profile.evaluation.dh_ft.values())
     if flight.lowest_height_ft < low:
         return None

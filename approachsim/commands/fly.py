@@ -9,8 +9,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
 from approachsim.commands._single_run import add_single_run_arguments, load_single_run
+
+FAILED_APPROACH = 3
+"""Exit status of a flight that ended as a failed approach (unstabilized, ground contact, diverged, timeout):
+the outputs are written, the run did not complete (as `evaluate`'s 3: no run completed)."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -36,6 +41,7 @@ def run(args: argparse.Namespace) -> int:
         "seed": seed,
         "run": args.run,
         "termination": result.termination,
+        "ok": result.ok,
         "duration_s": float(result.truth.t_s[-1]),
         "lowest_height_ft": result.lowest_height_ft,
         "touchdown_past_threshold_ft": result.touchdown_x_m / 0.3048 if args.land else None,
@@ -60,4 +66,7 @@ def run(args: argparse.Namespace) -> int:
               f"sink {summary['touchdown_sink_fps']:.1f} ft/s")
     extra = "" if args.no_figures else ", figures"
     print(f"  wrote {args.out / 'truth.npz'} (+ truth.json schema, flight.json{extra})")
+    if not result.ok:
+        sys.stderr.write(f"approachsim fly: failed approach: {result.termination}\n")
+        return FAILED_APPROACH
     return 0

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
 import numpy as np
 
@@ -59,6 +60,10 @@ def _summary(nav, truth, profile, res) -> dict:
     return out
 
 
+FAILED_APPROACH = 3
+"""Exit status when the flight ended as a failed approach (outputs written; see commands/fly.py)."""
+
+
 def run(args: argparse.Namespace) -> int:
     """Fly, navigate, write files and figures; print a summary."""
     from approachsim.flight.run import Approach
@@ -95,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
         status_test_ratio=st.test_ratio, status_weight=st.weight, status_accepted=st.accepted,
         fte_m=err.fte_m, nse_m=err.nse_m, tse_m=err.tse_m,
     )
-    summary = {**meta, "filter": profile.nav.filter, "termination": res.termination,
+    summary = {**meta, "filter": profile.nav.filter, "termination": res.termination, "ok": res.ok,
                "lowest_height_ft": res.lowest_height_ft, **_summary(nav, truth, profile, res)}
     (args.out / "nav.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     if not args.no_figures:
@@ -111,6 +116,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"  at 200 ft: NSE lat {a['nse_lateral_m']:+.2f} m vert {a['nse_vertical_m']:+.2f} m; "
               f"FTE lat {a['fte_lateral_m']:+.2f} m vert {a['fte_vertical_m']:+.2f} m")
     print(f"  wrote {args.out / 'nav.npz'}, nav.json, truth.npz{'' if args.no_figures else ', figures'}")
+    if not res.ok:
+        sys.stderr.write(f"approachsim navigate: failed approach: {res.termination}\n")
+        return FAILED_APPROACH
     return 0
 
 

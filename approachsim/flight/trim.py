@@ -42,7 +42,7 @@ def start_condition(profile: Profile, aircraft: Aircraft, *, still_air: bool = F
         wind_speed_mps=0.0 if still_air else env.wind_speed_mps,
         wind_from_rad=env.wind_from_rad,
         isa_dev_k=env.isa_dev_k,
-        sl_pressure_pa=env.true_qnh_pa,
+        sl_pressure_pa=env.sea_level_pa,
     )
 
 

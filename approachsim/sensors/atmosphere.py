@@ -9,6 +9,10 @@ Two directions of one model (standards.md 4.1; ICAO Doc 7488 / US Standard Atmos
   h_ind = (T0 / L) (1 - (p / p_set) ^ (R L / g0)).
 
 H is geopotential height above mean sea level (this simulator has no geoid: MSL = ellipsoid, profile.py).
+QNH is the setting with which the altimeter reads the field elevation H_f at the field on any day, so the
+day's sea-level pressure is the one whose ISA+dT atmosphere has QNH's ISA pressure at H_f,
+p_sl = QNH ((1 - L H_f / T0) / (1 - L H_f / (T0 + dT))) ^ (g0 / (R L)) (sea_level_pressure_pa); the
+temperature error then grows with the height above the field (cold-is-low), zero at the field.
 On a standard day (dT = 0, p_set = p_sl) the indication is exactly H. In a cold atmosphere the indication is
 H T0 / (T0 + dT): the cold-is-low error that the PANS-OPS 4 %-per-10-C rule approximates. A setting error
 dp gives dh = R T / (g0 p) dp = 8.32 m (27.3 ft) per hPa at sea level.
@@ -45,6 +49,13 @@ def static_pressure_pa(h_geopot_m: ArrayLike, isa_dev_k: float = 0.0, sea_level_
     """Static pressure (Pa) at geopotential height H (m) in an ISA+dT troposphere with sea-level pressure p_sl."""
     h = np.asarray(h_geopot_m, dtype=float)
     return sea_level_pa * (1.0 - LAPSE_K_PER_M * h / (T0_K + isa_dev_k)) ** EXPONENT
+
+
+def sea_level_pressure_pa(qnh_pa: float, field_geopot_m: float, isa_dev_k: float = 0.0) -> float:
+    """The day's true sea-level pressure (Pa) of an ISA+dT troposphere in which an altimeter set to QNH (Pa)
+    reads the field's geopotential elevation (m) at the field (module docstring)."""
+    p_field = qnh_pa * (1.0 - LAPSE_K_PER_M * field_geopot_m / T0_K) ** EXPONENT
+    return float(p_field / (1.0 - LAPSE_K_PER_M * field_geopot_m / (T0_K + isa_dev_k)) ** EXPONENT)
 
 
 def air_temperature_k(h_geopot_m: ArrayLike, isa_dev_k: float = 0.0) -> np.ndarray:

@@ -36,7 +36,8 @@ Array = np.ndarray
 
 @dataclass(frozen=True)
 class Baro:
-    """Barometric altimeter. setting_pa: the QNH set on the instrument (profile environment.qnh_pa), Pa."""
+    """Barometric altimeter. setting_pa: the setting on the instrument, Pa (profile environment.setting_pa:
+    QNH + the setting error)."""
 
     setting_pa: float = atmosphere.P0_PA
     rate_hz: float = 10.0

@@ -113,7 +113,7 @@ class SensorSuite:
     @classmethod
     def from_profile(cls, profile: Any) -> SensorSuite:
         """The suite of a Profile (its sensors, faults, runway and QNH setting)."""
-        return cls.from_config(profile.sensors, profile.runway.frame, profile.environment.qnh_pa, profile.faults)
+        return cls.from_config(profile.sensors, profile.runway.frame, profile.environment.setting_pa, profile.faults)
 
     def without(self, *names: str) -> SensorSuite:
         """The same suite with sensors removed (the clock stays while a ranging sensor remains)."""

@@ -41,7 +41,7 @@ def test_default_profile_in_si():
     assert p.runway.tch_m == pytest.approx(50 * 0.3048)
     assert p.environment.wind_speed_mps == pytest.approx(5 * 1852 / 3600)
     assert p.environment.turbulence == "light"
-    assert p.environment.true_qnh_pa == pytest.approx(101325.0)
+    assert p.environment.sea_level_pa == pytest.approx(101325.0)
     assert p.rates.imu_hz >= 100.0  # the issue: truth at >= 100 Hz
 
 
