@@ -92,7 +92,10 @@ class Environment:
 class Terrain:
     """Terrain height (ellipsoid, m) against runway-frame x (m, negative before the threshold).
 
-    Linear interpolation between points, held constant beyond the ends. Flat: one point.
+    In the profile: [terrain] distance_nmi (before the threshold, decreasing) and height_ft, absolute heights
+    in ft above MSL (not above the field). Linear interpolation between points, held constant beyond the ends.
+    Flat (no [terrain]): the runway elevation. Checked by check_terrain: it meets the runway elevation at the
+    threshold and stays below the glidepath with terrain_clearance_m.
     """
 
     along_m: tuple[float, ...]
@@ -221,7 +224,45 @@ def _terrain(s: Section, runway: Runway) -> Terrain:
     if any(h < -1500.0 or h > 15000.0 for h in hgt):
         raise ProfileError(f"{s.path}.height_ft: every height must be in [-1500, 15000] ft")
     along = tuple(-d * units.NMI for d in dist)  # distance before the threshold is negative x
-    return Terrain(along_m=along, height_m=tuple(h * units.FT for h in hgt))
+    terrain = Terrain(along_m=along, height_m=tuple(h * units.FT for h in hgt))
+    check_terrain(terrain, runway, s.path)
+    return terrain
+
+
+TERRAIN_THRESHOLD_TOLERANCE_M = 1.0 * units.FT
+"""How far the terrain may be from the runway elevation at the threshold (the heights are given in ft)."""
+TERRAIN_CLEARANCE_MAX_M = 250.0 * units.FT
+
+
+def terrain_clearance_m(glidepath_height_m: np.ndarray | float) -> np.ndarray:
+    """Required clearance of the terrain below the glidepath (m) at a glidepath height above the threshold (m):
+    half that height, at most 250 ft. This project's rule, not an obstacle assessment (PANS-OPS): it keeps the
+    approach out of rising ground and the threshold on the runway (25 ft below a 50 ft threshold crossing)."""
+    return np.minimum(0.5 * np.asarray(glidepath_height_m, dtype=float), TERRAIN_CLEARANCE_MAX_M)
+
+
+def check_terrain(terrain: Terrain, runway: Runway, path: str = "terrain") -> None:
+    """ProfileError (one line) unless the terrain meets the runway elevation at the threshold and stays below
+    the glidepath by terrain_clearance_m from the start of the approach to the threshold."""
+    h0 = float(terrain.height_at(0.0))
+    if abs(h0 - runway.elevation_m) > TERRAIN_THRESHOLD_TOLERANCE_M:
+        raise ProfileError(
+            f"{path}.height_ft: {h0 / units.FT:.0f} ft at the threshold, but the runway is at "
+            f"{runway.elevation_m / units.FT:.0f} ft; terrain heights are absolute (ft above MSL) and must meet "
+            "the runway elevation at the threshold"
+        )
+    x = np.unique(np.concatenate([np.linspace(-runway.start_distance_m, 0.0, 2001),
+                                  [a for a in terrain.along_m if -runway.start_distance_m <= a <= 0.0]]))
+    gp = runway.elevation_m + runway.glidepath_height_m(x)
+    room = gp - terrain.height_at(x) - terrain_clearance_m(gp - runway.elevation_m)
+    k = int(np.argmin(room))
+    if room[k] < 0.0:
+        raise ProfileError(
+            f"{path}.height_ft: terrain {terrain.height_at(x[k]) / units.FT:.0f} ft at {-x[k] / units.NMI:.2f} nmi "
+            f"is within {terrain_clearance_m(gp[k] - runway.elevation_m) / units.FT:.0f} ft of the glidepath "
+            f"({gp[k] / units.FT:.0f} ft there); terrain must stay below the glidepath by half its height above "
+            "the threshold, at most 250 ft"
+        )
 
 
 def _rates(s: Section) -> Rates:
