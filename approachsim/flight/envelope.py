@@ -54,6 +54,9 @@ LOC_ANTENNA_PAST_THRESHOLD_M = 3300.0
 a profile); only the localizer dot's size depends on it."""
 STABILIZATION_HEIGHT_M = 1000.0 * units.FT
 """FSF ALAR BN 7.1: stabilized by 1000 ft above the airport in IMC, and stay so below it."""
+WATCH_HEIGHT_M = 1400.0 * units.FT
+"""The monitor is fed from this height down (its 10 s means are full by 1000 ft at any sink rate below
+2400 ft/min); above it the run loop skips it."""
 GS_DOT_FLOOR_HEIGHT_M = 200.0 * units.FT
 SPEED_HIGH_MPS = 10.0 * units.KT
 SPEED_LOW_MPS = 5.0 * units.KT

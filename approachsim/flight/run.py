@@ -40,7 +40,7 @@ from approachsim.config import ProfileError
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import Linearization
-from approachsim.flight.envelope import StabilityMonitor, check_envelope
+from approachsim.flight.envelope import WATCH_HEIGHT_M, StabilityMonitor, check_envelope
 from approachsim.flight.fdm import FDM, InitialCondition, TrimError
 from approachsim.flight.trim import (
     CAS_TOLERANCE_MPS,
@@ -428,7 +428,7 @@ class Approach:
                 term = "ground contact"
             elif abs(phi) > 1.0 or abs(zr - (tch - xr * tan_gp)) > 300.0 or abs(yr) > 1500.0:
                 term = "diverged"
-            elif zr > monitor_floor:  # speed through the mean air mass (gusts removed), as CAS
+            elif monitor_floor < zr < WATCH_HEIGHT_M:  # speed through the mean air mass (gusts removed), as CAS
                 an, ae = vn_f * FPS - w_n, ve_f * FPS - w_e
                 v_air = sqrt(an * an + ae * ae + (vd_f * FPS) ** 2)
                 term = mon_step(xr, yr, zr, v_air * (vc_kt * KT) / (vt_fps * FPS), vd, sqrt(vn * vn + ve * ve))
