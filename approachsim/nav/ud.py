@@ -5,22 +5,20 @@ filter steps, so it stays symmetric and non-negative where the covariance form l
 (Bierman 1977). Only the covariance storage differs from the Joseph-form `KalmanFilter` of nav/base.py: with
 the Gauss influence function both give the same x and P (to round-off) on well-conditioned problems.
 
-Robust variant (Chernodarov, sec. 4, eq. 3 and the Joseph-Bierman update):
-    v_j = z_j - H_j m_{j-1};  beta_j = v_j / alpha_j;  psi_j = psi(beta_j);  psi'_j = psi'(beta_j)
-    f_j = H_j U_{j-1};  V_j = D_{j-1} f_j'
-    alpha~_j^2 = f_j V_j psi'_j + alpha_j^2;  K_j = U_{j-1} V_j / alpha~_j^2
-    m_j = m_{j-1} + K_j alpha_j psi_j
-    MWGS{ W = [K_j f_j psi'_j - U_{j-1} : K_j],  D = diag(D_{j-1}, alpha_j^2 psi'_j) } -> U_j, D_j
-with the scaling parameter alpha_j = sqrt(r_j) (the measurement noise std: then psi = beta gives exactly the
-Kalman update, as the paper's Gauss case must). The MWGS update equals the optimal update with the noise
-variance inflated to r / psi' (psi' = 0: P unchanged), so it is computed here by Bierman's scalar update
-with r / psi' (`mwgs_robust_update` keeps the paper's literal MWGS form for the tests to compare).
+Robust variant (Chernodarov, sec. 4, eq. 3 and the Joseph-Bierman update), with the residual scaled by its
+predicted standard deviation alpha_j = sqrt(S_j), S_j = h' P h + r:
+    v_j = z_j - H_j m_{j-1};  b_j = v_j / sqrt(S_j);  psi_j = psi(b_j);  psi'_j = psi'(b_j)
+    m_j = m_{j-1} + K_j sqrt(S_j) psi_j,                K_j = P h / S_j (the Kalman gain)
+    P_j = P - psi'_j K_j S_j K_j'       (Bierman: r_eff = S_j / psi'_j - h'Ph = r / psi' + h'Ph (1/psi' - 1))
+so that psi = b (Gauss) is exactly the Kalman update, psi = b / 3 (Gauss-Laplace band) a third of it, and no
+influence function takes a longer step than the Kalman one: |sqrt(S) psi(b)| <= |v| for every |psi(b)| <= |b|.
+The paper's own scaling alpha_j = sqrt(r_j) (step P h alpha psi(v / alpha) / (f V psi' + alpha^2)) does not
+have that property: with h' P h >> r (tightly coupled GPS with channel states) its Laplace step P h sign(v) /
+sqrt(r) exceeds the Kalman step (scalar P = 100 m^2, r = 1 m^2, a 3.1 sigma innovation: Kalman 31 m, paper 100 m), so
+an influence function meant to bound an outlier's effect made it worse; `mwgs_robust_update` keeps the paper's
+literal MWGS covariance form (alpha = sqrt(r)) for the tests to compare.
 
-Which branch of the influence function applies is decided by the innovation normalized by its predicted
-standard deviation, b = v / sqrt(S), S = h' P h + r, so that the paper's 3-sigma rule (eq. 4-6,
-|beta| < 3 for beta ~ N(0, 1)) holds whatever the size of P relative to r.
-
-Influence functions (psi, psi'), evaluated at beta_j = v_j / alpha_j:
+Influence functions (psi, psi'), evaluated at b_j:
     gauss          psi = beta, psi' = 1                                  (everywhere)
     laplace        Gauss for |b| < outer; psi = sign(beta), psi' = 0     (off-design, |b| >= outer)
     gauss-laplace  Gauss for |b| < inner; psi = beta / 3, psi' = 1/3     (inner <= |b| < outer, the
@@ -155,7 +153,7 @@ class InfluenceFunction:
             raise ValueError(f"inner: must be below outer ({self.outer}); got {self.inner!r}")
 
     def __call__(self, beta: float, b: float) -> tuple[float, float]:
-        """(psi, psi') at the scaled residual beta = v / alpha, branch chosen by b = v / sqrt(S)."""
+        """(psi, psi') at the scaled residual beta, branch chosen by b = v / sqrt(S) (the filter passes beta = b)."""
         psi, dpsi = self.arrays(np.asarray(beta, float), np.asarray(b, float))
         return float(psi), float(dpsi)
 
@@ -230,16 +228,16 @@ def robust_update_batch(
     """
     f = np.einsum("rji,j->ri", U, h)
     hph = np.einsum("ri,ri->r", f, d * f)
-    S = hph + r
-    nu = z - x @ h
-    alpha = np.sqrt(r)
-    psi, dpsi = influence.arrays(nu / alpha, nu / np.sqrt(S))
+    S = hph + r  # S = h' P h + r
+    nu = z - x @ h  # v = z - h' x
+    sqrt_s = np.sqrt(S)
+    b = nu / sqrt_s
+    psi, dpsi = influence.arrays(b, b)
     Ph = np.einsum("rij,rj->ri", U, d * f)
-    denom = hph * dpsi + r
-    x_new = x + Ph * (alpha * psi / denom)[:, None]
+    x_new = x + Ph * (psi / sqrt_s)[:, None]  # m+ = m + K sqrt(S) psi(b), K = P h / S
     with np.errstate(divide="ignore", invalid="ignore"):
-        weight = np.where(nu == 0.0, 1.0, alpha * psi * S / (denom * nu))
-        r_eff = np.where(dpsi > 0.0, r / dpsi, np.inf)
+        weight = np.where(nu == 0.0, 1.0, psi / b)
+        r_eff = np.where(dpsi > 0.0, r / dpsi + hph * (1.0 / dpsi - 1.0), np.inf)  # P+ = P - psi' K S K'
     U_new, d_new = bierman_update_batch(U, d, h, r_eff)
     return x_new, U_new, d_new, nu, S, weight
 
@@ -266,19 +264,20 @@ class UDFilter:
         return FilterState(x=F @ state.x, U=U, d=d, memory=state.memory)
 
     def update(self, state: FilterState, meas: ScalarMeasurement) -> tuple[FilterState, UpdateStatus]:
-        """One scalar robust update (Chernodarov sec. 4 with alpha = sqrt(r)); Bierman on r / psi'."""
+        """One scalar robust update (Chernodarov sec. 4, residual scaled by sqrt(S); module docstring)."""
         x, U, d, h, r = state.x, state.U, state.d, np.asarray(meas.h, float), float(meas.r)
         f = U.T @ h
         hph = float(f @ (d * f))  # h' P h
         S = hph + r  # S = h' P h + r
         nu = float(meas.z - h @ x)  # innovation v_j = z_j - H_j m_{j-1}
-        alpha = np.sqrt(r)
-        psi, dpsi = self.influence(nu / alpha, nu / np.sqrt(S))
-        step = (U @ (d * f)) * (alpha * psi) / (hph * dpsi + r)  # K_j alpha_j psi_j, K_j = U V / alpha~^2
-        weight = 1.0 if nu == 0.0 else float(alpha * psi * S / ((hph * dpsi + r) * nu))
+        b = nu / np.sqrt(S)  # normalized innovation
+        psi, dpsi = self.influence(b, b)
+        step = (U @ (d * f)) * (psi / np.sqrt(S))  # K sqrt(S) psi(b), K = P h / S
+        weight = 1.0 if nu == 0.0 else float(psi / b)
         status = UpdateStatus(meas.name, meas.t_s, nu, S, nu * nu / S, weight, True)
         if dpsi > 0.0:
-            U, d, _, _ = bierman_update(U, d, h, r / dpsi)  # = MWGS{[K f psi' - U : K], diag(D, r psi')}
+            # P+ = P - psi' K S K': r_eff = S / psi' - h'Ph, written so that psi' = 1 gives r exactly
+            U, d, _, _ = bierman_update(U, d, h, r / dpsi + hph * (1.0 / dpsi - 1.0))
         return FilterState(x=x + step, U=U, d=d, memory=state.memory), status
 
     def covariance(self, state: FilterState) -> Array:
