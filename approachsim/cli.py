@@ -21,6 +21,7 @@ COMMAND_MODULES = (
     "approachsim.commands.evaluate",
     "approachsim.commands.study",
     "approachsim.commands.regress",
+    "approachsim.commands.profiles",
 )
 """Modules that each add sub-commands; a new command adds its line here."""
 
@@ -33,9 +34,34 @@ class _OneLineParser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
+EPILOG = """start here:
+  approachsim profiles                              the shipped profiles
+  approachsim profiles init default ~/approaches    copy one to edit (keys: docs/profiles.md)
+  approachsim evaluate ~/approaches/default.toml    Monte Carlo verdict against CAT I / II / III
+`approachsim COMMAND --help` describes each command with an example."""
+
+
+def version() -> str:
+    """The installed package version (the source tree's pyproject version when run uninstalled)."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as dist_version
+
+    try:
+        return dist_version("approachsim")
+    except PackageNotFoundError:
+        return "unknown (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The full parser with every stage's sub-commands."""
-    parser = _OneLineParser(prog="approachsim", description=__doc__.splitlines()[0])
+    parser = _OneLineParser(
+        prog="approachsim",
+        description="Precision-approach navigation simulator: fly a JSBSim approach, model the sensors, run the "
+        "INS + filter, and score Monte Carlo campaigns against FAA CAT I / II / III.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"approachsim {version()}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_OneLineParser)
     for mod in COMMAND_MODULES:
         importlib.import_module(mod).register(sub)
