@@ -26,6 +26,17 @@ COMMAND_MODULES = (
 """Modules that each add sub-commands; a new command adds its line here."""
 
 
+def command_parser(
+    sub: argparse._SubParsersAction, name: str, *, help: str, description: str, examples: Sequence[str]
+) -> argparse.ArgumentParser:
+    """A sub-command parser with a one-line `help` (top-level list), a `description` and worked `examples`."""
+    return sub.add_parser(
+        name, help=help, description=description,
+        epilog="example" + ("s" if len(examples) > 1 else "") + ":\n" + "\n".join(f"  {e}" for e in examples),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+
+
 class _OneLineParser(argparse.ArgumentParser):
     """argparse that reports a bad option as one line and exit status 2."""
 
@@ -56,7 +67,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The full parser with every stage's sub-commands."""
     parser = _OneLineParser(
         prog="approachsim",
-        description="Precision-approach navigation simulator: fly a JSBSim approach, model the sensors, run the "
+        description="Precision-approach navigation simulator: fly a JSBSim approach, model the sensors, run the\n"
         "INS + filter, and score Monte Carlo campaigns against FAA CAT I / II / III.",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,

@@ -15,7 +15,17 @@ from approachsim.commands._single_run import add_single_run_arguments, load_sing
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `fly` sub-command."""
-    p = sub.add_parser("fly", help="fly one closed-loop approach (truth navigation) and write the truth record")
+    from approachsim.cli import command_parser
+
+    p = command_parser(
+        sub, "fly", help="fly one closed-loop approach (truth navigation) and write the truth record",
+        description="JSBSim flies the profile's approach on the autopilot, guided by the true position, from the\n"
+        "start distance to 50 ft (or to touchdown with --land). Writes DIR/truth.npz + truth.json (docs/truth.md),\n"
+        "DIR/flight.json (termination, tracking statistics) and the figures vertical.png, lateral.png,\n"
+        "airspeed.png, attitude.png.",
+        examples=["approachsim fly profiles/default.toml --out out/fly",
+                  "approachsim fly ~/approaches/default.toml --out out/land --land --seed 3"],
+    )
     add_single_run_arguments(p)
     p.add_argument("--land", action="store_true", help="fly on through the flare to touchdown (default: stop 50 ft)")
     p.set_defaults(func=run)
