@@ -23,6 +23,7 @@ from __future__ import annotations
 import copy
 import itertools
 import re
+import sys
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -218,7 +219,10 @@ def run_study(
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     summaries = []
-    for v in study.variants:
+    for i, v in enumerate(study.variants, start=1):
+        if progress:
+            sys.stderr.write(f"study {study.name}: variant {i}/{len(study.variants)} {v.name} ({study.runs} runs)\n")
+            sys.stderr.flush()
         ev = evaluate_profile(
             v.profile, runs=study.runs, seed=study.seed, mode=study.mode, out_dir=out_dir / v.slug,
             workers=workers, scheduler=scheduler, resume=resume, progress=progress,
