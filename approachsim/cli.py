@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Sequence
 
@@ -88,6 +89,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ProfileError as e:
         sys.stderr.write(f"approachsim: error: {e}\n")
         return 2
+    except BrokenPipeError:  # output piped into `head` and the like: stop quietly (Python docs, signal note)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 1
 
 
 if __name__ == "__main__":
