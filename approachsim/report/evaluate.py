@@ -193,7 +193,10 @@ def fig_availability(results: list[RunResult]) -> Figure:
     ax.set_xlabel("true height above threshold, ft")
     ax.set_ylabel("availability (fraction of runs)")
     ax.set_title(f"Availability against height, {vpl.shape[0]} runs", fontsize=10)
-    ax.legend(fontsize=8, loc="center left", framealpha=0.9)
+    if ax.get_lines():
+        ax.legend(fontsize=8, loc="center left", framealpha=0.9)
+    else:
+        ax.text(0.5, 0.5, "no completed run", transform=ax.transAxes, ha="center", va="center")
     ax.grid(True, alpha=0.3)
     return fig
 

@@ -92,3 +92,11 @@ def test_every_report_figure_has_a_caption(tmp_path):
         title, caption = rep.FIGURE_CAPTIONS[key]
         assert title in page and len(caption.split()) > 25
     assert set(rep.FIGURE_CAPTIONS) >= {"errors_vs_height", "histograms_dh", "stanford", "availability", "sky_dop"}
+
+
+def test_report_of_a_campaign_where_every_run_failed_draws_without_warnings(tmp_path):
+    """Warnings are errors in the test suite: an all-failed campaign still gets a report naming the reason."""
+    results = [RunResult.failed(i, "ProfileError: aircraft.name: no aircraft file a380.toml") for i in range(3)]
+    summary, det = evaluate_results(results, EvaluationConfig(), profile="p", seed=1, closed_loop=True)
+    page = rep.write_report(tmp_path, results, summary, det).read_text()
+    assert "no aircraft file a380.toml" in page and page.count("<figcaption>") == 4
