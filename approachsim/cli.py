@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Sequence
 
@@ -21,8 +22,20 @@ COMMAND_MODULES = (
     "approachsim.commands.evaluate",
     "approachsim.commands.study",
     "approachsim.commands.regress",
+    "approachsim.commands.profiles",
 )
 """Modules that each add sub-commands; a new command adds its line here."""
+
+
+def command_parser(
+    sub: argparse._SubParsersAction, name: str, *, help: str, description: str, examples: Sequence[str]
+) -> argparse.ArgumentParser:
+    """A sub-command parser with a one-line `help` (top-level list), a `description` and worked `examples`."""
+    return sub.add_parser(
+        name, help=help, description=description,
+        epilog="example" + ("s" if len(examples) > 1 else "") + ":\n" + "\n".join(f"  {e}" for e in examples),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
 
 
 class _OneLineParser(argparse.ArgumentParser):
@@ -33,9 +46,34 @@ class _OneLineParser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
+EPILOG = """start here:
+  approachsim profiles                              the shipped profiles
+  approachsim profiles init default ~/approaches    copy one to edit (keys: docs/profiles.md)
+  approachsim evaluate ~/approaches/default.toml    Monte Carlo verdict against CAT I / II / III
+`approachsim COMMAND --help` describes each command with an example."""
+
+
+def version() -> str:
+    """The installed package version (the source tree's pyproject version when run uninstalled)."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as dist_version
+
+    try:
+        return dist_version("approachsim")
+    except PackageNotFoundError:
+        return "unknown (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The full parser with every stage's sub-commands."""
-    parser = _OneLineParser(prog="approachsim", description=__doc__.splitlines()[0])
+    parser = _OneLineParser(
+        prog="approachsim",
+        description="Precision-approach navigation simulator: fly a JSBSim approach, model the sensors, run the\n"
+        "INS + filter, and score Monte Carlo campaigns against FAA CAT I / II / III.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"approachsim {version()}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_OneLineParser)
     for mod in COMMAND_MODULES:
         importlib.import_module(mod).register(sub)
@@ -51,6 +89,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ProfileError as e:
         sys.stderr.write(f"approachsim: error: {e}\n")
         return 2
+    except BrokenPipeError:  # output piped into `head` and the like: stop quietly (Python docs, signal note)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 1
 
 
 if __name__ == "__main__":

@@ -279,6 +279,35 @@ def _run(s: Section) -> RunDefaults:
     return RunDefaults(runs=runs, seed=seed, mode=mode)
 
 
+def _run_duration_estimate_s(runway: Runway, aircraft: AircraftChoice, env: Environment, source: Path | None) -> float:
+    """Estimate (s) of a run's length, for checking fault times: the glidepath from the start distance to
+    50 ft above the threshold at the approach ground speed.
+
+    Ground speed = TAS - headwind; TAS = CAS sqrt(rho0 / rho) (incompressible, M < 0.3) at the approach's
+    mid height in the ISA atmosphere with the profile's temperature deviation. The approach speed is the
+    profile's, else the aircraft file's (approachsim.resources lookup).
+    """
+    cas = aircraft.approach_speed_mps
+    if cas is None:
+        from approachsim.resources import find_aircraft_file
+
+        path = find_aircraft_file(aircraft.name, source)
+        try:
+            cas = float(tomllib.loads(path.read_text(encoding="utf-8"))["approach"]["approach_speed_kt"]) * units.KT
+        except (tomllib.TOMLDecodeError, KeyError, TypeError, ValueError):
+            raise ProfileError(f"aircraft.name: {str(path)!r} has no valid approach.approach_speed_kt") from None
+    tan_gp = math.tan(runway.glidepath_rad)
+    h_mid = runway.elevation_m + 0.5 * runway.start_distance_m * tan_gp
+    t_isa = 288.15 - 0.0065 * h_mid  # ISA troposphere, K
+    p_ratio = (t_isa / 288.15) ** 5.25588  # p / p0
+    rho_ratio = p_ratio * 288.15 / (t_isa + env.isa_dev_k)  # rho / rho0 with the temperature deviation
+    tas = cas / math.sqrt(rho_ratio)
+    headwind = env.wind_speed_mps * math.cos(env.wind_from_rad - runway.heading_rad)
+    ground_speed = max(tas - headwind, 0.3 * tas)
+    path_m = runway.start_distance_m + (runway.tch_m - 50.0 * units.FT) / tan_gp
+    return path_m / ground_speed
+
+
 def parse_profile(data: dict, source: Path | None = None) -> Profile:
     """Validate a profile given as the dict TOML parsing gives; ProfileError names the first bad field."""
     top = Section(data, "")
@@ -292,7 +321,9 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
     run = _run(top.section("run"))
     evaluation = parse_evaluation(top.section("evaluation"))
     sensors = parse_sensors(top.section("sensors"))
-    faults = parse_faults(top.sections("faults"), sensors)
+    fault_items = top.sections("faults")
+    duration = _run_duration_estimate_s(runway, aircraft, env, source) if fault_items else None
+    faults = parse_faults(fault_items, sensors, duration_s=duration, imu_hz=rates.imu_hz)
     nav = parse_nav(top.section("nav"))
     top.done()
     return Profile(

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# The README's test command: install the package with its test extras, lint, check layering, run pytest,
-# then the profile regression baselines.
+# The README's test command: install the package with its test extras, lint, check layering, check that
+# docs/profiles.md is current, run pytest, then the profile regression baselines.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 python -m pip install --quiet -e ".[test]"
 ruff check .
 lint-imports
+# docs/profiles.md is generated from the profile / study / aircraft parsers: fail when it is not current.
+python tools/gen_profiles_doc.py --check
 set +e
 python -m pytest -q "$@"
 status=$?

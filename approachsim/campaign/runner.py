@@ -82,47 +82,95 @@ def run_task(run_fn: RunFn | None, group_fn: GroupFn | None, profile: Any, seed:
     return results
 
 
+PLAIN_INTERVAL_S = 10.0
+"""Seconds between the plain progress lines written when stderr is not a terminal (a log file, CI)."""
+
+
 @dataclass
 class Progress:
-    """A one-line progress bar on stderr: done / total runs, failures, elapsed and remaining time."""
+    """Campaign progress on stderr: done / total runs, failures, elapsed and remaining time.
+
+    On a terminal: a tqdm bar redrawn in place. Otherwise (redirected to a log, CI): one plain line at the start,
+    then at most one every PLAIN_INTERVAL_S seconds, and one at the end, never a carriage return. `label` names
+    what runs (a study's variant).
+    """
 
     total: int
     done: int = 0
     failed: int = 0
     stream: TextIO | None = None
     enabled: bool = True
+    label: str = ""
+    interval_s: float = PLAIN_INTERVAL_S
     _t0: float = 0.0
     _last: float = -1.0
     _start_done: int = 0
+    _bar: Any = None
+
+    def _stream(self) -> TextIO:
+        return self.stream or sys.stderr
+
+    def _is_tty(self) -> bool:
+        isatty = getattr(self._stream(), "isatty", None)
+        try:
+            return bool(isatty and isatty())
+        except ValueError:  # a closed stream
+            return False
 
     def start(self) -> None:
+        """Start the clock and show the initial state."""
         self._t0 = time.monotonic()
         self._start_done = self.done
-        self.draw(force=True)
-
-    def update(self, results: Sequence[RunResult]) -> None:
-        self.done += len(results)
-        self.failed += sum(not r.ok for r in results)
-        self.draw()
-
-    def draw(self, force: bool = False) -> None:
         if not self.enabled:
             return
-        now = time.monotonic()
-        if not force and now - self._last < 0.25 and self.done < self.total:
-            return
-        self._last = now
-        el = now - self._t0
+        if self._is_tty():
+            from tqdm import tqdm
+
+            self._bar = tqdm(total=self.total, initial=self.done, desc=self.label or "runs", unit="run",
+                             file=self._stream(), dynamic_ncols=True, leave=True, smoothing=0.1)
+            self._bar.set_postfix_str(f"{self.failed} failed", refresh=True)
+            if self.done >= self.total:
+                self._close()
+        else:
+            self.draw(force=True)
+
+    def update(self, results: Sequence[RunResult]) -> None:
+        """Count finished runs (failed ones too) and redraw."""
+        self.done += len(results)
+        self.failed += sum(not r.ok for r in results)
+        if self._bar is not None:
+            self._bar.set_postfix_str(f"{self.failed} failed", refresh=False)
+            self._bar.update(len(results))
+            if self.done >= self.total:
+                self._close()
+        else:
+            self.draw()
+
+    def _close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+    def line(self) -> str:
+        """The plain progress line: '<label>: 3/20 runs, 0 failed, 12 s elapsed, about 68 s left'."""
+        el = time.monotonic() - self._t0
         new = self.done - self._start_done
         eta = el / new * (self.total - self.done) if new > 0 else float("nan")
-        w = 30
-        fill = int(w * self.done / max(self.total, 1))
-        s = self.stream or sys.stderr
-        eta_s = f"{eta:5.0f} s left" if math.isfinite(eta) else "   ?  s left"
-        s.write(f"\r[{'#' * fill}{'.' * (w - fill)}] {self.done}/{self.total} runs, {self.failed} failed, "
-                f"{el:5.0f} s, {eta_s}")
-        if self.done >= self.total:
-            s.write("\n")
+        left = "done" if self.done >= self.total else (f"about {eta:.0f} s left" if math.isfinite(eta) else "")
+        head = f"{self.label}: " if self.label else ""
+        tail = f", {left}" if left else ""
+        return f"{head}{self.done}/{self.total} runs, {self.failed} failed, {el:.0f} s elapsed{tail}"
+
+    def draw(self, force: bool = False) -> None:
+        """Plain mode: write a line when forced, at the end, or when interval_s has passed since the last one."""
+        if not self.enabled or self._bar is not None:
+            return
+        now = time.monotonic()
+        if not force and self.done < self.total and now - self._last < self.interval_s:
+            return
+        self._last = now
+        s = self._stream()
+        s.write(self.line() + "\n")
         s.flush()
 
 
@@ -250,12 +298,15 @@ def run_campaign(
     per_task: int | None = None,
     progress: bool = True,
     progress_stream: TextIO | None = None,
+    progress_label: str = "",
     scheduler_timeout_s: float = 10.0,
 ) -> CampaignResult:
     """Run runs 0..runs-1 (those not already in out_dir when resuming) and return them all, in order.
 
     Exactly one of run_fn / group_fn (with group_size). workers: local processes (default all cores; 1 runs
     in this process). scheduler: address of an existing Dask scheduler instead of the local pool.
+    progress_label names the campaign in the progress display (default: the profile's name, which for a study
+    variant is "<base>[<variant>]").
     """
     if (run_fn is None) == (group_fn is None):
         raise ValueError("give exactly one of run_fn and group_fn")
@@ -274,7 +325,7 @@ def run_campaign(
     tasks = plan_chunks(todo, workers=workers, group_size=group_size if group_fn else None, per_task=per_task)
     # a group function gets some runs of one group: a run's result must not depend on which others it gets
     bar = Progress(total=runs, done=len(done), failed=sum(not r.ok for r in done.values()),
-                   stream=progress_stream, enabled=progress)
+                   stream=progress_stream, enabled=progress, label=progress_label or str(getattr(profile, "name", "")))
     t0 = time.monotonic()
     bar.start()
     args = (run_fn, group_fn, profile, seed)

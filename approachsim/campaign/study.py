@@ -1,7 +1,7 @@
 """Trade studies: a study file (TOML) that varies profile fields; every variant is evaluated and compared.
 
     name = "ins-grade-x-wind"
-    profile = "../profiles/default.toml"   # base profile, relative to the study file
+    profile = "default"                    # base profile: a shipped profile name or a path relative to this file
     runs = 20                              # per variant (default: the base profile's run.runs)
     seed = 1                               # the same campaign seed for every variant (common random numbers)
     mode = "open"                          # default: the base profile's run.mode
@@ -15,7 +15,7 @@
     set = { "environment.wind_speed_kt" = 0, "environment.turbulence" = "none" }
 
 Every variant's profile is built and validated before anything runs, so a bad value fails at once with
-one line naming the study field (and the profile field it set).
+one line naming the study field (and the profile field it set). Every key: docs/profiles.md.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from __future__ import annotations
 import copy
 import itertools
 import re
+import sys
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -98,12 +99,16 @@ def load_study(path: str | Path) -> Study:
         data = tomllib.loads(p.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
         raise ProfileError(f"study: {str(p)!r} is not valid TOML ({e})") from None
+    if "runway" in data and "profile" not in data:
+        raise ProfileError(
+            f"study: {str(p)!r} is a profile, not a study file; a study names its base profile (profile = \"default\" "
+            "or a path) and the fields to vary ([axes] or [[variant]]), see docs/profiles.md; "
+            f"to evaluate this profile: approachsim evaluate {p}"
+        )
     top = Section(data, "")
     name = top.string("name", p.stem)
     base_rel = top.string("profile")
-    base = (p.parent / base_rel).resolve()
-    if not base.is_file():
-        raise ProfileError(f"profile: no such base profile {base_rel!r} (relative to the study file)")
+    base = _base_profile(p, base_rel)
     try:
         base_data = tomllib.loads(base.read_text(encoding="utf-8"))
         base_profile = parse_profile(copy.deepcopy(base_data), source=base)
@@ -147,6 +152,22 @@ def load_study(path: str | Path) -> Study:
     if len(set(slugs)) != len(slugs):
         raise ProfileError("variant: two variant names map to the same directory name; rename one")
     return Study(name=name, base=base, runs=runs, seed=seed, mode=mode, variants=tuple(variants))
+
+
+def _base_profile(study_path: Path, ref: str) -> Path:
+    """The base profile: a path relative to the study file, else a shipped profile name (approachsim profiles)."""
+    from approachsim.resources import shipped_profiles
+
+    base = (study_path.parent / ref).resolve()
+    if base.is_file():
+        return base
+    shipped = {s.name: s.path for s in shipped_profiles()}
+    if ref in shipped:
+        return shipped[ref]
+    raise ProfileError(
+        f"profile: no such base profile {ref!r} (a path relative to the study file, or a shipped profile: "
+        f"{', '.join(shipped)})"
+    )
 
 
 def _flatten(d: dict, prefix: str = ""):
@@ -198,7 +219,10 @@ def run_study(
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     summaries = []
-    for v in study.variants:
+    for i, v in enumerate(study.variants, start=1):
+        if progress:
+            sys.stderr.write(f"study {study.name}: variant {i}/{len(study.variants)} {v.name} ({study.runs} runs)\n")
+            sys.stderr.flush()
         ev = evaluate_profile(
             v.profile, runs=study.runs, seed=study.seed, mode=study.mode, out_dir=out_dir / v.slug,
             workers=workers, scheduler=scheduler, resume=resume, progress=progress,

@@ -26,7 +26,18 @@ _ADDRESS = re.compile(r"^(tcp|tls|inproc|ws|wss|ucx)://\S+$|^[A-Za-z0-9_.\-\[\]:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `evaluate` sub-command."""
-    p = sub.add_parser("evaluate", help="Monte Carlo evaluation of a profile against FAA CAT I/II/III")
+    from approachsim.cli import command_parser
+
+    p = command_parser(
+        sub, "evaluate", help="Monte Carlo evaluation of a profile against FAA CAT I/II/III",
+        description="Runs the profile's Monte Carlo campaign and scores the navigation error at each decision height\n"
+        "against the FAA 1-sigma limits (README: the verdict). Writes DIR/summary.json (docs/contract.md),\n"
+        "details.json, runs.parquet, heights.parquet, series/, runs.jsonl + campaign.json (for --resume), the\n"
+        "figures and report.html, and prints the verdict table.",
+        examples=["approachsim evaluate profiles/default.toml --runs 4 --out out/quick",
+                  "approachsim evaluate ~/approaches/default.toml --runs 200 --out out/full --workers 2",
+                  "approachsim evaluate ~/approaches/default.toml --out out/full --resume"],
+    )
     p.add_argument("profile", type=Path, help="approach profile (TOML)")
     p.add_argument("--runs", type=int, default=None, help="Monte Carlo runs (default: the profile's run.runs)")
     p.add_argument("--seed", type=int, default=None, help="campaign seed (default: the profile's run.seed)")
@@ -39,6 +50,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--overwrite", action="store_true", help="start afresh in --out, discarding a campaign there")
     p.add_argument("--no-report", action="store_true", help="skip figures and report.html")
     p.set_defaults(func=run)
+
+
+def require_distributed() -> None:
+    """--scheduler needs dask.distributed (the optional `dask` extra); ProfileError saying how to install it."""
+    import importlib.util
+
+    if importlib.util.find_spec("distributed") is None:
+        raise ProfileError("--scheduler: needs dask.distributed, not installed: pip install approachsim[dask]")
 
 
 def check_options(args: argparse.Namespace, profile) -> tuple[int, int, str, Path]:
@@ -57,12 +76,17 @@ def check_options(args: argparse.Namespace, profile) -> tuple[int, int, str, Pat
             raise ProfileError("--workers: not used with --scheduler (the Dask cluster has its own workers)")
         if not _ADDRESS.match(args.scheduler):
             raise ProfileError(f"--scheduler: must be an address like tcp://host:8786, got {args.scheduler!r}")
+        require_distributed()
     out = args.out if args.out is not None else Path(f"evaluate-{profile.name}")
     if out.exists() and not out.is_dir():
         raise ProfileError(f"--out: {str(out)!r} exists and is not a directory")
     if args.resume and args.overwrite:
         raise ProfileError("--overwrite: cannot be combined with --resume")
     jl = out / "runs.jsonl"
+    if args.resume and not jl.is_file():
+        raise ProfileError(
+            f"--resume: no campaign to resume in {str(out)!r} (no runs.jsonl); drop --resume to start one"
+        )
     if not args.resume and not args.overwrite and jl.is_file() and jl.stat().st_size > 0:
         raise ProfileError(
             f"--out: {str(out)!r} already holds a campaign; add --resume to continue it, --overwrite to discard it, "

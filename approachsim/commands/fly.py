@@ -1,7 +1,8 @@
 """`approachsim fly PROFILE --out DIR [--seed S] [--run I] [--land]`: fly one approach, write truth and figures.
 
 Writes DIR/truth.npz + DIR/truth.json (the truth record and its schema, see docs/truth.md and
-approachsim.flight.truthfile), DIR/flight.json (termination, tracking statistics) and the figures
+approachsim.flight.truthfile), DIR/flight.json (termination, duration, truth_samples = the rows of truth.npz,
+tracking statistics of the 1000-200 ft window with its tracking_window_samples) and the figures
 DIR/vertical.png, DIR/lateral.png, DIR/airspeed.png, DIR/attitude.png; prints a short summary.
 """
 
@@ -20,7 +21,17 @@ the outputs are written, the run did not complete (as `evaluate`'s 3: no run com
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `fly` sub-command."""
-    p = sub.add_parser("fly", help="fly one closed-loop approach (truth navigation) and write the truth record")
+    from approachsim.cli import command_parser
+
+    p = command_parser(
+        sub, "fly", help="fly one closed-loop approach (truth navigation) and write the truth record",
+        description="JSBSim flies the profile's approach on the autopilot, guided by the true position, from the\n"
+        "start distance to 50 ft (or to touchdown with --land). Writes DIR/truth.npz + truth.json (docs/truth.md),\n"
+        "DIR/flight.json (termination, tracking statistics) and the figures vertical.png, lateral.png,\n"
+        "airspeed.png, attitude.png.",
+        examples=["approachsim fly profiles/default.toml --out out/fly",
+                  "approachsim fly ~/approaches/default.toml --out out/land --land --seed 3"],
+    )
     add_single_run_arguments(p)
     p.add_argument("--land", action="store_true", help="fly on through the flare to touchdown (default: stop 50 ft)")
     p.set_defaults(func=run)
@@ -36,6 +47,10 @@ def run(args: argparse.Namespace) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     save_truth(args.out / "truth.npz", result.truth, meta={"profile": profile.name, "seed": seed, "run": args.run})
     stats = tracking_stats(result, profile)
+    # flight.json: "samples" of tracking_stats counts the 1000-200 ft window only; name it so, and give the
+    # truth record's own length beside it (the same number as truth.json's "samples")
+    window = stats.pop("samples")
+    stats["tracking_window_samples"] = window
     summary = {
         "profile": profile.name,
         "seed": seed,
@@ -43,6 +58,7 @@ def run(args: argparse.Namespace) -> int:
         "termination": result.termination,
         "ok": result.ok,
         "duration_s": float(result.truth.t_s[-1]),
+        "truth_samples": len(result.truth),
         "lowest_height_ft": result.lowest_height_ft,
         "touchdown_past_threshold_ft": result.touchdown_x_m / 0.3048 if args.land else None,
         "touchdown_sink_fps": result.touchdown_sink_mps / 0.3048 if args.land else None,

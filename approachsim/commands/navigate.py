@@ -22,7 +22,20 @@ from approachsim.commands._single_run import add_single_run_arguments, load_sing
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `navigate` sub-command."""
-    p = sub.add_parser("navigate", help="fly one approach and navigate it (INS + filter): solution, status, figures")
+    from approachsim.cli import command_parser
+    from approachsim.nav.registry import FILTERS
+
+    p = command_parser(
+        sub, "navigate", help="fly one approach and navigate it (INS + filter): solution, status, figures",
+        description="Flies one approach and runs the strapdown INS and the profile's filter over its sensors:\n"
+        "closed loop (the autopilot flies on the navigation solution) or open loop (flown on truth, navigated\n"
+        "afterwards). Writes DIR/nav.npz (solution, covariances, true errors, measurement status), DIR/nav.json\n"
+        "(summary, SI units in the key names), DIR/truth.npz and the error figures with +-1 / +-3 sigma.\n\n"
+        "filters (profile [nav] filter = NAME; tuning in [nav.filter_tuning], see docs/profiles.md):\n  "
+        + ", ".join(FILTERS),
+        examples=["approachsim navigate profiles/default.toml --out out/nav",
+                  "approachsim navigate my-rkf.toml --out out/nav-open --mode open --seed 5"],
+    )
     add_single_run_arguments(p)
     p.add_argument("--mode", choices=("closed", "open"), default=None, help="default: the profile's run.mode")
     p.set_defaults(func=run)

@@ -20,7 +20,14 @@ DEFAULT_DIR = Path("baselines")
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `regress` sub-command."""
-    p = sub.add_parser("regress", help="rerun the committed profile baselines and compare with tolerances")
+    from approachsim.cli import command_parser
+
+    p = command_parser(
+        sub, "regress", help="rerun the committed profile baselines and compare with tolerances",
+        description="Reruns every committed baseline (small campaigns with fixed seeds) and compares the results\n"
+        "with the stored ones within statistical tolerances; --update rewrites them.",
+        examples=["approachsim regress", "approachsim regress --update --add profiles/hot-high-crosswind.toml"],
+    )
     p.add_argument("--baselines", type=Path, default=DEFAULT_DIR, help="baseline directory (default baselines/)")
     p.add_argument("--update", action="store_true", help="rewrite the baselines from new runs")
     p.add_argument("--add", type=Path, default=None, help="with --update: create a baseline for this profile")

@@ -38,7 +38,17 @@ VALUE_FIELDS = {"imu": ("dtheta_body", "dv_body"), "baro": ("h_baro_m",), "radal
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `sense` sub-command."""
-    p = sub.add_parser("sense", help="fly one approach and write its sensor streams (with faults) and figures")
+    from approachsim.cli import command_parser
+
+    p = command_parser(
+        sub, "sense", help="fly one approach and write its sensor streams (with faults) and figures",
+        description="Flies the approach (or, with --synthetic, uses a still-air synthetic truth), measures it with\n"
+        "the profile's sensors and [[faults]], and writes DIR/sensors/<sensor>.npz and .csv (every record field and\n"
+        "its noise-free value), DIR/sensors.json (schema with units), an error figure per sensor and the GPS\n"
+        "sky plot.",
+        examples=["approachsim sense profiles/default.toml --out out/sense",
+                  "approachsim sense my-faults.toml --out out/faults --synthetic --no-figures"],
+    )
     add_single_run_arguments(p)
     p.add_argument("--synthetic", action="store_true",
                    help="use the synthetic constant-velocity test truth instead of flying JSBSim")

@@ -1,8 +1,8 @@
 """Aircraft approach configuration: aircraft/<name>.toml (JSBSim model name, approach speed, flaps, gear, IMU
 location, autopilot gains), read strictly and converted to SI.
 
-Lookup order for `<name>.toml`: the `aircraft/` directory beside the profile's directory (``profiles/../aircraft``),
-then the repository's `aircraft/` next to the installed package. Errors name the file and field (ProfileError).
+Lookup of `<name>.toml` (approachsim.resources): beside the profile (``<dir>/aircraft``, ``<dir>/../aircraft``),
+then $APPROACHSIM_AIRCRAFT_PATH, then the installed package's data. Errors name the file and field (ProfileError).
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from approachsim import units
+from approachsim import resources, units
 from approachsim.config import ProfileError, Section
 from approachsim.flight.design import AutopilotGains
 from approachsim.flight.envelope import TURBULENCE_ORDER, ApproachLimits
@@ -43,24 +43,13 @@ class Aircraft:
 
 
 def aircraft_dirs(profile: Profile | None) -> list[Path]:
-    """Directories searched for aircraft files, in order."""
-    dirs = []
-    if profile is not None and profile.source is not None:
-        dirs.append(Path(profile.source).resolve().parent.parent / "aircraft")
-    dirs.append(Path(__file__).resolve().parent.parent.parent / "aircraft")
-    return dirs
+    """Directories searched for aircraft files, in order (approachsim.resources.aircraft_dirs)."""
+    return resources.aircraft_dirs(None if profile is None else profile.source)
 
 
 def find_aircraft_file(name: str, profile: Profile | None = None) -> Path:
     """The aircraft file for `name`; ProfileError (naming aircraft.name) when none exists."""
-    dirs = aircraft_dirs(profile)
-    for d in dirs:
-        p = d / f"{name}.toml"
-        if p.is_file():
-            return p
-    raise ProfileError(
-        f"aircraft.name: no aircraft file {name}.toml in {', '.join(str(d) for d in dirs)}"
-    )
+    return resources.find_aircraft_file(name, None if profile is None else profile.source)
 
 
 def _gains(s: Section) -> AutopilotGains:

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter, MaxNLocator
 
 from approachsim import units
 from approachsim.campaign.outputs import verdict_table
@@ -94,6 +95,10 @@ def fig_histograms(results: list[RunResult], dh_ft: dict[str, float]) -> Figure:
                 ax.axvline(s, color="k", ls="--", lw=1)
             ax.set_title(f"{cat} (DH {dh_ft[cat]:g} ft): {comp}", fontsize=9)
             ax.set_xlabel("error, ft (dashed: FAA 1-sigma limit)", fontsize=8)
+            ax.set_ylabel("runs", fontsize=8)
+            ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+    n = sum(r.ok for r in results)
+    fig.suptitle(f"Error at each decision height over {n} runs (one value per run)", fontsize=10)
     return fig
 
 
@@ -106,34 +111,63 @@ def _series(out_dir: Path) -> list[dict[str, np.ndarray]]:
     return [{k: np.asarray(v) for k, v in pq.read_table(p).to_pydict().items()} for p in sorted(d.glob("*.parquet"))]
 
 
-def fig_stanford(series: list[dict[str, np.ndarray]], det: dict) -> Figure:
-    """Stanford diagrams (PE against PL, per epoch of the series runs) against the CAT I alert limits."""
-    fig = Figure(figsize=(11, 5), constrained_layout=True)
-    axes = fig.subplots(1, 2)
-    lim = LIMITS["CAT I"]
-    for ax, pe_k, pl_k, al, name in (
-        (axes[0], "vertical_m", "vpl_m", lim.vertical_al_m, "vertical"),
-        (axes[1], "hpe_m", "hpl_m", lim.horizontal_al_m, "horizontal"),
-    ):
-        pe = np.concatenate([np.abs(s[pe_k]) for s in series]) if series else np.empty(0)
-        pl = np.concatenate([s[pl_k] for s in series]) if series else np.empty(0)
-        ok = np.isfinite(pe) & np.isfinite(pl)
-        top = max(2.0 * al, float(np.max(pl[ok], initial=0.0)) * 1.1, float(np.max(pe[ok], initial=0.0)) * 1.1)
-        if ok.any():
-            ax.hist2d(pe[ok], pl[ok], bins=80, range=[[0, top], [0, top]], norm=LogNorm(), cmap="viridis", cmin=1)
-        ax.plot([0, top], [0, top], "k-", lw=1)
-        ax.axhline(al, color="r", lw=1)
-        ax.axvline(al, color="r", lw=1)
-        counts = det["categories"]["CAT I"][f"stanford_{name}"]
-        ax.set_title(
-            f"{name}: AL {al:.1f} m (CAT I). All runs, epochs: normal {counts['normal']}, MI {counts['mi']}, "
-            f"HMI {counts['hmi']}, unavailable {counts['unavailable']}",
-            fontsize=8,
-        )
-        ax.set_xlabel("position error, m")
-        ax.set_ylabel("protection level, m")
-        ax.set_xlim(0, top)
-        ax.set_ylim(0, top)
+def _down_to(series: dict[str, np.ndarray], dh_m: float) -> slice:
+    """The epochs of one run from its start to its first one at or below dh_m (the scoring's window)."""
+    below = np.flatnonzero(np.asarray(series["hat_m"]) <= dh_m)
+    return slice(0, int(below[0]) + 1 if below.size else len(series["hat_m"]))
+
+
+def fig_stanford(series: list[dict[str, np.ndarray]], det: dict, dh_ft: dict[str, float] | None = None) -> Figure:
+    """Stanford diagrams per category (columns) and axis (rows: vertical, horizontal): per epoch of the runs
+    that kept time series, from the start down to the category's DH, position error against protection level,
+    as a 2-D histogram (colour: epochs per cell, log scale), with the category's alert limit and the regions
+    labelled; the titles give the all-run region counts of details.json."""
+    dh_ft = dh_ft or {c: float(det["categories"][c]["height_ft"]) for c in CATEGORIES}
+    fig = Figure(figsize=(15, 9), constrained_layout=True)
+    axes = fig.subplots(2, len(CATEGORIES), squeeze=False)
+    mappable = None
+    for j, cat in enumerate(CATEGORIES):
+        lim = LIMITS[cat]
+        dh_m = dh_ft[cat] * units.FT
+        for i, (pe_k, pl_k, al, name) in enumerate((
+            ("vertical_m", "vpl_m", lim.vertical_al_m, "vertical"),
+            ("hpe_m", "hpl_m", lim.horizontal_al_m, "horizontal"),
+        )):
+            ax = axes[i, j]
+            wins = [_down_to(x, dh_m) for x in series]
+            pairs = list(zip(series, wins, strict=True))
+            pe = np.concatenate([np.abs(x[pe_k][w]) for x, w in pairs]) if pairs else np.empty(0)
+            pl = np.concatenate([x[pl_k][w] for x, w in pairs]) if pairs else np.empty(0)
+            ok = np.isfinite(pe) & np.isfinite(pl)
+            top = max(2.0 * al, float(np.max(pl[ok], initial=0.0)) * 1.1, float(np.max(pe[ok], initial=0.0)) * 1.1)
+            if ok.any():
+                *_, im = ax.hist2d(pe[ok], pl[ok], bins=60, range=[[0, top], [0, top]], norm=LogNorm(),
+                                   cmap="viridis", cmin=1)
+                mappable = im
+            ax.plot([0, top], [0, top], "k-", lw=1)
+            ax.plot([al, al], [0, al], color="r", lw=1.2)  # PE = AL below the PL = AL line
+            ax.axhline(al, color="r", lw=1.2)
+            ax.plot([al, top], [al, top], "k-", lw=1)
+            box = dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.75)
+            ax.text(0.3 * al, 0.85 * al, "normal", fontsize=8, color="0.15", ha="center", va="center", bbox=box)
+            ax.text(0.7 * al, 0.2 * al, "MI", fontsize=8, color="tab:orange", weight="bold", ha="center", bbox=box)
+            ax.text(al + 0.04 * top, 0.5 * al, "HMI", fontsize=8, color="r", weight="bold", bbox=box)
+            ax.text(0.5 * top, al + 0.5 * (top - al), "unavailable\n(PL >= AL)", fontsize=8, color="0.3",
+                    ha="center", va="center", bbox=box)
+            ax.text(al * 1.02, al * 1.02, f" AL {al:.1f} m", fontsize=7, color="r", va="bottom")
+            counts = det["categories"][cat][f"stanford_{name}"]
+            ax.set_title(
+                f"{cat} {name} (epochs down to DH {dh_ft[cat]:g} ft)\nall runs: normal {counts['normal']}, "
+                f"MI {counts['mi']}, HMI {counts['hmi']}, unavailable {counts['unavailable']}",
+                fontsize=8,
+            )
+            ax.set_xlabel(f"{name} position error |PE|, m", fontsize=8)
+            ax.set_ylabel(f"{name} protection level PL, m", fontsize=8)
+            ax.set_xlim(0, top)
+            ax.set_ylim(0, top)
+    if mappable is not None:
+        fig.colorbar(mappable, ax=axes, shrink=0.8, label="epochs per cell (log scale)")
+    fig.suptitle(f"Stanford diagrams, {len(series)} runs with time series", fontsize=11)
     return fig
 
 
@@ -142,17 +176,27 @@ def fig_availability(results: list[RunResult]) -> Figure:
     fig = Figure(figsize=(10, 4), constrained_layout=True)
     ax = fig.subplots()
     vpl, hpl = _stack(results, "vpl_m"), _stack(results, "hpl_m")
+    # CAT II and CAT III alert limits are nearly equal, so their curves often coincide: distinct line styles and
+    # widths (wide solid under narrow dashed under dotted with markers) keep every one visible
+    styles = {"CAT I": dict(ls="-", lw=5.0, alpha=0.45), "CAT II": dict(ls="--", lw=2.5),
+              "CAT III": dict(ls=":", lw=2.0, marker="o", markersize=3, markevery=0.05)}
     for cat in CATEGORIES:
         if vpl.shape[0]:
             ok = np.isfinite(vpl) & np.isfinite(hpl)
             av = (vpl <= LIMITS[cat].vertical_al_m) & (hpl <= LIMITS[cat].horizontal_al_m) & ok
             frac = np.where(ok.sum(0) > 0, av.sum(0) / np.maximum(ok.sum(0), 1), np.nan)
-            ax.plot(HEIGHT_GRID_FT, frac, color=COLORS[cat], label=cat)
+            lim = LIMITS[cat]
+            ax.plot(HEIGHT_GRID_FT, frac, color=COLORS[cat], **styles[cat],
+                    label=f"{cat}: VPL <= {lim.vertical_al_m:.1f} m and HPL <= {lim.horizontal_al_m:.1f} m")
     ax.set_xlim(HEIGHT_GRID_FT.max(), 0.0)
     ax.set_ylim(-0.02, 1.02)
     ax.set_xlabel("true height above threshold, ft")
     ax.set_ylabel("availability (fraction of runs)")
-    ax.legend()
+    ax.set_title(f"Availability against height, {vpl.shape[0]} runs", fontsize=10)
+    if ax.get_lines():
+        ax.legend(fontsize=8, loc="center left", framealpha=0.9)
+    else:
+        ax.text(0.5, 0.5, "no completed run", transform=ax.transAxes, ha="center", va="center")
     ax.grid(True, alpha=0.3)
     return fig
 
@@ -208,6 +252,48 @@ def _table(header: list[str], rows: list[list]) -> str:
     return f"<table><tr>{h}</tr>{body}</table>"
 
 
+FIGURE_CAPTIONS = {
+    "errors_vs_height": (
+        "Navigation error against height",
+        "Lateral (top) and vertical (bottom) navigation error, estimate minus truth in the runway frame, of every "
+        "run (grey) against the true height above the threshold, the aircraft flying right to left. Blue: +-1 "
+        "sigma, the RMS over runs at each height (bias included), the figure the verdict uses. Coloured bars: "
+        "each category's FAA 1-sigma limit at its decision height; the category is met where the blue curve at "
+        "its decision height lies inside its bar, laterally and vertically.",
+    ),
+    "histograms_dh": (
+        "Error distribution at the decision heights",
+        "One value per run: the lateral (top) and vertical (bottom) error when the true aircraft passes each "
+        "decision height, in ft; y axis: number of runs per bin. Dashed: the FAA 1-sigma limit. A wide or "
+        "off-centre histogram (bias) raises the RMS the verdict uses.",
+    ),
+    "stanford": (
+        "Stanford diagrams (integrity)",
+        "For each category (columns) and for the vertical and horizontal axes (rows), every epoch of the runs "
+        "that kept time series, from the start down to the category's decision height: position error against "
+        "the protection level computed from the filter covariance, in m, as the standards define the alert "
+        "limits (AL, red). Colour: epochs per cell, log scale. Above the diagonal and below AL is normal; below "
+        "the diagonal the protection level did not bound the error (MI, misleading information), and to the "
+        "right of AL below it is hazardous (HMI); above AL the approach is unavailable. The titles count every "
+        "run's epochs. Integrity is reported beside the verdict, not part of it.",
+    ),
+    "availability": (
+        "Availability against height",
+        "Fraction of the runs whose vertical and horizontal protection levels are both within the category's "
+        "alert limits, against the true height above the threshold (right to left as flown). CAT II and CAT III "
+        "alert limits are nearly equal, so their curves often overlap (dashed and dotted drawn over the wide "
+        "CAT I line). Reported beside the verdict, not part of it.",
+    ),
+    "sky_dop": (
+        "GPS geometry of one run",
+        "Left: the satellites above the mask during the first run (elevation from the centre outwards, azimuth "
+        "clockwise from north; numbers are PRNs at their last position). Right: PDOP of the satellites used, "
+        "against time from the run start.",
+    ),
+}
+"""Per report figure: its heading and its caption (what it shows, how to read it)."""
+
+
 def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: dict) -> Path:
     """Write the figures and DIR/report.html (verdict table first, images embedded); returns its path."""
     out_dir = Path(out_dir)
@@ -215,7 +301,7 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
     imgs = {
         "errors_vs_height": fig_errors_vs_height(results, dh_ft),
         "histograms_dh": fig_histograms(results, dh_ft),
-        "stanford": fig_stanford(_series(out_dir), det),
+        "stanford": fig_stanford(_series(out_dir), det, dh_ft),
         "availability": fig_availability(results),
     }
     sky = next((x for x in _series(out_dir) if "pdop" in x), None)
@@ -248,7 +334,8 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
         f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>",
         "<style>body{font-family:sans-serif;margin:2em;max-width:1200px}table{border-collapse:collapse;"
         "margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}"
-        "img{max-width:100%}</style></head><body>",
+        "img{max-width:100%}figure{margin:0 0 2em 0}figcaption{max-width:900px;color:#333;font-size:0.95em}"
+        "</style></head><body>",
         f"<h1>{html.escape(title)}</h1>",
         f"<p><b>Best category met: {html.escape(str(summary['best_category'] or 'none'))}</b> &mdash; "
         f"{summary['runs']} runs ({summary['failed_runs']} failed), seed {summary['seed']}, "
@@ -268,11 +355,24 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
     if failures:
         parts.append("<h2>Failed runs</h2>" + _table(["run", "reason"], [[k, v] for k, v in failures.items()]))
     for k in imgs:
-        parts.append(f"<h2>{k.replace('_', ' ')}</h2><img alt='{k}' src='data:image/png;base64,{b64[k]}'>")
+        title, caption = FIGURE_CAPTIONS[k]
+        parts.append(f"<h2>{html.escape(title)}</h2><figure><img alt='{k}' src='data:image/png;base64,{b64[k]}'>"
+                     f"<figcaption>{html.escape(caption)} (file {k}.png)</figcaption></figure>")
     parts.append("</body></html>")
     path = out_dir / "report.html"
     path.write_text("\n".join(parts), encoding="utf-8")
     return path
+
+
+def _plain_tick(v: float, _pos: int | None = None) -> str:
+    """A log-axis tick as a plain number (0.3, 1, 30), not 3x10^1."""
+    return f"{v:g}"
+
+
+def _minor_tick(v: float, _pos: int | None = None) -> str:
+    """Minor log ticks labelled at 2 and 5 times a decade only (keeps the axis readable)."""
+    mant = v / 10.0 ** np.floor(np.log10(v)) if v > 0 else 0.0
+    return f"{v:g}" if round(mant) in (2, 5) and abs(mant - round(mant)) < 1e-6 else ""
 
 
 def write_study_figure(out_dir: Path, rows: list[dict]) -> Path:
@@ -289,9 +389,13 @@ def write_study_figure(out_dir: Path, rows: list[dict]) -> Path:
             ax.bar(x + (j - 1) * w, vals, w, color=COLORS[cat], label=f"{cat} (limit dashed)")
             ax.axhline(getattr(LIMITS[cat], lim_key), color=COLORS[cat], ls="--", lw=1)
         ax.set_yscale("log")
-        ax.set_ylabel(f"{comp} 1-sigma at DH, ft")
+        ax.yaxis.set_major_formatter(FuncFormatter(_plain_tick))
+        ax.yaxis.set_minor_formatter(FuncFormatter(_minor_tick))
+        ax.set_ylabel(f"{comp} 1-sigma at DH, ft (log scale)")
         ax.grid(True, axis="y", alpha=0.3)
     axes[0].legend(fontsize=8)
+    axes[0].set_title("1-sigma error (RMS over runs) at each decision height per variant; dashed: FAA limits",
+                      fontsize=10)
     axes[1].set_xticks(x, [r["variant"] for r in rows], rotation=30, ha="right", fontsize=8)
     path = Path(out_dir) / "study.png"
     fig.savefig(path, dpi=110)

@@ -61,7 +61,7 @@ def write_sensor_figures(meas: dict[str, Any], exact: dict[str, Any], out_dir: P
             err = (getattr(m, fld) - getattr(e, fld)) / units.FT
             ax.plot(m.t_s, err, lw=0.7, label=f"{label} error")
             if name == "radalt":
-                ax.plot(m.t_s, m.sigma_m / units.FT, "k--", lw=0.7, label="+-1 sigma (seed 002)")
+                ax.plot(m.t_s, m.sigma_m / units.FT, "k--", lw=0.7, label="+-1 sigma (Gray & Maybeck model)")
                 ax.plot(m.t_s, -m.sigma_m / units.FT, "k--", lw=0.7)
             _shade_faults(ax, m.t_s, m.fault)
             ax.set_xlabel("time (s)")

@@ -205,33 +205,126 @@ def parse_sensors(s: Section) -> SensorsConfig:
     return SensorsConfig(imu=imu, baro=baro, radalt=radalt, gnss=gnss, pseudolite=pseudolite)
 
 
-def parse_faults(items: list[Section], sensors: SensorsConfig) -> tuple[FaultSpec, ...]:
-    """Parse [[faults]]; a fault on a sensor the suite does not fit is an error naming it."""
+FAULT_PARAMETERS: Mapping[str, tuple[str, ...]] = MappingProxyType({
+    "outage": (), "spike": ("k", "steps", "every"), "iam": ("magnitude", "steps", "every"),
+    "cbm": ("magnitude",), "mni": ("factor",), "step": ("magnitude",), "ramp": ("rate",),
+})
+"""The parameters each fault kind uses (besides sensor, kind, start_s, end_s, target, channel); others are errors."""
+_REQUIRED: Mapping[str, tuple[str, float]] = MappingProxyType({
+    "spike": ("k", 1.0), "iam": ("magnitude", 0.0), "cbm": ("magnitude", 0.0), "mni": ("factor", 1.0),
+    "step": ("magnitude", 0.0), "ramp": ("rate", 0.0),
+})
+"""Per kind, the parameter that sets its size and the value at which the fault would change nothing."""
+FAULT_UNITS: Mapping[tuple[str, str], str] = MappingProxyType({
+    ("imu", "dv"): "m/s per IMU sample", ("imu", "dtheta"): "rad per IMU sample", ("baro", "h"): "m",
+    ("radalt", "h"): "m", ("gnss", "pseudorange"): "m", ("gnss", "pseudorange_rate"): "m/s",
+    ("pseudolite", "pseudorange"): "m",
+})
+"""Unit of `magnitude` per (sensor, target); `rate` is that unit per second."""
+
+
+RUN_DURATION_MARGIN = 1.1
+"""Faults must start before this multiple of the estimated run length (a run may end a little later than
+estimated: turbulence, speed changes, a flare to touchdown); a start after it can only be a mistake."""
+
+
+def _sensor_rate_hz(sensor: str, sensors: SensorsConfig, imu_hz: float) -> float:
+    if sensor == "imu":
+        return imu_hz
+    if sensor == "pseudolite":  # pseudolites are channels of the GPS receiver
+        return sensors.gnss.rate_hz if sensors.gnss is not None else 1.0
+    return getattr(sensors, sensor).rate_hz
+
+
+def _check_channel(f: Section, sensor: str, channel: int, sensors: SensorsConfig) -> None:
+    """The channel must exist on the sensor: IMU axis 0-2, a GPS PRN of the constellation, a pseudolite unit."""
+    name = f"{f.path}.channel"
+    if sensor == "imu" and not 0 <= channel <= 2:
+        raise ProfileError(f"{name}: the IMU has axes 0, 1, 2 (x, y, z body), got {channel}")
+    if sensor in ("baro", "radalt"):
+        raise ProfileError(f"{name}: the {sensor} has one channel; remove channel")
+    if sensor == "gnss":
+        from approachsim.sensors.gnss.constellation import SLOTS
+
+        prns = sorted(slot[3] for slot in SLOTS)
+        if channel not in prns:
+            raise ProfileError(f"{name}: no PRN {channel} in the constellation (PRNs {prns[0]}-{prns[-1]})")
+    if sensor == "pseudolite":
+        n = len(sensors.pseudolite.positions_rwy)
+        if not 0 <= channel < n:
+            raise ProfileError(f"{name}: pseudolite unit index must be in [0, {n - 1}] ({n} unit(s)), got {channel}")
+
+
+def parse_faults(
+    items: list[Section], sensors: SensorsConfig, *, duration_s: float | None = None, imu_hz: float = 120.0
+) -> tuple[FaultSpec, ...]:
+    """Parse [[faults]], each checked against the sensor it targets and the run it falls in.
+
+    A fault on a sensor the suite does not fit, a channel the sensor does not have, a parameter its kind does
+    not use, a missing or no-op size (magnitude 0, rate 0, factor 1, k 1), an IMU outage (the strapdown INS
+    needs every IMU sample) or a start (or step) after the run's end (`duration_s`, the caller's estimate of
+    the run length, with RUN_DURATION_MARGIN; None: not checked) are errors naming the field.
+    """
+    last_s = None if duration_s is None else RUN_DURATION_MARGIN * duration_s
     out = []
     for f in items:
         sensor = f.string("sensor", choices=SENSOR_NAMES)
         if sensor != "imu" and getattr(sensors, sensor) is None:
             raise ProfileError(f"{f.path}.sensor: {sensor!r} is not fitted (enable [sensors.{sensor}])")
         kind = f.string("kind", choices=FAULT_KINDS)
+        if sensor == "imu" and kind == "outage":
+            raise ProfileError(
+                f"{f.path}.kind: an IMU outage is not modelled (the strapdown INS integrates every IMU sample); "
+                "use step, ramp, spike, iam, cbm or mni on the IMU, or an outage of an aiding sensor"
+            )
         start = f.number("start_s", 0.0, lo=0.0, unit="s")
         end = f.number("end_s", math.inf, lo=0.0, unit="s") if f.has("end_s") else math.inf
         if end <= start:
             raise ProfileError(f"{f.path}.end_s: must be after start_s ({start:g} s), got {end:g}")
+        if last_s is not None and start >= last_s:
+            raise ProfileError(
+                f"{f.path}.start_s: must be before {last_s:.0f} s (the run lasts about {duration_s:.0f} s: start "
+                f"distance at the approach ground speed), got {start:g}"
+            )
+        for key in ("magnitude", "rate", "factor", "k", "steps", "every"):
+            if f.has(key) and key not in FAULT_PARAMETERS[kind]:
+                uses = ", ".join(FAULT_PARAMETERS[kind]) or "no size parameter"
+                raise ProfileError(f"{f.path}.{key}: not used by a {kind} fault (it uses {uses})")
         steps = f.raw("steps", [])
         if not isinstance(steps, list) or any(isinstance(x, bool) or not isinstance(x, int) or x < 0 for x in steps):
             raise ProfileError(f"{f.path}.steps: must be a list of sample numbers (integers >= 0), got {steps!r}")
+        if steps and f.has("every"):
+            raise ProfileError(f"{f.path}.every: give steps or every, not both")
+        rate_hz = _sensor_rate_hz(sensor, sensors, imu_hz)
+        if steps and last_s is not None and max(steps) / rate_hz >= last_s:
+            raise ProfileError(
+                f"{f.path}.steps: sample {max(steps)} is at {max(steps) / rate_hz:g} s, after the end of the run "
+                f"(about {duration_s:.0f} s; the {sensor} samples at {rate_hz:g} Hz)"
+            )
         channel = f.raw("channel", None)
         if channel is not None:
             channel = f.integer("channel", lo=0)
+            _check_channel(f, sensor, channel, sensors)
         target = f.raw("target", None)
         if target is not None:
             target = f.string("target", choices=FAULT_TARGETS[sensor])
+            if target == "pseudorange_rate" and not sensors.gnss.doppler:
+                raise ProfileError(f"{f.path}.target: pseudorange_rate needs [sensors.gnss] doppler = true")
+        if kind in _REQUIRED:
+            key, noop = _REQUIRED[kind]
+            if not f.has(key):
+                raise ProfileError(f"{f.path}.{key}: missing (required by a {kind} fault)")
+        unit = FAULT_UNITS[(sensor, target or FAULT_TARGETS[sensor][0])]
         spec = FaultSpec(
             sensor=sensor, kind=kind, start_s=start, end_s=end, target=target, channel=channel,
-            magnitude=f.number("magnitude", 0.0), rate=f.number("rate", 0.0),
+            magnitude=f.number("magnitude", 0.0, unit=unit), rate=f.number("rate", 0.0, unit=f"{unit} per s"),
             factor=f.number("factor", 1.0, lo=0.0, lo_open=True), k=f.number("k", 1.0, lo=0.0),
             steps=tuple(steps), every=f.integer("every", 1, lo=1),
         )
+        if kind in _REQUIRED:
+            key, noop = _REQUIRED[kind]
+            if getattr(spec, key) == noop:
+                raise ProfileError(f"{f.path}.{key}: a {kind} fault with {key} = {noop:g} changes nothing")
         f.done()
         out.append(spec)
     return tuple(out)

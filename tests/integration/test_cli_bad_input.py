@@ -91,3 +91,70 @@ def test_through_the_console_entry_point(tmp_path):
     assert p.returncode == 2
     lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
     assert len(lines) == 1 and "runway.glidepath_deg" in lines[0], p.stderr
+
+
+def _fault(body: str, extra: str = "") -> str:
+    return GOOD + extra + "\n[[faults]]\n" + body + "\n"
+
+
+FAULT_CASES = [
+    # (id, profile text, text the one-line message must contain)
+    ("imu-outage", _fault('sensor = "imu"\nkind = "outage"\nstart_s = 100.0\nend_s = 120.0'), "faults[0].kind"),
+    ("imu-channel-5", _fault('sensor = "imu"\nkind = "step"\nchannel = 5\nmagnitude = 0.01\nstart_s = 100.0'),
+     "faults[0].channel"),
+    ("gnss-prn-77", _fault('sensor = "gnss"\nkind = "step"\nchannel = 77\nmagnitude = 30.0\nstart_s = 100.0'),
+     "faults[0].channel: no PRN 77"),
+    ("gnss-outage-after-the-run", _fault('sensor = "gnss"\nkind = "outage"\nstart_s = 5000.0\nend_s = 5060.0'),
+     "faults[0].start_s: must be before 286 s (the run lasts about 260 s"),
+    ("baro-step-without-magnitude", _fault('sensor = "baro"\nkind = "step"\nstart_s = 100.0'),
+     "faults[0].magnitude: missing (required by a step fault)"),
+    ("baro-step-zero-magnitude", _fault('sensor = "baro"\nkind = "step"\nstart_s = 100.0\nmagnitude = 0.0'),
+     "faults[0].magnitude: a step fault with magnitude = 0 changes nothing"),
+    ("ramp-without-rate", _fault('sensor = "radalt"\nkind = "ramp"\nstart_s = 100.0'), "faults[0].rate: missing"),
+    ("mni-factor-one", _fault('sensor = "baro"\nkind = "mni"\nstart_s = 100.0\nfactor = 1.0'), "faults[0].factor"),
+    ("spike-without-k", _fault('sensor = "radalt"\nkind = "spike"\nsteps = [10, 20]'), "faults[0].k: missing"),
+    ("outage-with-magnitude", _fault('sensor = "gnss"\nkind = "outage"\nstart_s = 100.0\nmagnitude = 5.0'),
+     "faults[0].magnitude: not used by a outage fault"),
+    ("baro-channel", _fault('sensor = "baro"\nkind = "step"\nchannel = 0\nmagnitude = 5.0'), "faults[0].channel"),
+    ("spike-step-after-the-run", _fault('sensor = "radalt"\nkind = "spike"\nk = 100.0\nsteps = [10, 900]'),
+     "faults[0].steps: sample 900"),
+    ("steps-and-every", _fault('sensor = "radalt"\nkind = "iam"\nmagnitude = 3.0\nsteps = [10]\nevery = 5'),
+     "faults[0].every"),
+    ("pseudolite-unit-3", _fault(
+        'sensor = "pseudolite"\nkind = "step"\nchannel = 3\nmagnitude = 5.0',
+        "\n[sensors.pseudolite]\nenabled = true\n[[sensors.pseudolite.units]]\nalong_ft = 0.0\ncross_ft = -500.0\n"
+        "height_ft = 30.0\n"), "faults[0].channel: pseudolite unit index must be in [0, 0]"),
+    ("doppler-target-without-doppler",
+     _fault('sensor = "gnss"\nkind = "step"\ntarget = "pseudorange_rate"\nmagnitude = 0.5'), "faults[0].target"),
+    ("unfitted-sensor", _fault('sensor = "pseudolite"\nkind = "outage"'), "faults[0].sensor"),
+]
+
+
+@pytest.mark.parametrize("command", ["sense", "navigate", "evaluate"])
+@pytest.mark.parametrize(("case", "text", "must"), FAULT_CASES, ids=[c[0] for c in FAULT_CASES])
+def test_fault_misspecification_exits_2_with_one_line(tmp_path, capsys, command, case, text, must):
+    """Every fault mistake is caught when the profile loads, before anything flies, by every command."""
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    assert main([command, str(path), "--out", str(tmp_path / "out")]) == 2
+    _check(capsys.readouterr().err, must)
+    assert not (tmp_path / "out").exists()
+
+
+def test_fault_specifications_that_are_right_still_load(tmp_path):
+    """The checks reject mistakes only: a fault of each kind on its sensor, inside the run, loads."""
+    from approachsim.profile import load_profile
+
+    ok = [
+        'sensor = "gnss"\nkind = "outage"\nstart_s = 150.0\nend_s = 210.0',
+        'sensor = "gnss"\nkind = "step"\nchannel = 24\nmagnitude = 30.0\nstart_s = 100.0',
+        'sensor = "imu"\nkind = "step"\nchannel = 2\nmagnitude = 0.001\nstart_s = 100.0',
+        'sensor = "baro"\nkind = "ramp"\nrate = 0.1\nstart_s = 200.0',
+        'sensor = "radalt"\nkind = "spike"\nk = 100.0\nsteps = [101, 201]',
+        'sensor = "baro"\nkind = "mni"\nfactor = 4.0\nstart_s = 100.0\nend_s = 150.0',
+        'sensor = "baro"\nkind = "iam"\nmagnitude = 20.0\nstart_s = 100.0\nevery = 10',
+        'sensor = "gnss"\nkind = "cbm"\nmagnitude = 10.0\nstart_s = 250.0',  # late, but inside a 260 s run
+    ]
+    path = tmp_path / "ok.toml"
+    path.write_text(GOOD + "".join(f"\n[[faults]]\n{b}\n" for b in ok))
+    assert len(load_profile(path).faults) == len(ok)

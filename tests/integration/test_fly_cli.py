@@ -51,6 +51,8 @@ def test_fly_writes_truth_schema_and_figures(tmp_path, capsys):
     assert np.all(np.diff(t.t_s) > 0)
     flight = json.loads((out / "flight.json").read_text())
     assert flight["termination"] == "reached stop height" and flight["seed"] == 4
+    assert flight["truth_samples"] == len(t) == schema["samples"]  # flight.json agrees with truth.npz
+    assert 0 < flight["tracking_window_samples"] < len(t)  # the 1000-200 ft window only
 
 
 def test_same_seed_bit_identical_different_seed_different_turbulence(tmp_path):
