@@ -138,7 +138,7 @@ def exercise() -> dict[str, list[Key]]:
     full["terrain"] = {"distance_nmi": [10.0, 0.0], "height_ft": [13.0, 13.0]}
     full["evaluation"] = {}
     full["aircraft"].update(approach_speed_kt=140.0, flaps_norm=1.0)
-    full["environment"]["true_qnh_hPa"] = 1013.25
+    full["environment"]["qnh_setting_error_hPa"] = 0.0
     full["nav"]["filter_tuning"] = {}
     sizes = {"spike": {"k": 100.0, "every": 10}, "iam": {"magnitude": 10.0, "steps": [5]}, "cbm": {"magnitude": 1.0},
              "mni": {"factor": 4.0}, "step": {"magnitude": 1.0}, "ramp": {"rate": 0.1}, "outage": {}}
