@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from approachsim.commands.reproduce import reproduce
 from approachsim.nav import monitors as mon
 from approachsim.nav.ud import InfluenceFunction
 from approachsim.papers import chernodarov as ch
@@ -74,7 +75,7 @@ def test_nees_bounds_are_the_chi2_quantiles() -> None:
 
 @pytest.mark.slow
 def test_reproduce_writes_claims_numbers_and_figures(tmp_path: Path) -> None:
-    result = ch.reproduce(tmp_path, seed=5, runs=6)
+    result = reproduce("chernodarov", tmp_path, seed=5, runs=6)
     on_disk = json.loads((tmp_path / "chernodarov.json").read_text())
     assert on_disk["verdict"] == json.loads(json.dumps(result["verdict"]))
     assert set(on_disk["claims"]["ours"]["nees_consistency"]) == {"ekf"} | {f"robust-ud-{k}" for k in

@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from approachsim.commands.reproduce import reproduce
 from approachsim.papers import hajiyev_saltoglu as hs
 
 RUNS = 100
@@ -100,7 +101,7 @@ def test_seeding_is_reproducible_and_seed_dependent() -> None:
 
 @pytest.mark.slow
 def test_reproduce_writes_tables_note_and_figures(tmp_path) -> None:
-    result = hs.reproduce(tmp_path, seed=1, runs=8)
+    result = reproduce("hajiyev-saltoglu", tmp_path, seed=1, runs=8)
     data = json.loads((tmp_path / "hajiyev-saltoglu.json").read_text())
     assert data["verdict"] == result["verdict"]
     t1, t2 = data["tables"]["table1"], data["tables"]["table2"]

@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from approachsim.commands.reproduce import reproduce
 from approachsim.papers import manero_hajiyev as mh
 
 RUNS = 100
@@ -99,7 +100,7 @@ def test_seeding_is_reproducible() -> None:
 
 @pytest.mark.slow
 def test_reproduce_writes_tables_note_and_figures(tmp_path) -> None:
-    result = mh.reproduce(tmp_path, seed=1, runs=6)
+    result = reproduce("manero-hajiyev", tmp_path, seed=1, runs=6)
     data = json.loads((tmp_path / "manero-hajiyev.json").read_text())
     assert data["verdict"]["all_orders_match"] == result["verdict"]["all_orders_match"]
     for s, table in data["tables"].items():

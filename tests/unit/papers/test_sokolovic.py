@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from approachsim.commands.reproduce import reproduce
 from approachsim.nav import vertical_loop as vl
 from approachsim.papers import sokolovic as sk
 
@@ -77,7 +78,7 @@ def test_printed_constant_gains_are_stable_but_not_eq5() -> None:
 
 @pytest.mark.slow
 def test_reproduce_writes_the_tables_side_by_side(tmp_path: Path) -> None:
-    result = sk.reproduce(tmp_path, seed=1, runs=4)
+    result = reproduce("sokolovic", tmp_path, seed=1, runs=4)
     on_disk = json.loads((tmp_path / "sokolovic.json").read_text())
     assert on_disk["table_2"]["paper"] == sk.PAPER_TABLE_2
     ours = on_disk["table_2"]["ours"]
