@@ -104,7 +104,8 @@ def test_seeding_is_reproducible_and_seed_dependent() -> None:
 
 
 def _riccati(p: hs.Section7) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Prior S (innovation variance), gain K1 on dH_I and posterior P(1,1) per iteration 1..steps of the optimal KF, from the
+    """Prior S (innovation variance), gain K1 on dH_I and posterior P(1,1) per iteration 1..steps of the optimal
+    KF, from the
     textbook recursion written here: P- = F P F' + Q, S = h P- h' + R, K = P- h' / S, P = (I - K h) P-."""
     dt = p.dt_s
     F = np.eye(5)
