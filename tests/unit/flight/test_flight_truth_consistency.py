@@ -10,6 +10,7 @@ reproduce the recorded NED velocity within 0.05 m/s, and integrating the recorde
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,6 +19,8 @@ from approachsim import geo
 from approachsim.flight.run import Approach
 from approachsim.profile import load_profile
 
+PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+
 pytestmark = pytest.mark.slow
 
 DURATION_S = 60.0
@@ -25,7 +28,7 @@ DURATION_S = 60.0
 
 @pytest.fixture(scope="module")
 def flight():
-    profile = load_profile("profiles/default.toml")
+    profile = load_profile(PROFILES / "default.toml")
     assert profile.environment.turbulence == "light"
     return Approach(profile).fly(seed=3, run=0, max_time_s=DURATION_S)
 

@@ -4,6 +4,7 @@ status log and the NavSolution have the documented shapes; feedback and feed-for
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,7 +18,9 @@ from approachsim.profile import load_profile
 from approachsim.seeding import stream
 from approachsim.sensors.suite import SensorSuite
 
-PROFILE = load_profile("profiles/default.toml")
+PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+
+PROFILE = load_profile(PROFILES / "default.toml")
 
 
 def _truth(duration_s=60.0):
