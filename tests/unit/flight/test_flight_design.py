@@ -19,14 +19,16 @@ from approachsim.profile import load_profile
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 
+pytestmark = pytest.mark.slow  # trims and linearizes JSBSim for every shipped profile
+
 GM_MIN_DB = 6.0
 PM_MIN_DEG = 45.0
 
 
-PROFILES = ("default", "gray-maybeck", "hot-high-crosswind")
+NAMES = ("default", "gray-maybeck", "hot-high-crosswind")
 
 
-@pytest.fixture(scope="module", params=PROFILES)
+@pytest.fixture(scope="module", params=NAMES)
 def setup(request):
     profile = load_profile(PROFILES / f"{request.param}.toml")
     approach = Approach(profile)
