@@ -1,8 +1,10 @@
 """`approachsim reproduce PAPER --out DIR [--seed S] [--runs N]`: rerun a seed paper's own experiment.
 
-Each paper module provides `reproduce(out_dir: Path, *, seed: int, runs: int) -> dict`, which writes
-DIR/<paper>.json (the paper's table and ours side by side), its figures and a markdown note, and returns
-the JSON content. Papers are loaded lazily by name.
+The command composes the two stages: the paper module (`approachsim.papers.<name>`) computes and returns
+(`compute(*, seed, runs) -> (result, data)`, `note(result, figures) -> str`, `headline(result) -> list[str]`),
+the report module (`approachsim.report.papers_<name>`) draws the figures from `data`; this command writes
+DIR/<paper>.json (the paper's tables and ours side by side), DIR/<paper>.md (the reproduction note) and the
+figures, and prints a short summary and the paths. Papers are loaded lazily by name.
 """
 
 from __future__ import annotations
@@ -10,19 +12,47 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from approachsim.config import ProfileError
 
 PAPERS = {
-    "hajiyev-saltoglu": "approachsim.papers.hajiyev_saltoglu",
-    "manero-hajiyev": "approachsim.papers.manero_hajiyev",
-    "sokolovic": "approachsim.papers.sokolovic",
-    "chernodarov": "approachsim.papers.chernodarov",
+    "hajiyev-saltoglu": ("approachsim.papers.hajiyev_saltoglu", "approachsim.report.papers_hajiyev_saltoglu"),
+    "manero-hajiyev": ("approachsim.papers.manero_hajiyev", "approachsim.report.papers_manero_hajiyev"),
+    "sokolovic": ("approachsim.papers.sokolovic", "approachsim.report.papers_sokolovic"),
+    "chernodarov": ("approachsim.papers.chernodarov", "approachsim.report.papers_chernodarov"),
 }
-"""Paper name -> module with reproduce(out_dir, *, seed, runs)."""
+"""Paper name -> (module that computes, module that draws)."""
 
 DEFAULT_RUNS = 100
+
+
+def _figure_writer(name: str) -> Callable[[Any, Path], list[str]]:
+    """The report module's figure function for paper `name`, as f(data, out_dir) -> file names."""
+    rep = importlib.import_module(PAPERS[name][1])
+    if name == "hajiyev-saltoglu":
+        return lambda d, out: [f.name for f in rep.plot_all(out, *d)]
+    if name == "manero-hajiyev":
+        return lambda d, out: [f.name for f in rep.plot_all(out, *d)]
+    if name == "chernodarov":
+        return lambda d, out: rep.write_figures(*d, out)
+    return lambda d, out: rep.write_figures(d, out)
+
+
+def reproduce(name: str, out_dir: Path, *, seed: int, runs: int) -> dict:
+    """Compute paper `name`'s reproduction, draw its figures, write DIR/<name>.json and DIR/<name>.md; return
+    the JSON content (with the figure names under "figures")."""
+    paper = importlib.import_module(PAPERS[name][0])
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    result, data = paper.compute(seed=seed, runs=runs)
+    figures = _figure_writer(name)(data, out_dir)
+    result["figures"] = figures
+    (out_dir / f"{name}.json").write_text(json.dumps(result, indent=2))
+    (out_dir / f"{name}.md").write_text(paper.note(result, figures))
+    return result
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -36,16 +66,18 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run one reproduction and print where its results went."""
+    """Run one reproduction; print its headline findings and where the files went."""
     if args.paper not in PAPERS:
         raise ProfileError(f"paper: must be one of {', '.join(PAPERS)}; got {args.paper!r}")
     if args.runs < 1:
         raise ProfileError(f"--runs: must be >= 1, got {args.runs}")
     if args.seed < 0:
         raise ProfileError(f"--seed: must be >= 0, got {args.seed}")
-    module = importlib.import_module(PAPERS[args.paper])
-    args.out.mkdir(parents=True, exist_ok=True)
-    result = module.reproduce(args.out, seed=args.seed, runs=args.runs)
-    print(json.dumps(result.get("verdict", {}), indent=2))
-    print(f"wrote {args.out / (args.paper + '.json')}")
+    result = reproduce(args.paper, args.out, seed=args.seed, runs=args.runs)
+    paper = importlib.import_module(PAPERS[args.paper][0])
+    print(f"{args.paper}: {args.runs} runs, seed {args.seed}")
+    for line in paper.headline(result):
+        print(f"  {line}")
+    print(f"wrote {args.out / (args.paper + '.md')} (the note), {args.out / (args.paper + '.json')} (all numbers) "
+          f"and {len(result['figures'])} figure(s) in {args.out}")
     return 0

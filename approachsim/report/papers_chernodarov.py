@@ -1,4 +1,4 @@
-"""Figures of the seed-004 reproduction in the style of the paper's Figs. 1, 2 and 4, plus the NEES check.
+"""Figures of the Chernodarov reproduction in the style of the paper's Figs. 1, 2 and 4, plus the NEES check.
 
 Fig. 1: influence functions psi(beta) and psi'(beta); Fig. 2: the primary channel's signal (light) and the
 robust filter's estimate (dark), with the monitor's decisions; Fig. 4: drift and its estimate (deg/h);

@@ -1,4 +1,4 @@
-"""Figures of the Hajiyev & Saltoglu (seed 000) reproduction, in the style of the paper's Figures 2-7.
+"""Figures of the Hajiyev & Saltoglu reproduction, in the style of the paper's Figures 2-7.
 
 Figure 2/4/6 style: INS altitude error (solid) against the integrated system error (dotted) over the
 iterations, one realization (run 0) with the Monte Carlo RMS envelope of the integrated error. Figure 3/5/7

@@ -1,4 +1,4 @@
-"""Figures of the Manero Contreras & Hajiyev (seed 001) reproduction, in the style of the paper's Figures 4-6.
+"""Figures of the Manero Contreras & Hajiyev reproduction, in the style of the paper's Figures 4-6.
 
 One figure per scenario: top, the altitude-error estimates of the IBI, IIG and fused IBIG altimeters against
 the true INS altitude error (run 0, as the paper shows one realization); bottom, the Monte Carlo mean

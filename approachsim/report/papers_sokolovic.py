@@ -1,4 +1,4 @@
-"""Figures of the seed-003 reproduction in the style of the paper's Figs. 3, 5, 6 and 7.
+"""Figures of the Sokolovic, Dikic & Stancic reproduction in the style of the paper's Figs. 3, 5, 6 and 7.
 
 Fig. 3: altitude profile and baro error; Figs. 5-7: rms (over the Monte Carlo runs) of the altitude and
 velocity errors against time, constant vs tanh, constant vs sinh, tanh vs sinh; GPS gaps shaded.

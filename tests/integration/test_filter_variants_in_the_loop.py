@@ -16,10 +16,12 @@ from approachsim.nav.closed_loop import NavInTheLoop
 from approachsim.nav.registry import FILTERS
 from approachsim.profile import parse_profile
 
+PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+
 
 @pytest.fixture(scope="module")
 def approach_2nmi():
-    path = Path("profiles/default.toml")
+    path = PROFILES / "default.toml"
     data = tomllib.loads(path.read_text(encoding="utf-8"))
     data["runway"]["start_distance_nmi"] = 2.0
     return data, path

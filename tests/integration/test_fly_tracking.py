@@ -5,10 +5,21 @@
 - default profile in calm air: <= 1 ft both;
 - hot-high-crosswind: reaches 50 ft, vertical RMS <= 10 ft, lateral RMS <= 20 ft;
 - a biased navigation source moves the aircraft off the path by the bias (guidance really flies on it).
+
+The vertical deviation is recomputed here from the runway geometry in ECEF (independent of the truth's
+`gs_dev_m`, which uses the autopilot's `tch - x tan(gamma)` on the runway-frame coordinates): the threshold
+point and its local vertical from the WGS-84 formulas, the along-track distance x = (r - r_thr) . u_along,
+the ellipsoid height by fixed-point iteration (Hofmann-Wellenhof, Lichtenegger & Wasle, *GNSS*, eq. 5.48).
+The project's glidepath holds the height above the threshold's ellipsoid height at tch - x tan(gamma), so it
+follows the Earth's curvature; a straight-line glidepath in ECEF (as an ILS beam or an LPV / GLS final
+approach segment defines it) lies x^2 / (2 R) above it: 2.6 m at 1000 ft. Measured on the calm default
+approach, 1000-200 ft: 0.17 ft RMS against the project's glidepath, 3.7 ft RMS / 7.7 ft max (low) against
+the straight line (a finding reported to the lead, not a tolerance).
 """
 
 from __future__ import annotations
 
+import math
 import tomllib
 from pathlib import Path
 
@@ -22,6 +33,51 @@ from approachsim.profile import load_profile, parse_profile
 pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[2]
+
+
+A_WGS84_M = 6378137.0
+E2_WGS84 = 6.69437999014e-3
+
+
+def _ecef(lat: float, lon: float, h: float) -> np.ndarray:
+    n = A_WGS84_M / math.sqrt(1.0 - E2_WGS84 * math.sin(lat) ** 2)
+    return np.array([(n + h) * math.cos(lat) * math.cos(lon), (n + h) * math.cos(lat) * math.sin(lon),
+                     (n * (1.0 - E2_WGS84) + h) * math.sin(lat)])
+
+
+def _height_m(r: np.ndarray) -> np.ndarray:
+    """Ellipsoid height of ECEF points (n, 3) by fixed-point iteration on the latitude, m."""
+    p = np.hypot(r[:, 0], r[:, 1])
+    lat = np.arctan2(r[:, 2], p * (1.0 - E2_WGS84))
+    for _ in range(8):
+        n = A_WGS84_M / np.sqrt(1.0 - E2_WGS84 * np.sin(lat) ** 2)
+        h = p / np.cos(lat) - n
+        lat = np.arctan2(r[:, 2], p * (1.0 - E2_WGS84 * n / (n + h)))
+    return h
+
+
+def glidepath_deviation(r_ecef: np.ndarray, runway) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(height above threshold, deviation from the project's glidepath, deviation from the straight-line
+    glidepath), m, from ECEF positions and the runway's threshold, heading, glidepath angle and TCH."""
+    lat, lon = runway.threshold_lat_rad, runway.threshold_lon_rad
+    r_thr = _ecef(lat, lon, runway.elevation_m)
+    up = np.array([math.cos(lat) * math.cos(lon), math.cos(lat) * math.sin(lon), math.sin(lat)])
+    north = np.array([-math.sin(lat) * math.cos(lon), -math.sin(lat) * math.sin(lon), math.cos(lat)])
+    east = np.array([-math.sin(lon), math.cos(lon), 0.0])
+    u_along = math.cos(runway.heading_rad) * north + math.sin(runway.heading_rad) * east
+    x = (r_ecef - r_thr) @ u_along
+    path = runway.tch_m - x * math.tan(runway.glidepath_rad)
+    hat = _height_m(r_ecef) - runway.elevation_m
+    return hat, hat - path, (r_ecef - r_thr) @ up - path
+
+
+def _segment_rms_ft(r_ecef: np.ndarray, runway) -> tuple[float, float, float]:
+    """RMS deviation (ft) from the project's glidepath and from the straight line, and max from the line,
+    while the aircraft is between 1000 ft and 200 ft above the threshold."""
+    hat, dev, dev_line = glidepath_deviation(r_ecef, runway)
+    sel = (hat <= 1000.0 * units.FT) & (hat >= 200.0 * units.FT)
+    return (float(np.sqrt(np.mean(dev[sel] ** 2)) / units.FT), float(np.sqrt(np.mean(dev_line[sel] ** 2)) / units.FT),
+            float(np.max(np.abs(dev_line[sel])) / units.FT))
 
 
 def _calm_default():
@@ -44,7 +100,7 @@ def test_default_light_turbulence_ten_seeds():
               f"lateral RMS {s['lateral_rms_ft']:.2f} ft")
         assert r.termination == "reached stop height"
         assert s["samples"] > 5000  # the whole 800 ft segment was flown (about 80 s at 120 Hz)
-        assert s["vertical_rms_ft"] <= 5.0
+        assert _segment_rms_ft(r.truth.r_ecef, profile.runway)[0] <= 5.0  # from the ECEF geometry
         assert s["lateral_rms_ft"] <= 10.0
     # turbulence is really there: the seeds differ
     assert len({round(v, 6) for _, _, v, _ in rows}) == 10
@@ -54,10 +110,17 @@ def test_default_calm_air_within_one_foot():
     profile = _calm_default()
     r = Approach(profile).fly(seed=1)
     s = tracking_stats(r, profile)
-    print(s)
+    rms, rms_line, max_line = _segment_rms_ft(r.truth.r_ecef, profile.runway)
+    print(s, f"ECEF geometry: {rms:.2f} ft RMS; straight line {rms_line:.2f} ft RMS, {max_line:.2f} ft max")
     assert r.termination == "reached stop height"
-    assert s["vertical_rms_ft"] <= 1.0
+    assert rms <= 1.0
     assert s["lateral_rms_ft"] <= 1.0
+    # the truth's recorded deviation is the geometric one (bookkeeping: 5e-9 m measured)
+    _, dev, dev_line = glidepath_deviation(r.truth.r_ecef, profile.runway)
+    np.testing.assert_allclose(r.truth.gs_dev_m, dev, rtol=0, atol=1e-3)
+    # the straight-line path differs by the Earth's curvature x^2 / (2 R) (3.5 mm measured, R = 6371 km)
+    x = r.truth.r_rwy[:, 0]
+    assert np.max(np.abs((dev - dev_line) - x**2 / (2 * 6.371e6))[np.abs(x) < 10_000.0]) < 0.02
 
 
 def test_hot_high_crosswind_reaches_50_ft():

@@ -1,63 +1,62 @@
-"""Issue 4, acceptance "Adaptive damping" (seed 003 Table 2 ordering): on a vertical-manoeuvre profile with GPS
-gaps, altitude RMS error of the full navigation system with the 3rd-order baro loop in its three gain forms.
+"""Adaptive damping of the vertical channel (Sokolovic, Dikic & Stancic, Table 2 ordering) in the full navigation
+system: a pre-registered test.
 
-Paper's expected ordering (seed 003 Table 2, 100 runs, altitude rms): constant 1.11 m > tanh 0.91 m > sinh
-0.78 m. This test asserts the ordering the faithful implementation gives instead, with margins from the
-run-to-run spread (paired differences of the per-run mean-square errors and their standard errors).
+Pre-registration (fixed in this docstring before the runs below were made; the only earlier data were an
+exploratory run on campaign seed 3, not used here):
 
-Set-up (everything not printed in seed 003 is our choice, stated here and in approachsim/manoeuvre.py):
-* truth: manoeuvre.vertical_manoeuvre (exact increments), level at 600 m, +300 m / -60 m / -250 m / +40 m
-  legs (SEED003_LEGS), 520 s at 10 Hz (the IMU rate here: seed 003's receiver rate; the default profile's
-  120 Hz would cost 12x the CPU), 70 m/s ground speed along the default runway heading;
-* sensors: the default profile's own (nav-2.0 IMU, baro 10 Hz 1 m noise / 1 m 100 s Markov bias, tight P(Y)
-  GPS best-4 at 1 Hz) through SensorSuite, without the radar altimeter (seed 003's system is INS/GPS/baro,
-  and at 600-900 m the radalt would be in range and pin the height); GPS outages as `outage` faults over
-  SEED003_GAPS_S = 80-200 s and 320-480 s, each covering a large manoeuvre;
-* navigation: NavSystem with the profile's [nav] and baro_loop = constant / tanh / sinh at the config's
-  tau = 100 s (eq. 5) and b = 0.5 /m, adaptive amplitudes C_KF = C / b (same small-signal slope as the constant
-  loop, eq. 7 linearizes to eq. 3); the loop damps the INS at the IMU rate, the EKF (feed-forward, baro and
-  pseudoranges; only baro in the gaps) corrects the output; shared covariance across runs (one gain per
-  epoch, each run its own state and innovations); 100 runs, seed 3, the same sensor draws for all forms.
+* Claim under test (the paper's Table 2, altitude rms, 100 runs): constant 1.11 m > tanh 0.91 m > sinh 0.78 m.
+* Statistic: for each campaign seed and each pair (a, b) of loop forms, the paired difference
+  d_r = MS_a,r - MS_b,r of the per-run mean-square altitude error (m^2, over the 1 Hz epochs of run r; all forms
+  see the same sensor draws of run r: common random numbers), and t = mean(d) / (std(d) / sqrt(n)).
+* Significance level: two-sided alpha = 0.05 per comparison, t against the Student quantile with n - 1 degrees
+  of freedom; no multiplicity correction within a seed (the campaign verdict below needs every seed to agree).
+* Run count: RUNS = 20 runs per seed (runs 0..19), campaign seeds SEEDS = (101, 102, 103).
+* Per-seed verdict on the ordering constant > tanh > sinh: "reproduced" if d(constant - tanh) and
+  d(tanh - sinh) are both significantly > 0; "refuted" if either is significantly < 0; else "indeterminate".
+  Campaign verdict: the per-seed verdict if all three seeds agree, else "indeterminate".
+* Expected (from the exploratory seed-3 run): navigation output "refuted" (tanh worse than constant);
+  loop-damped INS alone (before the EKF's correction): sinh better than constant, tanh worst ("refuted").
+  The test fails on "reproduced" or a mixed reproduced / refuted campaign, passes on "refuted", and reports
+  "indeterminate" as an xfail with its numbers (a run count that cannot decide is not a finding).
+* Same filter form for all three loops: every loop is filtered per run (shared_covariance=False); the shared
+  covariance the constant loop allows is not used. The confound that remains, and is part of the claim, is
+  that the filter's error model is exact for the constant loop and a statistical linearization for tanh / sinh;
+  it is measured here as the mean normalized altitude error e_h^2 / P_hh per form (1 for a consistent filter).
 
-Measured (seed 3; altitude error at the 1 Hz epochs, RMS over epochs and runs; d = paired difference of the
-per-run mean squares, mean +- standard error; the constant loop's filter shares one covariance across runs,
-the adaptive loops' filters are per run, as NavSystem requires for their statistical linearization):
+Set-up (everything the paper does not print is our choice, stated here and in approachsim/manoeuvre.py):
+truth manoeuvre.vertical_manoeuvre (exact increments, SEED003_LEGS, 520 s at 10 Hz); the default profile's
+sensors without radar altimeter or pseudolite, GPS outages SEED003_GAPS_S; NavSystem with the profile's [nav]
+and baro_loop = constant / tanh / sinh at the profile's tau and b (never tuned).
 
-  navigation output (INS - EKF estimate; the issue's metric)   100 runs            25 runs (CI)
-    altitude rms constant / tanh / sinh                        0.970/1.078/0.992   0.997/1.109/1.014 m
-    d(tanh - constant)                                         +0.220 +- 0.050     +0.237 +- 0.116 m^2
-    d(tanh - sinh)                                             +0.177 +- 0.053     +0.203 +- 0.121 m^2
-    d(sinh - constant)                                         +0.043 +- 0.017     +0.033 +- 0.033 m^2
-    (gaps only: 1.002 / 1.114 / 1.010 m; d(sinh - constant) +0.016 +- 0.016 m^2)
-  loop-damped INS alone (output + the EKF's dp_D estimate)
-    altitude rms constant / tanh / sinh                        1.655/4.977/1.384   1.711/4.940/1.416 m
-    d(tanh - constant)                                         +22.0 +- 5.5        +21.5 +- 7.0 m^2
-    d(constant - sinh)                                         +0.82 +- 0.10       +0.92 +- 0.16 m^2
-    (max |error|: constant 12.2 m, tanh 56.5 m, sinh 8.9 m over 100 runs)
+Measured, the pre-registered run (python -m pytest tests/integration/test_nav_adaptive_damping.py -s -rx prints
+this table; 233 s CPU on the 2-core CI machine). d = paired mean difference of the per-run mean squares, m^2:
 
-Finding: the navigation output orders tanh > sinh > constant (paper: constant > tanh > sinh); the loop alone orders
-tanh > constant > sinh. tanh is the worst in both, sinh beats constant only before the EKF. Why (seed 003 eq. 3, 7,
-16): with C_KF = C / b the adaptive correction C_KF f(b e) has the constant loop's slope at e = 0; |tanh x| <= |x|
-makes the tanh loop *weaker* than the constant one at every loop error (effective gain tanh(b e) / (b e) = 0.92 at
-1 m, 0.76 at 2 m, 0.48 at 4 m), and its C2 branch cannot push more than C2 / b = 6.1e-4 m/s^2 (62 micro-g, barely
-above the nav-2.0 accelerometer turn-on bias, 50 micro-g 1 sigma), so the unstable channel wanders until the slow
-C3 integral catches up (5 m rms, 57 m max); sinh(x) >= x makes the sinh loop stiffer (1.04 at 1 m, 1.18 at 2 m,
-1.81 at 4 m), which cuts the large excursions (max 12.2 -> 8.9 m). The EKF then estimates the residual from the
-same baro (and GPS outside the gaps); the constant loop is the one the filter's linear model describes exactly,
-while the adaptive ones enter by statistical linearization (tanh is known over-confident: the strict xfail in
-tests/integration/test_nav_loop_consistency.py), so after the filter sinh's advantage is gone and tanh's loss
-remains. The paper's gains double the loop in the gaps (tanh C1KF = 0.06 = 2 C1 at an unprinted b), a different
-bandwidth rather than the nonlinearity; approachsim/papers/sokolovic.py finds tanh behind constant on the paper's
-own model too. Never tuned: tau and b are the profile's [nav] defaults.
+  navigation output   rms c / t / s (m)     d(c - t)  t      d(t - s)  t      d(c - s)  t      verdict
+    seed 101          1.094 / 1.187 / 1.096  -0.214  -1.5    +0.209  +1.2    -0.005  -0.1    indeterminate
+    seed 102          0.943 / 1.099 / 0.932  -0.318  -2.2    +0.340  +2.1    +0.022  +1.1    refuted
+    seed 103          0.979 / 1.155 / 0.968  -0.374  -2.0    +0.397  +2.1    +0.022  +0.6    indeterminate
+    campaign: INDETERMINATE (t_crit = 2.09 at 19 dof). tanh is worse than constant in all three seeds, significant
+    in one; sinh and constant are indistinguishable. The paper's ordering is reproduced in no seed.
+  loop-damped INS alone
+    seed 101          1.937 / 5.345 / 1.585  -24.8   -2.4    +26.1   +2.5    +1.24   +4.0    refuted
+    seed 102          1.616 / 3.355 / 1.409  -8.65   -2.3    +9.27   +2.4    +0.63   +5.2    refuted
+    seed 103          1.544 / 6.133 / 1.285  -35.2   -1.5    +36.0   +1.5    +0.73   +3.6    indeterminate
+    campaign: INDETERMINATE; sinh below constant significant in every seed (the pre-registered sub-claim holds).
+  filter confound, mean e_h^2 / P_hh of the output (c / t / s): 1.16 / 1.35 / 1.17, 0.86 / 1.17 / 0.84,
+    0.93 / 1.29 / 0.91: the tanh loop's filter is 25-35 % over-confident against the other two, which agree.
+    With the constant loop, the shared covariance and the per-run filter give the same output to
+    -1.8e-5 +- 1.8e-5 m^2 (10 runs, seed 3), so the former test's shared/per-run difference was not a confound.
 """
 
 from __future__ import annotations
 
-import os
 from dataclasses import replace
+from functools import cache
+from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy import stats
 
 from approachsim import manoeuvre
 from approachsim.nav.system import NavSystem
@@ -66,78 +65,115 @@ from approachsim.seeding import stream
 from approachsim.sensors.faults import FaultSpec
 from approachsim.sensors.suite import SensorSuite
 
-RUNS = int(os.environ.get("ADAPTIVE_DAMPING_RUNS", "25"))
-"""Runs 0 .. RUNS-1 (CI: 25, 55 s CPU measured; the issue's 100: ADAPTIVE_DAMPING_RUNS=100, 3.6 min CPU). A run's
-numbers do not depend on its batch, so the CI runs are the first 25 of the 100-run experiment."""
-SEED = 3
+PROFILE = Path(__file__).resolve().parents[2] / "profiles" / "default.toml"
+RUNS = 20
+SEEDS = (101, 102, 103)
+ALPHA = 0.05
 RATE_HZ = 10.0
 FORMS = ("constant", "tanh", "sinh")
 PAPER_RMS_M = {"constant": 1.11, "tanh": 0.91, "sinh": 0.78}
-"""Seed 003 Table 2 altitude rms (m): the expected ordering constant > tanh > sinh."""
+"""Table 2 altitude rms (m): the claimed ordering constant > tanh > sinh."""
 
 
-def run_forms() -> tuple[dict, dict, np.ndarray]:
-    """Per form: (runs, epochs) altitude error (m, up) of the navigation output and of the loop-damped INS
-    alone (output + the EKF's estimate), and the epochs' gap mask."""
-    prof = load_profile("profiles/default.toml")
+@cache
+def run_seed(seed: int) -> dict:
+    """Per form: per-run mean-square altitude error (m^2) of the navigation output and of the loop-damped INS
+    alone (output + the EKF's estimate), and the mean normalized altitude error e_h^2 / P_hh of the output."""
+    prof = load_profile(PROFILE)
     rw = prof.runway.frame
     truth = manoeuvre.vertical_manoeuvre(rw, rate_hz=RATE_HZ, isa_dev_k=prof.environment.isa_dev_k,
                                          sea_level_pa=prof.environment.true_qnh_pa)
     sensors = replace(prof.sensors, radalt=None, pseudolite=None)
     faults = tuple(FaultSpec("gnss", "outage", a, b) for a, b in manoeuvre.SEED003_GAPS_S)
     recs = SensorSuite.from_config(sensors, rw, prof.environment.qnh_pa, faults).measure(
-        truth, seed=SEED, runs=range(RUNS))
-    assert not recs["gnss"].valid[:, (recs["gnss"].t_s >= 100.0) & (recs["gnss"].t_s < 180.0)].any()
-    out, raw = {}, {}
+        truth, seed=seed, runs=range(RUNS))
+    out: dict = {"output": {}, "ins_alone": {}, "normalized": {}}
     for form in FORMS:
         nav = NavSystem.build(replace(prof.nav, baro_loop=form), sensors, rw, prof.terrain)
-        # one shared covariance is exact for the constant loop (linear error model); NavSystem filters the
-        # adaptive loops per run (their statistical linearization depends on each run's estimate)
-        runs = nav.run(truth, recs, [stream(SEED, r, "nav") for r in range(RUNS)],
-                       shared_covariance=form == "constant")
-        out[form] = -np.stack([r.true_error_nav[:, 2] for r in runs])  # h error = -dp_D
-        raw[form] = -np.stack([r.true_error_nav[:, 2] + r.x[:, 2] for r in runs])  # INS = output + x_hat
-    t = runs[0].t_epoch_s
-    gap = np.zeros(t.shape, dtype=bool)
-    for a, b in manoeuvre.SEED003_GAPS_S:
-        gap |= (t >= a) & (t < b)
-    return out, raw, gap
+        runs = nav.run(truth, recs, [stream(seed, r, "nav") for r in range(RUNS)], shared_covariance=False)
+        e_out = np.stack([r.true_error_nav[:, 2] for r in runs])  # dp_D of the output, m
+        e_ins = np.stack([r.true_error_nav[:, 2] + r.x[:, 2] for r in runs])  # INS = output + x_hat
+        p_dd = np.stack([r.P_nav[:, 2, 2] for r in runs])
+        out["output"][form] = (e_out**2).mean(axis=1)
+        out["ins_alone"][form] = (e_ins**2).mean(axis=1)
+        out["normalized"][form] = float((e_out**2 / p_dd).mean())
+    return out
 
 
-@pytest.fixture(scope="module")
-def altitude_errors():
-    """run_forms(), once for the module."""
-    return run_forms()
-
-
-def _paired(ms_a, ms_b):
+def paired_t(ms_a: np.ndarray, ms_b: np.ndarray) -> tuple[float, float, str]:
+    """(mean d, t, relation) of d = ms_a - ms_b: '>' / '<' if |t| exceeds the two-sided ALPHA Student quantile."""
     d = ms_a - ms_b
-    return d.mean(), d.std(ddof=1) / np.sqrt(d.size)
+    se = d.std(ddof=1) / np.sqrt(d.size)
+    t = float(d.mean() / se)
+    crit = stats.t.isf(ALPHA / 2, d.size - 1)
+    return float(d.mean()), t, ">" if t > crit else "<" if t < -crit else "~"
+
+
+def ordering_verdict(ms: dict[str, np.ndarray]) -> str:
+    """Per-seed verdict on the claimed ordering constant > tanh > sinh (the pre-registered rule)."""
+    steps = [paired_t(ms["constant"], ms["tanh"])[2], paired_t(ms["tanh"], ms["sinh"])[2]]
+    if "<" in steps:
+        return "refuted"
+    return "reproduced" if steps == [">", ">"] else "indeterminate"
+
+
+def campaign_verdict(verdicts: list[str]) -> str:
+    """The common per-seed verdict, or 'indeterminate' when the seeds disagree."""
+    return verdicts[0] if len(set(verdicts)) == 1 else "indeterminate"
+
+
+def _table(kind: str) -> list[str]:
+    lines = []
+    for seed in SEEDS:
+        ms = run_seed(seed)[kind]
+        rms = " / ".join(f"{np.sqrt(ms[f].mean()):.3f}" for f in FORMS)
+        pairs = "; ".join(f"{a}-{b} {m:+.3f} m^2 t={t:+.1f} {rel}" for a, b in
+                          (("constant", "tanh"), ("tanh", "sinh"), ("constant", "sinh"))
+                          for m, t, rel in [paired_t(ms[a], ms[b])])
+        norm = " / ".join(f"{run_seed(seed)['normalized'][f]:.2f}" for f in FORMS)
+        lines.append(f"seed {seed}: rms c/t/s {rms} m; {pairs}; verdict {ordering_verdict(ms)}; "
+                     f"e_h^2/P_hh c/t/s {norm}")
+    return lines
+
+
+def _decide(kind: str) -> None:
+    verdicts = [ordering_verdict(run_seed(s)[kind]) for s in SEEDS]
+    table = "\n".join(_table(kind))
+    print(f"\n{kind}:\n{table}")
+    overall = campaign_verdict(verdicts)
+    assert overall != "reproduced" and not {"reproduced", "refuted"} <= set(verdicts), table
+    if overall == "indeterminate":
+        pytest.xfail(f"indeterminate at {RUNS} runs x {len(SEEDS)} seeds: {verdicts}\n{table}")
+    assert overall == "refuted", table
+
+
+def test_verdict_rules_on_constructed_samples() -> None:
+    """The decision rule itself, on samples whose answer is known: a clear ordering, a reversal, pure noise."""
+    rng = np.random.default_rng(0)
+    base = rng.normal(1.0, 0.1, RUNS)
+    noise = rng.normal(0.0, 0.01, (3, RUNS))
+    paper_like = {"constant": base + 0.3 + noise[0], "tanh": base + 0.15 + noise[1], "sinh": base + noise[2]}
+    assert ordering_verdict(paper_like) == "reproduced"
+    reversed_ = {"constant": base + noise[0], "tanh": base + 0.3 + noise[1], "sinh": base + 0.1 + noise[2]}
+    assert ordering_verdict(reversed_) == "refuted"
+    same = {f: base + noise[i] for i, f in enumerate(FORMS)}
+    assert ordering_verdict(same) == "indeterminate"
+    assert campaign_verdict(["refuted"] * 3) == "refuted"
+    assert campaign_verdict(["refuted", "indeterminate", "refuted"]) == "indeterminate"
 
 
 @pytest.mark.slow
-def test_navigation_output_altitude_rms_ordering(altitude_errors):
-    """The issue's metric. Paper: constant > tanh > sinh. Faithful system: tanh > sinh > constant."""
-    errs, _, _ = altitude_errors
-    ms = {f: (e**2).mean(axis=1) for f, e in errs.items()}  # per-run mean square, m^2
-    rms = {f: float(np.sqrt(m.mean())) for f, m in ms.items()}
-    # the navigation works at all: altitude RMS at the baro's 1 m level, not a diverged vertical channel
-    assert all(0.5 < r < 2.0 for r in rms.values()), rms
-    d, se = _paired(ms["tanh"], ms["constant"])
-    assert d > 1.5 * se, (d, se, rms)  # finding: tanh WORSE than constant (paper: better); 2.0 / 4.4 SE
-    d, se = _paired(ms["tanh"], ms["sinh"])
-    assert d > 1.5 * se, (d, se, rms)  # tanh worse than sinh (as the paper); 1.7 / 3.3 SE at 25 / 100 runs
-    d, se = _paired(ms["sinh"], ms["constant"])
-    assert d > 0.5 * se, (d, se, rms)  # finding: sinh does not beat constant (paper: best); 1.0 / 2.5 SE
-    assert not (rms["constant"] > rms["tanh"] > rms["sinh"]), (rms, PAPER_RMS_M)
+def test_navigation_output_altitude_ordering_preregistered() -> None:
+    """The issue's metric (navigation output). Expected: refuted (tanh worse than constant)."""
+    for seed in SEEDS:  # the navigation works at all: altitude rms at the baro's 1 m level, not diverged
+        assert all(0.5 < np.sqrt(m.mean()) < 2.0 for m in run_seed(seed)["output"].values())
+    _decide("output")
 
 
 @pytest.mark.slow
-def test_loop_damped_ins_alone_sinh_beats_constant_and_tanh_is_worst(altitude_errors):
-    """Before the EKF's correction: seed 003's sinh claim holds, its tanh claim does not."""
-    _, raw, _ = altitude_errors
-    ms = {f: (e**2).mean(axis=1) for f, e in raw.items()}
-    d, se = _paired(ms["constant"], ms["sinh"])
-    assert d > 3.0 * se, (d, se)  # 5.6 / 8.3 SE at 25 / 100 runs
-    d, se = _paired(ms["tanh"], ms["constant"])
-    assert d > 2.5 * se, (d, se)  # 3.1 / 4.0 SE
+def test_loop_damped_ins_alone_ordering_preregistered() -> None:
+    """Before the EKF's correction. Expected: refuted (tanh worst), with sinh below constant in every seed."""
+    for seed in SEEDS:
+        ms = run_seed(seed)["ins_alone"]
+        assert paired_t(ms["constant"], ms["sinh"])[2] == ">", _table("ins_alone")
+    _decide("ins_alone")

@@ -2,17 +2,21 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from approachsim.cli import main
+
+PROFILES = Path(__file__).resolve().parents[2] / "profiles"
 
 
 @pytest.mark.parametrize(
     ("argv", "needle"),
     [
         (["navigate", "profiles/none.toml", "--out", "OUT"], "no such file"),
-        (["navigate", "profiles/default.toml", "--out", "OUT", "--seed", "-1"], "--seed"),
-        (["navigate", "profiles/default.toml", "--out", "OUT", "--run", "-2"], "--run"),
+        (["navigate", str(PROFILES / "default.toml"), "--out", "OUT", "--seed", "-1"], "--seed"),
+        (["navigate", str(PROFILES / "default.toml"), "--out", "OUT", "--run", "-2"], "--run"),
         (["navigate", "BAD", "--out", "OUT"], "nav.filter"),
         (["navigate", "TUNE", "--out", "OUT"], "nav.filter_tuning.gate"),
         (["navigate", "RATE", "--out", "OUT"], "nav.aiding_rate_hz"),
@@ -37,5 +41,5 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, needle):
 
 def test_bad_mode_is_an_argparse_error(capsys):
     with pytest.raises(SystemExit) as e:
-        main(["navigate", "profiles/default.toml", "--out", "x", "--mode", "sideways"])
+        main(["navigate", str(PROFILES / "default.toml"), "--out", "x", "--mode", "sideways"])
     assert e.value.code == 2

@@ -16,10 +16,12 @@ from approachsim.flight.run import Approach
 from approachsim.nav.closed_loop import NavInTheLoop, approach_errors, path_deviation
 from approachsim.profile import parse_profile
 
+PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+
 
 @pytest.fixture(scope="module")
 def flown():
-    path = Path("profiles/default.toml")
+    path = PROFILES / "default.toml"
     data = tomllib.loads(path.read_text(encoding="utf-8"))
     data["runway"]["start_distance_nmi"] = 3.0
     prof = parse_profile(data, source=path.resolve())

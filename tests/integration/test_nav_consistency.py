@@ -6,6 +6,8 @@ have fails here."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.stats import chi2
@@ -16,13 +18,15 @@ from approachsim.profile import load_profile
 from approachsim.seeding import stream
 from approachsim.sensors.suite import SensorSuite
 
+PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+
 RUNS = 100
 SEED = 1
 
 
 @pytest.fixture(scope="module")
 def runs():
-    prof = load_profile("profiles/default.toml")
+    prof = load_profile(PROFILES / "default.toml")
     truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 90.0,
                                         ground_speed_mps=70.0)
     recs = SensorSuite.from_profile(prof).measure(truth, seed=SEED, runs=range(RUNS))

@@ -17,6 +17,8 @@ full GPS geometry history are in.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.stats import chi2
@@ -27,13 +29,15 @@ from approachsim.profile import load_profile
 from approachsim.seeding import stream
 from approachsim.sensors.suite import SensorSuite
 
+PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+
 RUNS = 100
 SEED = 1
 
 
 def fly_and_sense():
     """The default profile flown once (seed SEED, run 0) and RUNS seeded sensor realizations on its truth."""
-    prof = load_profile("profiles/default.toml")
+    prof = load_profile(PROFILES / "default.toml")
     assert prof.environment.turbulence == "light"
     flight = Approach(prof).fly(seed=SEED, run=0)
     assert flight.termination == "reached stop height"

@@ -14,6 +14,7 @@ the IMU point (docs/truth.md). Before, with Somigliana normal gravity, the INS d
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,9 +29,11 @@ from approachsim.seeding import stream
 from approachsim.sensors.imu import true_increments
 from approachsim.sensors.suite import SensorSuite
 
+PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+
 pytestmark = pytest.mark.slow
 
-PROFILE = load_profile("profiles/default.toml")
+PROFILE = load_profile(PROFILES / "default.toml")
 
 
 @pytest.fixture(scope="module")

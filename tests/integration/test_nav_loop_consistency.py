@@ -6,6 +6,7 @@ for >= 90 % of the epochs (20 runs, default sensors, shared synthetic glidepath)
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,6 +17,8 @@ from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream
 from approachsim.sensors.suite import SensorSuite
+
+PROFILES = Path(__file__).resolve().parents[2] / "profiles"
 
 RUNS = 20
 
@@ -33,7 +36,7 @@ RUNS = 20
     ],
 )
 def test_filter_with_damping_loop_is_consistent(form):
-    prof = load_profile("profiles/default.toml")
+    prof = load_profile(PROFILES / "default.toml")
     truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 90.0,
                                         ground_speed_mps=70.0)
     recs = SensorSuite.from_profile(prof).measure(truth, seed=1, runs=range(RUNS))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,6 +11,8 @@ from scipy import stats as sps
 
 from approachsim.campaign.regress import compare, f_band
 from approachsim.cli import main
+
+PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 
 SUMMARY = {
     "schema": "approachsim.summary/1", "profile": "p", "runs": 8, "seed": 7, "closed_loop": False,
@@ -67,7 +70,7 @@ def test_verdict_and_failures_are_regressions():
         (["--workers", "0"], "--workers"),
         (["--runs", "0"], "--runs"),
         (["--seed", "-1"], "--seed"),
-        (["--add", "profiles/default.toml"], "--add"),
+        (["--add", str(PROFILES / "default.toml")], "--add"),
         (["--update", "--add", "/nonexistent.toml"], "--add"),
         (["--mode", "x"], "--mode"),
     ],

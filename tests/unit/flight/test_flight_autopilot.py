@@ -4,6 +4,7 @@ each loop's response, checked without JSBSim."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -12,13 +13,15 @@ from approachsim.flight.aircraft import load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.profile import load_profile
 
+PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+
 GP = math.radians(3.0)
 TCH = 50.0 * units.FT
 
 
 @pytest.fixture()
 def ap():
-    ac = load_aircraft(load_profile("profiles/default.toml"))
+    ac = load_aircraft(load_profile(PROFILES / "default.toml"))
     geom = Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0)
     return Autopilot(ac.gains, Trim(theta_rad=0.02, throttle=0.47, cas_mps=72.0), geom, 1.0 / 120.0)
 
@@ -61,7 +64,7 @@ def test_slow_adds_throttle_and_sideslip_gets_rudder(ap):
 
 def test_meridian_convergence_rotates_the_runway_axes():
     """East of the threshold at 60 N, flying the runway's true heading is not flying parallel to it."""
-    ac = load_aircraft(load_profile("profiles/default.toml"))
+    ac = load_aircraft(load_profile(PROFILES / "default.toml"))
     lat = math.radians(60.0)
     ap = Autopilot(ac.gains, Trim(0.0, 0.5, 72.0), Geometry(0.0, GP, TCH, lat), 1 / 120)
     # 10 km east of a north-pointing runway: the local north differs by 10e3 tan(60 deg)/R ~ 0.156 deg

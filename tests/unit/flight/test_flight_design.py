@@ -8,6 +8,7 @@ phase margin >= 45 deg (python-control stability_margins), and the fully closed 
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,16 +17,20 @@ from approachsim.flight import design
 from approachsim.flight.run import Approach
 from approachsim.profile import load_profile
 
+PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+
+pytestmark = pytest.mark.slow  # trims and linearizes JSBSim for every shipped profile
+
 GM_MIN_DB = 6.0
 PM_MIN_DEG = 45.0
 
 
-PROFILES = ("default", "gray-maybeck", "hot-high-crosswind")
+NAMES = ("default", "gray-maybeck", "hot-high-crosswind")
 
 
-@pytest.fixture(scope="module", params=PROFILES)
+@pytest.fixture(scope="module", params=NAMES)
 def setup(request):
-    profile = load_profile(f"profiles/{request.param}.toml")
+    profile = load_profile(PROFILES / f"{request.param}.toml")
     approach = Approach(profile)
     return approach.linearization, approach.aircraft, profile.runway.glidepath_rad
 

@@ -8,6 +8,7 @@ must give what the per-run EKF gives, to a small fraction of the estimated sigma
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,7 +19,9 @@ from approachsim.profile import load_profile
 from approachsim.seeding import stream
 from approachsim.sensors.suite import SensorSuite
 
-PROFILE = load_profile("profiles/default.toml")
+PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+
+PROFILE = load_profile(PROFILES / "default.toml")
 
 
 def _truth(duration_s: float):
@@ -55,7 +58,7 @@ def test_shared_runs_bit_identical_in_any_batch_also_with_a_departing_schedule()
     np.testing.assert_array_equal(batch[0].P_diag, batch[2].P_diag)  # same schedule: one covariance
 
 
-@pytest.mark.parametrize("path", ["profiles/default.toml", "profiles/gray-maybeck.toml"])  # GPS; + pseudolite
+@pytest.mark.parametrize("path", [PROFILES / "default.toml", PROFILES / "gray-maybeck.toml"])  # GPS; + pseudolite
 def test_shared_matches_per_run_filters_to_a_small_fraction_of_sigma(path):
     prof = load_profile(path)
     truth = _truth(20.0)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from fractions import Fraction
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,6 +23,8 @@ from approachsim.nav.ud import (
     thornton_predict,
     ud_factor,
 )
+
+PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 
 
 def _spd(rng: np.random.Generator, n: int) -> np.ndarray:
@@ -251,7 +254,7 @@ def test_ud_variants_run_inside_the_navigation_system_named_in_the_profile() -> 
     from approachsim.seeding import stream
     from approachsim.sensors.suite import SensorSuite
 
-    profile = load_profile("profiles/default.toml")
+    profile = load_profile(PROFILES / "default.toml")
     truth = synthetic.glidepath_descent(profile.runway.frame, rate_hz=20.0, start_distance_m=70.0 * 20,
                                         ground_speed_mps=70.0)
     recs = SensorSuite.from_profile(profile).measure(truth, seed=3, runs=0)
