@@ -15,9 +15,9 @@ On a linear time-invariant model with one scalar measurement per step:
 3. Zero innovation leaves the state estimate unchanged.
 4. Gain weight at a given innovation. One update with normalized innovation b = nu / sqrt(S): the gated and
    adaptive RKFs give P+ = P- - w(b) K S K' (K = P- h' / S; Hajiyev & Saltoglu eq. 23, Manero Contreras &
-   Hajiyev eq. 25, 29); the robust U-D filters (Chernodarov sec. 4) scale the measurement's information by
-   psi'(b), i.e. a Kalman update with r / psi' (P unchanged when psi' = 0). w(b) and psi'(b) are written
-   here from the papers.
+   Hajiyev eq. 25, 29); the robust U-D filters (Chernodarov sec. 4, residual scaled by sqrt(S)) likewise
+   P- - psi'(b) K S K' (P unchanged when psi' = 0). w(b) and psi'(b) are written here from the papers.
+   The step-length property (no robust step longer than the Kalman one) is in test_robust_step.py.
 """
 
 from __future__ import annotations
@@ -145,9 +145,8 @@ def test_gain_weight_follows_the_papers_rule_at_the_innovation(name: str, b: flo
     z = float(H_ROW @ state.x + b * np.sqrt(S))
     new, _ = f.update(state, ScalarMeasurement(z=z, h=H_ROW, r=R_M2, name="pos"))
     w = expected_weight(name, b)
-    if name.startswith("robust-ud"):  # psi' scales the information: Kalman update with r / psi'
-        expected = P if w == 0.0 else P - np.outer(P @ H_ROW, H_ROW @ P) / (H_ROW @ P @ H_ROW + R_M2 / w)
-    else:
-        K = P @ H_ROW / S
-        expected = P - w * S * np.outer(K, K)
+    # every robust variant: P+ = P - w K S K' (RKF eq. 29; robust U-D with the residual scaled by sqrt(S),
+    # nav/ud.py: psi' = w; the former sqrt(r) scaling, a Kalman update with r / psi', fails here at b = 2.5)
+    K = P @ H_ROW / S
+    expected = P - w * S * np.outer(K, K)
     np.testing.assert_allclose(f.covariance(new), expected, rtol=1e-9, atol=1e-12)

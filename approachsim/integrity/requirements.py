@@ -1,0 +1,145 @@
+"""Integrity requirements per approach category and the multipliers and thresholds derived from them.
+
+Numbers (the project's reference notes, integrity-envelope.md sec. 1-3, with their confidence marks):
+
+| category | integrity risk | exposure | TTA | continuity risk | LAL / VAL at DH |
+|---|---|---|---|---|---|
+| CAT I (GAST-C) | 2e-7 / approach [S] | 150 s [S] | 6 s [V] | 8e-6 / 15 s [V] | 40 / 10 m, scaled (*) [V] |
+| CAT II, III (GAST-D) | 1e-9 / 15 s (vert.) [S] | 15 s | 2 s [S] | 8e-6 / 15 s [S] | 17 / 10 m [S] |
+
+(*) with distance and height, Annex 10 App. B Tables B-68 / B-69.
+
+[V]: ICAO Annex 10 Vol I (2006 copy); [S]: RTCA DO-245A Table 2-1 via Pullen (Stanford) slides: check against
+the standards before a certification claim rests on them.
+
+Derived here (each a function with its equation):
+
+* effective independent samples over the exposure N_es = exposure / TTA (ARAIM ADD v4.2 practice);
+* the integrity risk split evenly between the fault-free (H0) and the faulted (H1) hypotheses and between the
+  vertical and lateral axes;
+* fault-free multiplier K_ff = Q^-1(P_H0 / (2 N_es)) (two-sided Gaussian tail per effective sample;
+  Q^-1 = scipy.stats.norm.isf);
+* false-alert probability per test and filter epoch from the continuity budget: the budget per 15 s spread
+  over the epochs in 15 s (1 Hz filter: 15) and the monitors' tests: P_fa = C / (15 f n_tests); the
+  chi-square residual threshold chi2.isf(P_fa, dof) and the solution-separation threshold
+  K_fa = Q^-1(P_fa / 2);
+* missed-detection multiplier K_md = Q^-1(P_H1 / (N_es P_fault)) with the prior probability of a satellite
+  fault per approach P_fault (1e-5 per satellite, the ARAIM ISM value [S]).
+
+With the CAT I numbers this gives K_ff = 6.00 (a two-sided tail of 2e-9 per effective sample), K_md = 3.54 and,
+at 1 Hz with six tests, K_fa = 5.35; CAT II/III K_ff = 6.63, K_md = 4.50: against the SBAS K_V = 5.33 (1e-7)
+the project used for every category before.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from types import MappingProxyType
+
+import numpy as np
+from scipy.stats import chi2, norm
+
+from approachsim import units
+
+
+@dataclass(frozen=True)
+class IntegrityRequirement:
+    """One category's integrity requirement (SI)."""
+
+    category: str
+    integrity_risk: float
+    """Probability of hazardously misleading information over the exposure (both axes, all hypotheses)."""
+    exposure_s: float
+    time_to_alert_s: float
+    continuity_risk_per_15s: float
+    lal_m: float
+    """Lateral alert limit at the decision height (CAT I: at the threshold end of Table B-68's scaling), m."""
+    val_m: float
+    """Vertical alert limit at the decision height, m."""
+    scaled: bool
+    """True: the alert limits grow with distance / height as Annex 10 App. B Tables B-68 / B-69."""
+    p_fault_per_sat: float = 1e-5
+    """Prior probability of a satellite fault over an approach (ARAIM ISM P_sat, [S])."""
+
+    @property
+    def n_es(self) -> float:
+        """Effective independent samples over the exposure: exposure / time to alert."""
+        return max(1.0, self.exposure_s / self.time_to_alert_s)
+
+    def p_h0_axis(self) -> float:
+        """Fault-free integrity allocation of one axis over the exposure: risk / 4 (H0/H1, vertical/lateral)."""
+        return self.integrity_risk / 4.0
+
+    def k_ff(self) -> float:
+        """Fault-free multiplier K_ff = Q^-1(P_H0,axis / (2 N_es))."""
+        return float(norm.isf(self.p_h0_axis() / (2.0 * self.n_es)))
+
+    def p_fa(self, epoch_hz: float, n_tests: int) -> float:
+        """False-alert probability per test and epoch: continuity budget / (15 s x rate x tests)."""
+        if epoch_hz <= 0 or n_tests < 1:
+            raise ValueError("epoch_hz must be > 0 and n_tests >= 1")
+        return self.continuity_risk_per_15s / (15.0 * epoch_hz * n_tests)
+
+    def chi2_threshold(self, dof: int, epoch_hz: float, n_tests: int = 1) -> float:
+        """Residual-test threshold on the normalized innovation squared sum, chi2.isf(P_fa, dof)."""
+        return float(chi2.isf(self.p_fa(epoch_hz, n_tests), dof))
+
+    def k_fa(self, epoch_hz: float, n_tests: int) -> float:
+        """Solution-separation threshold multiplier K_fa = Q^-1(P_fa / 2) (two-sided)."""
+        return float(norm.isf(self.p_fa(epoch_hz, n_tests) / 2.0))
+
+    def k_md(self) -> float:
+        """Missed-detection multiplier K_md = Q^-1(P_H1,axis / (N_es P_fault)), at least 0."""
+        p = self.p_h0_axis() / (self.n_es * self.p_fault_per_sat)
+        return float(norm.isf(min(p, 0.5)))
+
+
+REQUIREMENTS = MappingProxyType({
+    "CAT I": IntegrityRequirement("CAT I", 2e-7, 150.0, 6.0, 8e-6, 40.0, 10.0, True),
+    "CAT II": IntegrityRequirement("CAT II", 1e-9, 15.0, 2.0, 8e-6, 17.0, 10.0, False),
+    "CAT III": IntegrityRequirement("CAT III", 1e-9, 15.0, 2.0, 8e-6, 17.0, 10.0, False),
+})
+"""Integrity requirements by category (module docstring table)."""
+
+
+def lateral_alert_limit_m(req: IntegrityRequirement, distance_m: np.ndarray | float) -> np.ndarray:
+    """Lateral alert limit (m) at horizontal distance D (m) from the landing threshold along the final approach
+    path. Scaled (CAT I, Annex 10 App. B Table B-68, FASLAL = req.lal_m): FASLAL for D <= 873 m,
+    0.0044 D + FASLAL - 3.85 for 873 < D <= 7500 m, FASLAL + 29.15 beyond. Otherwise constant."""
+    d = np.abs(np.asarray(distance_m, dtype=float))
+    if not req.scaled:
+        return np.full_like(d, req.lal_m)
+    return np.where(d <= 873.0, req.lal_m, np.where(d <= 7500.0, 0.0044 * d + req.lal_m - 3.85, req.lal_m + 29.15))
+
+
+def vertical_alert_limit_m(req: IntegrityRequirement, height_m: np.ndarray | float) -> np.ndarray:
+    """Vertical alert limit (m) at height H above the threshold on the final approach path. Scaled (CAT I,
+    Annex 10 App. B Table B-69, FASVAL = req.val_m): FASVAL for H <= 200 ft, 0.02925 H(ft) + FASVAL - 5.85 for
+    200 < H <= 1340 ft, FASVAL + 33.35 above (the table starts at 100 ft; below, FASVAL is kept)."""
+    h_ft = np.asarray(height_m, dtype=float) / units.FT
+    if not req.scaled:
+        return np.full_like(h_ft, req.val_m)
+    return np.where(h_ft <= 200.0, req.val_m,
+                    np.where(h_ft <= 1340.0, 0.02925 * h_ft + req.val_m - 5.85, req.val_m + 33.35))
+
+
+def gaussian_tail_two_sided(k: float) -> float:
+    """P(|X| > k sigma) of a Gaussian, 2 Q(k): the probability a multiplier k stands for."""
+    return float(2.0 * norm.sf(k))
+
+
+def describe(req: IntegrityRequirement, epoch_hz: float = 1.0, n_tests: int = 1) -> dict[str, float]:
+    """The derived numbers of one category (for reports): K_ff, K_md, K_fa, P_fa, N_es."""
+    return {
+        "k_ff": req.k_ff(),
+        "k_md": req.k_md(),
+        "k_fa": req.k_fa(epoch_hz, n_tests),
+        "p_fa_per_test_epoch": req.p_fa(epoch_hz, n_tests),
+        "n_es": req.n_es,
+        "time_to_alert_s": req.time_to_alert_s,
+        "lal_at_dh_m": req.lal_m,
+        "val_at_dh_m": req.val_m,
+        "tail_k_ff": gaussian_tail_two_sided(req.k_ff()),
+        "log10_integrity_risk": math.log10(req.integrity_risk),
+    }
