@@ -62,7 +62,9 @@ class NavInTheLoop:
         self.s: ins.InsState | None = None
         self.runs: list = []
         self.h_baro_hold = math.nan
-        self.f_sum = np.zeros(3)
+        self.f_sum = np.zeros((1, 3))
+        self._dth, self._dv = np.zeros((1, 1, 3)), np.zeros((1, 1, 3))  # the kernel's inputs, reused per step
+        self._bg, self._ba, self._hb = np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 1))
         self.t_last = 0.0
         self.out: dict[str, list] = {k: [] for k in ("lat", "lon", "h", "v", "c", "snap")}
         self.snaps: list[tuple[Array, Array]] = []
@@ -118,7 +120,6 @@ class NavInTheLoop:
     def step(self, k: int, truth: Truth) -> tuple[Array, Array]:
         """Runway-frame position (m) and NED velocity (m/s) of the navigation output at truth row k."""
         nav = self.nav
-        scalar = self.gains is None  # single run without a loop: the INS state lives in a 15-tuple
         if k == 0:
             g = self.errors.sensors.get("gnss")
             el = None
@@ -126,32 +127,25 @@ class NavInTheLoop:
                 rec = self._apply("gnss", 0, truth)
                 el = rec.elevation_rad[0] if rec is not None else None
             self.s, self.runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el)
-            self.st = ins.to_scalar(self.s)
+            self.x = ins.pack(self.s)  # the INS state between epochs: packed (1, 16), stepped by the kernel
             self._snapshot()
         else:
             dth, dv = self._imu(k, truth)
+            self._dth[0, 0] = dth
+            self._dv[0, 0] = dv
             if nav.nav.feedback:
-                dth = dth - self.runs[0].bg_fb * self.dt
-                dv = dv - self.runs[0].ba_fb * self.dt
-            if scalar:
-                c = self.st[6:15]
-                self.f_sum += (c[0] * dv[0] + c[1] * dv[1] + c[2] * dv[2], c[3] * dv[0] + c[4] * dv[1] + c[5] * dv[2],
-                               c[6] * dv[0] + c[7] * dv[1] + c[8] * dv[2])
-                self.st = ins.step_scalar(self.st, (float(dth[0]), float(dth[1]), float(dth[2])),
-                                          (float(dv[0]), float(dv[1]), float(dv[2])), self.dt)
-            else:
-                self.f_sum += self.s.c_bn[0] @ dv
-                self.s = ins.step(self.s, dth.reshape(1, 3), dv.reshape(1, 3), self.dt,
-                                  h_baro_m=np.array([self.h_baro_hold]), loop=self.gains)
+                self._bg[0], self._ba[0] = self.runs[0].bg_fb, self.runs[0].ba_fb
+            self._hb[0, 0] = self.h_baro_hold
+            ins.propagate(self.x, self._dth, self._dv, self.dt, bias_g=self._bg, bias_a=self._ba,
+                          h_baro_m=self._hb if self.gains is not None else None, loop=self.gains, f_sum=self.f_sum)
             if k % self.epoch_rows == 0:
-                if scalar:
-                    self.s = ins.from_scalar(self.st)
+                self.s = ins.unpack(self.x)
                 t = float(truth.t_s[k])
                 recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite")
                         if (r := self._apply(name, k, truth)) is not None}
                 obs = nav.observations(recs, t, 0.25 * self.dt, False)
-                self.s = nav.aid(self.s, self.runs, t, t - self.t_last, (self.f_sum / (t - self.t_last))[None], obs)
-                self.st = ins.to_scalar(self.s)  # feedback may have corrected it
+                self.s = nav.aid(self.s, self.runs, t, t - self.t_last, self.f_sum / (t - self.t_last), obs)
+                self.x = ins.pack(self.s)  # feedback may have corrected it
                 self.f_sum[:] = 0.0
                 self.t_last = t
                 self._snapshot()
@@ -159,8 +153,9 @@ class NavInTheLoop:
         if self.gains is not None and (b := self._apply("baro", k, truth)) is not None:
             self.h_baro_hold = float(np.ravel(b.h_baro_m)[0])
             if k == 0:
-                self.s = ins.replace(self.s, h_m=np.array([self.h_baro_hold]))
-        st = self.st if scalar else ins.to_scalar(self.s)
+                self.x[0, 2] = self.h_baro_hold
+                self.s = ins.unpack(self.x)
+        st = self.x[0].tolist()
         lat, lon, h = st[0], st[1], st[2]
         d = self.out
         d["lat"].append(lat)
