@@ -14,7 +14,7 @@ from the JSBSim-read scalars (in JSBSim's units, the order of RAW_FIELDS), `imu_
     attitude  roll, pitch, heading of the IMU point's NED axes and its body-to-NED quaternion
 
 (docs/truth.md and flight/run.py's module docstring say why each term is there.) The kernel is a plain function
-of arrays so that it is testable without JSBSim (tests/unit/flight/test_kernels.py: kernel = the vectorized
+of arrays so that it is testable without JSBSim (tests/unit/flight/test_flight_kernels.py: kernel = the vectorized
 numpy `imu_point_rows_reference` to 1e-12 relative). The flight loop calls it as
 
     const = imu_point_constants(lever_arm_m, lat0_rad, profile.runway, dt_s)     # once per flight

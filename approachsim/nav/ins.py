@@ -227,7 +227,10 @@ def loop_vector(loop: vl.LoopGains | None) -> Array:
     return np.array([code, loop.c1, loop.c2, loop.c3, loop.b1_per_m, loop.b2_per_m], dtype=float)
 
 
-_NO_OUT = np.empty((0, 0, sk.NX))
+NX = sk.NX
+"""Columns of a packed state (pack / unpack)."""
+
+_NO_OUT = np.empty((0, 0, NX))
 
 
 def propagate(x: Array, dtheta_body: Array, dv_body: Array, dt_s: float, *, bias_g: Array | None = None,

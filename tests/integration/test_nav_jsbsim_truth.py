@@ -3,7 +3,7 @@ stays below 1 cm / 1 mm/s.
 
 Default profile (light turbulence), the whole approach to 50 ft (260 s): the exact IMU increments
 (sensors/imu.py true_increments) through the INS alone (the compiled mechanization `ins.propagate`, the path of
-the closed loop and of the system; equal to the numpy `step_reference` to 1e-12, tests/unit/nav/test_kernels.py).
+the closed loop and of the system; equal to the numpy `step_reference` to 1e-12, tests/unit/nav/test_nav_kernels.py).
 Then the whole navigation system
 (INS + EKF, every sensor's noise off, no initial error) on the first 60 s of the same kind of flight (the
 whole approach takes ~25 s per run; measured over 260 s it stays within 4.9 mm / 0.12 mm/s).

@@ -3,7 +3,7 @@
 Each kernel is a small pure function with the equation it implements in its docstring, compiled with
 ``cache=True`` (the machine code is kept in __pycache__, so a second process starts without compiling), and
 has a readable numpy version elsewhere in the package that serves as its test oracle (tests/unit/nav/
-test_kernels.py checks they agree to 1e-12 relative). The stages import these modules; the kernels import
+test_nav_kernels.py checks they agree to 1e-12 relative). The stages import these modules; the kernels import
 nothing of the stages (import-linter contract in pyproject.toml).
 
     geodesy    WGS-84 radii, geodetic -> ECEF, the simulated world's gravity (geo.py's equations, scalar)

@@ -1,7 +1,7 @@
 """Scalar WGS-84 geodesy and the simulated world's gravity for compiled kernels (numba, cache=True).
 
 The same equations, in the same order, as approachsim.geo (radii, geodetic_to_ecef, gravity_ned): the numpy
-functions there are the oracle (tests/unit/nav/test_kernels.py). The constants are read from approachsim.geo
+functions there are the oracle (tests/unit/nav/test_nav_kernels.py). The constants are read from approachsim.geo
 when this module is imported, so there is one source for each of them.
 """
 

@@ -182,3 +182,47 @@ def strapdown(x: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, dt: float, bias
         for q in range(9):
             x[i, 6 + q] = c0[q]
         x[i, 15] = a_comp
+
+
+@njit(cache=True)
+def imu_increment(m_err: np.ndarray, true_row: np.ndarray, dt: float, c: np.ndarray, out: np.ndarray) -> None:
+    """One affine IMU increment (sensors/imu.py): out = d + M d + c, d = dt * true_row (the rate or specific
+    force of truth sample k-1 held over the interval), M (3, 3) scale factor + misalignment, c (3,) the
+    sample's bias, noise and drift terms."""
+    d0, d1, d2 = dt * true_row[0], dt * true_row[1], dt * true_row[2]
+    for r in range(3):
+        d = d0 if r == 0 else (d1 if r == 1 else d2)
+        out[r] = d + (m_err[r, 0] * d0 + m_err[r, 1] * d1 + m_err[r, 2] * d2) + c[r]
+
+
+@njit(cache=True)
+def inloop_step(k: int, w_ib: np.ndarray, f_body: np.ndarray, affine: bool, m_g: np.ndarray, m_a: np.ndarray,
+                c_g: np.ndarray, c_a: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, dt: float,
+                bias_g: np.ndarray, bias_a: np.ndarray, h_baro: np.ndarray, loop: np.ndarray, x: np.ndarray,
+                f_sum: np.ndarray) -> None:
+    """The closed loop's INS step into truth row k for one run: with `affine`, the IMU increments of interval
+    (k-1, k] from truth rows w_ib, f_body (n, 3) and the pre-drawn error terms (imu_increment; M m_g, m_a and
+    c_g, c_a (m, 3) indexed by sample k-1), else the given dtheta, dv (1, 1, 3); then `strapdown` on x (1, 16)."""
+    if affine:
+        imu_increment(m_g, w_ib[k - 1], dt, c_g[k - 1], dtheta[0, 0])
+        imu_increment(m_a, f_body[k - 1], dt, c_a[k - 1], dv[0, 0])
+    strapdown(x, dtheta, dv, dt, bias_g, bias_a, h_baro, loop, f_sum, np.empty((1, 0, NX)), 0)
+
+
+@njit(cache=True)
+def guidance(x: np.ndarray, x_nav: np.ndarray, c_rwy: np.ndarray, o_rwy: np.ndarray, h_thr: float,
+             out: np.ndarray) -> None:
+    """Feed-forward navigation output for guidance: position INS - dp_hat in the runway frame (x, y along and
+    across; z the height above the threshold, as Truth.r_rwy) and velocity v_INS - dv_hat (NED), into out (6,).
+    x (1, 16) packed INS state, x_nav (>= 6,) the estimated errors (dp NED m, dv m/s)."""
+    lat, lon, h = x[0, 0], x[0, 1], x[0, 2]
+    r_n, r_e = gk.radii(lat)
+    lat_c = lat - x_nav[0] / (r_n + h)
+    lon_c = lon - x_nav[1] / ((r_e + h) * math.cos(lat))
+    h_c = h + x_nav[2]
+    ex, ey, ez = gk.geodetic_to_ecef(lat_c, lon_c, h_c)
+    dx, dy, dz = ex - o_rwy[0], ey - o_rwy[1], ez - o_rwy[2]
+    out[0] = c_rwy[0, 0] * dx + c_rwy[0, 1] * dy + c_rwy[0, 2] * dz
+    out[1] = c_rwy[1, 0] * dx + c_rwy[1, 1] * dy + c_rwy[1, 2] * dz
+    out[2] = h_c - h_thr
+    out[3], out[4], out[5] = x[0, 3] - x_nav[3], x[0, 4] - x_nav[4], x[0, 5] - x_nav[5]

@@ -111,3 +111,38 @@ def test_geodesy_kernels_equal_geo():
         _close(gk.geodetic_to_ecef(lat, lon, h), geo.geodetic_to_ecef(lat, lon, h), "ecef")
         g = geo.gravity_ned(lat, h)
         _close(gk.gravity_nd(lat, h), (g[0], g[2]), "gravity")
+
+
+@pytest.mark.parametrize("feedback", [False, True])
+def test_closed_loop_steps_equal_the_open_loop_pass_to_rounding(feedback):
+    """The closed loop (kernels.strapdown.inloop_step, increments made in the loop from truth sample k-1) and the
+    open-loop pass (IMU record from sensors/imu.py, `propagate`) share one kernel: the same navigation to
+    rounding (nanometres), not merely to the 1e-6 m of two different increment definitions."""
+    import tomllib
+    from pathlib import Path
+
+    from approachsim import synthetic
+    from approachsim.nav.closed_loop import NavInTheLoop
+    from approachsim.nav.system import NavSystem
+    from approachsim.profile import parse_profile
+    from approachsim.seeding import stream
+    from approachsim.sensors.suite import SensorSuite
+
+    path = Path("profiles/gray-maybeck.toml")
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    data.setdefault("nav", {})["feedback"] = feedback
+    prof = parse_profile(data, source=path.resolve())
+    truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=prof.rates.imu_hz, start_distance_m=300.0,
+                                        ground_speed_mps=70.0)
+    src = NavInTheLoop(prof, seed=4, run=2, max_time_s=30.0)
+    guide = np.array([np.concatenate(src.step(k, truth)) for k in range(len(truth))])
+    closed = src.result(truth)
+    recs = SensorSuite.from_profile(prof).measure(truth, seed=4, runs=2)
+    open_ = NavSystem.from_profile(prof).run(truth, recs, stream(4, 2, "nav"))
+    np.testing.assert_allclose(closed.solution.r_ecef, open_.solution.r_ecef, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(closed.solution.v_ned, open_.solution.v_ned, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(closed.x, open_.x, rtol=1e-12, atol=1e-15)
+    # guidance flew on the feed-forward output in the runway frame (without feedback: INS - x_hat of the epoch)
+    r_rwy = prof.runway.frame.from_ecef(open_.solution.r_ecef)
+    np.testing.assert_allclose(guide[:, 0:2], r_rwy[:, 0:2], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(guide[:, 3:6], open_.solution.v_ned, rtol=0, atol=1e-9)
