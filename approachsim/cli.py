@@ -12,6 +12,7 @@ import os
 import sys
 from collections.abc import Sequence
 
+from approachsim.commands._help import command_parser  # noqa: F401  (re-exported)
 from approachsim.config import ProfileError
 
 COMMAND_MODULES = (
@@ -25,17 +26,6 @@ COMMAND_MODULES = (
     "approachsim.commands.profiles",
 )
 """Modules that each add sub-commands; a new command adds its line here."""
-
-
-def command_parser(
-    sub: argparse._SubParsersAction, name: str, *, help: str, description: str, examples: Sequence[str]
-) -> argparse.ArgumentParser:
-    """A sub-command parser with a one-line `help` (top-level list), a `description` and worked `examples`."""
-    return sub.add_parser(
-        name, help=help, description=description,
-        epilog="example" + ("s" if len(examples) > 1 else "") + ":\n" + "\n".join(f"  {e}" for e in examples),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
 
 
 class _OneLineParser(argparse.ArgumentParser):

@@ -26,7 +26,7 @@ _ADDRESS = re.compile(r"^(tcp|tls|inproc|ws|wss|ucx)://\S+$|^[A-Za-z0-9_.\-\[\]:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `evaluate` sub-command."""
-    from approachsim.cli import command_parser
+    from approachsim.commands._help import command_parser
 
     p = command_parser(
         sub, "evaluate", help="Monte Carlo evaluation of a profile against FAA CAT I/II/III",

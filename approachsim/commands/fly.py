@@ -21,7 +21,7 @@ the outputs are written, the run did not complete (as `evaluate`'s 3: no run com
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `fly` sub-command."""
-    from approachsim.cli import command_parser
+    from approachsim.commands._help import command_parser
 
     p = command_parser(
         sub, "fly", help="fly one closed-loop approach (truth navigation) and write the truth record",

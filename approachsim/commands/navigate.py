@@ -22,7 +22,7 @@ from approachsim.commands._single_run import add_single_run_arguments, load_sing
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `navigate` sub-command."""
-    from approachsim.cli import command_parser
+    from approachsim.commands._help import command_parser
     from approachsim.nav.registry import FILTERS
 
     p = command_parser(

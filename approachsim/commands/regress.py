@@ -20,7 +20,7 @@ DEFAULT_DIR = Path("baselines")
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `regress` sub-command."""
-    from approachsim.cli import command_parser
+    from approachsim.commands._help import command_parser
 
     p = command_parser(
         sub, "regress", help="rerun the committed profile baselines and compare with tolerances",

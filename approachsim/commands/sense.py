@@ -38,7 +38,7 @@ VALUE_FIELDS = {"imu": ("dtheta_body", "dv_body"), "baro": ("h_baro_m",), "radal
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `sense` sub-command."""
-    from approachsim.cli import command_parser
+    from approachsim.commands._help import command_parser
 
     p = command_parser(
         sub, "sense", help="fly one approach and write its sensor streams (with faults) and figures",

@@ -20,7 +20,7 @@ NO_RUN_COMPLETED = 3
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `study` sub-command."""
-    from approachsim.cli import command_parser
+    from approachsim.commands._help import command_parser
 
     p = command_parser(
         sub, "study", help="trade study: evaluate every variant of a study file and compare",

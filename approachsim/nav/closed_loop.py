@@ -22,12 +22,16 @@ import numpy as np
 
 from approachsim import geo
 from approachsim.nav import ins
+from approachsim.nav.kernels import strapdown as sk
 from approachsim.nav.system import NavRun, NavSystem, StatusLog
 from approachsim.records import ApproachErrors, NavSolution, Truth
 from approachsim.seeding import stream
 from approachsim.sensors.suite import SensorSuite, SuiteErrors
 
 Array = np.ndarray
+
+_EMPTY = np.zeros((1, 3))
+"""Placeholder for the affine IMU terms when the increments come from `apply` (quantized or faulted IMU)."""
 
 _VEC3 = ("r_ecef", "v_ned", "euler_rad", "w_ib_body", "f_body", "r_rwy")
 
@@ -62,21 +66,29 @@ class NavInTheLoop:
         self.s: ins.InsState | None = None
         self.runs: list = []
         self.h_baro_hold = math.nan
-        self.f_sum = np.zeros(3)
+        self.f_sum = np.zeros((1, 3))
+        # the kernels' inputs and outputs, allocated once (kernels/strapdown.py inloop_step, guidance)
+        self._dth, self._dv = np.zeros((1, 1, 3)), np.zeros((1, 1, 3))
+        self._bg, self._ba, self._hb = np.zeros((1, 3)), np.zeros((1, 3)), np.full((1, 1), math.nan)
+        self._loop = ins.loop_vector(self.gains)
+        self._guide = np.zeros(6)
         self.t_last = 0.0
-        self.out: dict[str, list] = {k: [] for k in ("lat", "lon", "h", "v", "c", "snap")}
+        n = self.t_s.shape[0]
+        self.rows = np.full((n, ins.NX), np.nan)  # the raw INS state at every truth row (packed, ins.pack)
+        self.snap = np.zeros(n, dtype=int)  # the filter snapshot in force at each row
         self.snaps: list[tuple[Array, Array]] = []
         self.x_nav = np.zeros(9)
-        self._c_rwy = self.profile.runway.frame.c_ecef_to_rwy
-        self._o_rwy = self.profile.runway.frame.origin_ecef
+        self._c_rwy = np.ascontiguousarray(self.profile.runway.frame.c_ecef_to_rwy)
+        self._o_rwy = np.ascontiguousarray(self.profile.runway.frame.origin_ecef)
+        self._h_thr = float(self.profile.runway.elevation_m)
         self.epochs: dict[str, list] = {"t": [], "x": [], "pd": [], "pnav": [], "err": []}
 
     def _imu_error_terms(self) -> tuple[Array, Array, Array, Array] | None:
         """The IMU error model is affine in the true increments (sensors/imu.py):
             dtheta_k = (I + S_g + M_g) dtheta_true_k + c_g,k ,   dv_k = (I + S_a + M_a) dv_true_k + c_a,k
         so the error terms c_k of every sample come from one `apply` of the pre-drawn errors to a motionless
-        (all-zero) truth, and the matrices from the drawn constants. Returns (A_g, A_a, c_g, c_a), or None when
-        the IMU is quantized or fault-wrapped (not affine): then every sample goes through `apply`."""
+        (all-zero) truth, and the matrices from the drawn constants. Returns (S_g + M_g, S_a + M_a, c_g, c_a),
+        or None when the IMU is quantized or fault-wrapped (not affine): then every sample goes through `apply`."""
         imu = self.suite.sensors.get("imu")
         e = self.errors.sensors.get("imu")
         if imu is None or e is None or type(imu).__name__ == "Faulted":
@@ -89,20 +101,10 @@ class NavInTheLoop:
         zeros["t_s"] = self.t_s
         zero_truth = Truth(**zeros, runway=self.profile.runway.frame)
         rec = imu.apply(zero_truth, e)
-        eye = np.eye(3)
-        return (eye + e.constants["gyro_m"], eye + e.constants["accel_m"], np.asarray(rec.dtheta_body),
-                np.asarray(rec.dv_body))
-
-    def _imu(self, k: int, truth: Truth) -> tuple[Array, Array]:
-        """Increments (rad, m/s) of the IMU interval (k-1, k], body axes."""
-        if self._imu_affine is None:
-            imu = self._apply("imu", k, truth)
-            return imu.dtheta_body.reshape(3), imu.dv_body.reshape(3)
-        a_g, a_a, c_g, c_a = self._imu_affine
-        h = 0.5 * self.dt  # the trapezoid of samples k-1, k (sensors/imu.py increment definition)
-        dth = a_g @ (h * (truth.w_ib_body[k - 1] + truth.w_ib_body[k])) + c_g[k - 1]
-        dv = a_a @ (h * (truth.f_body[k - 1] + truth.f_body[k])) + c_a[k - 1]
-        return dth, dv
+        # a row of c is the increment ending at truth row j + 1 (e.rows = 1 .. n-1): index by row k - 1
+        return (np.ascontiguousarray(e.constants["gyro_m"], dtype=float),
+                np.ascontiguousarray(e.constants["accel_m"], dtype=float),
+                np.ascontiguousarray(rec.dtheta_body, dtype=float), np.ascontiguousarray(rec.dv_body, dtype=float))
 
     def _apply(self, name: str, k: int, truth: Truth) -> Any:
         """The record of sensor `name` at truth row k (one sample), or None when it has no sample there."""
@@ -116,9 +118,11 @@ class NavInTheLoop:
         return self.suite.apply(truth, sub, names=[name])[name]
 
     def step(self, k: int, truth: Truth) -> tuple[Array, Array]:
-        """Runway-frame position (m) and NED velocity (m/s) of the navigation output at truth row k."""
+        """Runway-frame position (m) and NED velocity (m/s) of the navigation output at truth row k.
+
+        The IMU increment of (k-1, k] (the truth sample k-1 held, sensors/imu.py) and the INS step run in one
+        compiled call (kernels.strapdown.inloop_step); the filter runs at the aiding epochs."""
         nav = self.nav
-        scalar = self.gains is None  # single run without a loop: the INS state lives in a 15-tuple
         if k == 0:
             g = self.errors.sensors.get("gnss")
             el = None
@@ -126,32 +130,29 @@ class NavInTheLoop:
                 rec = self._apply("gnss", 0, truth)
                 el = rec.elevation_rad[0] if rec is not None else None
             self.s, self.runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el)
-            self.st = ins.to_scalar(self.s)
+            self.x = ins.pack(self.s)  # the INS state between epochs: packed (1, 16), stepped by the kernel
             self._snapshot()
         else:
-            dth, dv = self._imu(k, truth)
-            if nav.nav.feedback:
-                dth = dth - self.runs[0].bg_fb * self.dt
-                dv = dv - self.runs[0].ba_fb * self.dt
-            if scalar:
-                c = self.st[6:15]
-                self.f_sum += (c[0] * dv[0] + c[1] * dv[1] + c[2] * dv[2], c[3] * dv[0] + c[4] * dv[1] + c[5] * dv[2],
-                               c[6] * dv[0] + c[7] * dv[1] + c[8] * dv[2])
-                self.st = ins.step_scalar(self.st, (float(dth[0]), float(dth[1]), float(dth[2])),
-                                          (float(dv[0]), float(dv[1]), float(dv[2])), self.dt)
+            affine = self._imu_affine is not None
+            if affine:
+                m_g, m_a, c_g, c_a = self._imu_affine
             else:
-                self.f_sum += self.s.c_bn[0] @ dv
-                self.s = ins.step(self.s, dth.reshape(1, 3), dv.reshape(1, 3), self.dt,
-                                  h_baro_m=np.array([self.h_baro_hold]), loop=self.gains)
+                imu = self._apply("imu", k, truth)
+                self._dth[0, 0], self._dv[0, 0] = imu.dtheta_body.reshape(3), imu.dv_body.reshape(3)
+                m_g = m_a = c_g = c_a = _EMPTY
+            if nav.nav.feedback:
+                self._bg[0], self._ba[0] = self.runs[0].bg_fb, self.runs[0].ba_fb
+            self._hb[0, 0] = self.h_baro_hold
+            sk.inloop_step(k, truth.w_ib_body, truth.f_body, affine, m_g, m_a, c_g, c_a, self._dth, self._dv,
+                           self.dt, self._bg, self._ba, self._hb, self._loop, self.x, self.f_sum)
             if k % self.epoch_rows == 0:
-                if scalar:
-                    self.s = ins.from_scalar(self.st)
+                self.s = ins.unpack(self.x)
                 t = float(truth.t_s[k])
                 recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite")
                         if (r := self._apply(name, k, truth)) is not None}
                 obs = nav.observations(recs, t, 0.25 * self.dt, False)
-                self.s = nav.aid(self.s, self.runs, t, t - self.t_last, (self.f_sum / (t - self.t_last))[None], obs)
-                self.st = ins.to_scalar(self.s)  # feedback may have corrected it
+                self.s = nav.aid(self.s, self.runs, t, t - self.t_last, self.f_sum / (t - self.t_last), obs)
+                self.x = ins.pack(self.s)  # feedback may have corrected it
                 self.f_sum[:] = 0.0
                 self.t_last = t
                 self._snapshot()
@@ -159,36 +160,13 @@ class NavInTheLoop:
         if self.gains is not None and (b := self._apply("baro", k, truth)) is not None:
             self.h_baro_hold = float(np.ravel(b.h_baro_m)[0])
             if k == 0:
-                self.s = ins.replace(self.s, h_m=np.array([self.h_baro_hold]))
-        st = self.st if scalar else ins.to_scalar(self.s)
-        lat, lon, h = st[0], st[1], st[2]
-        d = self.out
-        d["lat"].append(lat)
-        d["lon"].append(lon)
-        d["h"].append(h)
-        d["v"].append(st[3:6])
-        d["c"].append(st[6:15])
-        d["snap"].append(len(self.snaps) - 1)
-        # guidance: feed-forward output INS - x_hat (position and velocity only; attitude in result())
-        dp, dvel = self.x_nav[0:3], self.x_nav[3:6]
-        r_n, r_e = self.radii(lat)
-        lat_c = lat - dp[0] / (r_n + h)
-        lon_c = lon - dp[1] / ((r_e + h) * math.cos(lat))
-        h_c = h + dp[2]
-        # geo.geodetic_to_ecef in scalar arithmetic, then RunwayFrame.from_ecef
-        sl, cl = math.sin(lat_c), math.cos(lat_c)
-        re = geo.A_WGS84 / math.sqrt(1.0 - geo.E2_WGS84 * sl * sl)
-        r_e = ((re + h_c) * cl * math.cos(lon_c), (re + h_c) * cl * math.sin(lon_c),
-               (re * (1.0 - geo.E2_WGS84) + h_c) * sl)
-        r_rwy = self._c_rwy @ (np.array(r_e) - self._o_rwy)
-        r_rwy[2] = h_c - self.profile.runway.elevation_m  # height above threshold, as truth.r_rwy
-        return r_rwy, np.array(st[3:6]) - dvel
-
-    @staticmethod
-    def radii(lat: float) -> tuple[float, float]:
-        """Meridian and prime-vertical radii (m) at latitude lat (rad), scalar."""
-        w = math.sqrt(1.0 - geo.E2_WGS84 * math.sin(lat) ** 2)
-        return geo.A_WGS84 * (1.0 - geo.E2_WGS84) / w**3, geo.A_WGS84 / w
+                self.x[0, 2] = self.h_baro_hold
+                self.s = ins.unpack(self.x)
+        self.rows[k] = self.x[0]
+        self.snap[k] = len(self.snaps) - 1
+        g = self._guide
+        sk.guidance(self.x, self.x_nav, self._c_rwy, self._o_rwy, self._h_thr, g)  # feed-forward INS - x_hat
+        return g[0:3], g[3:6]
 
     def _snapshot(self) -> None:
         """Keep the filter's x and P (the estimate in force until the next epoch)."""
@@ -209,10 +187,9 @@ class NavInTheLoop:
     def result(self, truth: Truth) -> NavRun:
         """The navigation run over the flown truth (call after the flight)."""
         n = len(truth)
-        d = self.out
-        raw = ins.InsState(np.array(d["lat"][:n]), np.array(d["lon"][:n]), np.array(d["h"][:n]),
-                           np.array(d["v"][:n]), np.array(d["c"][:n]).reshape(n, 3, 3), np.zeros(n))
-        snap = np.array(d["snap"][:n])
+        raw = ins.unpack(self.rows[:n])
+        raw = ins.replace(raw, a_comp_mps2=np.zeros(n))
+        snap = self.snap[:n]
         X = np.stack([x for x, _ in self.snaps])[snap]
         PP = np.stack([p for _, p in self.snaps])  # per snapshot; index the small blocks per row only
         o = ins.perturb(raw, -X[:, 0:3], -X[:, 3:6], -X[:, 6:9])

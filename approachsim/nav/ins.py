@@ -17,19 +17,21 @@ the integral over [t_{k-1}, t_k] of the body rate / specific force (sensors/imu.
 samples k-1, k form increment k).
 
 Every function is a plain array function over a leading run axis: a state holds (N,) / (N, 3) / (N, 3, 3)
-arrays, so many Monte Carlo runs step together. An optional 3rd-order baro damping loop (nav/vertical_loop.py,
-seed 003 eq. 3, 7) stabilizes the vertical channel.
+arrays, so many Monte Carlo runs step together. The mechanization runs compiled (nav/kernels/strapdown.py,
+numba): `propagate` steps packed (N, 16) states over many intervals in one call, `step` is one interval of it
+on an InsState, and `step_reference` is the same equations in numpy, kept as the kernel's test oracle. An
+optional 3rd-order baro damping loop (nav/vertical_loop.py, seed 003 eq. 3, 7) stabilizes the vertical channel.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from approachsim import geo
 from approachsim.nav import vertical_loop as vl
+from approachsim.nav.kernels import strapdown as sk
 
 Array = np.ndarray
 
@@ -198,6 +200,63 @@ def perturb(state: InsState, dp_ned_m: Array, dv_ned_mps: Array, psi_rad: Array)
     return replace(state, lat_rad=lat, lon_rad=lon, h_m=h, v_ned=state.v_ned + dv_ned_mps, c_bn=c)
 
 
+def pack(s: InsState) -> Array:
+    """The packed (N, 16) form of a state for the compiled kernel (kernels/strapdown.py: lat, lon, h, v_ned,
+    C_bn row-major, a_comp)."""
+    n = s.lat_rad.shape[0]
+    x = np.empty((n, sk.NX))
+    x[:, 0], x[:, 1], x[:, 2] = s.lat_rad, s.lon_rad, s.h_m
+    x[:, 3:6] = s.v_ned
+    x[:, 6:15] = np.asarray(s.c_bn, dtype=float).reshape(n, 9)
+    x[:, 15] = s.a_comp_mps2
+    return x
+
+
+def unpack(x: Array) -> InsState:
+    """An InsState (copies) from packed rows (..., 16); a leading run axis stays the run axis."""
+    x = np.asarray(x, dtype=float)
+    return InsState(x[..., 0].copy(), x[..., 1].copy(), x[..., 2].copy(), x[..., 3:6].copy(),
+                    x[..., 6:15].reshape(x.shape[:-1] + (3, 3)).copy(), x[..., 15].copy())
+
+
+def loop_vector(loop: vl.LoopGains | None) -> Array:
+    """The damping loop as the kernel's (6,) vector (form code, c1, c2, c3, b1, b2); form 0 without a loop."""
+    if loop is None:
+        return np.zeros(6)
+    code = {"constant": sk.LOOP_CONSTANT, "tanh": sk.LOOP_TANH, "sinh": sk.LOOP_SINH}[loop.form]
+    return np.array([code, loop.c1, loop.c2, loop.c3, loop.b1_per_m, loop.b2_per_m], dtype=float)
+
+
+NX = sk.NX
+"""Columns of a packed state (pack / unpack)."""
+
+_NO_OUT = np.empty((0, 0, NX))
+
+
+def propagate(x: Array, dtheta_body: Array, dv_body: Array, dt_s: float, *, bias_g: Array | None = None,
+              bias_a: Array | None = None, h_baro_m: Array | None = None, loop: vl.LoopGains | None = None,
+              f_sum: Array | None = None, out: Array | None = None, row0: int = 0) -> Array:
+    """Step packed states x (N, 16) in place over m IMU intervals with the compiled mechanization
+    (kernels.strapdown.strapdown: the equations of `step_reference`); returns x.
+
+    dtheta_body, dv_body (N, m, 3) rad, m/s; bias_g, bias_a (N, 3) rad/s, m/s^2 subtracted from the rates
+    (feedback); h_baro_m (N, m) the baro height held at each interval start (with `loop`); f_sum (N, 3)
+    accumulates C_bn dv (NED, m/s) when given; out (N, rows, 16) receives the state after interval j at
+    row row0 + j + 1 when given.
+    """
+    n = x.shape[0]
+    dth = np.ascontiguousarray(dtheta_body, dtype=float).reshape(n, -1, 3)
+    dvb = np.ascontiguousarray(dv_body, dtype=float).reshape(n, -1, 3)
+    zeros = np.zeros((n, 3))
+    hb = np.zeros((n, 0)) if h_baro_m is None or loop is None else np.ascontiguousarray(h_baro_m, dtype=float
+                                                                                         ).reshape(n, -1)
+    lv = loop_vector(loop if h_baro_m is not None else None)
+    sk.strapdown(x, dth, dvb, float(dt_s), zeros if bias_g is None else np.ascontiguousarray(bias_g, dtype=float),
+                 zeros if bias_a is None else np.ascontiguousarray(bias_a, dtype=float), hb, lv,
+                 np.zeros((n, 3)) if f_sum is None else f_sum, _NO_OUT if out is None else out, int(row0))
+    return x
+
+
 def step(
     s: InsState,
     dtheta_body: Array,
@@ -207,11 +266,31 @@ def step(
     h_baro_m: Array | None = None,
     loop: vl.LoopGains | None = None,
 ) -> InsState:
-    """Advance the INS by one IMU interval dt_s (s) with increments dtheta (rad) and dv (m/s), body axes (N, 3).
+    """Advance the INS by one IMU interval dt_s (s) with increments dtheta (rad) and dv (m/s), body axes (N, 3):
+    the compiled kernel (`propagate`) on the state; the same result as `step_reference` to 1e-12 relative.
 
     With `loop` and `h_baro_m` (N,) given, the 3rd-order baro damping loop (seed 003 eq. 3 / 7) corrects
     height, vertical velocity and its compensator from the loop error e = h_ins - h_baro at the interval start.
     """
+    x = pack(s)
+    n = x.shape[0]
+    propagate(x, np.reshape(dtheta_body, (n, 1, 3)), np.reshape(dv_body, (n, 1, 3)), dt_s,
+              h_baro_m=None if h_baro_m is None else np.reshape(np.asarray(h_baro_m, dtype=float), (n, 1)),
+              loop=loop)
+    return unpack(x)
+
+
+def step_reference(
+    s: InsState,
+    dtheta_body: Array,
+    dv_body: Array,
+    dt_s: float,
+    *,
+    h_baro_m: Array | None = None,
+    loop: vl.LoopGains | None = None,
+) -> InsState:
+    """`step` in numpy (the readable version and the compiled kernel's test oracle): one IMU interval dt_s (s)
+    with increments dtheta (rad) and dv (m/s), body axes (N, 3), the module docstring's equations."""
     lat0, h0, v0, c0 = s.lat_rad, s.h_m, s.v_ned, s.c_bn
     dth = np.asarray(dtheta_body, dtype=float)
     dvb = np.asarray(dv_body, dtype=float)
@@ -312,107 +391,3 @@ def align_stationary(dtheta_body: Array, dv_body: Array, lat_rad: Array) -> Arra
     m_b = triad(f_b, w_b)
     m_n = triad(down_n, w_n)
     return m_n @ np.swapaxes(m_b, -1, -2)  # C_bn maps body triad onto NED triad
-
-
-def _rot_exp_scalar(x: float, y: float, z: float) -> tuple[float, ...]:
-    """Exp([phi x]) of one rotation vector as a row-major 9-tuple (Rodrigues, series near zero)."""
-    a2 = x * x + y * y + z * z
-    if a2 < 1e-12:
-        s, c = 1.0 - a2 / 6.0, 0.5 - a2 / 24.0
-    else:
-        a = math.sqrt(a2)
-        s, c = math.sin(a) / a, (1.0 - math.cos(a)) / a2
-    ca = 1.0 - c * a2
-    return (ca + c * x * x, c * x * y - s * z, c * x * z + s * y,
-            c * x * y + s * z, ca + c * y * y, c * y * z - s * x,
-            c * x * z - s * y, c * y * z + s * x, ca + c * z * z)
-
-
-def _mm(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, ...]:
-    """Product of two row-major 3x3 9-tuples."""
-    a0, a1, a2, a3, a4, a5, a6, a7, a8 = a
-    b0, b1, b2, b3, b4, b5, b6, b7, b8 = b
-    return (a0 * b0 + a1 * b3 + a2 * b6, a0 * b1 + a1 * b4 + a2 * b7, a0 * b2 + a1 * b5 + a2 * b8,
-            a3 * b0 + a4 * b3 + a5 * b6, a3 * b1 + a4 * b4 + a5 * b7, a3 * b2 + a4 * b5 + a5 * b8,
-            a6 * b0 + a7 * b3 + a8 * b6, a6 * b1 + a7 * b4 + a8 * b7, a6 * b2 + a7 * b5 + a8 * b8)
-
-
-def step_one(s: InsState, dtheta_body: Array, dv_body: Array, dt_s: float) -> InsState:
-    """`step` for a single run (N = 1) without a damping loop, in scalar arithmetic: the same equations and
-    the same result to rounding (tests/unit/nav/test_ins.py), several times cheaper for the closed loop."""
-    st = to_scalar(s)
-    out = step_scalar(st, tuple(float(u) for u in np.ravel(dtheta_body)), tuple(float(u) for u in np.ravel(dv_body)),
-                      dt_s)
-    return from_scalar(out, s.a_comp_mps2)
-
-
-def to_scalar(s: InsState) -> tuple[float, ...]:
-    """Run 0 of a state as a 15-tuple (lat, lon, h, vN, vE, vD, C row-major) for step_scalar."""
-    return (float(s.lat_rad[0]), float(s.lon_rad[0]), float(s.h_m[0]), *(float(u) for u in s.v_ned[0]),
-            *(float(u) for u in s.c_bn[0].ravel()))
-
-
-def from_scalar(st: tuple[float, ...], a_comp_mps2: Array | None = None) -> InsState:
-    """An N = 1 InsState from a step_scalar 15-tuple."""
-    return InsState(np.array([st[0]]), np.array([st[1]]), np.array([st[2]]), np.array([st[3:6]]),
-                    np.array(st[6:15]).reshape(1, 3, 3), np.zeros(1) if a_comp_mps2 is None else a_comp_mps2)
-
-
-def step_scalar(st: tuple[float, ...], dtheta_body: tuple[float, float, float],
-                dv_body: tuple[float, float, float], dt_s: float) -> tuple[float, ...]:
-    """The mechanization of `step` on one state held as a 15-tuple (to_scalar), increments as 3-tuples."""
-    lat0, lon0, h0, vn, ve, vd = st[0:6]
-    c0 = st[6:15]
-    tx, ty, tz = dtheta_body
-    ux, uy, uz = dv_body
-    om, a, e2 = geo.OMEGA_E, geo.A_WGS84, geo.E2_WGS84
-    sin, cos, tan, sqrt = math.sin, math.cos, math.tan, math.sqrt
-
-    def radii(lat: float) -> tuple[float, float]:
-        w = sqrt(1.0 - e2 * sin(lat) ** 2)
-        return a * (1.0 - e2) / w**3, a / w
-
-    def w_en(lat: float, h: float, n: float, e: float) -> tuple[float, float, float]:
-        rn, re = radii(lat)
-        return e / (re + h), -n / (rn + h), -e * tan(lat) / (re + h)
-
-    cl0, sl0 = cos(lat0), sin(lat0)
-    wie0 = (om * cl0, 0.0, -om * sl0)
-    wen0 = w_en(lat0, h0, vn, ve)
-    win0 = (wie0[0] + wen0[0], wie0[1] + wen0[1], wie0[2] + wen0[2])
-    # specific-force increment (Groves 5.84-5.86)
-    rx, ry, rz = ux + 0.5 * (ty * uz - tz * uy), uy + 0.5 * (tz * ux - tx * uz), uz + 0.5 * (tx * uy - ty * ux)
-    cd = (c0[0] * rx + c0[1] * ry + c0[2] * rz, c0[3] * rx + c0[4] * ry + c0[5] * rz,
-          c0[6] * rx + c0[7] * ry + c0[8] * rz)
-    c0u = (c0[0] * ux + c0[1] * uy + c0[2] * uz, c0[3] * ux + c0[4] * uy + c0[5] * uz,
-           c0[6] * ux + c0[7] * uy + c0[8] * uz)
-    k = 0.5 * dt_s
-    dvf = (cd[0] - k * (win0[1] * c0u[2] - win0[2] * c0u[1]),
-           cd[1] - k * (win0[2] * c0u[0] - win0[0] * c0u[2]),
-           cd[2] - k * (win0[0] * c0u[1] - win0[1] * c0u[0]))
-    h_mid = h0 - k * vd
-    rn0, _ = radii(lat0)
-    lat_mid = lat0 + k * vn / (rn0 + h0)
-    gn_mid, g_mid = geo.gravity_nd_scalar(lat_mid, h_mid)
-    w2 = (wie0[0] + win0[0], wie0[1] + win0[1], wie0[2] + win0[2])  # 2 w_ie + w_en at the start
-    cor0 = (w2[1] * vd - w2[2] * ve, w2[2] * vn - w2[0] * vd, w2[0] * ve - w2[1] * vn)
-    vm = (vn + 0.5 * (dvf[0] + (gn_mid - cor0[0]) * dt_s), ve + 0.5 * (dvf[1] - cor0[1] * dt_s),
-          vd + 0.5 * (dvf[2] + (g_mid - cor0[2]) * dt_s))
-    clm, slm = cos(lat_mid), sin(lat_mid)
-    wenm = w_en(lat_mid, h_mid, vm[0], vm[1])
-    wc = (2.0 * om * clm + wenm[0], wenm[1], -2.0 * om * slm + wenm[2])
-    cor = (wc[1] * vm[2] - wc[2] * vm[1], wc[2] * vm[0] - wc[0] * vm[2], wc[0] * vm[1] - wc[1] * vm[0])
-    v1 = (vn + dvf[0] + (gn_mid - cor[0]) * dt_s, ve + dvf[1] - cor[1] * dt_s, vd + dvf[2] + (g_mid - cor[2]) * dt_s)
-    # position: trapezoid, radii at the midpoint
-    vmn, vme, vmd = 0.5 * (vn + v1[0]), 0.5 * (ve + v1[1]), 0.5 * (vd + v1[2])
-    h1 = h0 - dt_s * vmd
-    hm = 0.5 * (h0 + h1)
-    lat_m2 = lat0 + k * vmn / (rn0 + hm)
-    rn, re = radii(lat_m2)
-    lat1 = lat0 + dt_s * vmn / (rn + hm)
-    lon1 = lon0 + dt_s * vme / ((re + hm) * cos(lat_m2))
-    # attitude
-    wenm2 = w_en(lat_m2, hm, vmn, vme)
-    wi = (om * cos(lat_m2) + wenm2[0], wenm2[1], -om * sin(lat_m2) + wenm2[2])
-    c1 = _mm(_mm(_rot_exp_scalar(-wi[0] * dt_s, -wi[1] * dt_s, -wi[2] * dt_s), c0), _rot_exp_scalar(tx, ty, tz))
-    return (lat1, lon1, h1, v1[0], v1[1], v1[2], *c1)

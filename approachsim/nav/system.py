@@ -622,22 +622,13 @@ class NavSystem:
             idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
             hb_full = hb[:, idx]
         n_out = m + 1
-        # raw INS rows and, per row, the filter snapshot in force; corrected (INS - x_hat) after the pass
-        lat = np.empty((n_runs, n_out))
-        lon = np.empty((n_runs, n_out))
-        hh = np.empty((n_runs, n_out))
-        vel = np.empty((n_runs, n_out, 3))
-        cbn = np.empty((n_runs, n_out, 3, 3))
+        # raw INS rows (packed, ins.pack) and, per row, the filter snapshot in force; corrected (INS - x_hat)
+        # after the pass
+        rows = np.empty((n_runs, n_out, ins.sk.NX))
         snap = np.zeros(n_out, dtype=int)
         snaps: list[tuple[Array, Array]] = []
         t_ep, xs, pds, pnav, terr = [], [], [], [], []
         lay = self.layout
-
-        def keep(k: int, s: ins.InsState) -> None:
-            lat[:, k], lon[:, k], hh[:, k] = s.lat_rad, s.lon_rad, s.h_m
-            vel[:, k], cbn[:, k] = s.v_ned, s.c_bn
-            snap[k] = len(snaps) - 1
-
         has_clk = lay.has("clk")
         ic = lay.i("clk") if has_clk else 0
 
@@ -646,24 +637,28 @@ class NavSystem:
             snaps.append((np.stack([r.fs.x for r in runs]), P[:, 0:3, 0:3].copy(), P[:, ic, ic].copy()))
 
         snapshot()
-        keep(0, s)
+        xk = ins.pack(s)
+        rows[:, 0] = xk
         f_sum = np.zeros((n_runs, 3))
         t_last = float(truth.t_s[0])
-        # one code path for every batch size: a run's numbers must not depend on the batch it shares (the
-        # campaign relies on it); the scalar single-run step (ins.step_scalar) serves the closed loop only
-        for j in range(m):
-            bg = np.stack([r.bg_fb for r in runs]) if self.nav.feedback else 0.0
-            ba = np.stack([r.ba_fb for r in runs]) if self.nav.feedback else 0.0
-            dth_j = dth[:, j] - bg * dt
-            dv_j = dvb[:, j] - ba * dt
-            if cov is None:  # the per-run filters linearize about each run's INS (shared: about the truth)
-                f_sum += np.einsum("nij,nj->ni", s.c_bn, dv_j)
-            s = ins.step(s, dth_j, dv_j, dt, h_baro_m=None if hb_full is None else hb_full[:, j], loop=gains)
-            row = j + 1
-            t = float(truth.t_s[row])
+        zeros3 = np.zeros((n_runs, 3))
+        # the compiled INS steps every run over the rows between two epochs in one call; a run's numbers do not
+        # depend on the batch it shares (the campaign relies on it: kernels/strapdown.py)
+        j0 = 0
+        while j0 < m:
+            j1 = min(m, (j0 // epoch_rows + 1) * epoch_rows)  # rows j0 + 1 .. j1; j1 an epoch unless the end
+            bg = np.stack([r.bg_fb for r in runs]) if self.nav.feedback else zeros3
+            ba = np.stack([r.ba_fb for r in runs]) if self.nav.feedback else zeros3
+            ins.propagate(xk, dth[:, j0:j1], dvb[:, j0:j1], dt, bias_g=bg, bias_a=ba,
+                          h_baro_m=None if hb_full is None else hb_full[:, j0:j1], loop=gains, f_sum=f_sum,
+                          out=rows, row0=j0)
+            snap[j0 + 1:j1 + 1] = len(snaps) - 1
+            row = j1
             if row % epoch_rows == 0:
+                t = float(truth.t_s[row])
+                s = ins.unpack(xk)
                 obs = self.observations(records, t, 0.25 * dt, batched)
-                if cov is not None:
+                if cov is not None:  # the per-run filters linearize about each run's INS (shared: the truth)
                     ref = ins.InsState(truth.lat_rad[row:row + 1], truth.lon_rad[row:row + 1],
                                        truth.h_m[row:row + 1], truth.v_ned[row:row + 1],
                                        ins.cbn_from_quaternion(truth.q_nb[row:row + 1]), np.zeros(1))
@@ -680,15 +675,17 @@ class NavSystem:
                 pds.append(np.diagonal(P, axis1=1, axis2=2))
                 pnav.append(P[:, 0:9, 0:9])
                 terr.append(self._true_error(o, truth, row))
-            keep(row, s)
+                xk = ins.pack(s)  # feedback may have corrected it
+                rows[:, row] = xk
+                snap[row] = len(snaps) - 1
+            j0 = j1
         X = np.stack([x for x, _, _ in snaps])[snap]  # (n_out, runs, n)
         PP = np.stack([p for _, p, _ in snaps])  # (snaps, runs, 3, 3)
         PC = np.stack([c for _, _, c in snaps])  # (snaps, runs)
         results = []
         for i, r in enumerate(runs):
             xi = X[:, i]
-            o = ins.perturb(ins.InsState(lat[i], lon[i], hh[i], vel[i], cbn[i], np.zeros(n_out)),
-                            -xi[:, 0:3], -xi[:, 3:6], -xi[:, 6:9])
+            o = ins.perturb(ins.unpack(rows[i]), -xi[:, 0:3], -xi[:, 3:6], -xi[:, 6:9])
             p_pos = PP[:, i][snap]  # the small blocks only: (rows, n, n) would be GBs at 120 Hz
             clk_sd = np.sqrt(PC[:, i][snap]) if has_clk else np.full(n_out, np.nan)
             sol = NavSolution(

@@ -1,0 +1,57 @@
+"""Scalar WGS-84 geodesy and the simulated world's gravity for compiled kernels (numba, cache=True).
+
+The same equations, in the same order, as approachsim.geo (radii, geodetic_to_ecef, gravity_ned): the numpy
+functions there are the oracle (tests/unit/nav/test_nav_kernels.py). The constants are read from approachsim.geo
+when this module is imported, so there is one source for each of them.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from approachsim import geo
+
+A = geo.A_WGS84
+E2 = geo.E2_WGS84
+OMEGA_E = geo.OMEGA_E
+_GM = geo.GM_JSBSIM
+_J2A2 = 1.5 * geo.J2_JSBSIM * geo.A_JSBSIM**2
+_OMEGA_J2 = geo.OMEGA_JSBSIM**2
+
+
+@njit(cache=True)
+def radii(lat: float) -> tuple[float, float]:
+    """Meridian radius R_N and prime-vertical radius R_E (m) at geodetic latitude lat (rad):
+    R_E = a / w, R_N = a (1 - e^2) / w^3, w = sqrt(1 - e^2 sin^2 L)."""
+    s = math.sin(lat)
+    w = math.sqrt(1.0 - E2 * (s * s))
+    return A * (1.0 - E2) / w**3, A / w
+
+
+@njit(cache=True)
+def geodetic_to_ecef(lat: float, lon: float, h: float) -> tuple[float, float, float]:
+    """ECEF position (m) of geodetic latitude, longitude (rad) and ellipsoid height h (m):
+    ((R_E + h) cos L cos l, (R_E + h) cos L sin l, (R_E (1 - e^2) + h) sin L)."""
+    _, r_e = radii(lat)
+    cl = math.cos(lat)
+    return ((r_e + h) * cl * math.cos(lon), (r_e + h) * cl * math.sin(lon), (r_e * (1.0 - E2) + h) * math.sin(lat))
+
+
+@njit(cache=True)
+def gravity_nd(lat: float, h: float) -> tuple[float, float]:
+    """North and down components (m/s^2) of geo.gravity_ned: JSBSim's J2 gravitation plus the centrifugal
+    term W^2 p, resolved on the geodetic NED axes (the east component is zero)."""
+    sl, cl = math.sin(lat), math.cos(lat)
+    _, r_e = radii(lat)
+    p = (r_e + h) * cl
+    z = (r_e * (1.0 - E2) + h) * sl
+    r2 = p * p + z * z
+    r = math.sqrt(r2)
+    s2 = z * z / r2
+    pre = _J2A2 / r2
+    k = -_GM / (r2 * r)
+    gp = k * (1.0 + pre * (1.0 - 5.0 * s2)) * p + _OMEGA_J2 * p
+    gz = k * (1.0 + pre * (3.0 - 5.0 * s2)) * z
+    return -sl * gp + cl * gz, -cl * gp - sl * gz

@@ -1,0 +1,33 @@
+"""Compiled sensor kernels (numba, cache=True): plain functions of float arrays, imported by the sensor models.
+
+    imu_apply   the IMU error application of sensors/imu.py (`Imu.apply`; `apply_reference` is the numpy
+                oracle, tests/unit/sensors/test_sensor_kernels.py checks they agree to 1e-12 relative)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def imu_apply(true_inc: np.ndarray, m_err: np.ndarray, bias0: np.ndarray, bias: np.ndarray, noise: np.ndarray,
+              dt: float, quant: float, out: np.ndarray) -> None:
+    """Increments of R runs (sensors/imu.py error model), in place into out (R, m, 3):
+
+        out = q round((d + M d + (b0 + b_k) dt + n_k) / q)      (no rounding when q = 0)
+
+    true_inc d (m, 3) the exact increments (shared by the runs), m_err M (R, 3, 3) scale factor + misalignment,
+    bias0 b0 (R, 3) turn-on bias, bias b_k (R, m, 3) Gauss-Markov bias at each sample, noise n_k (R, m, 3)
+    white noise per increment; dt (s); quant q the quantization step (rad or m/s), round half to even."""
+    n_runs, m = noise.shape[0], noise.shape[1]
+    for i in range(n_runs):
+        for k in range(m):
+            d0, d1, d2 = true_inc[k, 0], true_inc[k, 1], true_inc[k, 2]
+            for r in range(3):
+                d = d0 if r == 0 else (d1 if r == 1 else d2)
+                v = d + (m_err[i, r, 0] * d0 + m_err[i, r, 1] * d1 + m_err[i, r, 2] * d2) \
+                    + (bias0[i, r] + bias[i, k, r]) * dt + noise[i, k, r]
+                if quant > 0.0:
+                    v = quant * np.rint(v / quant)
+                out[i, k, r] = v
