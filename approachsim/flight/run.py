@@ -35,13 +35,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from approachsim import geo, units
+from approachsim import units
 from approachsim.config import ProfileError
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import Linearization
 from approachsim.flight.envelope import WATCH_HEIGHT_M, StabilityMonitor, check_envelope
 from approachsim.flight.fdm import FDM, InitialCondition, TrimError
+from approachsim.flight.kernels import RAW_FIELDS, imu_point_constants, imu_point_row
 from approachsim.flight.trim import (
     CAS_TOLERANCE_MPS,
     PATH_TOLERANCE_RAD,
@@ -79,17 +80,8 @@ _COLS = {
 _NCOL = 36
 _CTRL = 31
 
-_READ = (
-    "position/lat-geod-rad", "position/long-gc-rad", "position/geod-alt-ft",
-    "velocities/v-north-fps", "velocities/v-east-fps", "velocities/v-down-fps",
-    "attitude/phi-rad", "attitude/theta-rad", "attitude/psi-rad",
-    "velocities/pi-rad_sec", "velocities/qi-rad_sec", "velocities/ri-rad_sec",
-    "velocities/p-rad_sec", "velocities/q-rad_sec", "velocities/r-rad_sec",
-    "accelerations/pidot-rad_sec2", "accelerations/qidot-rad_sec2", "accelerations/ridot-rad_sec2",
-    "forces/fbx-total-lbs", "forces/fby-total-lbs", "forces/fbz-total-lbs", "inertia/mass-slugs",
-    "atmosphere/P-psf", "atmosphere/T-R", "velocities/vc-kts", "aero/beta-rad",
-    "velocities/vtrue-fps",
-)
+_READ = RAW_FIELDS
+"""The JSBSim properties read every step, in the kernel's order (flight/kernels.py)."""
 _READ_LOW = ("gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW", "gear/unit[1]/AGL-ft", "gear/unit[2]/AGL-ft")
 """Read only below LOW_READ_HEIGHT_M: the gear (nose, left main, right main)."""
 LOW_READ_HEIGHT_M = 100.0
@@ -239,16 +231,11 @@ class Approach:
                                     env.wind_from_rad + math.pi)
             set_tn, set_te, set_td = fdm.turbulence_setters()
             turb_step = turb.step
-        if on_truth:
-            rows: list[tuple[float, ...]] = []
-            rows_append = rows.append
-        else:
-            buf = np.full((n_max, _NCOL), np.nan)
-            gbuf = np.full((n_max, 6), np.nan)
-            truth = _truth_views(buf, rw.frame)
+        buf = np.full((n_max, _NCOL), np.nan)
+        gbuf = None if on_truth else np.full((n_max, 6), np.nan)
+        truth = _truth_views(buf, rw.frame)
 
-        nodes = [fdm.node(n) for n in _READ]
-        getters = [n.get_double_value for n in nodes]
+        getters = [fdm.node(n).get_double_value for n in _READ]
         getters_low = [fdm.node(n).get_double_value for n in _READ_LOW]
         w0 = w1 = w2 = 0.0
         g1_ft = g2_ft = math.inf
@@ -259,36 +246,21 @@ class Approach:
         pitch_trim = fdm["fcs/pitch-trim-cmd-norm"]
         terrain = prof.terrain
         flat_terrain = len(terrain.along_m) == 1
-        terr0 = terrain.height_m[0]
+        terr_along = np.asarray(terrain.along_m, dtype=float)
+        terr_height = np.asarray(terrain.height_m, dtype=float)
         set_terrain = fdm.node("position/terrain-elevation-asl-ft").set_double_value
 
-        # constants: lever arm (body axes, m), geodesy, runway frame
+        # constants of the IMU-point kernel: lever arm (body axes, m; CG to IMU), geodesy, runway frame
         cg = (fdm["inertia/cg-x-in"], fdm["inertia/cg-y-in"], fdm["inertia/cg-z-in"])
         imu = ac.imu_location_struct_m
         IN = 0.0254
-        lx = cg[0] * IN - imu[0]  # structural x aft, body x forward
-        ly = imu[1] - cg[1] * IN
-        lz = cg[2] * IN - imu[2]  # structural z up, body z down
-        r_n, r_e = geo.radii(ic.lat_rad)
-        r_n, r_e = float(r_n), float(r_e)
-        a, e2 = geo.A_WGS84, geo.E2_WGS84
-        c_rwy = rw.frame.c_ecef_to_rwy
-        o = rw.frame.origin_ecef
-        ox, oy, oz = float(o[0]), float(o[1]), float(o[2])
-        c00, c01, c02 = (float(v) for v in c_rwy[0])
-        c10, c11, c12 = (float(v) for v in c_rwy[1])
-        h_thr = rw.elevation_m
+        lever = (cg[0] * IN - imu[0], imu[1] - cg[1] * IN, cg[2] * IN - imu[2])  # structural x aft / z up
+        const = imu_point_constants(np.array(lever), ic.lat_rad, rw, dt)
+        raw = np.empty(len(_READ))
+        FT, FPS, KT = units.FT, units.FPS, units.KT
         tan_gp = math.tan(rw.glidepath_rad)
         tch = rw.tch_m
-        FT, FPS, KT = units.FT, units.FPS, units.KT
-        LBF_PER_SLUG = units.LBF / units.SLUG  # (lbf/slug) -> m/s^2
-        PSF = units.PSF
-        gm = geo.GM_JSBSIM
-        hdt = 0.5 * dt
-        omega = geo.OMEGA_JSBSIM
-        RANKINE = 1.8  # Rankine per kelvin
-        g0_over_r = units.G0 / R_AIR
-        sin, cos, sqrt = math.sin, math.cos, math.sqrt
+        sqrt = math.sqrt
 
         trim = Trim(theta_rad=fdm["attitude/theta-rad"], throttle=fdm["fcs/throttle-cmd-norm[0]"],
                     cas_mps=ac.approach_speed_mps)
@@ -311,110 +283,29 @@ class Approach:
         for k in range(n_max):
             if k > 0:
                 run_step()
-            (lat, lon, h_ft, vn_f, ve_f, vd_f, phi, th, psi, pi_, qi, ri, p, q, r, pid, qid, rid,
-             fx, fy, fz, m, p_psf, t_r, vc_kt, beta, vt_fps) = [gv() for gv in getters]
-            h = h_ft * FT
-            # body -> NED direction cosines from the Euler angles
-            sf, cf, st, ct, sp, cp = sin(phi), cos(phi), sin(th), cos(th), sin(psi), cos(psi)
-            n00, n01, n02 = ct * cp, sf * st * cp - cf * sp, cf * st * cp + sf * sp
-            n10, n11, n12 = ct * sp, sf * st * sp + cf * cp, cf * st * sp - sf * cp
-            n20, n21, n22 = -st, sf * ct, cf * ct
-            # lever-arm terms: w_eb x l (velocity), w_ib' x l + w_ib x (w_ib x l) (specific force)
-            ux, uy, uz = q * lz - r * ly, r * lx - p * lz, p * ly - q * lx
-            wx, wy, wz = qi * lz - ri * ly, ri * lx - pi_ * lz, pi_ * ly - qi * lx
-            s = LBF_PER_SLUG / m
-            # lever-arm acceleration over the step, exactly as JSBSim's rectangular-Euler step moves the IMU point:
-            # (R (w1 x l) - w x l) / dt, w1 = w + dt w' the next inertial rate, R the body rotation of the step
-            # (q(+) = normalize(q (1, dt w / 2))): w' x l + w x (w x l) + O(dt)
-            ex, ey, ez = hdt * pi_, hdt * qi, hdt * ri
-            ux1, uy1, uz1 = pi_ + dt * pid, qi + dt * qid, ri + dt * rid
-            ax, ay, az = uy1 * lz - uz1 * ly, uz1 * lx - ux1 * lz, ux1 * ly - uy1 * lx  # w1 x l
-            bx, by, bz = ey * az - ez * ay, ez * ax - ex * az, ex * ay - ey * ax  # e x (w1 x l)
-            k2 = 2.0 / (1.0 + ex * ex + ey * ey + ez * ez)
-            fbx = fx * s + (ax + k2 * (bx + ey * bz - ez * by) - wx) / dt
-            fby = fy * s + (ay + k2 * (by + ez * bx - ex * bz) - wy) / dt
-            fbz = fz * s + (az + k2 * (bz + ex * by - ey * bx) - wz) / dt
-            vn = vn_f * FPS + n00 * ux + n01 * uy + n02 * uz
-            ve = ve_f * FPS + n10 * ux + n11 * uy + n12 * uz
-            vd = vd_f * FPS + n20 * ux + n21 * uy + n22 * uz
-            # IMU position: geodetic offset of C_nb l, then ECEF and runway frame
-            dn = n00 * lx + n01 * ly + n02 * lz
-            dE = n10 * lx + n11 * ly + n12 * lz
-            dd = n20 * lx + n21 * ly + n22 * lz
-            lat_i = lat + dn / (r_n + h)
-            slat, clat = sin(lat_i), cos(lat_i)
-            lon_i = lon + dE / ((r_e + h) * cos(lat))
-            h_i = h - dd
-            re_i = a / sqrt(1.0 - e2 * slat * slat)
-            x_e = (re_i + h_i) * clat * cos(lon_i)
-            y_e = (re_i + h_i) * clat * sin(lon_i)
-            z_e = (re_i * (1.0 - e2) + h_i) * slat
-            # gravitation at the IMU differs from the CG's (JSBSim's, in f_cg) by the gradient GM/r^3 (3 uu' - I) d,
-            # d = C_nb l: the accelerometer there feels f_imu = ... - (G_imu - G_cg), in body axes
-            # GM/r^3 (l - 3 d_D C_nb' e_D)  (J2 part of the gradient: < 1e-8 m/s^2)
-            kg = gm / (x_e * x_e + y_e * y_e + z_e * z_e) ** 1.5
-            fbx += kg * (lx - 3.0 * dd * n20)
-            fby += kg * (ly - 3.0 * dd * n21)
-            fbz += kg * (lz - 3.0 * dd * n22)
-            # JSBSim's Euler step applies the gravitation of the step's start, G(r_i[k]), while the point moves at
-            # its inertial velocity v_i = v + W x r (~300 m/s east): the recorded trajectory is that of gravitation
-            # at the step's midpoint plus the specific force f + G(r_i[k]) - G(r_i[k] + v_i dt/2)
-            # = f + GM/r^3 dt/2 (v_i - 3 u (u . v_i)) (u up; <= 3e-6 m/s^2, JSBSim's O(dt) error put where an
-            # accelerometer on this trajectory would see it)
-            kv = kg * hdt
-            gn_, ge_, gd_ = kv * vn, kv * (ve + omega * sqrt(x_e * x_e + y_e * y_e)), -2.0 * kv * vd
-            fbx += n00 * gn_ + n10 * ge_ + n20 * gd_
-            fby += n01 * gn_ + n11 * ge_ + n21 * gd_
-            fbz += n02 * gn_ + n12 * ge_ + n22 * gd_
-            # JSBSim holds that specific force fixed in inertial axes over the step while the body turns at w: the
-            # record holds its body-axis mean, (1/dt) int_0^dt Exp(-[w x] t) dt f = f - c1 phi x f + c2 phi x (phi x f)
-            # (phi = w dt; c1 = (1 - cos a)/a^2, c2 = (a - sin a)/a^3, a = |phi|, series), so that dt f_body is the
-            # exact velocity increment of the step in body axes
-            px, py, pz = 2.0 * ex, 2.0 * ey, 2.0 * ez
-            a2 = px * px + py * py + pz * pz
-            c1, c2 = 0.5 - a2 / 24.0, 1.0 / 6.0 - a2 / 120.0
-            qx, qy, qz = py * fbz - pz * fby, pz * fbx - px * fbz, px * fby - py * fbx  # phi x f
-            fbx, fby, fbz = (fbx - c1 * qx + c2 * (py * qz - pz * qy), fby - c1 * qy + c2 * (pz * qx - px * qz),
-                             fbz - c1 * qz + c2 * (px * qy - py * qx))
-            # the IMU's own NED axes are turned from the CG's by t = (dE/(R_E+h), -dN/(R_N+h), -dE tan L/(R_E+h))
-            # (l/R ~ 1.4e-6 rad): velocity and attitude are resolved on them, x_imu = (I - [t x]) x_cg
-            ta, tb, tc = dE / (r_e + h), -dn / (r_n + h), -dE * math.tan(lat) / (r_e + h)
-            vn, ve, vd = vn - tb * vd + tc * ve, ve - tc * vn + ta * vd, vd - ta * ve + tb * vn
-            m00, m10, m20 = n00 - tb * n20 + tc * n10, n10 - tc * n00 + ta * n20, n20 - ta * n10 + tb * n00
-            m21, m22 = n21 - ta * n11 + tb * n01, n22 - ta * n12 + tb * n02
-            phi_i = math.atan2(m21, m22)
-            th_i = -math.asin(m20)
-            psi_i = psi + math.remainder(math.atan2(m10, m00) - psi, 2.0 * math.pi)
-            # static pressure at the IMU point: hydrostatic over the CG-to-IMU height difference (JSBSim gives it
-            # at the CG), dp = -p g0 / (R_air T) dz  (ISA hydrostatics in geopotential height, dH = dz here)
-            p_imu = p_psf * PSF * math.exp(dd * g0_over_r / (t_r / RANKINE))
-            dx, dy, dz = x_e - ox, y_e - oy, z_e - oz
-            xr = c00 * dx + c01 * dy + c02 * dz
-            yr = c10 * dx + c11 * dy + c12 * dz
-            zr = h_i - h_thr
-            if flat_terrain:
-                terr = terr0
-            else:
-                terr = float(np.interp(xr, terrain.along_m, terrain.height_m))
+            vals = [gv() for gv in getters]
+            raw[:] = vals
+            row = buf[k]
+            # the IMU point's truth row (flight/kernels.py: lever arm, gravitation terms, step-mean specific
+            # force, IMU-point NED axes, hydrostatic pressure, runway frame); returns the terrain under it
+            terr = imu_point_row(raw, const, terr_along, terr_height, k * dt, row)
+            (_lat, _lon, h_ft, vn_f, ve_f, vd_f, phi, th, _psi, _pi, _qi, _ri, p, q, _r, _pid, _qid, _rid,
+             _fx, _fy, _fz, _m, _p_psf, _t_r, vc_kt, beta, vt_fps) = vals
+            rv = row.tolist()
+            vn, ve, vd = rv[7], rv[8], rv[9]
+            h_i, xr, yr, zr = rv[3], rv[26], rv[27], rv[28]
+            cas = vc_kt * KT
+            if not flat_terrain:
                 set_terrain(terr / FT)
             if h_i - terr < LOW_READ_HEIGHT_M:
                 w0, w1, w2, g1_ft, g2_ft = [gv() for gv in getters_low]
             if turb is not None:  # turbulence for the next step, at the CG's height above the terrain
-                tn, te, td = turb_step(k, h - terr, vt_fps * FPS)
+                tn, te, td = turb_step(k, h_ft * FT - terr, vt_fps * FPS)
                 set_tn(tn)
                 set_te(te)
                 set_td(td)
-            # body -> NED quaternion (scalar first) from the IMU point's Euler angles
-            s1, c1 = sin(0.5 * phi_i), cos(0.5 * phi_i)
-            s2, c2 = sin(0.5 * th_i), cos(0.5 * th_i)
-            s3, c3 = sin(0.5 * psi_i), cos(0.5 * psi_i)
-            head = (
-                k * dt, lat_i, lon_i, h_i, x_e, y_e, z_e, vn, ve, vd,
-                c1 * c2 * c3 + s1 * s2 * s3, s1 * c2 * c3 - c1 * s2 * s3,
-                c1 * s2 * c3 + s1 * c2 * s3, c1 * c2 * s3 - s1 * s2 * c3,
-                phi_i, th_i, psi_i, pi_, qi, ri, fbx, fby, fbz, p_imu, t_r / 1.8, h_i - terr,
-                xr, yr, zr, zr - (tch - xr * tan_gp), yr,
-            )
+            # the controls of the previous step act on this row until replaced below
+            row[_CTRL], row[_CTRL + 1], row[_CTRL + 2], row[_CTRL + 3] = de + pitch_trim, da, dr, thr
             # termination checks on the true state
             if zr < lowest:
                 lowest = zr
@@ -431,32 +322,20 @@ class Approach:
             elif monitor_floor < zr < WATCH_HEIGHT_M:  # speed through the mean air mass (gusts removed), as CAS
                 an, ae = vn_f * FPS - w_n, ve_f * FPS - w_e
                 v_air = sqrt(an * an + ae * ae + (vd_f * FPS) ** 2)
-                term = mon_step(xr, yr, zr, v_air * (vc_kt * KT) / (vt_fps * FPS), vd, sqrt(vn * vn + ve * ve))
+                term = mon_step(xr, yr, zr, v_air * cas / (vt_fps * FPS), vd, sqrt(vn * vn + ve * ve))
             if on_truth:
-                # TruthSource.step would return this row's r_rwy and v_ned: fly on them directly, and keep the
-                # rows in a list (no one reads the arrays during the run)
-                if term is not None:  # the controls of the previous step still act on the last row
-                    rows_append(head + (de + pitch_trim, da, dr, thr, vc_kt * KT))
-                    termination = term
-                    break
-                h_gear = min(g1_ft, g2_ft) * FT if land else None
-                de, da, dr, thr = ap_step(xr, yr, zr, vn, ve, vd, phi, th, p, q, beta, vc_kt * KT, h_gear,
-                                          vt_fps * FPS)
-                rows_append(head + (de + pitch_trim, da, dr, thr, vc_kt * KT))
-            else:
-                # the navigation source sees row k (controls: those of the previous step until replaced below)
-                buf[k] = head + (de + pitch_trim, da, dr, thr, vc_kt * KT)
+                gx, gy, gz, gvn, gve, gvd = xr, yr, zr, vn, ve, vd
+            else:  # the navigation source sees row k (and rows before it)
                 gr, gv = src.step(k, truth)
                 gx, gy, gz = float(gr[0]), float(gr[1]), float(gr[2])
                 gvn, gve, gvd = float(gv[0]), float(gv[1]), float(gv[2])
                 gbuf[k] = (gx, gy, gz, gvn, gve, gvd)
-                if term is not None:
-                    termination = term
-                    break
-                h_gear = min(g1_ft, g2_ft) * FT if land else None
-                de, da, dr, thr = ap_step(gx, gy, gz, gvn, gve, gvd, phi, th, p, q, beta, vc_kt * KT, h_gear,
-                                          vt_fps * FPS)
-                buf[k, _CTRL:_CTRL + 4] = (de + pitch_trim, da, dr, thr)
+            if term is not None:
+                termination = term
+                break
+            h_gear = min(g1_ft, g2_ft) * FT if land else None
+            de, da, dr, thr = ap_step(gx, gy, gz, gvn, gve, gvd, phi, th, p, q, beta, cas, h_gear, vt_fps * FPS)
+            row[_CTRL], row[_CTRL + 1], row[_CTRL + 2], row[_CTRL + 3] = de + pitch_trim, da, dr, thr
             # the controls for the next step
             set_de(de)
             set_da(da)
@@ -465,9 +344,7 @@ class Approach:
             set_thr[1](thr)
         n = k + 1
         if on_truth:
-            buf = np.array(rows, dtype=float).reshape(n, _NCOL)
-            truth = _truth_views(buf, rw.frame)
-            gbuf = np.concatenate([truth.r_rwy, truth.v_ned], axis=1)
+            gbuf = np.concatenate([truth.r_rwy[:n], truth.v_ned[:n]], axis=1)
         final = Truth(**{name: np.ascontiguousarray(v[:n]) for name, v in truth.arrays().items()}, runway=rw.frame)
         return FlightResult(
             truth=final,
