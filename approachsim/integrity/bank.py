@@ -1,0 +1,200 @@
+"""The sub-filter bank of solution-separation integrity over one run's records, and its protection levels.
+
+The main filter uses every measurement; sub-filter k is the same navigation system on the same records with
+GNSS channel k never used (every channel the main filter used during the run is a fault mode). The bank runs
+as K + 1 copies of the run in one batched NavSystem pass (same sensor draws, same initial-error draw: the
+copies differ only in the excluded channel), with the shared covariance where the configuration allows it.
+
+At each filter epoch, in the approach frame (vertical up; lateral = cross-track, + right of the runway
+heading), the separation of sub-solution k is e_k - e_0 (the difference of the output errors against truth,
+which is the difference of the outputs: the truth cancels, in feed-forward and feedback alike), and the
+variances are those of the filters' navigation-error covariances projected on the two axes; the detection
+test, the H0 / H1 protection levels and the exclusion are integrity.separation's. Every category is scored at
+the filter epochs (not the 120 Hz samples between them, where P does not change): availability PL < AL with
+the category's alert limit at the aircraft's distance and height, misleading information |e_0| > PL.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from approachsim.integrity.requirements import (
+    REQUIREMENTS,
+    IntegrityRequirement,
+    lateral_alert_limit_m,
+    vertical_alert_limit_m,
+)
+from approachsim.integrity.separation import SeparationResult, separation
+
+Array = np.ndarray
+
+
+def used_channels(valid: Array) -> Array:
+    """Indices of the GNSS channels valid at any sample (valid (m, channels) of one run)."""
+    return np.nonzero(np.any(np.asarray(valid, bool), axis=0))[0]
+
+
+def bank_records(records: dict[str, Any], channels: Array) -> dict[str, Any]:
+    """K + 1 copies of one run's records (run axis first): copy 0 as given, copy k + 1 with GNSS channel
+    channels[k] marked invalid. Records must come from SensorSuite.measure(..., runs=[i] * (K + 1))."""
+    g = records["gnss"]
+    valid = np.array(g.valid, dtype=bool, copy=True)
+    if valid.ndim != 3 or valid.shape[0] != len(channels) + 1:
+        raise ValueError("bank_records: measure the run K + 1 times (runs=[i] * (K + 1)) first")
+    for k, c in enumerate(channels):
+        valid[k + 1, :, c] = False
+    out = dict(records)
+    out["gnss"] = dataclasses.replace(g, valid=valid)
+    return out
+
+
+@dataclass(frozen=True)
+class BankEpochs:
+    """Per filter epoch of one run (axis 0): the main and sub-solution errors and variances on the approach
+    axes (last axis: 0 vertical, 1 lateral), m and m^2, and where the aircraft was."""
+
+    t_s: Array
+    e0: Array
+    """(e, 2) main-solution error (output - truth)."""
+    p0: Array
+    """(e, 2) its variances."""
+    ek: Array
+    """(e, K, 2) sub-solution errors."""
+    pk: Array
+    """(e, K, 2) their variances."""
+    channels: Array
+    """(K,) the GNSS channel each sub-filter leaves out."""
+    along_m: Array
+    """(e,) runway-frame x of the aircraft (negative before the threshold), m."""
+    height_m: Array
+    """(e,) height above the threshold, m."""
+
+
+def _axes(heading_rad: float) -> Array:
+    """(2, 3) rows mapping NED to (up, right of the runway heading)."""
+    return np.array([[0.0, 0.0, -1.0], [-np.sin(heading_rad), np.cos(heading_rad), 0.0]])
+
+
+def bank_epochs(main: Any, subs: list[Any], channels: Array, truth: Any, heading_rad: float) -> BankEpochs:
+    """Project the NavRuns of the main filter and the sub-filters on the approach axes at the epochs."""
+    A = _axes(heading_rad)
+    t = np.asarray(main.t_epoch_s)
+
+    def err(run: Any) -> tuple[Array, Array]:
+        e = np.asarray(run.true_error_nav)[:, 0:3] @ A.T
+        p = np.einsum("ij,ejk,ik->ei", A, np.asarray(run.P_nav)[:, 0:3, 0:3], A)
+        return e, p
+
+    e0, p0 = err(main)
+    subs_ep = [err(r) for r in subs]
+    ek = np.stack([s[0] for s in subs_ep], axis=1) if subs_ep else np.zeros((t.size, 0, 2))
+    pk = np.stack([s[1] for s in subs_ep], axis=1) if subs_ep else np.zeros((t.size, 0, 2))
+    r = np.stack([np.interp(t, truth.t_s, truth.r_rwy[:, i]) for i in range(3)], axis=1)
+    return BankEpochs(t, e0, p0, ek, pk, np.asarray(channels), r[:, 0], r[:, 2])
+
+
+@dataclass(frozen=True)
+class CategoryIntegrity:
+    """One category's integrity over one run's epochs (after `start_height_m`, before the DH or the run end)."""
+
+    category: str
+    epochs: int
+    available: Array
+    """(e,) PL < AL on both axes."""
+    misleading: Array
+    """(e,) output error > PL on either axis (the output: main solution, after an exclusion the sub-solution)."""
+    hazardous: Array
+    """(e,) output error > AL on either axis while PL < AL (hazardously misleading)."""
+    detected: Array
+    """(e,) the separation test fired."""
+    pl_m: Array
+    """(e, 2) protection levels of the output (vertical, lateral); after an exclusion the excluded
+    sub-solution's fault-free level K_ff sigma_k (no second-level bank monitors it)."""
+    al_m: Array
+    """(e, 2) alert limits."""
+    result: SeparationResult
+    """The main filter's separation test and protection levels (before any exclusion)."""
+    excluded_channel: int
+    """GNSS channel excluded at the first detection (-1: none)."""
+    t_detect_s: float
+    """Time of the first detection (nan: none), s."""
+    time_to_alert_s: float
+    """First detection minus the first epoch at which the main solution's error exceeded its protection level
+    (negative: detected before; nan: the error never exceeded it), s."""
+    alert: Array
+    """(e,) the output cannot be protected: PL >= AL (unavailable), the flag a crew would see."""
+
+
+def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, window: Array | None = None
+                   ) -> CategoryIntegrity:
+    """Protection levels, detection and the per-epoch counts of one category (Annex 10 alert limits at the
+    aircraft's distance from the threshold and height above it)."""
+    sel = np.ones(ep.t_s.shape, bool) if window is None else np.asarray(window, bool)
+    n_modes = max(ep.ek.shape[1], 1)
+    r = separation(ep.e0[sel], ep.p0[sel], ep.ek[sel], ep.pk[sel], req.k_ff(), req.k_fa(epoch_hz, 2 * n_modes),
+                   req.k_md()) if ep.ek.shape[1] else _no_modes(ep, sel, req)
+    al = np.stack([vertical_alert_limit_m(req, ep.height_m[sel]), lateral_alert_limit_m(req, ep.along_m[sel])],
+                  axis=1)
+    t = ep.t_s[sel]
+    e_main = np.abs(ep.e0[sel])
+    err, pl = e_main.copy(), r.pl_m.copy()
+    excluded, t_det = -1, float("nan")
+    if r.detected.any():  # exclude the suspect from the first detection on: its sub-solution is the output
+        i = int(np.argmax(r.detected))
+        k = int(r.suspect[i])
+        excluded, t_det = int(ep.channels[k]), float(t[i])
+        err[i:] = np.abs(ep.ek[sel][i:, k])
+        pl[i:] = req.k_ff() * np.sqrt(ep.pk[sel][i:, k])
+    exceed = np.any(e_main > r.pl_m, axis=1)
+    tta = float(t_det - t[np.argmax(exceed)]) if exceed.any() and np.isfinite(t_det) else float("nan")
+    if exceed.any() and not np.isfinite(t_det):
+        tta = float("inf")  # the error exceeded the PL and nothing was ever detected
+    avail = np.all(pl < al, axis=1)
+    mi = np.any(err > pl, axis=1)
+    hmi = np.any(err > al, axis=1) & avail
+    return CategoryIntegrity(req.category, int(sel.sum()), avail, mi, hmi, r.detected, pl, al, r, excluded, t_det,
+                             tta, ~avail)
+
+
+def _no_modes(ep: BankEpochs, sel: Array, req: IntegrityRequirement) -> SeparationResult:
+    """No redundant channel (e.g. best-four selection): no fault can be detected, so no H1 protection:
+    PL = inf (unavailable)."""
+    n = int(sel.sum())
+    inf = np.full((n, 2), np.inf)
+    return SeparationResult(req.k_ff() * np.sqrt(ep.p0[sel]), inf, inf, np.zeros((n, 0, 2)),
+                            np.zeros(n, bool), np.full(n, -1))
+
+
+def score_run(ep: BankEpochs, epoch_hz: float, start_height_m: float, dh_m: dict[str, float]
+              ) -> dict[str, CategoryIntegrity]:
+    """Every category, from start_height_m above the threshold down to its decision height."""
+    out = {}
+    for cat, req in REQUIREMENTS.items():
+        window = (ep.height_m <= start_height_m) & (ep.height_m >= dh_m[cat])
+        out[cat] = score_category(ep, req, epoch_hz, window)
+    return out
+
+
+def run_bank(profile: Any, truth: Any, seed: int, run: int) -> tuple[BankEpochs, Any]:
+    """Measure run `run` of the campaign seeded `seed` on `truth`, navigate it with the main filter and the
+    sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun)."""
+    from approachsim.nav.system import NavSystem
+    from approachsim.seeding import stream
+    from approachsim.sensors.suite import SensorSuite
+
+    suite = SensorSuite.from_profile(profile)
+    probe = suite.measure(truth, seed=seed, runs=[run])
+    if "gnss" not in probe:
+        raise ValueError("integrity bank: the profile has no GNSS receiver")
+    channels = used_channels(np.asarray(probe["gnss"].valid)[0])
+    copies = len(channels) + 1
+    recs = bank_records(suite.measure(truth, seed=seed, runs=[run] * copies), channels)
+    nav = NavSystem.from_profile(profile)
+    navs = nav.run(truth, recs, [stream(seed, run, "nav") for _ in range(copies)],
+                   shared_covariance=nav.shares_covariance())
+    ep = bank_epochs(navs[0], navs[1:], channels, truth, profile.runway.heading_rad)
+    return ep, navs[0]
