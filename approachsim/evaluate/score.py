@@ -3,7 +3,7 @@
 Scalars (SI, names carry the unit): for each category key (cat1, cat2, cat3) at its decision height the
 along / lateral / vertical navigation error, VPL / HPL, the time of the crossing, and (always computed;
 meaningful in closed loop) flight technical and total system error; Stanford counts (vertical and
-horizontal) and availability over the approach down to that height; seed 002's time-averaged squared
+horizontal) and availability over the approach down to that height; Gray & Maybeck's time-averaged squared
 errors (ft^2) from evaluation.timeavg_settle_s on. Arrays: lateral / vertical error and VPL / HPL on a
 fixed height grid (HEIGHT_GRID_FT), for the error-against-height figures. Series (kept for a few runs):
 decimated per-epoch errors.

@@ -19,6 +19,7 @@ CFG = EvaluationConfig()
 CONTRACT_DH_KEYS = {
     "height_ft", "lateral_1sigma_ft", "vertical_1sigma_ft", "lateral_95_ft", "vertical_95_ft",
     "limit_lateral_1sigma_ft", "limit_vertical_1sigma_ft", "meets",
+    "verdict", "lateral_1sigma_upper_ft", "vertical_1sigma_upper_ft", "runs_needed",
 }
 
 
@@ -36,21 +37,28 @@ def _e(lateral_ft: float, vertical_ft: float) -> np.ndarray:
 
 
 def test_constant_bias_cat_i_only():
-    s, _ = _campaign([_e(20.0, 5.0)] * 5)
+    s, _ = _campaign([_e(20.0, 5.0)] * 10)  # MIN_RUNS: fewer runs cannot meet
     d = s["decision_heights"]
     # near the decision heights the runway axes and the local axes agree to < 1e-4 rad
     assert d["CAT I"]["lateral_1sigma_ft"] == pytest.approx(20.0, abs=0.01)
     assert d["CAT I"]["vertical_1sigma_ft"] == pytest.approx(5.0, abs=0.01)
     assert d["CAT I"]["lateral_95_ft"] == pytest.approx(20.0, abs=0.01)
     assert [d[c]["meets"] for c in ("CAT I", "CAT II", "CAT III")] == [True, False, False]
+    # a constant error is all bias: the upper bound is the RMS itself; 20 ft sqrt(10 / chi2_0.95(10)) = 15.0 ft
+    # is above CAT II's 8.6 ft, so CAT II fails rather than being indeterminate
+    assert d["CAT I"]["lateral_1sigma_upper_ft"] == pytest.approx(20.0, abs=0.01)
+    assert [d[c]["verdict"] for c in ("CAT I", "CAT II", "CAT III")] == ["meets", "fails", "fails"]
     assert s["best_category"] == "CAT I"
+    few, _ = _campaign([_e(20.0, 5.0)] * 5)  # the same errors from 5 runs: too few to meet
+    assert few["decision_heights"]["CAT I"]["verdict"] == "indeterminate" and few["best_category"] is None
+    assert few["decision_heights"]["CAT I"]["runs_needed"] == 10
 
 
 def test_constant_bias_cat_ii_and_none():
-    s, _ = _campaign([_e(-8.0, 2.5)] * 3)  # sign of a bias does not help it
+    s, _ = _campaign([_e(-8.0, 2.5)] * 10)  # sign of a bias does not help it
     assert [s["decision_heights"][c]["meets"] for c in ("CAT I", "CAT II", "CAT III")] == [True, True, False]
     assert s["best_category"] == "CAT II"
-    s, _ = _campaign([_e(30.0, 1.0)] * 3)  # lateral fails CAT I and CAT II; CAT III fails vertically... 30 > 6.8
+    s, _ = _campaign([_e(30.0, 1.0)] * 10)  # lateral fails CAT I and CAT II; CAT III fails vertically... 30 > 6.8
     assert s["best_category"] is None
 
 
