@@ -116,7 +116,8 @@ def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cf
             },
             "limits_ft": {k: _num(v) for k, v in asdict(r.limits).items()},
         }
-        for comp in ("along", "lateral", "vertical", "vpl", "hpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert"):
+        comps = ("along", "lateral", "vertical", "gpdev", "vpl", "hpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert")
+        for comp in comps:
             entry[f"{comp}_ft"] = _stats_ft(_col(columns, f"{key}_{comp}_m"))
         for axis, name in (("v", "vertical"), ("h", "horizontal")):
             entry[f"stanford_{name}"] = {

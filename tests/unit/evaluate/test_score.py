@@ -158,6 +158,9 @@ def test_unscorable_runs_raise_with_a_reason():
 def test_evaluation_section_parsing():
     cfg = parse_evaluation(Section({"dh_cat2_ft": 120, "verdict": "faa+icao"}, "evaluation"))
     assert cfg.dh_ft == {"CAT I": 200.0, "CAT II": 120.0, "CAT III": 50.0} and cfg.verdict == "faa+icao"
+    assert (cfg.confidence, cfg.max_failure_fraction) == (0.95, 0.0)
+    cfg = parse_evaluation(Section({"confidence": 0.99, "max_failure_fraction": 0.01}, "evaluation"))
+    assert (cfg.confidence, cfg.max_failure_fraction) == (0.99, 0.01)
     for bad, field in (
         ({"dh_cat1_ft": "200"}, "evaluation.dh_cat1_ft"),
         ({"dh_cat3_ft": 150}, "evaluation.dh_cat2_ft"),
@@ -167,6 +170,21 @@ def test_evaluation_section_parsing():
         ({"timeavg_settle_s": -1}, "evaluation.timeavg_settle_s"),
         ({"flight_group": 0}, "evaluation.flight_group"),
         ({"bogus": 1}, "evaluation.bogus"),
+        ({"confidence": 1.0}, "evaluation.confidence"),
+        ({"confidence": "95%"}, "evaluation.confidence"),
+        ({"max_failure_fraction": -0.1}, "evaluation.max_failure_fraction"),
     ):
         with pytest.raises(ProfileError, match=field.replace(".", r"\.")):
             parse_evaluation(Section(bad, "evaluation"))
+
+
+def test_glidepath_deviation_error_couples_the_along_track_error():
+    """e_gpdev = e_vertical + e_along tan(gamma): an along-track error alone moves the glidepath deviation."""
+    from evalpairs import GP, RWY
+
+    truth = make_truth(hz=4.0)
+    e = 20.0 * np.array([math.cos(RWY.heading_rad), math.sin(RWY.heading_rad), 0.0])  # 20 m along track only
+    sc = score_run(truth, make_nav(truth, e), CFG)[0]
+    assert sc["cat1_along_m"] == pytest.approx(20.0, abs=1e-3)
+    assert sc["cat1_gpdev_m"] == pytest.approx(sc["cat1_vertical_m"] + 20.0 * math.tan(GP), abs=1e-3)
+    assert sc["cat1_gpdev_m"] == pytest.approx(20.0 * math.tan(GP), abs=0.01)  # ~1.05 m at 3 deg
