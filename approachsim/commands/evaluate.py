@@ -1,12 +1,14 @@
 """`approachsim evaluate PROFILE [--runs N] [--seed S] [--out DIR] [--mode closed|open] [--workers K]
-[--scheduler ADDR] [--resume | --overwrite] [--no-report]`: the Monte Carlo evaluation of a profile
-against CAT I / II / III.
+[--scheduler ADDR] [--resume | --overwrite] [--no-report] [--require CAT]`: the Monte Carlo evaluation of
+a profile against CAT I / II / III.
 
 Writes DIR/summary.json (design.md's output contract), DIR/details.json (intervals, ICAO columns,
 integrity, FTE / TSE, time-averaged RMS), DIR/runs.parquet (one row per run), DIR/heights.parquet (per-run
 error profiles against height), DIR/series/ (time series of the first evaluation.series_runs runs),
 DIR/runs.jsonl + DIR/campaign.json (the resumable record), the figures and DIR/report.html; prints the
-verdict table. Bad options exit 2 with one line; a missing pipeline stage exits 1 with one line.
+verdict table. Exit status (docs/contract.md): 0 the campaign ran; 1 the --require'd category's verdict is
+not `meets` (or a pipeline stage is missing, with one line); 2 bad input, one line naming the field; 3 no run
+completed, with one line giving the first failure's reason.
 """
 
 from __future__ import annotations
@@ -49,6 +51,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--resume", action="store_true", help="continue the campaign in --out, keeping finished runs")
     p.add_argument("--overwrite", action="store_true", help="start afresh in --out, discarding a campaign there")
     p.add_argument("--no-report", action="store_true", help="skip figures and report.html")
+    p.add_argument("--require", default=None, metavar="CAT",
+                   help='exit 1 unless this category\'s verdict is meets ("CAT I", "CAT II" or "CAT III"): a CI gate')
     p.set_defaults(func=run)
 
 
@@ -58,6 +62,22 @@ def require_distributed() -> None:
 
     if importlib.util.find_spec("distributed") is None:
         raise ProfileError("--scheduler: needs dask.distributed, not installed: pip install approachsim[dask]")
+
+
+def parse_require(text: str | None) -> str | None:
+    """The category named by --require ("CAT II", "cat ii", "CAT2", "cat-2" ...); ProfileError otherwise."""
+    if text is None:
+        return None
+    from approachsim.evaluate.limits import CATEGORIES
+
+    t = re.sub(r"[\s_\-]+", "", text).upper()
+    roman = {"1": "I", "2": "II", "3": "III"}
+    if t.startswith("CAT") and t[3:] in roman:
+        t = "CAT" + roman[t[3:]]
+    for c in CATEGORIES:
+        if t == c.replace(" ", ""):
+            return c
+    raise ProfileError(f"--require: must be one of {', '.join(repr(c) for c in CATEGORIES)}, got {text!r}")
 
 
 def check_options(args: argparse.Namespace, profile) -> tuple[int, int, str, Path]:
@@ -104,6 +124,7 @@ def run(args: argparse.Namespace) -> int:
 
     profile = load_profile(args.profile)
     runs, seed, mode, out = check_options(args, profile)
+    require = parse_require(getattr(args, "require", None))
     try:
         spec = spec_for(profile, mode)
     except PipelineUnavailable as e:
@@ -123,4 +144,15 @@ def run(args: argparse.Namespace) -> int:
     if failed:
         print(f"{len(failed)} run(s) failed; first: run {failed[0].run}: {failed[0].error}")
     print(f"wrote {out / 'summary.json'}" + ("" if args.no_report else f", {out / 'report.html'}"))
+    if failed and len(failed) == len(ev.results):
+        sys.stderr.write(
+            f"approachsim evaluate: no run completed ({len(failed)} failed); first: run {failed[0].run}: "
+            f"{failed[0].error}\n"
+        )
+        return 3
+    if require is not None:
+        v = summary["decision_heights"][require]["verdict"]
+        if v != "meets":
+            sys.stderr.write(f"approachsim evaluate: --require {require}: verdict is {v}, not meets\n")
+            return 1
     return 0

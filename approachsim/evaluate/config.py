@@ -36,8 +36,12 @@ class EvaluationConfig:
     series_runs: int = 3
     flight_group: int = 25
     timeavg_settle_s: float = 10.0
-    """Start of seed 002's time averages after the run start, s: leaves out the filter's start-up (the
+    """Start of Gray & Maybeck's time averages after the run start, s: leaves out the filter's start-up (the
     receiver clock is acquired at the first GPS update, from hundreds of metres of initial uncertainty)."""
+    confidence: float = 0.95
+    """Confidence level of each one-sided bound the verdict is decided on (evaluate/verdict.py)."""
+    max_failure_fraction: float = 0.0
+    """Failure probability a category tolerates; 0: any failed run fails every category (evaluate/verdict.py)."""
 
     @property
     def dh_ft(self) -> dict[str, float]:
@@ -64,8 +68,10 @@ def parse_evaluation(s: Section) -> EvaluationConfig:
     series_runs = s.integer("series_runs", 3, lo=0, hi=1000)
     flight_group = s.integer("flight_group", 25, lo=1, hi=10000)
     settle = s.number("timeavg_settle_s", 10.0, lo=0.0, hi=600.0, unit="s")
+    confidence = s.number("confidence", 0.95, lo=0.5, hi=0.9999)
+    max_fail = s.number("max_failure_fraction", 0.0, lo=0.0, hi=0.5)
     s.done()
     return EvaluationConfig(
         *dh.values(), verdict=verdict, k_v=k_v, k_h=k_h, series_runs=series_runs, flight_group=flight_group,
-        timeavg_settle_s=settle,
+        timeavg_settle_s=settle, confidence=confidence, max_failure_fraction=max_fail,
     )

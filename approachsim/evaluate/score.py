@@ -3,7 +3,7 @@
 Scalars (SI, names carry the unit): for each category key (cat1, cat2, cat3) at its decision height the
 along / lateral / vertical navigation error, VPL / HPL, the time of the crossing, and (always computed;
 meaningful in closed loop) flight technical and total system error; Stanford counts (vertical and
-horizontal) and availability over the approach down to that height; seed 002's time-averaged squared
+horizontal) and availability over the approach down to that height; Gray & Maybeck's time-averaged squared
 errors (ft^2) from evaluation.timeavg_settle_s on. Arrays: lateral / vertical error and VPL / HPL on a
 fixed height grid (HEIGHT_GRID_FT), for the error-against-height figures. Series (kept for a few runs):
 decimated per-epoch errors.
@@ -11,6 +11,13 @@ decimated per-epoch errors.
 TSE, FTE, NSE (ICAO PBN, without path definition error): TSE = true deviation from the desired path
 (truth loc_dev_m / gs_dev_m); NSE = estimate - truth; FTE = the deviation guidance flew on. When the flight
 gives what guidance flew on (fte_lat_m / fte_vert_m series) that is used; otherwise FTE = TSE + NSE.
+
+Reference point (docs/contract.md): every error is the IMU point's, and the decision-height instant is the
+true IMU height's crossing. Glidepath-deviation error: the deviation from the glidepath is
+d = h - (TCH - x tan(gamma)) (runway-frame x, negative before the threshold), so its navigation error is
+e_d = e_vertical + e_along tan(gamma): the along-track error couples in through tan(gamma). tan(gamma) is
+taken from the truth's own deviation record (the slope of h - gs_dev against x, exact for a straight
+glidepath), so scoring needs no profile.
 """
 
 from __future__ import annotations
@@ -39,6 +46,20 @@ class RunScoreError(ValueError):
     """A run cannot be scored (it never reached a decision height, or its solution diverged)."""
 
 
+def glidepath_tan(truth: Truth, hat_m: np.ndarray) -> float:
+    """tan(glidepath angle) from the truth: minus the least-squares slope of (h - gs_dev) against runway x.
+
+    Fitted below 1000 ft above the threshold (where the decision heights are) when 10 samples are there.
+    """
+    n = hat_m.shape[0]
+    x = truth.runway.from_ecef(truth.r_ecef[:n])[:, 0]
+    y = hat_m - truth.gs_dev_m[:n]
+    low = hat_m < 1000.0 * units.FT
+    if np.count_nonzero(low) >= 10:
+        x, y = x[low], y[low]
+    return float(-np.polyfit(x, y, 1)[0])
+
+
 def score_run(
     truth: Truth,
     nav: NavSolution,
@@ -53,6 +74,7 @@ def score_run(
     err = runway_errors(truth, nav)
     integ = integrity_series(err.e_ned, nav.P_pos_ned, cfg.k_v, cfg.k_h)
     n = err.t_s.shape[0]
+    tan_gp = glidepath_tan(truth, err.hat_m)
     scalars: dict[str, float] = {}
     for cat in CATEGORIES:
         key = CATEGORY_KEYS[cat]
@@ -74,6 +96,7 @@ def score_run(
         }
         if not (np.isfinite(vals["lateral_m"]) and np.isfinite(vals["vertical_m"])):
             raise RunScoreError(f"navigation solution is not finite at the {cat} decision height (diverged)")
+        vals["gpdev_m"] = vals["vertical_m"] + vals["along_m"] * tan_gp
         vals["fte_lat_m"] = (
             vals["tse_lat_m"] + vals["lateral_m"] if fte_lat_m is None else at_crossing(fte_lat_m[:n], cr)
         )

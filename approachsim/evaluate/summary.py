@@ -36,14 +36,22 @@ def _col(columns: Mapping[str, np.ndarray], name: str) -> np.ndarray:
     return np.asarray(columns.get(name, np.empty(0)), dtype=float)
 
 
-def verdicts(columns: Mapping[str, np.ndarray], cfg: EvaluationConfig) -> list[CategoryResult]:
-    """Score every category from the per-run table (errors converted to ft here)."""
+def verdicts(
+    columns: Mapping[str, np.ndarray], cfg: EvaluationConfig, *, runs: int | None = None, failed_runs: int = 0
+) -> list[CategoryResult]:
+    """Score every category from the per-run table of the completed runs (errors converted to ft here).
+
+    runs / failed_runs: the campaign's run count and its failed runs, which count against every category.
+    """
     out = []
     for cat in CATEGORIES:
         key = CATEGORY_KEYS[cat]
         lat = _col(columns, f"{key}_lateral_m") / units.FT
         ver = _col(columns, f"{key}_vertical_m") / units.FT
-        out.append(category_verdict(cat, cfg.dh_ft[cat], lat, ver, cfg.verdict))
+        out.append(category_verdict(
+            cat, cfg.dh_ft[cat], lat, ver, cfg.verdict, runs=runs, failed_runs=failed_runs,
+            max_failure_fraction=cfg.max_failure_fraction, confidence=cfg.confidence,
+        ))
     return out
 
 
@@ -62,6 +70,10 @@ def contract_summary(
             "limit_lateral_1sigma_ft": _num(r.limits.lateral_1sigma_ft),
             "limit_vertical_1sigma_ft": _num(r.limits.vertical_1sigma_ft),
             "meets": bool(r.meets),
+            "verdict": r.verdict,
+            "lateral_1sigma_upper_ft": _num(r.lateral_axis.rms_upper_ft),
+            "vertical_1sigma_upper_ft": _num(r.vertical_axis.rms_upper_ft),
+            "runs_needed": r.runs_needed,
         }
     return {
         "schema": SCHEMA,
@@ -80,18 +92,32 @@ def _stats_ft(x_m: np.ndarray) -> dict:
 
 
 def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cfg: EvaluationConfig) -> dict:
-    """Everything beside the contract: intervals, ICAO limits, integrity, FTE / TSE, seed 002's figure."""
+    """Everything beside the contract: bounds, ICAO limits, failures, integrity, FTE / TSE, time-averaged RMS."""
     cats = {}
     for r in results:
         key = CATEGORY_KEYS[r.category]
         entry = {
             "height_ft": _num(r.height_ft),
             "meets": r.meets,
-            "meets_faa_1sigma": r.meets_faa,
-            "meets_icao_95": r.meets_icao,
+            "verdict": r.verdict,
+            "runs_needed": r.runs_needed,
+            "confidence": r.confidence,
+            "bounds_ft": {
+                name: {k: _num(v) if not isinstance(v, str) and v is not None else v for k, v in asdict(a).items()}
+                for name, a in (("lateral", r.lateral_axis), ("vertical", r.vertical_axis))
+            },
+            "failures": {
+                "runs": r.runs,
+                "failed_runs": r.failed_runs,
+                "fraction": _num(r.failed_runs / r.runs) if r.runs else None,
+                "fraction_upper": _num(r.failure_fraction_upper),
+                "allowed_fraction": cfg.max_failure_fraction,
+                "verdict": r.failure_verdict,
+            },
             "limits_ft": {k: _num(v) for k, v in asdict(r.limits).items()},
         }
-        for comp in ("along", "lateral", "vertical", "vpl", "hpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert"):
+        comps = ("along", "lateral", "vertical", "gpdev", "vpl", "hpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert")
+        for comp in comps:
             entry[f"{comp}_ft"] = _stats_ft(_col(columns, f"{key}_{comp}_m"))
         for axis, name in (("v", "vertical"), ("h", "horizontal")):
             entry[f"stanford_{name}"] = {
@@ -103,6 +129,8 @@ def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cf
     ta = campaign_rms_ft({s: _col(columns, f"ta_{s}_ft2") for s in STATES})
     return {
         "verdict_limits": cfg.verdict,
+        "confidence": cfg.confidence,
+        "max_failure_fraction": cfg.max_failure_fraction,
         "k_v": cfg.k_v,
         "k_h": cfg.k_h,
         "categories": cats,

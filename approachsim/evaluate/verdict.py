@@ -1,51 +1,198 @@
-"""Verdict per category: the FAA 1-sigma table (the contract's `meets`), the ICAO 95 % accuracy beside it.
+"""Verdict per category from confidence bounds: `meets`, `fails` or `indeterminate`, and the runs to decide it.
 
-meets (verdict "faa"): RMS over runs (bias included) of the lateral and of the vertical error at the
-category's decision height both within the FAA 1-sigma limits. With verdict "faa+icao" the 95th
-percentiles of |error| must also be within the ICAO 95 % accuracy. No completed run: not met.
-best_category: the most demanding category met (CAT III > CAT II > CAT I), None when none is.
+Each criterion is judged on one-sided confidence bounds at the profile's evaluation.confidence (default
+0.95), never on a point estimate alone:
+
+* FAA 1-sigma (always): for the lateral and the vertical error at the category's decision height, the RMS
+  over the completed runs (bias included) has a lower and an upper bound (stats.rms_bounds: Patnaik's
+  noncentral chi-square fit for the upper, the zero-mean chi-square bound for the lower). The axis meets
+  when its upper bound is within the FAA limit and at least stats.MIN_RUNS runs completed, fails when its
+  lower bound exceeds the limit, and is indeterminate otherwise.
+* ICAO 95 % accuracy (verdict = "faa+icao"): the distribution-free one-sided order-statistic bounds of the
+  95th percentile of |error| (binomial(n, 0.95) ranks): meets when the upper bound is within the ICAO value
+  (needs n >= 59), fails when the lower bound exceeds it.
+* Failed runs (diverged, unstabilized, never reached the decision height): they count against every
+  category. With evaluation.max_failure_fraction = 0 (the default) any failed run makes the category fail
+  (the observed failure rate is above the allowed zero). With an allowed fraction f > 0 the Clopper-Pearson
+  one-sided bounds of the failure probability decide: upper <= f passes, lower > f fails, else
+  indeterminate.
+
+The category fails when any criterion fails, meets when all meet, and is indeterminate otherwise.
+runs_needed (indeterminate only): the completed-run count at which the bounds would likely decide it if
+the point estimates stayed where they are: towards `fails` when a point estimate is beyond its limit,
+towards `meets` otherwise (the largest over the criteria); None when decided or beyond reach.
+best_category: the most demanding category whose verdict is `meets`, None when none is.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import stats as sps
 
 from approachsim.evaluate.limits import CATEGORIES, LIMITS, CategoryLimits
-from approachsim.evaluate.stats import ErrorStats, error_stats
+from approachsim.evaluate.stats import (
+    MIN_RUNS,
+    ErrorStats,
+    bias_ratio,
+    error_stats,
+    quantile_lower_rank,
+    quantile_upper_rank,
+    rms_bounds,
+    runs_to_decide,
+)
+
+VERDICTS = ("meets", "fails", "indeterminate")
+ICAO_MIN_RUNS = 59
+"""Fewest runs whose largest |error| is a 95 %-confidence upper bound of the 95th percentile (0.95^59 < 0.05)."""
+
+
+@dataclass(frozen=True)
+class AxisVerdict:
+    """One axis (lateral or vertical) of one category: bounds of its RMS (ft) and the axis verdict."""
+
+    rms_lower_ft: float
+    rms_upper_ft: float
+    p95_lower_ft: float
+    p95_upper_ft: float
+    verdict: str
+    runs_needed: int | None
 
 
 @dataclass(frozen=True)
 class CategoryResult:
-    """The scored errors of one category at its decision height, ft."""
+    """The scored errors of one category at its decision height, ft, and its verdict."""
 
     category: str
     height_ft: float
     lateral: ErrorStats
     vertical: ErrorStats
     limits: CategoryLimits
-    meets_faa: bool
-    meets_icao: bool
-    meets: bool
+    lateral_axis: AxisVerdict
+    vertical_axis: AxisVerdict
+    runs: int
+    failed_runs: int
+    failure_verdict: str
+    failure_fraction_upper: float
+    verdict: str
+    runs_needed: int | None
+    confidence: float
+
+    @property
+    def meets(self) -> bool:
+        """The contract's `meets`: true exactly when the verdict is `meets`."""
+        return self.verdict == "meets"
+
+
+def clopper_pearson(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
+    """One-sided (lower, upper) Clopper-Pearson bounds, each at `level`, of a probability from k of n."""
+    if n <= 0:
+        return 0.0, 1.0
+    lo = 0.0 if k == 0 else float(sps.beta.ppf(1.0 - level, k, n - k + 1))
+    hi = 1.0 if k == n else float(sps.beta.ppf(level, k + 1, n - k))
+    return lo, hi
+
+
+def failure_verdict(failed: int, runs: int, allowed: float, level: float = 0.95) -> str:
+    """Verdict of the failure criterion (module docstring)."""
+    if allowed <= 0.0:
+        return "fails" if failed > 0 else "meets"
+    lo, hi = clopper_pearson(failed, runs, level)
+    return "meets" if hi <= allowed else ("fails" if lo > allowed else "indeterminate")
+
+
+def _runs_for_failures(failed: int, runs: int, allowed: float, level: float) -> int | None:
+    """Runs at which the failure fraction's upper bound would reach `allowed` at the same failure rate."""
+    if allowed <= 0.0 or runs <= 0:
+        return None
+    rate = failed / runs
+    for n in (int(x) for x in np.unique(np.geomspace(max(runs, 1), 100000, 400).astype(int))):
+        if clopper_pearson(int(round(rate * n)), n, level)[1] <= allowed:
+            return n
+    return None
+
+
+def _combine(verdicts: Sequence[str]) -> str:
+    if "fails" in verdicts:
+        return "fails"
+    return "meets" if all(v == "meets" for v in verdicts) else "indeterminate"
+
+
+def axis_verdict(x_ft: np.ndarray, limit_1sigma_ft: float, limit_95_ft: float, icao: bool, level: float) -> AxisVerdict:
+    """Verdict of one axis from its per-run errors (ft, completed runs only)."""
+    x = np.asarray(x_ft, dtype=float)
+    x = x[np.isfinite(x)]
+    n = int(x.size)
+    nan = float("nan")
+    if n == 0:
+        return AxisVerdict(nan, nan, nan, nan, "indeterminate", None)
+    lo, hi = rms_bounds(x, level)
+    rms = float(np.sqrt(np.mean(x**2)))
+    faa = "fails" if lo > limit_1sigma_ft else ("meets" if hi <= limit_1sigma_ft and n >= MIN_RUNS else "indeterminate")
+    a = np.sort(np.abs(x))
+    ru, rl = quantile_upper_rank(n, 0.95, level), quantile_lower_rank(n, 0.95, level)
+    p_hi = float(a[ru - 1]) if ru is not None else math.inf
+    p_lo = float(a[rl - 1]) if rl is not None else 0.0
+    crit = [faa]
+    if icao:
+        crit.append("fails" if p_lo > limit_95_ft else ("meets" if p_hi <= limit_95_ft else "indeterminate"))
+    v = _combine(crit)
+    need = None
+    if v == "indeterminate":
+        need = runs_to_decide(rms, bias_ratio(x), limit_1sigma_ft, level)
+        if icao and rms < limit_1sigma_ft and float(np.percentile(a, 95.0)) <= limit_95_ft:
+            need = max(need or 0, ICAO_MIN_RUNS, n + 1)
+    return AxisVerdict(lo, hi, p_lo, p_hi, v, need)
 
 
 def category_verdict(
-    category: str, height_ft: float, lateral_ft: np.ndarray, vertical_ft: np.ndarray, verdict: str = "faa"
+    category: str,
+    height_ft: float,
+    lateral_ft: np.ndarray,
+    vertical_ft: np.ndarray,
+    verdict: str = "faa",
+    *,
+    runs: int | None = None,
+    failed_runs: int = 0,
+    max_failure_fraction: float = 0.0,
+    confidence: float = 0.95,
 ) -> CategoryResult:
-    """Score one category from the per-run errors (ft) at its decision height."""
+    """Score one category from the per-run errors (ft) at its decision height of the completed runs.
+
+    runs: all runs of the campaign (completed + failed_runs; default the completed count + failed_runs).
+    """
     lim = LIMITS[category]
-    lat = error_stats(lateral_ft)
-    ver = error_stats(vertical_ft)
-    have = lat.n > 0 and ver.n > 0
-    meets_faa = bool(have and lat.rms <= lim.lateral_1sigma_ft and ver.rms <= lim.vertical_1sigma_ft)
-    meets_icao = bool(have and lat.p95 <= lim.lateral_95_ft and ver.p95 <= lim.vertical_95_ft)
-    meets = meets_faa and (meets_icao or verdict == "faa")
-    return CategoryResult(category, height_ft, lat, ver, lim, meets_faa, meets_icao, meets)
+    lat = error_stats(lateral_ft, confidence)
+    ver = error_stats(vertical_ft, confidence)
+    icao = verdict == "faa+icao"
+    la = axis_verdict(lateral_ft, lim.lateral_1sigma_ft, lim.lateral_95_ft, icao, confidence)
+    va = axis_verdict(vertical_ft, lim.vertical_1sigma_ft, lim.vertical_95_ft, icao, confidence)
+    total = (min(lat.n, ver.n) + failed_runs) if runs is None else int(runs)
+    fv = failure_verdict(failed_runs, total, max_failure_fraction, confidence)
+    f_hi = clopper_pearson(failed_runs, total, confidence)[1]
+    v = _combine([la.verdict, va.verdict, fv])
+    need = None
+    if v == "indeterminate":
+        axes = [a for a in (la, va) if a.verdict == "indeterminate"]
+        rms_lim = ((lat.rms, lim.lateral_1sigma_ft), (ver.rms, lim.vertical_1sigma_ft))
+        beyond = [a.runs_needed for a, (r, L) in zip((la, va), rms_lim, strict=True)
+                  if a.verdict == "indeterminate" and r > L and a.runs_needed is not None]
+        if beyond:
+            need = min(beyond)
+        else:
+            needs = [a.runs_needed for a in axes]
+            if fv == "indeterminate":
+                needs.append(_runs_for_failures(failed_runs, total, max_failure_fraction, confidence))
+            need = None if not needs or any(x is None for x in needs) else max(needs)
+    return CategoryResult(
+        category, height_ft, lat, ver, lim, la, va, total, failed_runs, fv, f_hi, v, need, confidence
+    )
 
 
 def best_category(results: Sequence[CategoryResult]) -> str | None:
-    """The most demanding category met, or None."""
+    """The most demanding category whose verdict is `meets`, or None."""
     met = [r.category for r in results if r.meets]
     return max(met, key=CATEGORIES.index) if met else None

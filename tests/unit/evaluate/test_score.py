@@ -19,6 +19,7 @@ CFG = EvaluationConfig()
 CONTRACT_DH_KEYS = {
     "height_ft", "lateral_1sigma_ft", "vertical_1sigma_ft", "lateral_95_ft", "vertical_95_ft",
     "limit_lateral_1sigma_ft", "limit_vertical_1sigma_ft", "meets",
+    "verdict", "lateral_1sigma_upper_ft", "vertical_1sigma_upper_ft", "runs_needed",
 }
 
 
@@ -36,21 +37,28 @@ def _e(lateral_ft: float, vertical_ft: float) -> np.ndarray:
 
 
 def test_constant_bias_cat_i_only():
-    s, _ = _campaign([_e(20.0, 5.0)] * 5)
+    s, _ = _campaign([_e(20.0, 5.0)] * 10)  # MIN_RUNS: fewer runs cannot meet
     d = s["decision_heights"]
     # near the decision heights the runway axes and the local axes agree to < 1e-4 rad
     assert d["CAT I"]["lateral_1sigma_ft"] == pytest.approx(20.0, abs=0.01)
     assert d["CAT I"]["vertical_1sigma_ft"] == pytest.approx(5.0, abs=0.01)
     assert d["CAT I"]["lateral_95_ft"] == pytest.approx(20.0, abs=0.01)
     assert [d[c]["meets"] for c in ("CAT I", "CAT II", "CAT III")] == [True, False, False]
+    # a constant error is all bias: the upper bound is the RMS itself; 20 ft sqrt(10 / chi2_0.95(10)) = 15.0 ft
+    # is above CAT II's 8.6 ft, so CAT II fails rather than being indeterminate
+    assert d["CAT I"]["lateral_1sigma_upper_ft"] == pytest.approx(20.0, abs=0.01)
+    assert [d[c]["verdict"] for c in ("CAT I", "CAT II", "CAT III")] == ["meets", "fails", "fails"]
     assert s["best_category"] == "CAT I"
+    few, _ = _campaign([_e(20.0, 5.0)] * 5)  # the same errors from 5 runs: too few to meet
+    assert few["decision_heights"]["CAT I"]["verdict"] == "indeterminate" and few["best_category"] is None
+    assert few["decision_heights"]["CAT I"]["runs_needed"] == 10
 
 
 def test_constant_bias_cat_ii_and_none():
-    s, _ = _campaign([_e(-8.0, 2.5)] * 3)  # sign of a bias does not help it
+    s, _ = _campaign([_e(-8.0, 2.5)] * 10)  # sign of a bias does not help it
     assert [s["decision_heights"][c]["meets"] for c in ("CAT I", "CAT II", "CAT III")] == [True, True, False]
     assert s["best_category"] == "CAT II"
-    s, _ = _campaign([_e(30.0, 1.0)] * 3)  # lateral fails CAT I and CAT II; CAT III fails vertically... 30 > 6.8
+    s, _ = _campaign([_e(30.0, 1.0)] * 10)  # lateral fails CAT I and CAT II; CAT III fails vertically... 30 > 6.8
     assert s["best_category"] is None
 
 
@@ -150,6 +158,9 @@ def test_unscorable_runs_raise_with_a_reason():
 def test_evaluation_section_parsing():
     cfg = parse_evaluation(Section({"dh_cat2_ft": 120, "verdict": "faa+icao"}, "evaluation"))
     assert cfg.dh_ft == {"CAT I": 200.0, "CAT II": 120.0, "CAT III": 50.0} and cfg.verdict == "faa+icao"
+    assert (cfg.confidence, cfg.max_failure_fraction) == (0.95, 0.0)
+    cfg = parse_evaluation(Section({"confidence": 0.99, "max_failure_fraction": 0.01}, "evaluation"))
+    assert (cfg.confidence, cfg.max_failure_fraction) == (0.99, 0.01)
     for bad, field in (
         ({"dh_cat1_ft": "200"}, "evaluation.dh_cat1_ft"),
         ({"dh_cat3_ft": 150}, "evaluation.dh_cat2_ft"),
@@ -159,6 +170,21 @@ def test_evaluation_section_parsing():
         ({"timeavg_settle_s": -1}, "evaluation.timeavg_settle_s"),
         ({"flight_group": 0}, "evaluation.flight_group"),
         ({"bogus": 1}, "evaluation.bogus"),
+        ({"confidence": 1.0}, "evaluation.confidence"),
+        ({"confidence": "95%"}, "evaluation.confidence"),
+        ({"max_failure_fraction": -0.1}, "evaluation.max_failure_fraction"),
     ):
         with pytest.raises(ProfileError, match=field.replace(".", r"\.")):
             parse_evaluation(Section(bad, "evaluation"))
+
+
+def test_glidepath_deviation_error_couples_the_along_track_error():
+    """e_gpdev = e_vertical + e_along tan(gamma): an along-track error alone moves the glidepath deviation."""
+    from evalpairs import GP, RWY
+
+    truth = make_truth(hz=4.0)
+    e = 20.0 * np.array([math.cos(RWY.heading_rad), math.sin(RWY.heading_rad), 0.0])  # 20 m along track only
+    sc = score_run(truth, make_nav(truth, e), CFG)[0]
+    assert sc["cat1_along_m"] == pytest.approx(20.0, abs=1e-3)
+    assert sc["cat1_gpdev_m"] == pytest.approx(sc["cat1_vertical_m"] + 20.0 * math.tan(GP), abs=1e-3)
+    assert sc["cat1_gpdev_m"] == pytest.approx(20.0 * math.tan(GP), abs=0.01)  # ~1.05 m at 3 deg
