@@ -261,7 +261,7 @@ def gap_error(res: SokolovicRuns, form: str) -> dict[str, float]:
 def verdict(res: SokolovicRuns) -> dict:
     """Table 2's ordering checked on the runs: per-run altitude and down-velocity rms, Monte Carlo means, and the
     paired comparisons (claims.paired) constant - tanh, tanh - sinh, constant - sinh (positive: the paper's
-    order). 'order_reproduced' is True only if both steps of constant > tanh > sinh are significant."""
+    order). '<q>_rms_order_constant_tanh_sinh' is True only if both steps of constant > tanh > sinh are significant."""
     out: dict = {}
     for q, data in (("altitude", res.h_err_m), ("velocity", res.vd_err_mps)):
         rms = {f: np.sqrt(np.mean(data[f] ** 2, axis=1)) for f in data}

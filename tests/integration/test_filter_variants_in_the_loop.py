@@ -1,7 +1,15 @@
 """Every registered filter runs inside the full simulator when a profile names it (issue 6 acceptance):
 JSBSim flies the default approach (from 2 nmi, to keep CI short) on the navigation solution of that filter,
-reaches 200 ft, and the filter's claimed covariance covers its real error (mean NEES of the 9 navigation
-states not diverged)."""
+reaches 200 ft, and the filter's claimed position covariance covers its real error.
+
+Consistency on one flown run per filter: the position NEES e' P^-1 e (3 dof, P the solution's NED position
+covariance) at the IMU samples, averaged over the run. Its samples are strongly correlated in time, so the
+bound is the one that holds whatever the correlation: a time average of chi2(3) samples exceeds the single
+sample's 99.9 % quantile chi2_3(0.999) = 16.3 with probability at most about 0.1 % (convex order of the mean
+of exchangeable variables). Expected 3; a filter over-confident by a factor 5.4 in variance fails. The
+position error itself is bounded by 6 of the filter's own sigmas at every sample (per axis), not by a fixed
+30 m. Measured (seed 3, run 0, every filter): mean NEES 4.57-4.72, max 2.3 sigma, max 13.1 m (python -m
+pytest ... -s prints them)."""
 
 from __future__ import annotations
 
@@ -10,7 +18,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.stats import chi2
 
+from approachsim import geo
 from approachsim.flight.run import Approach
 from approachsim.nav.closed_loop import NavInTheLoop
 from approachsim.nav.registry import FILTERS
@@ -40,7 +50,12 @@ def test_filter_named_in_the_profile_flies_the_approach(name, approach_2nmi):
     nav = src.result(res.truth)
     e = nav.solution.r_ecef - res.truth.r_ecef
     assert np.all(np.isfinite(e))
-    # position error small against the 2 nmi approach and covered by the filter's own claim
-    assert np.max(np.linalg.norm(e, axis=1)) < 30.0
-    p_trace = np.trace(nav.solution.P_pos_ned, axis1=1, axis2=2)
-    assert np.mean(np.sum(e**2, axis=1) / p_trace) < 5.0
+    lat, lon, h = geo.ecef_to_geodetic(res.truth.r_ecef)
+    e_ned = np.einsum("nij,nj->ni", geo.c_ecef_to_ned(lat, lon), e)
+    P = nav.solution.P_pos_ned
+    nees = np.einsum("ni,ni->n", e_ned, np.linalg.solve(P, e_ned[..., None])[..., 0])
+    z = np.abs(e_ned) / np.sqrt(np.diagonal(P, axis1=1, axis2=2))
+    print(f"{name}: mean position NEES {nees.mean():.2f} (expected 3), max |e|/sigma {z.max():.2f}, "
+          f"max |e| {np.max(np.linalg.norm(e, axis=1)):.2f} m")
+    assert nees.mean() < chi2.ppf(0.999, 3), nees.mean()
+    assert np.all(z < 6.0), z.max()
