@@ -252,6 +252,18 @@ def _table(header: list[str], rows: list[list]) -> str:
     return f"<table><tr>{h}</tr>{body}</table>"
 
 
+def _min_runs_for_p95_upper() -> int:
+    """Smallest run count for which the 95th percentile has a distribution-free 95 % upper bound."""
+    from approachsim.evaluate.stats import quantile_ranks
+
+    n = 1
+    while quantile_ranks(n)[1] is None and n < 10000:
+        n += 1
+    return n
+
+
+_P95_HI_MIN_RUNS = _min_runs_for_p95_upper()
+
 FIGURE_CAPTIONS = {
     "errors_vs_height": (
         "Navigation error against height",
@@ -347,6 +359,8 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
         "<h2>Statistics at decision height (ft; 95 % intervals for the number of runs)</h2>",
         _table(["category", "error", "n", "RMS", "RMS lo", "RMS hi", "mean", "std", "95%", "95% lo", "95% hi"],
                detail_rows),
+        "<p>-- : no bound from this many runs (a distribution-free 95 % upper bound on a 95th percentile needs "
+        f"at least {_P95_HI_MIN_RUNS} runs).</p>",
         "<h2>Integrity (epochs over the approach down to each DH)</h2>",
         _table(["category", "axis", "normal", "MI", "HMI", "unavailable", "availability"], integ_rows),
         "<h2>Time-averaged RMS over the approach (Gray &amp; Maybeck Tables 3-6 quantity), ft</h2>",
