@@ -166,7 +166,7 @@ class NavInTheLoop:
         self.snap[k] = len(self.snaps) - 1
         g = self._guide
         sk.guidance(self.x, self.x_nav, self._c_rwy, self._o_rwy, self._h_thr, g)  # feed-forward INS - x_hat
-        return g[0:3], g[3:6]
+        return g[0:3].copy(), g[3:6].copy()  # copies: the kernel's buffer is rewritten at the next step
 
     def _snapshot(self) -> None:
         """Keep the filter's x and P (the estimate in force until the next epoch)."""
