@@ -57,7 +57,18 @@ def reproduce(name: str, out_dir: Path, *, seed: int, runs: int) -> dict:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `reproduce` sub-command."""
-    p = sub.add_parser("reproduce", help="reproduce a seed paper's experiment and tables")
+    from approachsim.commands._help import command_parser
+
+    p = command_parser(
+        sub, "reproduce", help="reproduce a source paper's experiment and tables",
+        description="Runs one source paper's own experiment (its models and numbers) and writes DIR/PAPER.md (the "
+                    "note: our tables beside the paper's, every finding chosen from the computed numbers), "
+                    "DIR/PAPER.json and the figures; prints the headline findings. Papers: hajiyev-saltoglu "
+                    "(Hajiyev & Saltoglu), manero-hajiyev (Manero Contreras & Hajiyev), sokolovic (Sokolovic, "
+                    "Dikic & Stancic), chernodarov (Chernodarov).",
+        examples=["approachsim reproduce sokolovic --out out/sokolovic",
+                  "approachsim reproduce hajiyev-saltoglu --out out/hs --runs 200 --seed 3"],
+    )
     p.add_argument("paper", help=f"one of: {', '.join(PAPERS)}")
     p.add_argument("--out", required=True, type=Path, help="output directory")
     p.add_argument("--seed", type=int, default=1, help="campaign seed (default 1)")
