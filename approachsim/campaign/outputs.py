@@ -86,6 +86,12 @@ def verdict_table(summary: dict, det: dict) -> str:
             + (f", allowed failure fraction {allowed:g} (upper bound {_f(f.get('fraction_upper'), '.3f').strip()})"
                if allowed else " (no failure allowed: every category fails)")
         )
+    if not summary["closed_loop"]:
+        lines.append(
+            "open loop: runs of one group share one flown truth (evaluation.flight_group), so they are not fully "
+            "independent and the bounds, which assume independent runs, are optimistic by the share of the error "
+            "the common flight explains; closed loop gives every run its own flight"
+        )
     ta = det.get("time_averaged_rms_ft", {})
     if ta:
         lines.append(

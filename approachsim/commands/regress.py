@@ -1,8 +1,9 @@
 """`approachsim regress [--baselines DIR] [--update] [--workers K] [--out DIR]`: profile regressions.
 
 Runs every committed baseline (DIR/*.json, default baselines/: a profile, a small run count, a fixed seed
-and mode) and compares the new summary with the stored one using statistical tolerances
-(campaign/regress.py). Prints a readable diff; exits 1 on a regression. --update reruns them and rewrites
+and mode, the summary and the per-run errors at each decision height) with the same seeds and judges the
+paired per-run changes (campaign/regress.py: common random numbers, the test, its false-alarm rate and
+power). Prints a readable diff; exits 1 on a regression. --update reruns them and rewrites
 the baselines; `--update --add PROFILE` creates a baseline for a new profile (--runs, --seed, --mode).
 """
 
@@ -31,7 +32,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--baselines", type=Path, default=DEFAULT_DIR, help="baseline directory (default baselines/)")
     p.add_argument("--update", action="store_true", help="rewrite the baselines from new runs")
     p.add_argument("--add", type=Path, default=None, help="with --update: create a baseline for this profile")
-    p.add_argument("--runs", type=int, default=8, help="runs of a new baseline (--add; default 8)")
+    p.add_argument("--runs", type=int, default=20,
+                   help="runs of a new baseline (--add; default 20: the paired test's power, campaign/regress.py)")
     p.add_argument("--seed", type=int, default=7, help="seed of a new baseline (--add; default 7)")
     p.add_argument("--mode", choices=("closed", "open"), default="open", help="mode of a new baseline (--add)")
     p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
@@ -70,7 +72,14 @@ def run(args: argparse.Namespace) -> int:
     from approachsim.campaign.evaluation import evaluate_profile
     from approachsim.campaign.outputs import write_json
     from approachsim.campaign.pipeline import PipelineUnavailable, require_stages
-    from approachsim.campaign.regress import baseline_doc, compare, read_baseline
+    from approachsim.campaign.regress import (
+        SCHEMA,
+        baseline_doc,
+        compare,
+        compare_paired,
+        per_run_errors,
+        read_baseline,
+    )
     from approachsim.profile import load_profile
 
     files = _check(args)
@@ -102,12 +111,18 @@ def run(args: argparse.Namespace) -> int:
         for (path, prof_path, runs, seed, mode, doc), profile in profiles:
             ev = evaluate_profile(profile, runs=runs, seed=seed, mode=mode, out_dir=root / path.stem,
                                   workers=args.workers, progress=False)
+            per_run = per_run_errors(ev.results)
             if args.update:
                 args.baselines.mkdir(parents=True, exist_ok=True)
-                write_json(path, baseline_doc(prof_path, ev.summary, runs=runs, seed=seed, mode=mode))
+                write_json(path, baseline_doc(prof_path, ev.summary, runs=runs, seed=seed, mode=mode, per_run=per_run))
                 print(f"updated {path} (best category {ev.summary['best_category'] or 'none'})")
                 continue
-            diffs = compare(doc["summary"], ev.summary)
+            if doc["schema"] == SCHEMA:
+                diffs = compare_paired(doc, ev.summary, per_run)
+            else:
+                print(f"{path.stem}: old baseline without per-run errors: summary-only F-band test (regenerate it "
+                      "with --update)")
+                diffs = compare(doc["summary"], ev.summary)
             bad = [d for d in diffs if d.regression]
             failed += bool(bad)
             changed = [d for d in diffs if d.old != d.new]

@@ -90,7 +90,7 @@ def test_empty_and_malformed_baselines_exit_2(tmp_path, capsys):
     (tmp_path / "x.json").write_text('{"schema": "other"}')
     assert main(["regress", "--baselines", str(tmp_path)]) == 2
     err = capsys.readouterr().err.splitlines()
-    assert len(err) == 2 and "no baseline files" in err[0] and "not an approachsim.baseline/1" in err[1]
+    assert len(err) == 2 and "no baseline files" in err[0] and "not an approachsim.baseline/2" in err[1]
 
 
 def test_committed_baselines_are_valid():
@@ -108,3 +108,69 @@ def test_committed_baselines_are_valid():
         assert doc["summary"]["profile"] == prof.name == f.stem
         assert (doc["summary"]["runs"], doc["summary"]["seed"]) == (doc["runs"], doc["seed"])
         assert set(doc["summary"]["decision_heights"]) == {"CAT I", "CAT II", "CAT III"}
+
+
+# --- the paired (common random numbers) test of schema-/2 baselines ---------------------------------------------
+
+def _crn(rng, trials: int, n: int, share: float, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per-run errors before / after scaling one error source (variance share `share`) by `scale`; the draws
+    of every source are common to both, as the per-sensor streams make them."""
+    g, o = rng.normal(size=(trials, n)), rng.normal(size=(trials, n))
+    return np.sqrt(share) * g + np.sqrt(1 - share) * o, scale * np.sqrt(share) * g + np.sqrt(1 - share) * o
+
+
+def test_paired_false_alarm_rate_on_reshuffled_draws():
+    """A reshuffle: the same model, independent draws. Nominal alpha = 1e-3 per field; the t reference is
+    approximate for n = 20 (squared errors are skewed): measured 0.2 % (8 of 4000), below 0.5 %."""
+    from approachsim.campaign.regress import ALPHA, paired_change
+
+    rng = np.random.default_rng(10)
+    for mu in (0.0, 1.0):  # with and without a bias
+        a, b = rng.normal(mu, 1.0, (4000, 20)), rng.normal(mu, 1.0, (4000, 20))
+        rate = np.mean([paired_change(x, y)["regression"] for x, y in zip(a, b, strict=True)])
+        assert rate < 5 * ALPHA, (mu, rate)
+    # a partial reshuffle (one source's stream redrawn) is not a change either
+    g, g2, o = rng.normal(size=(3, 4000, 20))
+    old, new = np.sqrt(0.8) * g + np.sqrt(0.2) * o, np.sqrt(0.8) * g2 + np.sqrt(0.2) * o
+    assert np.mean([paired_change(x, y)["regression"] for x, y in zip(old, new, strict=True)]) < 5 * ALPHA
+
+
+def test_paired_power_for_a_degraded_source():
+    """One source carrying 80 % of the error variance (the radar altimeter at the decision heights of the
+    default profile: its noise x1.1 moves the vertical 1-sigma by +6..9 %) degraded by 10 % and 2x."""
+    from approachsim.campaign.regress import paired_change
+
+    rng = np.random.default_rng(11)
+    old, new = _crn(rng, 400, 20, 0.8, 1.1)  # 1-sigma +8.5 %
+    power_10 = np.mean([paired_change(x, y)["regression"] for x, y in zip(old, new, strict=True)])
+    old, new = _crn(rng, 400, 20, 0.8, 2.0)  # 1-sigma +67 %
+    power_2x = np.mean([paired_change(x, y)["regression"] for x, y in zip(old, new, strict=True)])
+    old, new = _crn(rng, 400, 20, 1.0, 1.1)  # the whole error scaled by 1.1: every run's error moves alike
+    power_all = np.mean([paired_change(x, y)["regression"] for x, y in zip(old, new, strict=True)])
+    assert power_all == 1.0 and power_2x > 0.99 and power_10 > 0.9, (power_10, power_2x, power_all)
+    # a change below the margin (1 %) is within tolerance however significant
+    x = rng.normal(size=20)
+    t = paired_change(x, 1.01 * x)
+    assert t["p"] < 1e-100 and not t["regression"]
+    # identical reruns: nothing changed
+    assert paired_change(x, x.copy()) == {**paired_change(x, x.copy()), "L": 0.0, "p": 1.0, "regression": False}
+
+
+def test_compare_paired_fields_and_run_mismatch():
+    from approachsim.campaign.regress import baseline_doc, compare_paired
+
+    rng = np.random.default_rng(12)
+    errs = {c: {"lateral_ft": list(rng.normal(0, 5, 20)), "vertical_ft": list(rng.normal(0, 1, 20))}
+            for c in ("CAT I", "CAT II", "CAT III")}
+    per_run = {"runs": list(range(20)), **errs}
+    doc = baseline_doc("p.toml", SUMMARY, runs=20, seed=7, mode="open", per_run=per_run)
+    assert not any(d.regression for d in compare_paired(doc, SUMMARY, per_run))
+    worse = copy.deepcopy(per_run)
+    worse["CAT II"]["vertical_ft"] = [1.5 * v for v in worse["CAT II"]["vertical_ft"]]
+    bad = [d for d in compare_paired(doc, SUMMARY, worse) if d.regression]
+    assert len(bad) == 1 and bad[0].field.startswith("CAT II.vertical_1sigma_ft (20 paired runs, change +50.0%")
+    one_failed = copy.deepcopy(per_run)
+    one_failed["CAT I"]["lateral_ft"][3] = None  # left out of the pairs
+    assert "19 paired runs" in compare_paired(doc, SUMMARY, one_failed)[0].field
+    other = {**copy.deepcopy(per_run), "runs": list(range(1, 21))}
+    assert [d.field for d in compare_paired(doc, SUMMARY, other)] == ["runs"]

@@ -1,0 +1,57 @@
+"""`regress`'s paired test on the real pipeline: a degraded sensor is caught, a reshuffle of the draws is not.
+
+Against the committed default baseline (open loop, 20 runs, seed 7): the radar altimeter noise
+(percent_of_height and floor) scaled by 1.1 and by 2, and the unchanged profile on seed 8 (new, independent
+draws of the same model). Measured figures are in approachsim/campaign/regress.py.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from approachsim.campaign.evaluation import evaluate_profile
+from approachsim.campaign.regress import compare_paired, per_run_errors, read_baseline
+from approachsim.profile import load_profile
+
+ROOT = Path(__file__).resolve().parents[2]
+
+pytestmark = pytest.mark.slow
+
+
+def _variant(tmp_path: Path, name: str, scale: float) -> Path:
+    text = (ROOT / "profiles" / "default.toml").read_text()
+    text, k1 = re.subn(r"^percent_of_height = 1\.0", f"percent_of_height = {1.0 * scale}", text, flags=re.M)
+    text, k2 = re.subn(r"^floor_m = 0\.5", f"floor_m = {0.5 * scale}", text, flags=re.M)
+    assert k1 == k2 == 1, "profiles/default.toml no longer sets the radar altimeter noise as this test expects"
+    p = tmp_path / f"{name}.toml"
+    p.write_text(text)
+    return p
+
+
+def _rerun(path: Path, doc: dict, tmp_path: Path, seed: int | None = None):
+    prof = load_profile(path)
+    ev = evaluate_profile(prof, runs=doc["runs"], seed=doc["seed"] if seed is None else seed, mode=doc["mode"],
+                          out_dir=tmp_path / f"o-{path.stem}-{seed}", workers=2, progress=False)
+    return compare_paired(doc, ev.summary, per_run_errors(ev.results))
+
+
+def _flagged(diffs) -> set[str]:
+    return {d.field.split(" ")[0] + " " + d.field.split(" ")[1] for d in diffs if d.regression}
+
+
+def test_degraded_radar_altimeter_is_caught_and_a_reshuffle_is_not(tmp_path):
+    doc = read_baseline(ROOT / "baselines" / "default.json")
+    assert doc["runs"] >= 20 and doc["mode"] == "open" and "per_run" in doc
+    vertical = {f"CAT {c}.vertical_1sigma_ft" for c in ("I", "II", "III")}
+    # 10 %: the vertical 1-sigma moves by 7-9 % at every decision height, and every one is flagged
+    assert _flagged(_rerun(_variant(tmp_path, "radalt-1.1", 1.1), doc, tmp_path)) >= vertical
+    # 2x: flagged too; the lateral figures (GPS) are untouched
+    d2 = _rerun(_variant(tmp_path, "radalt-2", 2.0), doc, tmp_path)
+    assert vertical <= _flagged(d2) and not any("lateral" in f for f in _flagged(d2))
+    # the same model on other random numbers: its 1-sigma figures move by tens of per cent, nothing is flagged
+    reshuffled = _rerun(ROOT / "profiles" / "default.toml", doc, tmp_path, seed=doc["seed"] + 1)
+    moved = [d for d in reshuffled if "paired" in d.field and d.old != d.new]
+    assert moved and not any(d.regression for d in reshuffled if "paired" in d.field)
