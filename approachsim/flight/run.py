@@ -5,9 +5,10 @@ Two lines fly the default profile on truth navigation:
     approach = Approach(load_profile("profiles/default.toml"))
     result = approach.fly(seed=1, run=0)
 
-`Approach` parses the aircraft and linearizes it once; `fly` builds a fresh JSBSim instance per run (a few
-ms), sets the day's atmosphere, wind and seeded turbulence, trims on the glidepath and steps at the IMU
-rate. After writing Truth row k it calls `nav_source.step(k, truth)` (records.NavigationSource) and the
+`Approach` parses the aircraft, checks the profile against its approach envelope (flight.envelope) and solves
+the trimmed start once; `fly` builds a fresh JSBSim instance per run (a few ms), sets the day's atmosphere,
+wind and seeded turbulence, trims at the approach CAS on the glidepath in the wind (checked) and steps at the
+IMU rate. After writing Truth row k it calls `nav_source.step(k, truth)` (records.NavigationSource) and the
 autopilot flies guidance on the position and velocity it returns; what guidance flew on is kept in the
 FlightResult, so that
 
@@ -15,17 +16,17 @@ FlightResult, so that
     total system error = truth - desired path.
 
 The run ends when the IMU descends to `stop_height_m` above the threshold ("reached stop height"), or, with
-`land=True`, after a flare when the main gear touches ("touchdown"), or on ground contact, divergence or
-timeout (each a termination reason). With a navigation source, the Truth arrays are preallocated for the
-longest permitted run (NaN until written) and trimmed at the end; the source sees that record and may read
-rows <= k only. On truth navigation (the default) nothing reads the record during the run, so the rows are
-collected in a list and stacked at the end (same values; tested).
+`land=True`, after a flare when the main gear touches ("touchdown"), or as a failed approach: unstabilized
+below 1000 ft (flight.envelope's monitor), ground contact, a touchdown short of the threshold, divergence or
+timeout (`FlightResult.ok` / `failure`). The Truth arrays are preallocated for the longest permitted run (NaN
+until written) and trimmed at the end; a navigation source sees that record and may read rows <= k only.
 
-Truth is of the IMU point (aircraft file [imu]): position, velocity and specific force are moved from the
-CG with the rigid-body lever-arm terms (f_imu = f_cg + w_ib' x l + w_ib x (w_ib x l), in the exact form of
-JSBSim's Euler step, plus the gravitation gradient; v_imu = v_cg + C_nb (w_eb x l), resolved on the IMU's own
-NED axes), and the static pressure is moved hydrostatically to the IMU height; the lever arm l is fixed at
-trim (the CG moves by well under a millimetre as fuel burns). docs/truth.md says why each term is there.
+Truth is of the IMU point (aircraft file [imu]), one row per step from the compiled kernel of flight/kernels.py:
+position, velocity and specific force are moved from the CG with the rigid-body lever-arm terms (f_imu = f_cg +
+w_ib' x l + w_ib x (w_ib x l), in the exact form of JSBSim's Euler step, plus the gravitation gradient; v_imu =
+v_cg + C_nb (w_eb x l), resolved on the IMU's own NED axes), and the static pressure is moved hydrostatically to
+the IMU height; the lever arm l is fixed at trim (the CG moves by well under a millimetre as fuel burns).
+docs/truth.md says why each term is there.
 """
 
 from __future__ import annotations
