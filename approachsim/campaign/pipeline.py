@@ -67,6 +67,8 @@ class PipelineSpec:
 def spec_for(profile: Any, mode: str) -> PipelineSpec:
     """The campaign functions of `mode` ("closed" or "open") for this profile (after require_stages)."""
     require_stages(mode)
+    _approach(profile)  # the aircraft file and the approach envelope: a profile outside it is refused (exit 2) here,
+    # not as one failed run per worker
     size = profile.evaluation.flight_group
     if mode == "open":
         return PipelineSpec(open_loop_group, size, False)

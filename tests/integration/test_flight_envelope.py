@@ -101,7 +101,9 @@ def test_outside_the_envelope_is_refused_naming_the_limit(edit, field, words):
     assert "\n" not in str(e.value)
 
 
-def test_outside_the_envelope_exits_2_through_the_cli(tmp_path):
+@pytest.mark.parametrize("command", ["fly", "evaluate"])
+def test_outside_the_envelope_exits_2_through_the_cli(tmp_path, command):
+    """fly refuses it; evaluate refuses it before any run (not as one failed run per worker, exit 3)."""
     text = DEFAULT.read_text(encoding="utf-8").replace("wind_speed_kt = 5.0", "wind_speed_kt = 15.0").replace(
         "wind_from_deg = 300.0", "wind_from_deg = 118.0")
     prof = tmp_path / "profiles" / "tail15.toml"
@@ -109,7 +111,8 @@ def test_outside_the_envelope_exits_2_through_the_cli(tmp_path):
     prof.write_text(text, encoding="utf-8")
     (tmp_path / "aircraft").mkdir()
     (tmp_path / "aircraft" / "737.toml").write_text((ROOT / "aircraft" / "737.toml").read_text(), encoding="utf-8")
-    r = subprocess.run([sys.executable, "-m", "approachsim", "fly", str(prof), "--out", str(tmp_path / "o")],
+    extra = ["--runs", "2", "--no-report"] if command == "evaluate" else []
+    r = subprocess.run([sys.executable, "-m", "approachsim", command, str(prof), "--out", str(tmp_path / "o"), *extra],
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
