@@ -16,6 +16,7 @@ import numpy as np
 
 from approachsim.campaign.result import RunResult
 from approachsim.evaluate.config import EvaluationConfig
+from approachsim.evaluate.stats import MIN_GROUPS
 from approachsim.evaluate.summary import contract_summary, details, verdicts
 
 
@@ -32,13 +33,27 @@ def evaluate_results(
     """(summary, details) of a finished campaign."""
     cols = columns(results)
     failed = sum(not r.ok for r in results)
-    res = verdicts(cols, cfg, runs=len(results), failed_runs=failed)
+    # open loop: the runs of one flight group share one flown truth (pipeline.open_loop_group)
+    groups = None if closed_loop else np.array([r.run // cfg.flight_group for r in results if r.ok])
+    res = verdicts(cols, cfg, runs=len(results), failed_runs=failed, groups=groups)
     summary = contract_summary(
         res, profile=profile, runs=len(results), seed=seed, closed_loop=closed_loop, failed_runs=failed
     )
     det = details(cols, res, cfg)
     det["failures"] = {str(r.run): r.error for r in results if not r.ok}
     return summary, det
+
+
+def _shared_truth_note(det: dict) -> str:
+    """The report's line on the open-loop shared-truth correction (stats.effective_runs)."""
+    axes = [a for c in det["categories"].values() for a in c["bounds_ft"].values()]
+    rho = [a.get("shared_truth_rho") for a in axes]
+    if not rho or any(r is None for r in rho):
+        return (f"fewer than {MIN_GROUPS} groups, so their correlation cannot be estimated and the bounds assume "
+                "independent runs")
+    neff = [a["n_eff"] for a in axes if a.get("n_eff") is not None]
+    return (f"the bounds use the effective run count of the clustered runs (between-group correlation up to "
+            f"{max(rho):.2f}, effective runs down to {min(neff):.0f})")
 
 
 def write_json(path: Path, data: Any) -> None:
@@ -88,9 +103,9 @@ def verdict_table(summary: dict, det: dict) -> str:
         )
     if not summary["closed_loop"]:
         lines.append(
-            "open loop: runs of one group share one flown truth (evaluation.flight_group), so they are not fully "
-            "independent and the bounds, which assume independent runs, are optimistic by the share of the error "
-            "the common flight explains; closed loop gives every run its own flight"
+            "open loop: runs of one group share one flown truth (evaluation.flight_group); "
+            + _shared_truth_note(det)
+            + "; closed loop gives every run its own flight"
         )
     ta = det.get("time_averaged_rms_ft", {})
     if ta:

@@ -16,6 +16,12 @@
   - lower: the zero-mean chi-square bound rms sqrt(n / chi2_{level}(n)): exact at mu = 0 and conservative
     (coverage above `level`) with a bias (measured n = 20: 95.8 / 97.2 / 100 % at mu/s = 0 / 1 / 3), so
     `fails` is never claimed on less evidence than stated.
+* Shared truth (open loop: the runs of one flight group fly one truth): the runs are clustered, and the
+  bounds use the effective run count n_eff = n / (1 + (m0 - 1) rho) (Kish's design effect), rho the one-way
+  ANOVA intraclass correlation of the error between groups (clipped to [0, 1]; on the error itself, which for
+  Gaussian errors bounds that of the squared error, rho^2, from above: conservative for an RMS), m0 the
+  ANOVA mean group size (`effective_runs`). Estimated only with at least MIN_GROUPS groups; with fewer the
+  bounds assume independent runs and details.json says the correlation was not estimable.
 * 95th percentile of |error| (the ICAO 95 % accuracy figure), numpy's linear interpolation; its interval
   is distribution-free from order statistics: ranks (l, u) with P(X_(l) <= q95 <= X_(u)) >= level from
   the binomial(n, 0.95) law (the upper end is +inf when n is too small to bound it).
@@ -62,7 +68,32 @@ MIN_RUNS = 10
 short of its level for very few runs (module docstring)."""
 
 
-def _nu(n: int, d: float) -> float:
+MIN_GROUPS = 5
+"""Fewest flight groups from which the between-group (shared-truth) correlation is estimated."""
+
+
+def effective_runs(x: np.ndarray, groups: np.ndarray) -> tuple[float, float]:
+    """(n_eff, rho): Kish's effective sample size of the finite values of x clustered by `groups`, and the
+    one-way ANOVA intraclass correlation (module docstring); (n, nan) with fewer than MIN_GROUPS groups."""
+    x = np.asarray(x, dtype=float)
+    g = np.asarray(groups)
+    ok = np.isfinite(x)
+    x, g = x[ok], g[ok]
+    n = int(x.size)
+    labels, inv, m = np.unique(g, return_inverse=True, return_counts=True)
+    k = int(labels.size)
+    if k < MIN_GROUPS or n - k < 1:
+        return float(n), float("nan")
+    means = np.bincount(inv, weights=x) / m
+    msb = float(np.sum(m * (means - x.mean()) ** 2) / (k - 1))
+    msw = float(np.sum((x - means[inv]) ** 2) / (n - k))
+    m0 = (n - float(np.sum(m**2)) / n) / (k - 1)
+    den = msb + (m0 - 1.0) * msw
+    rho = 0.0 if den <= 0.0 else min(1.0, max(0.0, (msb - msw) / den))
+    return n / (1.0 + (m0 - 1.0) * rho), rho
+
+
+def _nu(n: float, d: float) -> float:
     """Patnaik's degrees of freedom of mean(e^2) for n Gaussian samples with bias ratio d = mu^2 / s^2."""
     return n * (1.0 + d) ** 2 / (1.0 + 2.0 * d)
 
@@ -79,26 +110,28 @@ def bias_ratio(x: np.ndarray) -> float:
     return max(0.0, float(np.mean(x)) ** 2 - s2 / n) / s2
 
 
-def rms_upper_factor(n: int, d: float = 0.0, level: float = 0.95) -> float:
+def rms_upper_factor(n: float, d: float = 0.0, level: float = 0.95) -> float:
     """theta_up / rms for n runs and bias ratio d: sqrt(nu / chi2_{1-level}(nu)) (module docstring)."""
     nu = _nu(n, d)
     return math.sqrt(nu / sps.chi2.ppf(1.0 - level, nu))
 
 
-def rms_lower_factor(n: int, level: float = 0.95) -> float:
+def rms_lower_factor(n: float, level: float = 0.95) -> float:
     """theta_lo / rms for n runs: sqrt(n / chi2_level(n)), the zero-mean chi-square bound."""
     return math.sqrt(n / sps.chi2.ppf(level, n))
 
 
-def rms_bounds(x: np.ndarray, level: float = 0.95) -> tuple[float, float]:
-    """One-sided (lower, upper) confidence bounds, each at `level`, of the RMS of the finite values of x."""
+def rms_bounds(x: np.ndarray, level: float = 0.95, n_eff: float | None = None) -> tuple[float, float]:
+    """One-sided (lower, upper) confidence bounds, each at `level`, of the RMS of the finite values of x
+    (n_eff: the effective run count of clustered runs, `effective_runs`; None: the finite values' count)."""
     x = np.asarray(x, dtype=float)
     x = x[np.isfinite(x)]
     n = int(x.size)
     if n == 0:
         return float("nan"), float("nan")
+    ne = float(n) if n_eff is None else float(n_eff)
     rms = float(np.sqrt(np.mean(x**2)))
-    return rms * rms_lower_factor(n, level), rms * rms_upper_factor(n, bias_ratio(x), level)
+    return rms * rms_lower_factor(ne, level), rms * rms_upper_factor(ne, bias_ratio(x), level)
 
 
 def runs_to_decide(rms: float, d: float, limit: float, level: float = 0.95, n_max: int = 100000) -> int | None:

@@ -37,11 +37,13 @@ def _col(columns: Mapping[str, np.ndarray], name: str) -> np.ndarray:
 
 
 def verdicts(
-    columns: Mapping[str, np.ndarray], cfg: EvaluationConfig, *, runs: int | None = None, failed_runs: int = 0
+    columns: Mapping[str, np.ndarray], cfg: EvaluationConfig, *, runs: int | None = None, failed_runs: int = 0,
+    groups: np.ndarray | None = None,
 ) -> list[CategoryResult]:
     """Score every category from the per-run table of the completed runs (errors converted to ft here).
 
     runs / failed_runs: the campaign's run count and its failed runs, which count against every category.
+    groups: the shared-truth (flight) group of each completed run in open loop; None: independent runs.
     """
     out = []
     for cat in CATEGORIES:
@@ -50,7 +52,7 @@ def verdicts(
         ver = _col(columns, f"{key}_vertical_m") / units.FT
         out.append(category_verdict(
             cat, cfg.dh_ft[cat], lat, ver, cfg.verdict, runs=runs, failed_runs=failed_runs,
-            max_failure_fraction=cfg.max_failure_fraction, confidence=cfg.confidence,
+            max_failure_fraction=cfg.max_failure_fraction, confidence=cfg.confidence, groups=groups,
         ))
     return out
 

@@ -11,6 +11,8 @@ Each criterion is judged on one-sided confidence bounds at the profile's evaluat
 * ICAO 95 % accuracy (verdict = "faa+icao"): the distribution-free one-sided order-statistic bounds of the
   95th percentile of |error| (binomial(n, 0.95) ranks): meets when the upper bound is within the ICAO value
   (needs n >= 59), fails when the lower bound exceeds it.
+* Shared truth (open loop): with `groups`, the RMS bounds use the effective run count of the clustered runs
+  (stats.effective_runs: Kish's design effect from the between-group correlation of the error).
 * Failed runs (diverged, unstabilized, never reached the decision height): they count against every
   category. With evaluation.max_failure_fraction = 0 (the default) any failed run makes the category fail
   (the observed failure rate is above the allowed zero). With an allowed fraction f > 0 the Clopper-Pearson
@@ -38,6 +40,7 @@ from approachsim.evaluate.stats import (
     MIN_RUNS,
     ErrorStats,
     bias_ratio,
+    effective_runs,
     error_stats,
     quantile_lower_rank,
     quantile_upper_rank,
@@ -60,6 +63,10 @@ class AxisVerdict:
     p95_upper_ft: float
     verdict: str
     runs_needed: int | None
+    n_eff: float | None = None
+    """Effective run count of the bounds (shared-truth groups, stats.effective_runs); None: independent runs."""
+    shared_truth_rho: float | None = None
+    """Estimated between-group correlation of the error (None: no groups; nan: too few groups to estimate)."""
 
 
 @dataclass(frozen=True)
@@ -121,15 +128,21 @@ def _combine(verdicts: Sequence[str]) -> str:
     return "meets" if all(v == "meets" for v in verdicts) else "indeterminate"
 
 
-def axis_verdict(x_ft: np.ndarray, limit_1sigma_ft: float, limit_95_ft: float, icao: bool, level: float) -> AxisVerdict:
-    """Verdict of one axis from its per-run errors (ft, completed runs only)."""
+def axis_verdict(x_ft: np.ndarray, limit_1sigma_ft: float, limit_95_ft: float, icao: bool, level: float,
+                 groups: np.ndarray | None = None) -> AxisVerdict:
+    """Verdict of one axis from its per-run errors (ft, completed runs only); groups: the shared-truth group
+    of each run (open loop), whose correlation lowers the effective run count of the RMS bounds."""
     x = np.asarray(x_ft, dtype=float)
-    x = x[np.isfinite(x)]
+    fin = np.isfinite(x)
+    n_eff = rho = None
+    if groups is not None:
+        n_eff, rho = effective_runs(x, np.asarray(groups))
+    x = x[fin]
     n = int(x.size)
     nan = float("nan")
     if n == 0:
-        return AxisVerdict(nan, nan, nan, nan, "indeterminate", None)
-    lo, hi = rms_bounds(x, level)
+        return AxisVerdict(nan, nan, nan, nan, "indeterminate", None, n_eff, rho)
+    lo, hi = rms_bounds(x, level, n_eff)
     rms = float(np.sqrt(np.mean(x**2)))
     faa = "fails" if lo > limit_1sigma_ft else ("meets" if hi <= limit_1sigma_ft and n >= MIN_RUNS else "indeterminate")
     a = np.sort(np.abs(x))
@@ -143,9 +156,11 @@ def axis_verdict(x_ft: np.ndarray, limit_1sigma_ft: float, limit_95_ft: float, i
     need = None
     if v == "indeterminate":
         need = runs_to_decide(rms, bias_ratio(x), limit_1sigma_ft, level)
+        if need is not None and n_eff is not None and n_eff < n:
+            need = int(math.ceil(need * n / n_eff))  # the same design effect
         if icao and rms < limit_1sigma_ft and float(np.percentile(a, 95.0)) <= limit_95_ft:
             need = max(need or 0, ICAO_MIN_RUNS, n + 1)
-    return AxisVerdict(lo, hi, p_lo, p_hi, v, need)
+    return AxisVerdict(lo, hi, p_lo, p_hi, v, need, n_eff, rho)
 
 
 def category_verdict(
@@ -159,17 +174,19 @@ def category_verdict(
     failed_runs: int = 0,
     max_failure_fraction: float = 0.0,
     confidence: float = 0.95,
+    groups: np.ndarray | None = None,
 ) -> CategoryResult:
     """Score one category from the per-run errors (ft) at its decision height of the completed runs.
 
     runs: all runs of the campaign (completed + failed_runs; default the completed count + failed_runs).
+    groups: the shared-truth group of each completed run (open loop), aligned with the error arrays.
     """
     lim = LIMITS[category]
     lat = error_stats(lateral_ft, confidence)
     ver = error_stats(vertical_ft, confidence)
     icao = verdict == "faa+icao"
-    la = axis_verdict(lateral_ft, lim.lateral_1sigma_ft, lim.lateral_95_ft, icao, confidence)
-    va = axis_verdict(vertical_ft, lim.vertical_1sigma_ft, lim.vertical_95_ft, icao, confidence)
+    la = axis_verdict(lateral_ft, lim.lateral_1sigma_ft, lim.lateral_95_ft, icao, confidence, groups)
+    va = axis_verdict(vertical_ft, lim.vertical_1sigma_ft, lim.vertical_95_ft, icao, confidence, groups)
     total = (min(lat.n, ver.n) + failed_runs) if runs is None else int(runs)
     fv = failure_verdict(failed_runs, total, max_failure_fraction, confidence)
     f_hi = clopper_pearson(failed_runs, total, confidence)[1]
