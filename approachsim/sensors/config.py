@@ -191,7 +191,7 @@ def parse_sensors(s: Section) -> SensorsConfig:
         except ValueError as e:
             raise ProfileError(f"{g.path}.epoch_utc: {e}") from None
         gnss = GnssConfig(
-            code=g.string("code", "P(Y)", choices=tuple(CODE_PRESETS)),
+            code=(code := g.string("code", "P(Y)", choices=tuple(CODE_PRESETS))),
             selection=g.string("selection", "best4", choices=SELECTIONS),
             mask_rad=math.radians(g.number("mask_deg", 5.0, lo=0.0, hi=45.0, unit="deg")),
             rate_hz=g.number("rate_hz", 1.0, lo=0.1, hi=100.0, unit="Hz"),
@@ -204,9 +204,9 @@ def parse_sensors(s: Section) -> SensorsConfig:
             epoch=g.string("epoch", "per-run", choices=EPOCH_MODES),
             epoch_window_s=g.number("epoch_window_h", SIDEREAL_DAY_S / 3600.0, lo=0.0, lo_open=True, hi=8760.0,
                                     unit="h") * 3600.0,
-            multipath_model=g.string("multipath_model", "do253", choices=MULTIPATH_MODELS),
-            multipath_tau_s=(g.number("multipath_tau_s", 60.0, lo=0.0, lo_open=True, hi=1e5, unit="s")
-                             if g.has("multipath_tau_s") else None),
+            multipath_model=(mp := g.string("multipath_model", "do253", choices=MULTIPATH_MODELS)),
+            multipath_tau_s=g.number("multipath_tau_s", make_budget(code, mp).multipath_tau_s, lo=0.0,
+                                     lo_open=True, hi=1e5, unit="s"),
             clock_ephemeris=g.string("clock_ephemeris", "current", choices=tuple(CLOCK_EPHEMERIS_M)),
         )
         if gnss.epoch == "fixed" and g.has("epoch_window_h"):
