@@ -31,7 +31,8 @@ Selectable on top of a preset (make_budget; the profile's [sensors.gnss] multipa
             "current": 2.4 m, the GPS URE (accuracy / continuity sigma) of the draft ICAO Annex 10 default ARAIM
             integrity support data, June 2024, as set in Stanford's MAAST for ARAIM (main_maast_araim.m,
             isd.ure_gps = 2.4 m, Blanch et al.); a conservative modern figure: the measured GPS signal-in-space
-            URE RMS of recent years is below 1 m (ARL:UT annual GPS SPS performance analyses).
+            URE RMS of recent years is lower still (Renfro et al., "An Analysis of Global Positioning System
+            (GPS) Standard Positioning Service Performance for 2019", ARL:UT TR-SGL-20-02, 2020).
 
 Epoch: every run's sky is the constellation at epoch_utc + its own offset (errors.constants["epoch_offset_s"],
 drawn by the sensor suite from the run's "gnss_epoch" stream); a batch of runs with offsets gives per-run geometry
