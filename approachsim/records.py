@@ -6,8 +6,8 @@ base) put the run axis first: (runs, time, ...). All SI; frames in the field nam
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
-from typing import Protocol
+from dataclasses import dataclass, field, fields, replace
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -202,6 +202,30 @@ class GnssSamples:
     """(m, 24) per run: fault label (int8)."""
     pseudorange_rate_mps: Array | None = None
     """(m, 24) per run: pseudorange rate (carrier Doppler), m/s (nan where not valid); None if not modelled."""
+    epoch_offset_s: Array | None = None
+    """() or (runs,): each run's constellation epoch after the profile's epoch_utc, s; None: one fixed sky.
+    With per-run offsets in a batch the geometry fields (r_sv_ecef, sigma_m, elevation_rad, azimuth_rad,
+    visible, pdop) also carry the leading run axis (`per_run_sky`)."""
+
+    @property
+    def per_run_sky(self) -> bool:
+        """True when the geometry fields carry a leading run axis (a batch of runs, each with its own epoch)."""
+        return np.ndim(self.elevation_rad) == 3
+
+    def run(self, k: int) -> GnssSamples:
+        """Run k of a batched record (every per-run field indexed; shared geometry kept)."""
+        def pick(v: Any, nd: int) -> Any:
+            return v[k] if v is not None and np.ndim(v) == nd else v
+        sky = self.per_run_sky
+        return replace(
+            self, r_sv_ecef=self.r_sv_ecef[k] if sky else self.r_sv_ecef, pseudorange_m=self.pseudorange_m[k],
+            sigma_m=self.sigma_m[k] if sky else self.sigma_m, elevation_rad=self.elevation_rad[k] if sky else
+            self.elevation_rad, azimuth_rad=self.azimuth_rad[k] if sky else self.azimuth_rad,
+            visible=self.visible[k] if sky else self.visible, valid=pick(self.valid, 3),
+            pdop=self.pdop[k] if sky else self.pdop, clock_bias_m=pick(self.clock_bias_m, 2),
+            clock_drift_mps=pick(self.clock_drift_mps, 2), fault=pick(self.fault, 3),
+            pseudorange_rate_mps=pick(self.pseudorange_rate_mps, 3), epoch_offset_s=pick(self.epoch_offset_s, 1),
+        )
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ import numpy as np
 from approachsim.campaign.result import RunResult
 from approachsim.evaluate.config import EvaluationConfig
 from approachsim.evaluate.stats import MIN_GROUPS
-from approachsim.evaluate.summary import contract_summary, details, verdicts
+from approachsim.evaluate.summary import contract_summary, details, gnss_geometry, verdicts
 
 
 def columns(results: list[RunResult]) -> dict[str, np.ndarray]:
@@ -41,6 +41,9 @@ def evaluate_results(
     )
     det = details(cols, res, cfg)
     det["failures"] = {str(r.run): r.error for r in results if not r.ok}
+    geom = gnss_geometry([r.run for r in results if r.ok], cols)
+    if geom is not None:
+        det["gnss_geometry"] = geom
     return summary, det
 
 

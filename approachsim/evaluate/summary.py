@@ -8,7 +8,7 @@ time-averaged RMS, FTE / TSE) goes to the details dictionary.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 
 import numpy as np
@@ -138,3 +138,35 @@ def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cf
         "categories": cats,
         "time_averaged_rms_ft": {k: _num(v) for k, v in ta.items()},
     }
+
+
+GEOMETRY_PERCENTILES = (5, 25, 50, 75, 95)
+"""Percentiles of the per-run DOP / satellite-count distributions in details.json."""
+
+
+def gnss_geometry(run_ids: Sequence[int], columns: Mapping[str, np.ndarray]) -> dict | None:
+    """details.json "gnss_geometry": per run (completed runs, run order) the PDOP / HDOP / VDOP and the
+    satellites in view / used at each decision height and the run's epoch offset (h); per category their
+    distribution (percentiles, min, max) and the fraction of runs with fewer than 4 used and fewer than 5 in
+    view. None without GNSS scalars (no GPS fitted)."""
+    fields = ("pdop", "hdop", "vdop", "sv_visible", "sv_used")
+    if not any(f"{k}_pdop" in columns for k in CATEGORY_KEYS.values()):
+        return None
+    per_run: dict = {"run": [int(r) for r in run_ids]}
+    if "gnss_epoch_offset_h" in columns:
+        per_run["epoch_offset_h"] = [_num(v) for v in columns["gnss_epoch_offset_h"]]
+    dist = {}
+    for cat, key in CATEGORY_KEYS.items():
+        per_run[cat] = {f: [_num(v) for v in _col(columns, f"{key}_{f}")] for f in fields}
+        entry = {}
+        for f in fields:
+            x = _col(columns, f"{key}_{f}")
+            x = x[np.isfinite(x)]
+            entry[f] = ({f"p{p}": _num(float(np.percentile(x, p))) for p in GEOMETRY_PERCENTILES}
+                        | {"min": _num(float(x.min())), "max": _num(float(x.max()))}) if x.size else None
+        used = _col(columns, f"{key}_sv_used")
+        vis = _col(columns, f"{key}_sv_visible")
+        entry["fraction_used_lt4"] = _num(float(np.mean(used < 4))) if used.size else None
+        entry["fraction_visible_lt5"] = _num(float(np.mean(vis < 5))) if vis.size else None
+        dist[cat] = entry
+    return {"per_run": per_run, "categories": dist}

@@ -124,7 +124,8 @@ class ErrorNoise:
     gse_sigma_m: float | Array = 0.0
     """Per-channel slow range-error 1-sigma (scalar or (n_sv,) by elevation), m."""
     gse_tau_s: float = 1800.0
-    gmp_sigma_m: float = 0.0
+    gmp_sigma_m: float | Array = 0.0
+    """Per-channel multipath 1-sigma (scalar, or (n_sv,) by elevation under the DO-253 model), m."""
     gmp_tau_s: float = 60.0
     pmp_sigma_m: float = 0.0
     pmp_tau_s: float = 30.0

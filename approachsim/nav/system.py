@@ -35,7 +35,7 @@ from approachsim.nav.config import DEFAULT_NAV, NavConfig
 from approachsim.records import NavSolution, Truth
 from approachsim.sensors.config import DEFAULT_SENSORS, SensorsConfig
 from approachsim.sensors.gnss.clock import ClockModel
-from approachsim.sensors.gnss.receiver import CODE_PRESETS, iono_obliquity, tropo_mapping
+from approachsim.sensors.gnss.receiver import iono_obliquity, tropo_mapping
 from approachsim.sensors.presets import PRESETS
 
 Array = np.ndarray
@@ -113,6 +113,12 @@ class _SharedCov:
         """P- = Phi P+ Phi' + Qd for every class."""
         for c, P in enumerate(self.P):
             P = phi @ P @ phi.T + qd
+            self.P[c] = 0.5 * (P + P.T)
+
+    def predict_each(self, phi: Array, qds: list) -> None:
+        """P- = Phi P+ Phi' + Qd_c with class c's own Qd_c (classes on different GPS skies)."""
+        for c, P in enumerate(self.P):
+            P = phi @ P @ phi.T + qds[c]
             self.P[c] = 0.5 * (P + P.T)
 
     def split(self, schedule: Array) -> None:
@@ -211,14 +217,16 @@ class NavSystem:
         clk = self._clock()
         kw: dict[str, Any] = {}
         if self.sensors.gnss is not None:
-            bud = CODE_PRESETS[self.sensors.gnss.code]
+            bud = self.sensors.gnss.budget()
             el = np.full(24, np.radians(30.0)) if elevation_rad is None else np.nan_to_num(elevation_rad, nan=0.5)
             el = np.maximum(el, np.radians(2.0))
             kw.update(
                 gse_sigma_m=np.sqrt(bud.clock_ephemeris_m**2 + (bud.iono_zenith_m * iono_obliquity(el)) ** 2
                                     + (bud.tropo_zenith_m * tropo_mapping(el)) ** 2),
                 gse_tau_s=min(bud.clock_ephemeris_tau_s, bud.iono_tau_s, bud.tropo_tau_s),
-                gmp_sigma_m=bud.multipath_m, gmp_tau_s=bud.multipath_tau_s,
+                # per channel at its elevation under do253 (the sensor's sigma_mp), one value under nrc1995
+                gmp_sigma_m=(bud.multipath_sigma_m(el) if bud.multipath_model == "do253" else bud.multipath_m),
+                gmp_tau_s=bud.multipath_tau_s,
             )
         if self.sensors.pseudolite is not None:
             p = self.sensors.pseudolite
@@ -338,9 +346,12 @@ class NavSystem:
         with feedback).
         """
         lay = self.layout
-        noise = self.noise(obs.get("gnss_el"))
+        sky = bool(obs.get("gnss_sky"))  # each run its own GPS sky: its own channel noise
+        noise = None if sky else self.noise(obs.get("gnss_el"))
         r_ins = ins.position_ecef(s)
         for i, run in enumerate(runs):
+            if sky:
+                noise = self.noise(obs["gnss_el"][i])
             gains = self.loop_slopes(run.fs, float(s.h_m[i]), noise)
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
                                 noise, gains)
@@ -385,12 +396,16 @@ class NavSystem:
         on the runs it shares a batch with. Phi and Qd are built once per epoch.
         """
         lay = self.layout
-        noise = self.noise(obs.get("gnss_el"))
+        sky = bool(obs.get("gnss_sky"))  # per-run skies: every run is its own class (run()), Qd per class
+        noise = self.noise(obs["gnss_el"][0] if sky else obs.get("gnss_el"))
         F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ned_ref, ref.c_bn[0],
                             noise, self.loop_gains())
         phi, qd = em.discretize(F, Qc, dt_epoch)
         X = np.stack([phi @ r.fs.x for r in runs])  # x- = Phi x+ (row by row: no batch-size-dependent BLAS path)
-        cov.predict(phi, qd)
+        if sky:
+            cov.predict_each(phi, [self._channel_qd(qd, obs["gnss_el"][m[0]], dt_epoch) for _, m in cov.classes()])
+        else:
+            cov.predict(phi, qd)
         cov.split(self._schedule(obs, len(runs)))
         r_ins = ins.position_ecef(s)
         r_ref = ins.position_ecef(ref)[0]
@@ -421,6 +436,19 @@ class NavSystem:
             s = self._feedback(s, runs)
         return s
 
+    def _channel_qd(self, qd: Array, el_rad: Array, dt_s: float) -> Array:
+        """Qd with the GPS channel states' (gse, gmp: decoupled first-order Markov) entries at elevations el_rad
+        (24,): sigma^2 (1 - exp(-2 dt / tau)), the closed form errormodel.discretize uses for them."""
+        lay = self.layout
+        if not lay.has("gse"):
+            return qd
+        nz = self.noise(el_rad)
+        q = qd.copy()
+        for grp, sig, tau in (("gse", nz.gse_sigma_m, nz.gse_tau_s), ("gmp", nz.gmp_sigma_m, nz.gmp_tau_s)):
+            k = np.arange(lay.index[grp].start, lay.index[grp].stop)
+            q[k, k] = np.broadcast_to(np.asarray(sig, dtype=float), k.shape) ** 2 * -np.expm1(-2.0 * dt_s / tau)
+        return q
+
     def _innovations(self, name: str, X: Array, idx: Array, s: ins.InsState, r_ins: Array, c_en: Array,
                      obs: Mapping[str, Any]) -> Array:
         """Innovations nu = z - g(x_hat) (m) of measurement `name` for runs idx at once, X (M, n) their
@@ -440,7 +468,7 @@ class NavSystem:
             return (h_ins + dp[:, 2]) - self.terrain_h(r_hat) - obs["radalt_h"][idx]
         if name.startswith("gps"):
             k = int(name[3:])
-            d = r_hat - obs["gnss_rsv"][k]
+            d = r_hat - (obs["gnss_rsv"][idx, k] if obs.get("gnss_sky") else obs["gnss_rsv"][k])
             rng_hat = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + d[:, 2] ** 2)
             nu = rng_hat - obs["gnss_rho"][idx, k]  # |r_hat - r_sv| - rho + clk + gse + gmp
             if lay.has("clk"):
@@ -487,6 +515,9 @@ class NavSystem:
             out["radalt_h"] = np.array([agl if ok else np.nan])
         if "gnss_rho" in obs:
             out["gnss_rho"] = np.asarray(obs["gnss_rho"])[i:i + 1]
+        if obs.get("gnss_sky"):  # run i's own sky, as a shared one for the reference rows
+            out.update(gnss_sky=False, gnss_rsv=obs["gnss_rsv"][i], gnss_sigma=obs["gnss_sigma"][i],
+                       gnss_el=obs["gnss_el"][i])
         if "pl_rho" in obs:
             out["pl_rho"] = np.asarray(obs["pl_rho"])[i:i + 1]
         return out
@@ -505,8 +536,10 @@ class NavSystem:
             sr = float(np.sqrt((self.sensors.radalt.percent_sigma * hr) ** 2 + self.sensors.radalt.floor_m**2))
             out.append(lambda x: meas.radalt(lay, x, lat, lon, h, hr, sr, self.terrain_h, t))
         c_en = geo.c_ecef_to_ned(lat, lon)
+        sky = bool(obs.get("gnss_sky"))
         if "gnss_rho" in obs and self.nav.gps_coupling == "loose":
-            fix = meas.gps_fix(r_ins, obs["gnss_rsv"], obs["gnss_rho"][i], obs["gnss_sigma"])
+            fix = meas.gps_fix(r_ins, obs["gnss_rsv"][i] if sky else obs["gnss_rsv"], obs["gnss_rho"][i],
+                               obs["gnss_sigma"][i] if sky else obs["gnss_sigma"])
             if fix is not None:
                 r_fix, cov = fix
                 glat, glon, gh = geo.ecef_to_geodetic(r_fix)
@@ -515,9 +548,9 @@ class NavSystem:
                 for m in meas.gps_position(lay, dz, sd, t):
                     out.append(lambda x, m=m: m)
         elif "gnss_rho" in obs:
-            rho, r_sv = obs["gnss_rho"][i], obs["gnss_rsv"]
-            bud = CODE_PRESETS[self.sensors.gnss.code]
-            sig = bud.code_noise_m if lay.has("gse") else obs["gnss_sigma"]
+            rho, r_sv = obs["gnss_rho"][i], obs["gnss_rsv"][i] if sky else obs["gnss_rsv"]
+            bud = self.sensors.gnss.budget()
+            sig = bud.code_noise_m if lay.has("gse") else (obs["gnss_sigma"][i] if sky else obs["gnss_sigma"])
             for k in np.flatnonzero(np.isfinite(rho)):
                 sk = float(sig if np.isscalar(sig) else sig[k])
                 out.append(lambda x, k=k, sk=sk, rk=float(rho[k]), rs=r_sv[k]: meas.pseudorange(
@@ -575,9 +608,11 @@ class NavSystem:
         g = records.get("gnss")
         if g is not None and (j := _epoch_index(g.t_s, t, tol)) is not None:
             obs["gnss_rho"] = np.where(per_run(g.valid)[:, j], per_run(g.pseudorange_m)[:, j], np.nan)
-            obs["gnss_rsv"] = g.r_sv_ecef[j]
-            obs["gnss_sigma"] = g.sigma_m[j]
-            obs["gnss_el"] = g.elevation_rad[j]
+            sky = batched and g.per_run_sky  # each run its own constellation epoch: (N, ...) geometry
+            obs["gnss_rsv"] = g.r_sv_ecef[:, j] if sky else g.r_sv_ecef[j]
+            obs["gnss_sigma"] = g.sigma_m[:, j] if sky else g.sigma_m[j]
+            obs["gnss_el"] = g.elevation_rad[:, j] if sky else g.elevation_rad[j]
+            obs["gnss_sky"] = sky
         p = records.get("pseudolite")
         if p is not None and (j := _epoch_index(p.t_s, t, tol)) is not None:
             obs["pl_rho"] = np.where(per_run(p.valid)[:, j], per_run(p.pseudorange_m)[:, j], np.nan)
@@ -607,11 +642,18 @@ class NavSystem:
         rate = 1.0 / dt
         epoch_rows = max(1, int(round(rate / self.nav.aiding_rate_hz)))
         gnss = records.get("gnss")
-        s, runs = self.start(truth, gens, elevation_rad=None if gnss is None else gnss.elevation_rad[0])
+        sky = gnss is not None and batched and gnss.per_run_sky
+        s, runs = self.start(truth, gens, elevation_rad=None if gnss is None else
+                             (gnss.elevation_rad[0, 0] if sky else gnss.elevation_rad[0]))
         n_runs = len(gens)
+        if sky:  # each run's P0 at its own sky (the drawn INS errors do not depend on the GPS channels)
+            for i, r in enumerate(runs):
+                r.fs = self.filter.init(np.zeros(self.layout.n), self.initial_covariance(gnss.elevation_rad[i, 0]))
         cov = None
         if shared_covariance:  # the reference trajectory (truth) and its specific force in NED, per row
-            cov = _SharedCov([runs[0].fs.P], np.zeros(n_runs, dtype=int))
+            # per-run skies: one class per run from the start (a covariance is shared only within one sky)
+            cov = (_SharedCov([r.fs.P for r in runs], np.arange(n_runs)) if sky
+                   else _SharedCov([runs[0].fs.P], np.zeros(n_runs, dtype=int)))
             f_ned_ref = np.einsum("nij,nj->ni", ins.cbn_from_quaternion(truth.q_nb[:m]), truth.f_body[:m])
         gains = self.loop_gains()
         baro = records.get("baro")

@@ -27,6 +27,8 @@ from scipy.signal import lfilter
 
 Array = np.ndarray
 RngLike = np.random.Generator | Sequence[np.random.Generator]
+NOT_ERRORS = ("epoch_offset_s",)
+"""Per-run constants that set the scene rather than an error (kept by SensorErrors.zeroed)."""
 
 
 def is_batched(rng: RngLike) -> bool:
@@ -115,11 +117,12 @@ class SensorErrors:
         )
 
     def zeroed(self) -> SensorErrors:
-        """The same structure with every error zero (for measure(..., noise=False))."""
+        """The same structure with every error zero (for measure(..., noise=False)); constants that are not
+        errors (NOT_ERRORS: a run's GPS epoch) are kept."""
         return SensorErrors(
             index=self.index, rows=self.rows, t_s=self.t_s, dt_s=self.dt_s,
             series={k: np.zeros_like(v) for k, v in self.series.items()},
-            constants={k: np.zeros_like(v) for k, v in self.constants.items()},
+            constants={k: v if k in NOT_ERRORS else np.zeros_like(v) for k, v in self.constants.items()},
             batched=self.batched,
         )
 

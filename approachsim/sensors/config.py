@@ -18,7 +18,15 @@ from approachsim.config import ProfileError, Section
 from approachsim.sensors.faults import FAULT_KINDS, FaultSpec
 from approachsim.sensors.gnss.clock import OSCILLATORS
 from approachsim.sensors.gnss.constellation import parse_epoch
-from approachsim.sensors.gnss.receiver import CODE_PRESETS, SELECTIONS
+from approachsim.sensors.gnss.receiver import (
+    CLOCK_EPHEMERIS_M,
+    CODE_PRESETS,
+    MULTIPATH_MODELS,
+    SELECTIONS,
+    SIDEREAL_DAY_S,
+    GnssErrorBudget,
+    make_budget,
+)
 from approachsim.sensors.presets import PRESETS
 
 SENSOR_NAMES = ("imu", "baro", "radalt", "gnss", "pseudolite")
@@ -72,6 +80,26 @@ class GnssConfig:
     clock_drift0_sigma_mps: float = 3.0
     doppler: bool = False
     doppler_noise_mps: float = 0.05
+    epoch: str = "per-run"
+    """"per-run": each run's sky at epoch_utc + U[0, epoch_window_s) (its own "gnss_epoch" stream); "fixed":
+    every run at epoch_utc."""
+    epoch_window_s: float = SIDEREAL_DAY_S
+    multipath_model: str = "do253"
+    multipath_tau_s: float | None = None
+    """None: the model's default (receiver.make_budget)."""
+    clock_ephemeris: str = "current"
+
+    def budget(self) -> GnssErrorBudget:
+        """The error budget these settings select (code preset, multipath model, clock/ephemeris budget)."""
+        return make_budget(self.code, self.multipath_model, self.clock_ephemeris, self.multipath_tau_s)
+
+    def epoch_window(self) -> float:
+        """Width (s) of the per-run epoch window; 0 for a fixed epoch."""
+        return self.epoch_window_s if self.epoch == "per-run" else 0.0
+
+
+EPOCH_MODES = ("per-run", "fixed")
+"""[sensors.gnss] epoch: one sky per run over the window, or the one epoch_utc."""
 
 
 @dataclass(frozen=True)
@@ -163,7 +191,7 @@ def parse_sensors(s: Section) -> SensorsConfig:
         except ValueError as e:
             raise ProfileError(f"{g.path}.epoch_utc: {e}") from None
         gnss = GnssConfig(
-            code=g.string("code", "P(Y)", choices=tuple(CODE_PRESETS)),
+            code=(code := g.string("code", "P(Y)", choices=tuple(CODE_PRESETS))),
             selection=g.string("selection", "best4", choices=SELECTIONS),
             mask_rad=math.radians(g.number("mask_deg", 5.0, lo=0.0, hi=45.0, unit="deg")),
             rate_hz=g.number("rate_hz", 1.0, lo=0.1, hi=100.0, unit="Hz"),
@@ -173,7 +201,16 @@ def parse_sensors(s: Section) -> SensorsConfig:
             clock_drift0_sigma_mps=g.number("clock_drift0_sigma_mps", 3.0, lo=0.0, unit="m/s"),
             doppler=g.boolean("doppler", False),
             doppler_noise_mps=g.number("doppler_noise_mps", 0.05, lo=0.0, unit="m/s"),
+            epoch=g.string("epoch", "per-run", choices=EPOCH_MODES),
+            epoch_window_s=g.number("epoch_window_h", SIDEREAL_DAY_S / 3600.0, lo=0.0, lo_open=True, hi=8760.0,
+                                    unit="h") * 3600.0,
+            multipath_model=(mp := g.string("multipath_model", "do253", choices=MULTIPATH_MODELS)),
+            multipath_tau_s=g.number("multipath_tau_s", make_budget(code, mp).multipath_tau_s, lo=0.0,
+                                     lo_open=True, hi=1e5, unit="s"),
+            clock_ephemeris=g.string("clock_ephemeris", "current", choices=tuple(CLOCK_EPHEMERIS_M)),
         )
+        if gnss.epoch == "fixed" and g.has("epoch_window_h"):
+            raise ProfileError(f"{g.path}.epoch_window_h: only used with epoch = \"per-run\" (epoch is \"fixed\")")
     g.done()
 
     p = s.section("pseudolite")

@@ -1,8 +1,10 @@
 """The sensor suite of a profile: builds each sensor from [sensors], wraps it with its [[faults]], and draws
 each sensor's errors from its own named random stream (approachsim.seeding.stream(seed, run, name)).
 
-Streams: "imu", "baro", "radalt", "gnss", "pseudolite", and "receiver_clock" for the GPS receiver clock
-that the GNSS and pseudolite channels share. A sensor's output depends only on its own stream(s), the
+Streams: "imu", "baro", "radalt", "gnss", "pseudolite", "receiver_clock" for the GPS receiver clock
+that the GNSS and pseudolite channels share, and "gnss_epoch" for each run's constellation epoch (one uniform
+draw over [sensors.gnss] epoch_window_h when epoch = "per-run"; nothing drawn when "fixed").
+A sensor's output depends only on its own stream(s), the
 truth and its configuration, so adding or removing a sensor leaves every other sensor's output
 bit-identical (tests/unit/sensors/test_suite.py).
 
@@ -28,7 +30,7 @@ from approachsim.sensors.config import SENSOR_NAMES, SensorsConfig
 from approachsim.sensors.faults import Faulted, FaultSpec
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.constellation import Constellation
-from approachsim.sensors.gnss.receiver import CODE_PRESETS, GnssReceiver, draw_receiver_clock
+from approachsim.sensors.gnss.receiver import GnssReceiver, draw_epoch_offsets, draw_receiver_clock
 from approachsim.sensors.imu import Imu
 from approachsim.sensors.presets import PRESETS
 from approachsim.sensors.pseudolite import Pseudolite
@@ -37,6 +39,8 @@ from approachsim.sensors.radalt import RadarAltimeter
 Array = np.ndarray
 CLOCK_STREAM = "receiver_clock"
 """Random stream of the GPS receiver clock shared by the GNSS and pseudolite channels."""
+EPOCH_STREAM = "gnss_epoch"
+"""Random stream of each run's GPS constellation epoch offset."""
 
 
 def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = ()) -> dict[str, Any]:
@@ -59,7 +63,7 @@ def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterab
         g = cfg.gnss
         gnss_rate = g.rate_hz
         out["gnss"] = GnssReceiver(
-            constellation=Constellation.nominal(g.epoch_utc), budget=CODE_PRESETS[g.code],
+            constellation=Constellation.nominal(g.epoch_utc), budget=g.budget(),
             clock=ClockModel.named(g.oscillator, g.clock_bias0_sigma_m, g.clock_drift0_sigma_mps),
             mask_rad=g.mask_rad, selection=g.selection, rate_hz=g.rate_hz, doppler=g.doppler,
             doppler_noise_mps=g.doppler_noise_mps,
@@ -94,6 +98,8 @@ class SensorSuite:
     sensors: Mapping[str, Any]
     clock: ClockModel | None
     clock_rate_hz: float
+    epoch_window_s: float = 0.0
+    """Width of the GNSS per-run epoch window, s (0: every run at the receiver's epoch)."""
 
     @classmethod
     def from_config(
@@ -108,7 +114,8 @@ class SensorSuite:
             rate = cfg.gnss.rate_hz
         elif cfg.pseudolite is not None:
             clock = ClockModel()
-        return cls(sensors=MappingProxyType(dict(sensors)), clock=clock, clock_rate_hz=rate)
+        window = cfg.gnss.epoch_window() if cfg.gnss is not None else 0.0
+        return cls(sensors=MappingProxyType(dict(sensors)), clock=clock, clock_rate_hz=rate, epoch_window_s=window)
 
     @classmethod
     def from_profile(cls, profile: Any) -> SensorSuite:
@@ -119,7 +126,8 @@ class SensorSuite:
         """The same suite with sensors removed (the clock stays while a ranging sensor remains)."""
         keep = {k: v for k, v in self.sensors.items() if k not in names}
         has_ranging = "gnss" in keep or "pseudolite" in keep
-        return SensorSuite(MappingProxyType(keep), self.clock if has_ranging else None, self.clock_rate_hz)
+        return SensorSuite(MappingProxyType(keep), self.clock if has_ranging else None, self.clock_rate_hz,
+                           self.epoch_window_s)
 
     @staticmethod
     def _rng(seed: int, runs: int | Iterable[int], name: str) -> base.RngLike:
@@ -131,6 +139,9 @@ class SensorSuite:
         """Every sensor's errors on time base t_s from its own stream; runs: one run index or several."""
         runs = runs if isinstance(runs, int | np.integer) else list(runs)
         errs = {name: s.draw(t_s, self._rng(seed, runs, name)) for name, s in self.sensors.items()}
+        if "gnss" in errs and self.epoch_window_s > 0.0:
+            off = draw_epoch_offsets(self.epoch_window_s, self._rng(seed, runs, EPOCH_STREAM))
+            errs["gnss"] = replace(errs["gnss"], constants={**errs["gnss"].constants, "epoch_offset_s": off})
         clock = None
         if self.clock is not None:
             clock = draw_receiver_clock(self.clock, t_s, self.clock_rate_hz, self._rng(seed, runs, CLOCK_STREAM))
@@ -175,4 +186,4 @@ def _clock_rows(clock: base.SensorErrors, e: base.SensorErrors) -> Array:
     return pos
 
 
-__all__ = ["CLOCK_STREAM", "SENSOR_NAMES", "SensorSuite", "SuiteErrors", "build_sensors"]
+__all__ = ["CLOCK_STREAM", "EPOCH_STREAM", "SENSOR_NAMES", "SensorSuite", "SuiteErrors", "build_sensors"]

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -134,6 +135,17 @@ def test_open_loop_evaluation_end_to_end(tmp_path, capsys):
         assert 0.0 < e["lateral_1sigma_ft"] < 28.1 * np.sqrt(q999 / 2), (cat, e)
         assert 0.0 < e["vertical_1sigma_ft"] < 6.8 * np.sqrt(q999 / 2), (cat, e)
     assert s["best_category"] is None
+    # details.json: the GPS geometry each run saw at each decision height (its own epoch) and its distribution
+    g = json.loads((out / "details.json").read_text())["gnss_geometry"]
+    assert g["per_run"]["run"] == [0, 1] and all(0.0 <= h < 23.9345 for h in g["per_run"]["epoch_offset_h"])
+    assert g["per_run"]["epoch_offset_h"][0] != g["per_run"]["epoch_offset_h"][1]
+    for cat in ("CAT I", "CAT II", "CAT III"):
+        pr, dist = g["per_run"][cat], g["categories"][cat]
+        assert pr["sv_used"] == [4, 4] and all(5 <= v <= 12 for v in pr["sv_visible"]), pr  # best four of 5-12
+        for p, h, v in zip(pr["pdop"], pr["hdop"], pr["vdop"], strict=True):
+            assert 1.0 < p < 20.0 and p == pytest.approx(math.hypot(h, v), rel=1e-9)
+        assert dist["pdop"]["min"] <= dist["pdop"]["p50"] <= dist["pdop"]["max"] == max(pr["pdop"])
+        assert dist["fraction_used_lt4"] == 0.0 and dist["fraction_visible_lt5"] == 0.0
     printed = capsys.readouterr().out
     assert "best category: none" in printed and "CAT III" in printed and "indeterminate" in printed
     # the same campaign resumed (nothing rerun) as a CI gate: CAT I is not `meets` on 2 runs, so exit 1

@@ -145,3 +145,26 @@ def dops(u_los: Array, use: Array, c_ecef_to_ned: Array) -> tuple[Array, Array, 
         out[2, enough] = np.sqrt(q_ned[:, 0, 0] + q_ned[:, 1, 1])
         out[3, enough] = np.sqrt(q_ned[:, 2, 2])
     return out[0], out[1], out[2], out[3]
+
+
+def dops_ned(el_rad: Array, az_rad: Array, use: Array) -> tuple[Array, Array, Array]:
+    """PDOP, HDOP, VDOP (...,) of the channels `use` (..., k) from their elevations and azimuths (rad, local NED).
+
+    Lines of sight u = (cos el cos az, cos el sin az, -sin el); geometry rows [-u, 1] (Kaplan eq. 7.46),
+    Q = (G'G)^-1 in NED directly. inf where fewer than 4 channels are used.
+    """
+    el = np.nan_to_num(np.asarray(el_rad, dtype=float))
+    az = np.nan_to_num(np.asarray(az_rad, dtype=float))
+    u = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)], axis=-1)
+    g = np.concatenate([-u, np.ones(u.shape[:-1] + (1,))], axis=-1) * np.asarray(use)[..., None]
+    a = np.einsum("...ki,...kj->...ij", g, g)
+    shape = a.shape[:-2]
+    a = a.reshape((-1, 4, 4))
+    enough = (np.asarray(use).sum(axis=-1) >= 4).reshape(-1)
+    out = np.full((3, a.shape[0]), np.inf)
+    if np.any(enough):
+        q = np.linalg.inv(a[enough])
+        out[0, enough] = np.sqrt(q[:, 0, 0] + q[:, 1, 1] + q[:, 2, 2])
+        out[1, enough] = np.sqrt(q[:, 0, 0] + q[:, 1, 1])
+        out[2, enough] = np.sqrt(q[:, 2, 2])
+    return out[0].reshape(shape), out[1].reshape(shape), out[2].reshape(shape)

@@ -16,6 +16,28 @@ Presets (1-sigma, m; NRC 1995 Table C-1 [S11]):
   C/A (SPS, SA off): clock/ephemeris 3.6, multipath 1.2, noise 0.6, atmospheric 7.0 as iono zenith 4.0
         (7.0 m slant at 30 deg, F = 1.75) and tropo zenith 0.2; UERE 8.0 m.
 
+Selectable on top of a preset (make_budget; the profile's [sensors.gnss] multipath_model and clock_ephemeris):
+  multipath "nrc1995": the preset's elevation-independent Gauss-Markov (1.8 m P(Y), 60 s);
+            "do253":   the RTCA DO-253 / DO-229 airframe multipath curve sigma_mp(el) = 0.13 + 0.53 exp(-el / 10 deg)
+            m (Stanford MAAST init_cnmp_mops.m, A0 = 0.13 m, A1 = 0.53 m, theta0 = 10 deg; reference
+            integrity-envelope.md 8), a unit Gauss-Markov scaled by sigma_mp at each channel's elevation. Its
+            correlation time defaults to 100 s: the curve bounds the multipath left in the 100 s carrier-smoothed
+            code of DO-253 / DO-229 airborne receivers, and the smoothing filter, not the few seconds in which raw
+            airframe multipath decorrelates on a moving aircraft, sets the correlation of that residual
+            (multipath_tau_s; a shorter time lets the navigation filter average it down faster).
+            The AAD-B receiver-noise curve 0.11 + 0.13 exp(-el / 4 deg) is not adopted: it describes smoothed code
+            noise correlated over the same 100 s, whereas the code noise here is the preset's white raw-code noise.
+  clock/ephemeris "nrc1995": the preset's 3.6 m (1995 constellation);
+            "current": 2.4 m, the GPS URE (accuracy / continuity sigma) of the draft ICAO Annex 10 default ARAIM
+            integrity support data, June 2024, as set in Stanford's MAAST for ARAIM (main_maast_araim.m,
+            isd.ure_gps = 2.4 m, Blanch et al.); a conservative modern figure: the measured GPS signal-in-space
+            URE RMS of recent years is lower still (Renfro et al., "An Analysis of Global Positioning System
+            (GPS) Standard Positioning Service Performance for 2019", ARL:UT TR-SGL-20-02, 2020).
+
+Epoch: every run's sky is the constellation at epoch_utc + its own offset (errors.constants["epoch_offset_s"],
+drawn by the sensor suite from the run's "gnss_epoch" stream); a batch of runs with offsets gives per-run geometry
+(r_sv_ecef, elevation, azimuth, visible, valid, sigma, pdop with a leading run axis). No offset: one sky.
+
 Satellite positions are those at the receive time (no light-time or Sagnac terms): the record carries them,
 so a navigation filter that uses the record's r_sv_ecef sees exactly the modelled geometry.
 Pseudorange rate (optional, doppler=True): rho_dot_i = u_i . (v_sv,i - v_rx) + d_rx + e_i, the geometric
@@ -33,7 +55,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import ClassVar
 
@@ -46,6 +68,15 @@ from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
 
 Array = np.ndarray
+
+MULTIPATH_MODELS = ("do253", "nrc1995")
+"""Multipath models (module docstring)."""
+CLOCK_EPHEMERIS_M: Mapping[str, float] = MappingProxyType({"current": 2.4, "nrc1995": 3.6})
+"""Satellite clock + ephemeris 1-sigma (m) by budget name (module docstring gives the sources)."""
+DO253_MULTIPATH_TAU_S = 100.0
+"""Default correlation time of the DO-253 multipath, s: the 100 s carrier-smoothing time constant (docstring)."""
+SIDEREAL_DAY_S = 86164.0905
+"""Mean sidereal day, s (23.934 h): the GPS ground tracks repeat about once per sidereal day."""
 
 SELECTIONS = ("best4", "best4-fixed", "all")
 """Satellite selection. best4: the best-PDOP four at every epoch. best4-fixed: seed 002's one planned set for
@@ -69,6 +100,41 @@ class GnssErrorBudget:
     iono_tau_s: float = 1800.0
     tropo_tau_s: float = 3600.0
     multipath_tau_s: float = 60.0
+    multipath_model: str = "nrc1995"
+    """"nrc1995": multipath_m at every elevation; "do253": sigma_mp(el) (multipath_m unused)."""
+
+    def multipath_sigma_m(self, el_rad: Array) -> Array:
+        """1-sigma multipath (m) at elevation el_rad (rad) of this budget's model."""
+        if self.multipath_model == "do253":
+            return do253_multipath_sigma_m(el_rad)
+        return np.full(np.shape(el_rad), self.multipath_m)
+
+
+def do253_multipath_sigma_m(el_rad: Array) -> Array:
+    """Airframe multipath 1-sigma (m): 0.13 + 0.53 exp(-el / 10 deg) (RTCA DO-253 / DO-229; MAAST init_cnmp_mops)."""
+    return 0.13 + 0.53 * np.exp(-np.degrees(np.asarray(el_rad, dtype=float)) / 10.0)
+
+
+def make_budget(code: str, multipath_model: str = "nrc1995", clock_ephemeris: str = "nrc1995",
+                multipath_tau_s: float | None = None) -> GnssErrorBudget:
+    """The code preset with the chosen multipath model and clock/ephemeris budget (module docstring); tau None:
+    the model's default (preset 60 s for nrc1995, DO253_MULTIPATH_TAU_S for do253)."""
+    if multipath_model not in MULTIPATH_MODELS:
+        raise ValueError(f"multipath_model must be one of {', '.join(MULTIPATH_MODELS)}; got {multipath_model!r}")
+    if clock_ephemeris not in CLOCK_EPHEMERIS_M:
+        raise ValueError(f"clock_ephemeris must be one of {', '.join(CLOCK_EPHEMERIS_M)}; got {clock_ephemeris!r}")
+    b = CODE_PRESETS[code]
+    if multipath_tau_s is None:
+        multipath_tau_s = DO253_MULTIPATH_TAU_S if multipath_model == "do253" else b.multipath_tau_s
+    return replace(b, multipath_model=multipath_model, clock_ephemeris_m=CLOCK_EPHEMERIS_M[clock_ephemeris],
+                   multipath_tau_s=multipath_tau_s)
+
+
+def draw_epoch_offsets(window_s: float, rng: base.RngLike) -> Array:
+    """Per-run epoch offsets (s), uniform on [0, window_s): one draw from each run's own generator."""
+    if base.is_batched(rng):
+        return np.array([g.uniform(0.0, window_s) for g in rng])  # type: ignore[union-attr]
+    return np.array(rng.uniform(0.0, window_s))  # type: ignore[union-attr]
 
 
 CODE_PRESETS: Mapping[str, GnssErrorBudget] = MappingProxyType({
@@ -144,9 +210,12 @@ class GnssReceiver:
             raise ValueError(f"selection must be one of {', '.join(SELECTIONS)}; got {self.selection!r}")
 
     def draw(self, t_s: Array, rng: base.RngLike) -> base.SensorErrors:
-        """series (m, 24) m: clock_ephemeris, iono_zenith, tropo_zenith, multipath, noise (+ rate_noise m/s)."""
+        """series (m, 24) m: clock_ephemeris, iono_zenith, tropo_zenith, multipath, noise (+ rate_noise m/s);
+        multipath is unit-sigma under the do253 model (apply scales it by sigma_mp at the channel's elevation)."""
         b = self.budget
         k = self.constellation.prn.shape[0]
+
+        mp_sigma = 1.0 if b.multipath_model == "do253" else b.multipath_m  # do253: scaled by sigma_mp(el) in apply
 
         def one(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
             z = g.standard_normal((m, (6 if self.doppler else 5) * k))
@@ -155,7 +224,7 @@ class GnssReceiver:
                 "clock_ephemeris": base.gauss_markov(z[:, 0:k], b.clock_ephemeris_m, b.clock_ephemeris_tau_s, dt),
                 "iono_zenith": base.gauss_markov(z[:, k : 2 * k], b.iono_zenith_m, b.iono_tau_s, dt),
                 "tropo_zenith": base.gauss_markov(z[:, 2 * k : 3 * k], b.tropo_zenith_m, b.tropo_tau_s, dt),
-                "multipath": base.gauss_markov(z[:, 3 * k : 4 * k], b.multipath_m, b.multipath_tau_s, dt),
+                "multipath": base.gauss_markov(z[:, 3 * k : 4 * k], mp_sigma, b.multipath_tau_s, dt),
                 "noise": b.code_noise_m * z[:, 4 * k : 5 * k],
             }
 
@@ -165,10 +234,14 @@ class GnssReceiver:
         """The receiver clock at this receiver's samples: series bias (m,) m and drift (m,) m/s."""
         return draw_receiver_clock(self.clock, t_s, self.rate_hz, rng)
 
-    def geometry(self, truth: Truth, rows: Array, t_s: Array) -> dict[str, Array]:
-        """Satellite positions, ranges, lines of sight, look angles, visibility, selection and DOPs."""
+    def geometry(self, truth: Truth, rows: Array, t_s: Array, epoch_offset_s: float = 0.0) -> dict[str, Array]:
+        """Satellite positions, ranges, lines of sight, look angles, visibility, selection and DOPs, with the
+        constellation epoch_offset_s (s) after the receiver's epoch (the run's own sky)."""
+        const = self.constellation
+        if epoch_offset_s != 0.0:
+            const = replace(const, epoch_s=const.epoch_s + float(epoch_offset_s))
         r_rx = truth.r_ecef[rows]
-        r_sv = self.constellation.positions_ecef(t_s)
+        r_sv = const.positions_ecef(t_s)
         rng_m, u, el, az = look_angles(r_rx, r_sv)
         visible = el >= self.mask_rad
         lat, lon, _ = geo.ecef_to_geodetic(r_rx)
@@ -180,7 +253,7 @@ class GnssReceiver:
         else:  # best4-fixed: planned at the run start (truth row 0) for the next fixed_hold_s
             t_plan = truth.t_s[0] + np.arange(0.0, self.fixed_hold_s + 1.0, 60.0)
             r0 = np.repeat(truth.r_ecef[:1], t_plan.shape[0], axis=0)
-            _, u0, el0, _ = look_angles(r0, self.constellation.positions_ecef(t_plan))
+            _, u0, el0, _ = look_angles(r0, const.positions_ecef(t_plan))
             stays = np.all(el0 >= self.mask_rad, axis=0, keepdims=True)
             first = best_pdop_four(u0[:1], stays)[0]
             keep = np.all(visible[:, first], axis=1)
@@ -188,27 +261,41 @@ class GnssReceiver:
             if not np.all(keep):
                 sel[~keep] = best_pdop_four(u[~keep], visible[~keep])
         _, pdop, _, _ = dops(u, sel, c_ned)
-        return {"r_sv": r_sv, "range": rng_m, "u": u, "el": el, "az": az, "visible": visible, "sel": sel,
-                "pdop": pdop}
+        out = {"r_sv": r_sv, "range": rng_m, "u": u, "el": el, "az": az, "visible": visible, "sel": sel,
+               "pdop": pdop}
+        if self.doppler:
+            out["v_sv"] = const.velocities_ecef(t_s)
+        return out
+
+    def geometries(self, truth: Truth, errors: base.SensorErrors) -> dict[str, Array]:
+        """geometry() at the samples of `errors`: one sky without an epoch offset; with per-run offsets
+        (constants["epoch_offset_s"], (runs,)) each run's own, stacked on a leading run axis."""
+        off = errors.constants.get("epoch_offset_s")
+        if off is None or np.ndim(off) == 0:
+            return self.geometry(truth, errors.rows, errors.t_s, 0.0 if off is None else float(off))
+        per = [self.geometry(truth, errors.rows, errors.t_s, float(o)) for o in np.asarray(off)]
+        return {k: np.stack([g[k] for g in per]) for k in per[0]}
 
     def sigma_m(self, el_rad: Array) -> Array:
         """Nominal 1-sigma pseudorange error at elevation el (m): RSS of the budget with its mappings."""
         b = self.budget
         return np.sqrt(
             b.clock_ephemeris_m**2 + (b.iono_zenith_m * iono_obliquity(el_rad)) ** 2
-            + (b.tropo_zenith_m * tropo_mapping(el_rad)) ** 2 + b.multipath_m**2 + b.code_noise_m**2
+            + (b.tropo_zenith_m * tropo_mapping(el_rad)) ** 2 + b.multipath_sigma_m(el_rad) ** 2
+            + b.code_noise_m**2
         )
 
     def apply(
         self, truth: Truth, errors: base.SensorErrors, clock: base.SensorErrors | None = None
     ) -> GnssSamples:
         """Pseudoranges at the truth rows of `errors`; `clock` from draw_clock (None: a zero receiver clock)."""
-        geo_ = self.geometry(truth, errors.rows, errors.t_s)
+        geo_ = self.geometries(truth, errors)
         s = errors.series
         el = geo_["el"]
+        mp = s["multipath"] * do253_multipath_sigma_m(el) if self.budget.multipath_model == "do253" else s["multipath"]
         pr = (
             geo_["range"] + s["clock_ephemeris"] + iono_obliquity(el) * s["iono_zenith"]
-            + tropo_mapping(el) * s["tropo_zenith"] + s["multipath"] + s["noise"]
+            + tropo_mapping(el) * s["tropo_zenith"] + mp + s["noise"]
         )
         shape_t = pr.shape[:-1]
         if clock is None:
@@ -224,8 +311,7 @@ class GnssReceiver:
             r = errors.rows
             lat, lon = truth.lat_rad[r], truth.lon_rad[r]
             v_rx = np.einsum("nji,nj->ni", geo.c_ecef_to_ned(lat, lon), truth.v_ned[r])  # NED -> ECEF
-            v_sv = self.constellation.velocities_ecef(errors.t_s)
-            rr = np.einsum("nki,nki->nk", geo_["u"], v_sv - v_rx[:, None, :])
+            rr = np.einsum("...ki,...ki->...k", geo_["u"], geo_["v_sv"] - v_rx[:, None, :])
             cd_ = np.zeros(shape_t) if clock is None else np.broadcast_to(clock.series["drift"], shape_t)
             prr = np.where(valid, rr + cd_[..., None] + s["rate_noise"], np.nan)
         return GnssSamples(
@@ -233,7 +319,7 @@ class GnssReceiver:
             pseudorange_m=np.where(valid, pr, np.nan), sigma_m=self.sigma_m(el), elevation_rad=el,
             azimuth_rad=geo_["az"], visible=geo_["visible"], valid=valid, pdop=geo_["pdop"],
             clock_bias_m=np.array(cb), clock_drift_mps=np.array(cd), fault=np.zeros(pr.shape, dtype=np.int8),
-            pseudorange_rate_mps=prr,
+            pseudorange_rate_mps=prr, epoch_offset_s=errors.constants.get("epoch_offset_s"),
         )
 
     def measure(

@@ -29,9 +29,14 @@ def _truth(duration_s: float):
                                        ground_speed_mps=70.0)
 
 
-def _records(truth, runs: list[int]):
+def _with_epoch(prof, epoch: str):
+    """The profile with [sensors.gnss] epoch = `epoch` ("fixed": one sky for all runs; "per-run": each its own)."""
+    return replace(prof, sensors=replace(prof.sensors, gnss=replace(prof.sensors.gnss, epoch=epoch)))
+
+
+def _records(truth, runs: list[int], prof=PROFILE):
     """Sensor records of `runs`; run 1 loses its baro from 5 s on (its schedule departs from the others')."""
-    recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=7, runs=runs)
+    recs = SensorSuite.from_profile(prof).measure(truth, seed=7, runs=runs)
     b = recs["baro"]
     valid = np.array(b.valid, copy=True)
     if 1 in runs:
@@ -39,14 +44,17 @@ def _records(truth, runs: list[int]):
     return {**recs, "baro": replace(b, valid=valid)}
 
 
-def test_shared_runs_bit_identical_in_any_batch_also_with_a_departing_schedule():
+@pytest.mark.parametrize("epoch", ["fixed", "per-run"])
+def test_shared_runs_bit_identical_in_any_batch_also_with_a_departing_schedule(epoch):
+    prof = _with_epoch(PROFILE, epoch)
     truth = _truth(12.0)
-    recs = _records(truth, [0, 1, 2])
-    nav = NavSystem.from_profile(PROFILE)
+    recs = _records(truth, [0, 1, 2], prof)
+    assert recs["gnss"].per_run_sky == (epoch == "per-run")
+    nav = NavSystem.from_profile(prof)
     assert nav.shares_covariance()
     batch = nav.run(truth, recs, [stream(7, r, "nav") for r in range(3)], shared_covariance=True)
     for k in range(3):
-        alone = nav.run(truth, _records(truth, [k]), [stream(7, k, "nav")], shared_covariance=True)[0]
+        alone = nav.run(truth, _records(truth, [k], prof), [stream(7, k, "nav")], shared_covariance=True)[0]
         np.testing.assert_array_equal(batch[k].x, alone.x)
         np.testing.assert_array_equal(batch[k].P_diag, alone.P_diag)
         np.testing.assert_array_equal(batch[k].solution.r_ecef, alone.solution.r_ecef)
@@ -55,12 +63,15 @@ def test_shared_runs_bit_identical_in_any_batch_also_with_a_departing_schedule()
     assert n_baro[1] < n_baro[0] == n_baro[2]
     iz = batch[0].layout.i("dp", 2)
     assert batch[1].P_diag[-1, iz] > batch[0].P_diag[-1, iz]
-    np.testing.assert_array_equal(batch[0].P_diag, batch[2].P_diag)  # same schedule: one covariance
+    if epoch == "fixed":
+        np.testing.assert_array_equal(batch[0].P_diag, batch[2].P_diag)  # same schedule and sky: one covariance
+    else:  # the same schedule but each run its own sky: its own covariance (the GPS channels' geometry differs)
+        assert not np.array_equal(batch[0].P_diag, batch[2].P_diag)
 
 
 @pytest.mark.parametrize("path", [PROFILES / "default.toml", PROFILES / "gray-maybeck.toml"])  # GPS; + pseudolite
 def test_shared_matches_per_run_filters_to_a_small_fraction_of_sigma(path):
-    prof = load_profile(path)
+    prof = load_profile(path)  # default: per-run skies (one class per run); Gray & Maybeck: one fixed sky
     truth = _truth(20.0)
     recs = SensorSuite.from_profile(prof).measure(truth, seed=6, runs=[0, 1, 2])
     if prof.runway.frame.threshold_h_m > 100.0:
