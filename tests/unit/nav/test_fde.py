@@ -211,8 +211,8 @@ def test_rollback_gives_the_filter_that_dropped_the_channel(truths, feedback):
 
 
 def test_alert_when_too_few_ranging_sources_are_left(truths):
-    """Best-four selection: excluding one satellite leaves three ranging sources, no position-and-clock fix
-    to check the INS against: the alert is raised from the exclusion on."""
+    """Best-four selection, CAT I (available fault-free): excluding one satellite leaves three ranging sources,
+    no position-and-clock fix to check the INS against: the alert is raised from the exclusion on."""
     prof = _profile(selection="best4-fixed", category="CAT I")
     truth = truths[5.0]
     recs = SensorSuite.from_profile(prof).measure(truth, seed=1, runs=0)
@@ -227,6 +227,7 @@ def test_alert_when_too_few_ranging_sources_are_left(truths):
     assert [e.channel for e in ev] == [int(used[0])]
     t = run.solution.t_s
     assert run.solution.alert[t >= ev[0].t_s].all()
+    assert not run.solution.alert[t < ev[0].t_s].any()  # CAT I: available before (PL < AL)
 
 
 @pytest.mark.parametrize("table, message", [
