@@ -1,8 +1,9 @@
 """Online FDE inside NavSystem (nav/fde.py) on the synthetic glidepath (all-in-view P(Y) GPS, baro, radar
 altimeter, tight coupling): fault-free it changes nothing and its false alerts stay within the allocation;
-GNSS steps and ramps, a baro step and a radar-altimeter bias are detected, the right source excluded before the
-unprotected error would leave the protection level, and the protected error stays inside it; the rollback
-gives the filter that stopped using the source `rollback_epochs` before the detection; parsing errors."""
+GNSS steps and ramps, a pseudolite step, a baro step and a radar-altimeter bias are detected, the right source
+excluded before the unprotected error would leave the protection level, and the protected error stays inside
+it; the rollback gives the filter that stopped using the source `rollback_epochs` before the detection;
+parsing errors."""
 
 from __future__ import annotations
 
@@ -30,8 +31,11 @@ ONSET_S = 30.0
 TTA_S = REQUIREMENTS["CAT II"].time_to_alert_s
 
 
-def _profile(faults=(), *, fde=True, nmi=5.0, selection="all", feedback=False, **fde_kw):
+def _profile(faults=(), *, fde=True, nmi=5.0, selection="all", feedback=False, pseudolite=False, **fde_kw):
     d = tomllib.loads(DEFAULT.read_text(encoding="utf-8"))
+    if pseudolite:  # one unit near the threshold (the default profile's commented example)
+        d["sensors"]["pseudolite"] = {"enabled": True, "synchronized": True,
+                                      "units": [{"along_ft": 0.0, "cross_ft": -500.0, "height_ft": 30.0}]}
     d["sensors"]["gnss"]["selection"] = selection
     d["runway"]["start_distance_nmi"] = nmi
     d["nav"]["feedback"] = feedback
@@ -181,6 +185,13 @@ def test_radalt_bias_excluded(truths, magnitude_m):
     c = _case(truths, [{"sensor": "radalt", "kind": "cbm", "start_s": ONSET_S, "magnitude": magnitude_m}])
     _check_excluded(c, "radalt")
     assert np.isfinite(c.t_exceed)  # unprotected, the bias would have become misleading
+
+
+def test_pseudolite_step_excluded(truths):
+    c = _case(truths, [{"sensor": "pseudolite", "kind": "step", "channel": 0, "start_s": ONSET_S,
+                        "magnitude": 10.0}], pseudolite=True)
+    t_x = _check_excluded(c, "pl0")
+    assert t_x - ONSET_S <= TTA_S
 
 
 @pytest.mark.parametrize("feedback", [False, True])
