@@ -99,6 +99,34 @@ class NavSolution:
     """(n,) estimated GPS receiver clock bias, m (nan where there is no GPS clock state)."""
     clock_bias_sigma_m: Array
     """(n,) its claimed 1-sigma, m (nan where none)."""
+    alert: Array | None = None
+    """(n,) bool, online FDE ([nav.fde] enabled; None when off): the solution cannot be protected (its
+    protection level reaches the alert limit, too few ranging sources left, or a fault nothing is left to
+    exclude)."""
+    flagged: Array | None = None
+    """(n,) bool, online FDE: a source has been excluded (the solution runs on fewer measurements)."""
+    protection_level_m: Array | None = None
+    """(n, 2) online FDE: the filter's (vertical, lateral) protection level at the latest epoch, m (nan before
+    the first)."""
+    exclusions: tuple[ExclusionEvent, ...] = ()
+    """Online FDE: every exclusion, in time order."""
+
+
+@dataclass(frozen=True)
+class ExclusionEvent:
+    """One online FDE exclusion (nav/fde.py): when, what, by which test and how far over its threshold."""
+
+    t_s: float
+    """Epoch of the detection, s since the run start."""
+    source: str
+    """Excluded source: "baro", "radalt", "gps07" (GNSS channel 7 of the constellation), "pl0", "gnss" (a
+    loosely coupled fix)."""
+    channel: int
+    """GNSS channel / pseudolite unit index (-1 for baro, radar altimeter, a loose fix)."""
+    test: str
+    """"chi2" (the epoch's residual test) or "sum" (the moving sum of the w-test)."""
+    statistic: float
+    threshold: float
 
 
 class NavigationSource(Protocol):

@@ -204,6 +204,7 @@ class NavInTheLoop:
             P_pos_ned=PP[:, 0:3, 0:3][snap],
             clock_bias_m=clk,
             clock_bias_sigma_m=clk_sd,
+            **(self.runs[0].fde.solution_fields(snap) if self.runs[0].fde is not None else {}),
         )
         e = self.epochs
         return NavRun(

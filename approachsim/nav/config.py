@@ -15,6 +15,11 @@
     velocity_mps = 0.05
     tilt_mrad = 0.05
     heading_mrad = 0.5
+    [nav.fde]                      # online fault detection and exclusion (nav/fde.py), off by default
+    enabled = false
+    category = "CAT II"            # whose continuity budget sets the false-alert allocation
+    window = 20                    # epochs of the w-test moving sum (gradual failures)
+    rollback_epochs = 30           # epochs re-run without the excluded source after an exclusion
 
 A bad key or value raises ProfileError naming the field; an unknown filter fails here, at load.
 """
@@ -25,8 +30,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from approachsim.config import ProfileError, Section
+from approachsim.integrity.requirements import REQUIREMENTS
 from approachsim.nav import registry
 from approachsim.nav import vertical_loop as vl
+from approachsim.nav.fde import FdeConfig
 
 LOOP_FORMS = ("none",) + tuple(vl.GAIN_FORMS)
 
@@ -56,6 +63,7 @@ class NavConfig:
     baro_loop_tau_s: float = 100.0
     baro_loop_b_per_m: float = 0.5
     initial_error: InitialError = field(default_factory=InitialError)
+    fde: FdeConfig = field(default_factory=FdeConfig)
 
     def make_filter(self) -> Any:
         """The filter object named by `filter`, with its tuning."""
@@ -97,11 +105,19 @@ def parse_nav(s: Section) -> NavConfig:
         heading_rad=ie.number("heading_mrad", 0.5, lo=0.0, hi=1000.0, unit="mrad") * 1e-3,
     )
     ie.done()
+    fs = s.section("fde")
+    fde = FdeConfig(
+        enabled=fs.boolean("enabled", False),
+        category=fs.string("category", "CAT II", choices=tuple(REQUIREMENTS)),
+        window=fs.integer("window", 20, lo=1, hi=600),
+        rollback_epochs=fs.integer("rollback_epochs", 30, lo=0, hi=600),
+    )
+    fs.done()
     s.done()
     cfg = NavConfig(
         filter=name, filter_tuning=tuple(sorted(tuning.items())), aiding_rate_hz=rate, feedback=feedback,
         gps_coupling=coupling, channel_states=channel, baro_loop=loop, baro_loop_tau_s=tau,
-        baro_loop_b_per_m=b, initial_error=init,
+        baro_loop_b_per_m=b, initial_error=init, fde=fde,
     )
     try:
         cfg.make_filter()  # unknown filter or bad tuning fails at load, not an hour into a campaign

@@ -32,6 +32,7 @@ from approachsim.nav import measurements as meas
 from approachsim.nav import vertical_loop as vl
 from approachsim.nav.base import FilterState, NavFilter, UpdateStatus
 from approachsim.nav.config import DEFAULT_NAV, NavConfig
+from approachsim.nav.fde import RESET_GROUPS, FdeState
 from approachsim.records import NavSolution, Truth
 from approachsim.sensors.config import DEFAULT_SENSORS, SensorsConfig
 from approachsim.sensors.gnss.clock import ClockModel
@@ -97,6 +98,8 @@ class _Run:
     statuses: list
     bg_fb: Array
     ba_fb: Array
+    fde: FdeState | None = None
+    """Online fault detection and exclusion ([nav.fde] enabled), else None."""
 
 
 @dataclass
@@ -295,8 +298,17 @@ class NavSystem:
         sd = np.sqrt(np.diag(P0)[:9])
         e = np.stack([sd * g.standard_normal(9) for g in rngs])  # INS errors after alignment + cruise
         s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
-        runs = [_Run(self.filter.init(np.zeros(self.layout.n), P0), [], np.zeros(3), np.zeros(3)) for _ in rngs]
+        runs = [_Run(self.filter.init(np.zeros(self.layout.n), P0), [], np.zeros(3), np.zeros(3), self._fde())
+                for _ in rngs]
         return s, runs
+
+    def _fde(self) -> FdeState | None:
+        """A run's online FDE state ([nav.fde] enabled), else None."""
+        if not self.nav.fde.enabled:
+            return None
+        reset = (np.concatenate([np.atleast_1d(np.arange(self.layout.n)[self.layout.index[g]]) for g in RESET_GROUPS])
+                 if self.nav.feedback else None)
+        return FdeState(self.nav.fde, self.nav.aiding_rate_hz, reset, self.runway.heading_rad)
 
     def loop_slopes(self, fs: FilterState, h_m: float, noise: em.ErrorNoise) -> vl.LoopGains | None:
         """The damping loop as the error model sees it: constant gains as they are; for the adaptive tanh /
@@ -356,6 +368,12 @@ class NavSystem:
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
                                 noise, gains)
             phi, qd = em.discretize(F, Qc, dt_epoch)
+            if run.fde is not None:  # predict, test, exclude, update (nav/fde.py)
+                run.fs, sts = run.fde.epoch(self.filter, run.fs, phi, qd,
+                                            self._measurements(s, i, r_ins[i], run.fs, obs, t), t,
+                                            self.runway.from_ecef(r_ins[i]))
+                run.statuses.extend(sts)
+                continue
             fs = self.filter.predict(run.fs, phi, qd)
             for m in self._measurements(s, i, r_ins[i], fs, obs, t):
                 fs, st = self.filter.update(fs, m(fs.x))
@@ -371,7 +389,7 @@ class NavSystem:
         loop the error model sees with constant gains (the adaptive forms linearize about each run's
         estimate). Decided from the configuration alone, so a campaign picks it once per profile."""
         g = self.loop_gains()
-        return (self.nav.filter == "ekf" and self.nav.gps_coupling == "tight"
+        return (self.nav.filter == "ekf" and self.nav.gps_coupling == "tight" and not self.nav.fde.enabled
                 and (g is None or g.form == "constant"))
 
     def aid_shared(
@@ -738,6 +756,7 @@ class NavSystem:
                 P_pos_ned=p_pos,
                 clock_bias_m=xi[:, ic] if has_clk else np.full(n_out, np.nan),
                 clock_bias_sigma_m=clk_sd,
+                **(r.fde.solution_fields(snap) if r.fde is not None else {}),
             )
             results.append(NavRun(
                 solution=sol, status=StatusLog.from_records(r.statuses), t_epoch_s=np.array(t_ep),
