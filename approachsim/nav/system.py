@@ -27,7 +27,7 @@ import numpy as np
 
 from approachsim import geo
 from approachsim.nav import errormodel as em
-from approachsim.nav import ins
+from approachsim.nav import initial, ins
 from approachsim.nav import measurements as meas
 from approachsim.nav import vertical_loop as vl
 from approachsim.nav.base import FilterState, NavFilter, UpdateStatus
@@ -37,6 +37,7 @@ from approachsim.sensors.config import DEFAULT_SENSORS, SensorsConfig
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.receiver import CODE_PRESETS, iono_obliquity, tropo_mapping
 from approachsim.sensors.presets import PRESETS
+from approachsim.sensors.states import SensorStates
 
 Array = np.ndarray
 
@@ -276,18 +277,36 @@ class NavSystem:
     # --- one pass ------------------------------------------------------------------------------------------
 
     def start(self, truth: Truth, rngs: list[np.random.Generator], row: int = 0,
-              elevation_rad: Array | None = None) -> tuple[ins.InsState, list[_Run]]:
-        """INS states of len(rngs) runs at truth row `row` with initial errors drawn from P0, and their filters
-        (elevation_rad: the GPS channels' elevations at the start, for their P0)."""
+              elevation_rad: Array | None = None, *, obs: Mapping[str, Any] | None = None,
+              states: SensorStates | None = None) -> tuple[ins.InsState, list[_Run]]:
+        """INS states of len(rngs) runs at truth row `row` with their initial errors, and their filters
+        (elevation_rad: the GPS channels' elevations at the start, for their P0).
+
+        [nav.initial_error] start = "prior": INS errors drawn from P0's navigation block, zero estimates, P0.
+        "converged" (nav/initial.py): obs, the observations at the row (`observations`, run axis first; the
+        first run's schedule is flown), and states, the runs' realized sensor errors there
+        (sensors/states.py), are required; all runs start with the same converged covariance."""
         n = len(rngs)
         c_true = ins.cbn_from_quaternion(truth.q_nb[row])
         s = ins.init_state(np.full(n, truth.lat_rad[row]), truth.lon_rad[row], truth.h_m[row], truth.v_ned[row],
                            c_true)
         P0 = self.initial_covariance(elevation_rad)
-        sd = np.sqrt(np.diag(P0)[:9])
-        e = np.stack([sd * g.standard_normal(9) for g in rngs])  # INS errors after alignment + cruise
+        if self.nav.initial_error.start == "prior":
+            sd = np.sqrt(np.diag(P0)[:9])
+            e = np.stack([sd * g.standard_normal(9) for g in rngs])  # INS errors after alignment + cruise
+            s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
+            runs = [_Run(self.filter.init(np.zeros(self.layout.n), P0), [], np.zeros(3), np.zeros(3))
+                    for _ in rngs]
+            return s, runs
+        if obs is None or states is None:
+            raise ValueError("the converged start ([nav.initial_error] start = 'converged') needs the "
+                             "observations and the realized sensor states at the start row "
+                             "(SensorSuite.draw + sensors.states.start_states)")
+        e, x_hat, P_conv = initial.draw(self, truth, dict(obs), states, list(rngs), row, P0)
         s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
-        runs = [_Run(self.filter.init(np.zeros(self.layout.n), P0), [], np.zeros(3), np.zeros(3)) for _ in rngs]
+        if self.layout.has("ac"):
+            s = replace(s, a_comp_mps2=e[:, self.layout.i("ac")])  # ac error = the INS compensator (truth 0)
+        runs = [_Run(self.filter.init(x_hat[i], P_conv), [], np.zeros(3), np.zeros(3)) for i in range(n)]
         return s, runs
 
     def loop_slopes(self, fs: FilterState, h_m: float, noise: em.ErrorNoise) -> vl.LoopGains | None:
@@ -586,13 +605,14 @@ class NavSystem:
         return obs
 
     def run(self, truth: Truth, records: Mapping[str, Any], rngs: np.random.Generator | list[np.random.Generator],
-            *, shared_covariance: bool = False) -> NavRun | list[NavRun]:
+            *, shared_covariance: bool = False, states: SensorStates | None = None) -> NavRun | list[NavRun]:
         """Navigate over whole records (open loop: the truth is only read at row 0 and for the error history).
 
         records: {"imu": ImuSamples, "baro": ..., ...} of one run (rngs a Generator) or of len(rngs) runs
         (run axis first, rngs a list). Returns one NavRun, or a list. shared_covariance (several runs, optimal
         'ekf' only): one covariance and gain for all runs at each epoch (`aid_shared`), several times faster;
-        epochs where the runs' measurement sets differ fall back to per-run filtering.
+        epochs where the runs' measurement sets differ fall back to per-run filtering. states: the runs'
+        realized sensor errors at truth row 0 (sensors.states.start_states), needed by the converged start.
         """
         if shared_covariance and not self.shares_covariance():
             raise ValueError("shared_covariance needs the optimal 'ekf' filter (robust filters gate per run), "
@@ -607,7 +627,9 @@ class NavSystem:
         rate = 1.0 / dt
         epoch_rows = max(1, int(round(rate / self.nav.aiding_rate_hz)))
         gnss = records.get("gnss")
-        s, runs = self.start(truth, gens, elevation_rad=None if gnss is None else gnss.elevation_rad[0])
+        obs0 = self.observations(records, float(truth.t_s[0]), 0.25 * dt, batched)
+        s, runs = self.start(truth, gens, elevation_rad=None if gnss is None else gnss.elevation_rad[0], obs=obs0,
+                             states=states)
         n_runs = len(gens)
         cov = None
         if shared_covariance:  # the reference trajectory (truth) and its specific force in NED, per row
