@@ -142,7 +142,7 @@ def condition(P_conv: Array, Pi_ss: Array, s: Array, x_s: Array, z: Array) -> tu
             w = np.sqrt(np.maximum(lam, 1.0))
             Pi = (V * w[None, :]) @ (V * w[None, :]).T / (d[:, None] * d[None, :])
         G = np.linalg.solve(Pi, P_conv[s, :]).T  # P_conv[:, s] Pi^-1  (n, s)
-        mean = x_s @ G.T
+        mean = np.stack([G @ xi for xi in x_s]) if len(x_s) else np.zeros((0, n))  # row by row (below)
         C = P_conv - G @ P_conv[s, :]
     C = 0.5 * (C + C.T)
     w, V = np.linalg.eigh(C)
@@ -150,7 +150,9 @@ def condition(P_conv: Array, Pi_ss: Array, s: Array, x_s: Array, z: Array) -> tu
     if w.min() < -1e-9 * scale:
         raise ValueError(f"converged start: conditional covariance not positive ({w.min():.3g})")
     L = V * np.sqrt(np.clip(w, 0.0, None))[None, :]
-    return mean + z @ L.T, excess
+    # one matrix-vector product per run: a run's draw must not depend on the batch it shares (no
+    # batch-size-dependent BLAS path; the campaign relies on it)
+    return mean + np.stack([L @ zi for zi in z]).reshape(mean.shape), excess
 
 
 def draw(system: Any, truth: Any, obs: dict[str, Any], states: SensorStates, rngs: list[np.random.Generator],
