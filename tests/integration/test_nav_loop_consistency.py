@@ -16,6 +16,7 @@ from approachsim import synthetic
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream
+from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"
@@ -39,9 +40,9 @@ def test_filter_with_damping_loop_is_consistent(form):
     prof = load_profile(PROFILES / "default.toml")
     truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 90.0,
                                         ground_speed_mps=70.0)
-    recs = SensorSuite.from_profile(prof).measure(truth, seed=1, runs=range(RUNS))
+    recs, st = measure_with_states(SensorSuite.from_profile(prof), truth, seed=1, runs=list(range(RUNS)))
     nav = NavSystem.build(replace(prof.nav, baro_loop=form), prof.sensors, prof.runway.frame, prof.terrain)
-    out = nav.run(truth, recs, [stream(1, r, "nav") for r in range(RUNS)])
+    out = nav.run(truth, recs, [stream(1, r, "nav") for r in range(RUNS)], states=st)
     e = np.stack([o.true_error_nav for o in out])
     P = np.stack([o.P_nav for o in out])
     nees = np.einsum("rki,rki->rk", e, np.linalg.solve(P, e[..., None])[..., 0]).mean(axis=0)
