@@ -11,6 +11,11 @@ each pseudolite range), each giving an UpdateStatus. Output (seed 002 feed-forwa
 with `feedback` the estimate is fed back into the INS (and the IMU bias estimates into the increments) and
 the corresponding error states reset to zero.
 
+The start ([nav.initial_error] start): "converged" (default) draws the INS error and the filter's sensor-state
+estimates jointly with the run's realized sensor errors from the filter's covariance after a pre-approach aided
+segment (nav/initial.py; `run(..., states=sensors.states.start_states(...))`); "prior" draws the INS errors
+from the diagonal prior alone.
+
 The same epoch machinery serves the closed loop (closed_loop.py): `start`, `aid`, `output`, with the INS
 stepped by the caller (nav/ins.py). Several Monte Carlo runs can share one call: the INS is stepped for all of
 them at once (run axis first); each run has its own filter state, or with `shared_covariance` one covariance

@@ -143,3 +143,17 @@ def test_profile_key_start_is_checked():
         parse_nav(Section({"initial_error": {"start": "warm"}}, "nav"))
     with pytest.raises(ProfileError, match="converge_s"):
         parse_nav(Section({"initial_error": {"converge_s": -1.0}}, "nav"))
+
+
+def test_zero_segment_is_the_prior_start_in_distribution():
+    """converge_s = 0: P_conv = P0, every sensor state keeps its prior (estimate 0, e_s = x_s)."""
+    truth = synthetic.glidepath_descent(PROFILE.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 5.0,
+                                        ground_speed_mps=70.0)
+    recs, st = measure_with_states(SensorSuite.from_profile(PROFILE), truth, seed=2, runs=[0, 1])
+    cfg = replace(PROFILE.nav, initial_error=replace(PROFILE.nav.initial_error, converge_s=0.0))
+    nav = NavSystem.build(cfg, PROFILE.sensors, PROFILE.runway.frame, PROFILE.terrain)
+    el = recs["gnss"].elevation_rad[0]
+    _, fl = nav.start(truth, [stream(2, r, "nav") for r in (0, 1)], 0, elevation_rad=el,
+                      obs=nav.observations(recs, float(truth.t_s[0]), 0.025, True), states=st)
+    np.testing.assert_array_equal(fl[0].fs.P, nav.initial_covariance(el))
+    assert all(np.max(np.abs(r.fs.x)) < 1e-5 for r in fl)  # round-off next to the 300 m clock prior
