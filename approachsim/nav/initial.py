@@ -18,12 +18,21 @@ steps build a start with exactly that structure.
    finite segment anyway (the filter has flown converge_s, not forever). The optimal filter's recursion is used
    for every filter variant: the robust gains equal it without outliers, the U-D form is the same algebra.
 
+   converge_s = 600 s by default: ten minutes of aided flight before the final (the intermediate segment). The
+   observable states settle within a few of their time constants (multipath 60 s, baro bias 100 s, clock and
+   vertical channel in tens of seconds); horizontal position tends to the level the slow GPS range errors allow
+   (1800 s time constant, inseparable from position at one geometry); heading and the bias random walks only
+   grow. Default profile at its JSBSim start, 1-sigma N / E / D position: 60 s 3.81 / 2.66 / 1.03 m, 600 s
+   4.53 / 2.84 / 0.97 m, 1800 s 4.83 / 2.92 / 0.85 m (the prior: 5 / 5 / 5 m); vertical velocity 0.023, 0.007,
+   0.003 m/s (prior 0.05). Longer segments change the approach little and make the unobservable directions
+   more conservative.
+
 2. The true state and the estimate, jointly (`condition`). A converged optimal filter's error e = x - x_hat
    has covariance P_conv and is orthogonal to its estimate: E[e x_hat'] = 0, hence E[e x'] = P_conv. The
    sensor models have already drawn the sensor states x_s (sensors/states.py, prior covariance Pi_ss = the
    sensor block of P0, which the error budgets were built to match). For the jointly Gaussian (x_s, e) with
    cov(x_s) = Pi_ss and cov(e, x_s) = P_conv[:, s], conditioning (Bar-Shalom, Li & Kirubarajan, "Estimation
-   with Applications to Tracking and Navigation", sec. 1.4.12, the fundamental equations of linear estimation):
+   with Applications to Tracking and Navigation", 2001, ch. 3: the fundamental equations of linear estimation):
 
        e | x_s ~ N( P_conv[:, s] Pi_ss^-1 x_s ,  P_conv - P_conv[:, s] Pi_ss^-1 P_conv[s, :] )
 
