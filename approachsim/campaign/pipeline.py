@@ -195,6 +195,7 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     """
     from approachsim.nav.system import NavSystem
     from approachsim.seeding import stream
+    from approachsim.sensors.states import start_states
     from approachsim.sensors.suite import SensorSuite
 
     size = profile.evaluation.flight_group
@@ -204,12 +205,14 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     if why is not None:
         return [RunResult.failed(i, f"shared flight of runs {first}-{first + size - 1}: {why}") for i in runs]
     truth = flight.truth
-    records = SensorSuite.from_profile(profile).measure(truth, seed=seed, runs=list(runs))
+    suite = SensorSuite.from_profile(profile)
+    errors = suite.draw(truth.t_s, seed, list(runs))
+    records = suite.apply(truth, errors)  # = suite.measure(truth, seed, runs)
     nav = NavSystem.from_profile(profile)
     # optimal filter: one covariance per measurement schedule for all runs (linearized along the shared truth);
     # robust / adaptive configurations filter each run on its own
     navruns = nav.run(truth, records, [stream(seed, i, "nav") for i in runs],
-                      shared_covariance=nav.shares_covariance())
+                      shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors))
     out = []
     for k, (i, nr) in enumerate(zip(runs, navruns, strict=True)):
         try:

@@ -84,6 +84,7 @@ def run(args: argparse.Namespace) -> int:
     from approachsim.nav.closed_loop import NavInTheLoop, approach_errors
     from approachsim.nav.system import NavSystem
     from approachsim.seeding import stream
+    from approachsim.sensors.states import start_states
     from approachsim.sensors.suite import SensorSuite
 
     profile, seed = load_single_run(args)
@@ -95,8 +96,11 @@ def run(args: argparse.Namespace) -> int:
         nav = src.result(res.truth)
     else:
         res = approach.fly(seed=seed, run=args.run)
-        recs = SensorSuite.from_profile(profile).measure(res.truth, seed=seed, runs=args.run)
-        nav = NavSystem.from_profile(profile).run(res.truth, recs, stream(seed, args.run, "nav"))
+        suite = SensorSuite.from_profile(profile)
+        errors = suite.draw(res.truth.t_s, seed, args.run)
+        recs = suite.apply(res.truth, errors)
+        nav = NavSystem.from_profile(profile).run(res.truth, recs, stream(seed, args.run, "nav"),
+                                                  states=start_states(suite, res.truth, errors))
     truth = res.truth
     args.out.mkdir(parents=True, exist_ok=True)
     meta = {"profile": profile.name, "seed": seed, "run": args.run, "mode": mode}

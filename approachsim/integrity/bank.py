@@ -184,6 +184,7 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int) -> tuple[BankEpochs,
     sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun)."""
     from approachsim.nav.system import NavSystem
     from approachsim.seeding import stream
+    from approachsim.sensors.states import start_states
     from approachsim.sensors.suite import SensorSuite
 
     suite = SensorSuite.from_profile(profile)
@@ -192,9 +193,11 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int) -> tuple[BankEpochs,
         raise ValueError("integrity bank: the profile has no GNSS receiver")
     channels = used_channels(np.asarray(probe["gnss"].valid)[0])
     copies = len(channels) + 1
-    recs = bank_records(suite.measure(truth, seed=seed, runs=[run] * copies), channels)
+    errors = suite.draw(truth.t_s, seed, [run] * copies)
+    recs = bank_records(suite.apply(truth, errors), channels)
     nav = NavSystem.from_profile(profile)
+    # every copy starts from the main filter's converged state (the first copy's schedule: all channels)
     navs = nav.run(truth, recs, [stream(seed, run, "nav") for _ in range(copies)],
-                   shared_covariance=nav.shares_covariance())
+                   shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors))
     ep = bank_epochs(navs[0], navs[1:], channels, truth, profile.runway.heading_rad)
     return ep, navs[0]

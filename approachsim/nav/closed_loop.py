@@ -26,6 +26,7 @@ from approachsim.nav.kernels import strapdown as sk
 from approachsim.nav.system import NavRun, NavSystem, StatusLog
 from approachsim.records import ApproachErrors, NavSolution, Truth
 from approachsim.seeding import stream
+from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite, SuiteErrors
 
 Array = np.ndarray
@@ -124,12 +125,12 @@ class NavInTheLoop:
         compiled call (kernels.strapdown.inloop_step); the filter runs at the aiding epochs."""
         nav = self.nav
         if k == 0:
-            g = self.errors.sensors.get("gnss")
-            el = None
-            if g is not None:
-                rec = self._apply("gnss", 0, truth)
-                el = rec.elevation_rad[0] if rec is not None else None
-            self.s, self.runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el)
+            recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite")
+                    if (r := self._apply(name, 0, truth)) is not None}
+            el = recs["gnss"].elevation_rad[0] if "gnss" in recs else None
+            obs = nav.observations(recs, float(truth.t_s[0]), 0.25 * self.dt, False)
+            self.s, self.runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el, obs=obs,
+                                          states=start_states(self.suite, truth, self.errors))
             self.x = ins.pack(self.s)  # the INS state between epochs: packed (1, 16), stepped by the kernel
             self._snapshot()
         else:

@@ -15,6 +15,8 @@
     velocity_mps = 0.05
     tilt_mrad = 0.05
     heading_mrad = 0.5
+    start = "converged"            #   "converged": the converged pre-approach state (nav/initial.py) built from
+    converge_s = 600.0             #   this prior and converge_s of aiding at the start; "prior": drawn from it
     [nav.fde]                      # online fault detection and exclusion (nav/fde.py), off by default
     enabled = false
     category = "CAT II"            # whose continuity budget sets the false-alert allocation
@@ -36,16 +38,23 @@ from approachsim.nav import vertical_loop as vl
 from approachsim.nav.fde import FdeConfig
 
 LOOP_FORMS = ("none",) + tuple(vl.GAIN_FORMS)
+START_MODES = ("converged", "prior")
+"""[nav.initial_error] start: the converged pre-approach state, or today's independent draw from the prior."""
 
 
 @dataclass(frozen=True)
 class InitialError:
-    """1-sigma INS errors at the start of the run (drawn per run; the filter's P0), SI."""
+    """1-sigma INS errors of the prior P0, SI, and how the run starts from it: start "prior" draws the INS
+    errors from P0 (independent of the sensor errors, zero sensor-state estimates); "converged" (default) from
+    the filter's covariance after converge_s (s) of aiding at the start state, jointly with the realized
+    sensor errors (nav/initial.py)."""
 
     position_m: float = 5.0
     velocity_mps: float = 0.05
     tilt_rad: float = 0.05e-3
     heading_rad: float = 0.5e-3
+    start: str = "converged"
+    converge_s: float = 600.0
 
 
 @dataclass(frozen=True)
@@ -103,6 +112,8 @@ def parse_nav(s: Section) -> NavConfig:
         velocity_mps=ie.number("velocity_mps", 0.05, lo=0.0, hi=100.0, unit="m/s"),
         tilt_rad=ie.number("tilt_mrad", 0.05, lo=0.0, hi=100.0, unit="mrad") * 1e-3,
         heading_rad=ie.number("heading_mrad", 0.5, lo=0.0, hi=1000.0, unit="mrad") * 1e-3,
+        start=ie.string("start", "converged", choices=START_MODES),
+        converge_s=ie.number("converge_s", 600.0, lo=0.0, hi=36000.0, unit="s"),
     )
     ie.done()
     fs = s.section("fde")

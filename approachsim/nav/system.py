@@ -11,6 +11,11 @@ each pseudolite range), each giving an UpdateStatus. Output (seed 002 feed-forwa
 with `feedback` the estimate is fed back into the INS (and the IMU bias estimates into the increments) and
 the corresponding error states reset to zero.
 
+The start ([nav.initial_error] start): "converged" (default) draws the INS error and the filter's sensor-state
+estimates jointly with the run's realized sensor errors from the filter's covariance after a pre-approach aided
+segment (nav/initial.py; `run(..., states=sensors.states.start_states(...))`); "prior" draws the INS errors
+from the diagonal prior alone.
+
 The same epoch machinery serves the closed loop (closed_loop.py): `start`, `aid`, `output`, with the INS
 stepped by the caller (nav/ins.py). Several Monte Carlo runs can share one call: the INS is stepped for all of
 them at once (run axis first); each run has its own filter state, or with `shared_covariance` one covariance
@@ -27,7 +32,7 @@ import numpy as np
 
 from approachsim import geo
 from approachsim.nav import errormodel as em
-from approachsim.nav import ins
+from approachsim.nav import initial, ins
 from approachsim.nav import measurements as meas
 from approachsim.nav import vertical_loop as vl
 from approachsim.nav.base import FilterState, NavFilter, UpdateStatus
@@ -38,6 +43,7 @@ from approachsim.sensors.config import DEFAULT_SENSORS, SensorsConfig
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.receiver import iono_obliquity, tropo_mapping
 from approachsim.sensors.presets import PRESETS
+from approachsim.sensors.states import SensorStates
 
 Array = np.ndarray
 
@@ -287,20 +293,58 @@ class NavSystem:
     # --- one pass ------------------------------------------------------------------------------------------
 
     def start(self, truth: Truth, rngs: list[np.random.Generator], row: int = 0,
-              elevation_rad: Array | None = None) -> tuple[ins.InsState, list[_Run]]:
-        """INS states of len(rngs) runs at truth row `row` with initial errors drawn from P0, and their filters
-        (elevation_rad: the GPS channels' elevations at the start, for their P0)."""
+              elevation_rad: Array | None = None, *, obs: Mapping[str, Any] | None = None,
+              states: SensorStates | None = None) -> tuple[ins.InsState, list[_Run]]:
+        """INS states of len(rngs) runs at truth row `row` with their initial errors, and their filters
+        (elevation_rad: the GPS channels' elevations at the start, for their P0).
+
+        [nav.initial_error] start = "prior": INS errors drawn from P0's navigation block, zero estimates, P0.
+        "converged" (nav/initial.py): obs, the observations at the row (`observations`, run axis first; the
+        first run's schedule is flown), and states, the runs' realized sensor errors there
+        (sensors/states.py), are required; all runs start with the same converged covariance."""
         n = len(rngs)
         c_true = ins.cbn_from_quaternion(truth.q_nb[row])
         s = ins.init_state(np.full(n, truth.lat_rad[row]), truth.lon_rad[row], truth.h_m[row], truth.v_ned[row],
                            c_true)
         P0 = self.initial_covariance(elevation_rad)
-        sd = np.sqrt(np.diag(P0)[:9])
-        e = np.stack([sd * g.standard_normal(9) for g in rngs])  # INS errors after alignment + cruise
+        if self.nav.initial_error.start == "prior":
+            sd = np.sqrt(np.diag(P0)[:9])
+            e = np.stack([sd * g.standard_normal(9) for g in rngs])  # INS errors after alignment + cruise
+            s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
+            runs = [_Run(self.filter.init(np.zeros(self.layout.n), P0), [], np.zeros(3), np.zeros(3), self._fde())
+                    for _ in rngs]
+            return s, runs
+        if obs is None or states is None:
+            raise ValueError("the converged start ([nav.initial_error] start = 'converged') needs the "
+                             "observations and the realized sensor states at the start row "
+                             "(SensorSuite.draw + sensors.states.start_states)")
+        if obs.get("gnss_sky"):  # each run its own GPS sky: its own P0 and converged covariance
+            draws = [initial.draw(self, truth, self._run_obs(obs, i), states.take(i), [g], row,
+                                  self.initial_covariance(np.asarray(obs["gnss_el"])[i])) for i, g in enumerate(rngs)]
+            e = np.concatenate([d[0] for d in draws])
+            x_hat = np.concatenate([d[1] for d in draws])
+            P_convs = [d[2] for d in draws]
+        else:
+            e, x_hat, P_conv = initial.draw(self, truth, dict(obs), states, list(rngs), row, P0)
+            P_convs = [P_conv] * n
         s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
-        runs = [_Run(self.filter.init(np.zeros(self.layout.n), P0), [], np.zeros(3), np.zeros(3), self._fde())
-                for _ in rngs]
+        if self.layout.has("ac"):
+            s = replace(s, a_comp_mps2=e[:, self.layout.i("ac")])  # ac error = the INS compensator (truth 0)
+        runs = [_Run(self.filter.init(x_hat[i], P_convs[i]), [], np.zeros(3), np.zeros(3), self._fde())
+                for i in range(n)]
         return s, runs
+
+    @staticmethod
+    def _run_obs(obs: Mapping[str, Any], i: int) -> dict[str, Any]:
+        """The observations of run i alone (run axis of length 1; a per-run GPS sky as one shared sky)."""
+        out: dict[str, Any] = dict(obs)
+        for k in ("baro_h", "radalt_h", "gnss_rho", "pl_rho"):
+            if k in obs:
+                out[k] = np.asarray(obs[k])[i:i + 1]
+        if obs.get("gnss_sky"):
+            out.update(gnss_sky=False, gnss_rsv=obs["gnss_rsv"][i], gnss_sigma=obs["gnss_sigma"][i],
+                       gnss_el=obs["gnss_el"][i])
+        return out
 
     def _fde(self) -> FdeState | None:
         """A run's online FDE state ([nav.fde] enabled), else None."""
@@ -639,13 +683,14 @@ class NavSystem:
         return obs
 
     def run(self, truth: Truth, records: Mapping[str, Any], rngs: np.random.Generator | list[np.random.Generator],
-            *, shared_covariance: bool = False) -> NavRun | list[NavRun]:
+            *, shared_covariance: bool = False, states: SensorStates | None = None) -> NavRun | list[NavRun]:
         """Navigate over whole records (open loop: the truth is only read at row 0 and for the error history).
 
         records: {"imu": ImuSamples, "baro": ..., ...} of one run (rngs a Generator) or of len(rngs) runs
         (run axis first, rngs a list). Returns one NavRun, or a list. shared_covariance (several runs, optimal
         'ekf' only): one covariance and gain for all runs at each epoch (`aid_shared`), several times faster;
-        epochs where the runs' measurement sets differ fall back to per-run filtering.
+        epochs where the runs' measurement sets differ fall back to per-run filtering. states: the runs'
+        realized sensor errors at truth row 0 (sensors.states.start_states), needed by the converged start.
         """
         if shared_covariance and not self.shares_covariance():
             raise ValueError("shared_covariance needs the optimal 'ekf' filter (robust filters gate per run), "
@@ -661,11 +706,12 @@ class NavSystem:
         epoch_rows = max(1, int(round(rate / self.nav.aiding_rate_hz)))
         gnss = records.get("gnss")
         sky = gnss is not None and batched and gnss.per_run_sky
+        obs0 = self.observations(records, float(truth.t_s[0]), 0.25 * dt, batched)
         s, runs = self.start(truth, gens, elevation_rad=None if gnss is None else
-                             (gnss.elevation_rad[0, 0] if sky else gnss.elevation_rad[0]))
+                             (gnss.elevation_rad[0, 0] if sky else gnss.elevation_rad[0]), obs=obs0, states=states)
         n_runs = len(gens)
-        if sky:  # each run's P0 at its own sky (the drawn INS errors do not depend on the GPS channels)
-            for i, r in enumerate(runs):
+        if sky and self.nav.initial_error.start == "prior":  # each run's P0 at its own sky (start() did the
+            for i, r in enumerate(runs):  # converged start per sky; the prior's INS errors do not depend on it)
                 r.fs = self.filter.init(np.zeros(self.layout.n), self.initial_covariance(gnss.elevation_rad[i, 0]))
         cov = None
         if shared_covariance:  # the reference trajectory (truth) and its specific force in NED, per row

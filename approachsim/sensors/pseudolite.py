@@ -60,23 +60,26 @@ class Pseudolite:
         return np.array(out)
 
     def draw(self, t_s: Array, rng: base.RngLike) -> base.SensorErrors:
-        """series (m, p): multipath, noise (m), pl_clock (m); constants survey (p, 3) m, tropo_ppm (p,)."""
+        """series (m, p): multipath, noise (m), pl_clock (m), pl_clock_drift (m/s); constants survey (p, 3) m,
+        tropo_ppm (p,)."""
         p = len(self.positions_rwy)
 
         def one(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
             c = g.standard_normal(6 * p)
             z = g.standard_normal((m, 4 * p))
             clk = np.zeros((m, p))
+            drift = np.zeros((m, p))
             if not self.synchronized:
                 for j in range(p):
-                    clk[:, j], _ = self.pl_clock.series(c[4 * p + 2 * j : 4 * p + 2 * j + 2], z[:, 2 * p + 2 * j :
-                                                                                               2 * p + 2 * j + 2], dt)
+                    c0 = c[4 * p + 2 * j : 4 * p + 2 * j + 2]
+                    clk[:, j], drift[:, j] = self.pl_clock.series(c0, z[:, 2 * p + 2 * j : 2 * p + 2 * j + 2], dt)
             return {
                 "c_survey": self.survey_sigma_m * c[: 3 * p].reshape(p, 3),
                 "c_tropo_ppm": self.tropo_ppm_sigma * c[3 * p : 4 * p],
                 "multipath": base.gauss_markov(z[:, :p], self.multipath_m, self.multipath_tau_s, dt),
                 "noise": self.code_noise_m * z[:, p : 2 * p],
                 "pl_clock": clk,
+                "pl_clock_drift": drift,
             }
 
         return base.make_errors(t_s, self.rate_hz, rng, one)

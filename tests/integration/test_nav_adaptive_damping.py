@@ -63,6 +63,7 @@ from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream
 from approachsim.sensors.faults import FaultSpec
+from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILE = Path(__file__).resolve().parents[2] / "profiles" / "default.toml"
@@ -85,12 +86,13 @@ def run_seed(seed: int) -> dict:
                                          sea_level_pa=prof.environment.true_qnh_pa)
     sensors = replace(prof.sensors, radalt=None, pseudolite=None)
     faults = tuple(FaultSpec("gnss", "outage", a, b) for a, b in manoeuvre.SEED003_GAPS_S)
-    recs = SensorSuite.from_config(sensors, rw, prof.environment.qnh_pa, faults).measure(
-        truth, seed=seed, runs=range(RUNS))
+    recs, st = measure_with_states(SensorSuite.from_config(sensors, rw, prof.environment.qnh_pa, faults), truth,
+                                   seed=seed, runs=list(range(RUNS)))
     out: dict = {"output": {}, "ins_alone": {}, "normalized": {}}
     for form in FORMS:
         nav = NavSystem.build(replace(prof.nav, baro_loop=form), sensors, rw, prof.terrain)
-        runs = nav.run(truth, recs, [stream(seed, r, "nav") for r in range(RUNS)], shared_covariance=False)
+        runs = nav.run(truth, recs, [stream(seed, r, "nav") for r in range(RUNS)], shared_covariance=False,
+                       states=st)
         e_out = np.stack([r.true_error_nav[:, 2] for r in runs])  # dp_D of the output, m
         e_ins = np.stack([r.true_error_nav[:, 2] + r.x[:, 2] for r in runs])  # INS = output + x_hat
         p_dd = np.stack([r.P_nav[:, 2, 2] for r in runs])

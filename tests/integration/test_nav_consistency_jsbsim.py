@@ -27,6 +27,7 @@ from approachsim.flight.run import Approach
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream
+from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"
@@ -42,14 +43,16 @@ def fly_and_sense():
     flight = Approach(prof).fly(seed=SEED, run=0)
     assert flight.termination == "reached stop height"
     truth = flight.truth
-    return prof, truth, SensorSuite.from_profile(prof).measure(truth, seed=SEED, runs=range(RUNS))
+    return prof, truth, measure_with_states(SensorSuite.from_profile(prof), truth, seed=SEED, runs=list(range(RUNS)))
 
 
 def navigate(prof, truth, recs, shared_covariance: bool):
     """RUNS open-loop navigation runs (each with its own 'nav' stream) over the shared truth."""
     nav = NavSystem.from_profile(prof)
     assert nav.shares_covariance()  # the default configuration is the one campaigns run with shared P
-    return nav.run(truth, recs, [stream(SEED, r, "nav") for r in range(RUNS)], shared_covariance=shared_covariance)
+    recs, st = recs  # (records, start states)
+    return nav.run(truth, recs, [stream(SEED, r, "nav") for r in range(RUNS)], shared_covariance=shared_covariance,
+                   states=st)
 
 
 @pytest.fixture(scope="module")

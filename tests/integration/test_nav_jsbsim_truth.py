@@ -72,7 +72,7 @@ def test_navigation_system_with_exact_sensors_stays_within_1cm_1mmps():
     truth = Approach(PROFILE).fly(seed=2, run=0, max_time_s=60.0).truth
     recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=2, runs=0, noise=False)
     base = NavSystem.from_profile(PROFILE).nav
-    nav = NavSystem.build(replace(base, initial_error=InitialError(0.0, 0.0, 0.0, 0.0)), PROFILE.sensors,
+    nav = NavSystem.build(replace(base, initial_error=InitialError(0.0, 0.0, 0.0, 0.0, start="prior")), PROFILE.sensors,
                           PROFILE.runway.frame, PROFILE.terrain)
     run = nav.run(truth, recs, stream(2, 0, "nav"))
     lat, lon, h = geo.ecef_to_geodetic(run.solution.r_ecef)

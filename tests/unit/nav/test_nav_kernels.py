@@ -126,6 +126,7 @@ def test_closed_loop_steps_equal_the_open_loop_pass_to_rounding(feedback):
     from approachsim.nav.system import NavSystem
     from approachsim.profile import parse_profile
     from approachsim.seeding import stream
+    from approachsim.sensors.states import measure_with_states
     from approachsim.sensors.suite import SensorSuite
 
     path = Path("profiles/gray-maybeck.toml")
@@ -137,8 +138,8 @@ def test_closed_loop_steps_equal_the_open_loop_pass_to_rounding(feedback):
     src = NavInTheLoop(prof, seed=4, run=2, max_time_s=30.0)
     guide = np.array([np.concatenate(src.step(k, truth)) for k in range(len(truth))])
     closed = src.result(truth)
-    recs = SensorSuite.from_profile(prof).measure(truth, seed=4, runs=2)
-    open_ = NavSystem.from_profile(prof).run(truth, recs, stream(4, 2, "nav"))
+    recs, st = measure_with_states(SensorSuite.from_profile(prof), truth, seed=4, runs=2)
+    open_ = NavSystem.from_profile(prof).run(truth, recs, stream(4, 2, "nav"), states=st)
     np.testing.assert_allclose(closed.solution.r_ecef, open_.solution.r_ecef, rtol=0, atol=1e-9)
     np.testing.assert_allclose(closed.solution.v_ned, open_.solution.v_ned, rtol=0, atol=1e-12)
     np.testing.assert_allclose(closed.x, open_.x, rtol=1e-12, atol=1e-15)

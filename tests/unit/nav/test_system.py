@@ -17,6 +17,7 @@ from approachsim.nav.registry import FILTERS
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream
+from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
@@ -38,7 +39,7 @@ def _system(**nav_kw):
 def test_noiseless_sensors_and_no_initial_error_stay_within_1cm(feedback):
     truth = _truth()
     recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=3, runs=0, noise=False)
-    nav = _system(initial_error=InitialError(0.0, 0.0, 0.0, 0.0), feedback=feedback)
+    nav = _system(initial_error=InitialError(0.0, 0.0, 0.0, 0.0, start="prior"), feedback=feedback)
     run = nav.run(truth, recs, stream(3, 0, "nav"))
     sol = run.solution
     lat, lon, h = geo.ecef_to_geodetic(sol.r_ecef)
@@ -51,8 +52,8 @@ def test_noiseless_sensors_and_no_initial_error_stay_within_1cm(feedback):
 
 def test_solution_and_status_shapes_and_names():
     truth = _truth(20.0)
-    recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=3, runs=0)
-    run = _system().run(truth, recs, stream(3, 0, "nav"))
+    recs, st = measure_with_states(SensorSuite.from_profile(PROFILE), truth, seed=3, runs=0)
+    run = _system().run(truth, recs, stream(3, 0, "nav"), states=st)
     n = len(truth)
     assert run.solution.r_ecef.shape == (n, 3) and run.solution.P_pos_ned.shape == (n, 3, 3)
     assert run.t_epoch_s.shape == (20,) and run.x.shape == (20, run.layout.n)
@@ -67,8 +68,10 @@ def test_batched_runs_equal_single_runs():
     truth = _truth(10.0)
     suite = SensorSuite.from_profile(PROFILE)
     nav = _system()
-    both = nav.run(truth, suite.measure(truth, seed=5, runs=[0, 1]), [stream(5, r, "nav") for r in (0, 1)])
-    one = nav.run(truth, suite.measure(truth, seed=5, runs=1), stream(5, 1, "nav"))
+    recs2, st2 = measure_with_states(suite, truth, seed=5, runs=[0, 1])
+    recs1, st1 = measure_with_states(suite, truth, seed=5, runs=1)
+    both = nav.run(truth, recs2, [stream(5, r, "nav") for r in (0, 1)], states=st2)
+    one = nav.run(truth, recs1, stream(5, 1, "nav"), states=st1)
     # bit-identical: a run's numbers must not depend on the batch it shares (campaign/pipeline.py relies on it)
     np.testing.assert_array_equal(both[1].solution.r_ecef, one.solution.r_ecef)
     np.testing.assert_array_equal(both[1].x, one.x)
@@ -79,7 +82,7 @@ def test_loose_coupling_uses_position_fixes():
     exact sensors give an exact fix (innovations at the centimetre level)."""
     truth = _truth(10.0)
     recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=3, runs=0, noise=False)
-    nav = _system(gps_coupling="loose", initial_error=InitialError(0.0, 0.0, 0.0, 0.0))
+    nav = _system(gps_coupling="loose", initial_error=InitialError(0.0, 0.0, 0.0, 0.0, start="prior"))
     assert not nav.layout.has("clk") and not nav.layout.has("gse")
     run = nav.run(truth, recs, stream(3, 0, "nav"))
     names = list(run.status.name)
@@ -93,18 +96,18 @@ def test_shared_covariance_matches_per_run_filters():
     estimates to a small fraction of their sigma, the same status records, and is refused for robust filters."""
     truth = _truth(20.0)
     suite = SensorSuite.from_profile(PROFILE)
-    recs = suite.measure(truth, seed=6, runs=[0, 1, 2])
+    recs, st = measure_with_states(suite, truth, seed=6, runs=[0, 1, 2])
     nav = _system()
     rngs = [stream(6, r, "nav") for r in range(3)]
-    per = nav.run(truth, recs, rngs)
-    shared = nav.run(truth, recs, [stream(6, r, "nav") for r in range(3)], shared_covariance=True)
+    per = nav.run(truth, recs, rngs, states=st)
+    shared = nav.run(truth, recs, [stream(6, r, "nav") for r in range(3)], shared_covariance=True, states=st)
     for a, b in zip(per, shared, strict=True):
         sd = np.sqrt(a.P_diag)
         assert np.max(np.abs(a.x - b.x) / sd) < 0.2  # gains linearized along the truth (measured 0.06)
         assert list(a.status.name) == list(b.status.name)
         np.testing.assert_allclose(b.status.variance, a.status.variance, rtol=0.1)  # measured: within 4.6 %
     with pytest.raises(ValueError, match="optimal"):
-        _system(filter="rkf-gate").run(truth, recs, rngs, shared_covariance=True)
+        _system(filter="rkf-gate").run(truth, recs, rngs, shared_covariance=True, states=st)
 
 
 NEES_RUNS = 20
@@ -119,8 +122,8 @@ def test_every_registered_filter_is_drop_in(name):
     a factor 1.3 in variance (ANEES ~13.4) fails."""
     truth = _truth(8.0)
     runs = range(NEES_RUNS)
-    recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=2, runs=runs)
-    out = _system(filter=name).run(truth, recs, [stream(2, r, "nav") for r in runs])
+    recs, st = measure_with_states(SensorSuite.from_profile(PROFILE), truth, seed=2, runs=runs)
+    out = _system(filter=name).run(truth, recs, [stream(2, r, "nav") for r in runs], states=st)
     for run in out:
         assert run.x.shape == (8, run.layout.n) and np.all(np.isfinite(run.P_nav))
     e = np.stack([r.true_error_nav for r in out])

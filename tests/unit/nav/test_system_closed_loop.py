@@ -14,6 +14,7 @@ from approachsim.nav.closed_loop import NavInTheLoop
 from approachsim.nav.system import NavSystem
 from approachsim.profile import parse_profile
 from approachsim.seeding import stream
+from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
@@ -35,8 +36,8 @@ def test_step_by_step_equals_open_loop_pass(quantized, feedback):
     assert (src._imu_affine is None) == quantized
     r_rwy = np.array([src.step(k, truth)[0] for k in range(len(truth))])
     closed = src.result(truth)
-    recs = SensorSuite.from_profile(prof).measure(truth, seed=4, runs=2)
-    open_ = NavSystem.from_profile(prof).run(truth, recs, stream(4, 2, "nav"))
+    recs, st = measure_with_states(SensorSuite.from_profile(prof), truth, seed=4, runs=2)
+    open_ = NavSystem.from_profile(prof).run(truth, recs, stream(4, 2, "nav"), states=st)
     np.testing.assert_allclose(closed.solution.r_ecef, open_.solution.r_ecef, rtol=0, atol=1e-6)
     np.testing.assert_allclose(closed.x, open_.x, rtol=1e-6, atol=1e-6)  # increments in another summation order
     assert list(closed.status.name) == list(open_.status.name)

@@ -17,6 +17,7 @@ from approachsim import synthetic
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream
+from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
@@ -36,25 +37,26 @@ def _with_epoch(prof, epoch: str):
 
 def _records(truth, runs: list[int], prof=PROFILE):
     """Sensor records of `runs`; run 1 loses its baro from 5 s on (its schedule departs from the others')."""
-    recs = SensorSuite.from_profile(prof).measure(truth, seed=7, runs=runs)
+    recs, st = measure_with_states(SensorSuite.from_profile(prof), truth, seed=7, runs=runs)
     b = recs["baro"]
     valid = np.array(b.valid, copy=True)
     if 1 in runs:
         valid[runs.index(1), b.t_s >= 5.0] = False
-    return {**recs, "baro": replace(b, valid=valid)}
+    return {**recs, "baro": replace(b, valid=valid)}, st
 
 
 @pytest.mark.parametrize("epoch", ["fixed", "per-run"])
 def test_shared_runs_bit_identical_in_any_batch_also_with_a_departing_schedule(epoch):
     prof = _with_epoch(PROFILE, epoch)
     truth = _truth(12.0)
-    recs = _records(truth, [0, 1, 2], prof)
+    recs, st = _records(truth, [0, 1, 2], prof)
     assert recs["gnss"].per_run_sky == (epoch == "per-run")
     nav = NavSystem.from_profile(prof)
     assert nav.shares_covariance()
-    batch = nav.run(truth, recs, [stream(7, r, "nav") for r in range(3)], shared_covariance=True)
+    batch = nav.run(truth, recs, [stream(7, r, "nav") for r in range(3)], shared_covariance=True, states=st)
     for k in range(3):
-        alone = nav.run(truth, _records(truth, [k], prof), [stream(7, k, "nav")], shared_covariance=True)[0]
+        rk, sk = _records(truth, [k], prof)
+        alone = nav.run(truth, rk, [stream(7, k, "nav")], shared_covariance=True, states=sk)[0]
         np.testing.assert_array_equal(batch[k].x, alone.x)
         np.testing.assert_array_equal(batch[k].P_diag, alone.P_diag)
         np.testing.assert_array_equal(batch[k].solution.r_ecef, alone.solution.r_ecef)
@@ -73,15 +75,15 @@ def test_shared_runs_bit_identical_in_any_batch_also_with_a_departing_schedule(e
 def test_shared_matches_per_run_filters_to_a_small_fraction_of_sigma(path):
     prof = load_profile(path)  # default: per-run skies (one class per run); Gray & Maybeck: one fixed sky
     truth = _truth(20.0)
-    recs = SensorSuite.from_profile(prof).measure(truth, seed=6, runs=[0, 1, 2])
+    recs, st = measure_with_states(SensorSuite.from_profile(prof), truth, seed=6, runs=[0, 1, 2])
     if prof.runway.frame.threshold_h_m > 100.0:
         # the synthetic descent's radar heights do not see this elevated runway's terrain (a 250 m innovation
         # whose linearization points legitimately differ): compare the GPS + pseudolite updates only
         recs = {k: v for k, v in recs.items() if k != "radalt"}
     nav = NavSystem.from_profile(prof)
     assert nav.shares_covariance()
-    per = nav.run(truth, recs, [stream(6, r, "nav") for r in range(3)])
-    shared = nav.run(truth, recs, [stream(6, r, "nav") for r in range(3)], shared_covariance=True)
+    per = nav.run(truth, recs, [stream(6, r, "nav") for r in range(3)], states=st)
+    shared = nav.run(truth, recs, [stream(6, r, "nav") for r in range(3)], shared_covariance=True, states=st)
     for a, b in zip(per, shared, strict=True):
         assert list(a.status.name) == list(b.status.name)
         # the same innovations z - g(x_hat) (vectorized over runs in the shared path), to a fraction of sigma

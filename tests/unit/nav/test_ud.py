@@ -252,17 +252,18 @@ def test_ud_variants_run_inside_the_navigation_system_named_in_the_profile() -> 
     from approachsim.nav.system import NavSystem
     from approachsim.profile import load_profile
     from approachsim.seeding import stream
+    from approachsim.sensors.states import measure_with_states
     from approachsim.sensors.suite import SensorSuite
 
     profile = load_profile(PROFILES / "default.toml")
     truth = synthetic.glidepath_descent(profile.runway.frame, rate_hz=20.0, start_distance_m=70.0 * 20,
                                         ground_speed_mps=70.0)
-    recs = SensorSuite.from_profile(profile).measure(truth, seed=3, runs=0)
+    recs, st = measure_with_states(SensorSuite.from_profile(profile), truth, seed=3, runs=0)
     base = NavSystem.from_profile(profile).nav
     sols = {}
     for name in ("ekf", "ud", "robust-ud-gauss-laplace"):
         system = NavSystem.build(replace(base, filter=name), profile.sensors, profile.runway.frame, profile.terrain)
-        sols[name] = system.run(truth, recs, stream(3, 0, "nav")).solution
+        sols[name] = system.run(truth, recs, stream(3, 0, "nav"), states=st).solution
     scale = np.max(np.abs(sols["ekf"].P_pos_ned))
     assert np.max(np.abs(sols["ud"].P_pos_ned - sols["ekf"].P_pos_ned)) < 1e-9 * scale
     np.testing.assert_allclose(sols["ud"].r_ecef, sols["ekf"].r_ecef, rtol=0, atol=1e-6)

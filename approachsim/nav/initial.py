@@ -1,0 +1,180 @@
+"""The converged pre-approach start of the navigation system ([nav.initial_error] start = "converged").
+
+After GPS-aided flight the INS error is not an independent diagonal draw: it is correlated with the slow GPS
+range errors, the clock, the baro bias and the IMU biases, and the filter already knows part of those. Two
+steps build a start with exactly that structure.
+
+1. Converged covariance (`converged_covariance`). P_conv is the optimal filter's a-posteriori covariance after
+   converge_s seconds of aiding flown *at the start state* (the truth row: its position, velocity, attitude and
+   specific force; the GNSS geometry and the sensors valid there), from today's prior P0, by iterating the
+   filter's own recursion at the aiding interval:
+
+       P- = Phi P+ Phi' + Qd                      (errormodel.dynamics + discretize)
+       P+ = (I - K h') P- (I - K h')' + K r K'    for every scalar row h, r valid at the start (Joseph form)
+
+   Why the recursion and not scipy.linalg.solve_discrete_are: the steady state does not exist here. Heading,
+   the along-line-of-sight slow range errors against position, and the bias random walks are unobservable at
+   one fixed geometry (not detectable), so the Riccati recursion has no stabilizing limit; and the question is a
+   finite segment anyway (the filter has flown converge_s, not forever). The optimal filter's recursion is used
+   for every filter variant: the robust gains equal it without outliers, the U-D form is the same algebra.
+
+   converge_s = 600 s by default: ten minutes of aided flight before the final (the intermediate segment). The
+   observable states settle within a few of their time constants (multipath 60 s, baro bias 100 s, clock and
+   vertical channel in tens of seconds); horizontal position tends to the level the slow GPS range errors allow
+   (1800 s time constant, inseparable from position at one geometry); heading and the bias random walks only
+   grow. Default profile at its JSBSim start, 1-sigma N / E / D position: 60 s 3.81 / 2.66 / 1.03 m, 600 s
+   4.53 / 2.84 / 0.97 m, 1800 s 4.83 / 2.92 / 0.85 m (the prior: 5 / 5 / 5 m); vertical velocity 0.023, 0.007,
+   0.003 m/s (prior 0.05). Longer segments change the approach little and make the unobservable directions
+   more conservative.
+
+2. The true state and the estimate, jointly (`condition`). A converged optimal filter's error e = x - x_hat
+   has covariance P_conv and is orthogonal to its estimate: E[e x_hat'] = 0, hence E[e x'] = P_conv. The
+   sensor models have already drawn the sensor states x_s (sensors/states.py, prior covariance Pi_ss = the
+   sensor block of P0, which the error budgets were built to match). For the jointly Gaussian (x_s, e) with
+   cov(x_s) = Pi_ss and cov(e, x_s) = P_conv[:, s], conditioning (Bar-Shalom, Li & Kirubarajan, "Estimation
+   with Applications to Tracking and Navigation", 2001, ch. 3: the fundamental equations of linear estimation):
+
+       e | x_s ~ N( P_conv[:, s] Pi_ss^-1 x_s ,  P_conv - P_conv[:, s] Pi_ss^-1 P_conv[s, :] )
+
+   The joint exists iff cov(x_hat_s) = Pi_ss - P_conv[s, s] >= 0 (checked). Then the INS true error is e_nav
+   (dp, dv, psi and the loop compensator ac: the INS was reset by the pre-approach feedback, its estimate is
+   0), the filter's estimate of the sensor states is x_hat_s = x_s - e_s, its covariance P_conv; and
+   E[e x_hat'] = E[e x_s'] - E[e e_s'] = P_conv[:, s] - P_conv[:, s] = 0: orthogonal, as a converged filter is.
+
+   Singular and unobservable states: states with zero prior variance are left out of s (their value is 0, so
+   is e). A channel not in view at the start is never updated and stays decoupled: P_conv keeps its prior row
+   exactly, and the conditioning gives e_j = x_j with zero variance (estimate 0, it keeps its prior). The
+   filter models the IMU biases as random walks while the sensors' biases are stationary (turn-on constant +
+   Gauss-Markov), so a bias combination the segment hardly observes can end with P_conv above its prior
+   (default profile, 600 s: the vertical gyro bias direction, by 1.5 %); in those directions only the prior
+   is raised to P_conv (`condition`), the draw takes e = x there, and the filter is conservative by that
+   excess. The conditional covariance is factored by its eigen-decomposition (it is singular by design).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from approachsim.nav import errormodel as em
+from approachsim.nav import ins
+from approachsim.sensors.states import STATE_GROUPS, SensorStates
+
+Array = np.ndarray
+
+NAV_GROUPS = ("dp", "dv", "psi", "ac")
+"""Error-state groups that are INS states: their true value is the INS error, their start estimate 0."""
+
+_PSD_TOL = 1e-9
+"""Relative tolerance of the Pi_ss >= P_conv[s, s] check (eigenvalues of Pi^-1/2 P_conv Pi^-1/2 above 1)."""
+
+
+def converged_covariance(system: Any, truth: Any, obs: dict[str, Any], row: int, P0: Array,
+                         converge_s: float) -> Array:
+    """P_conv (n, n): the optimal filter's covariance after converge_s (s) of aiding at truth row `row` from P0,
+    with the measurements available in obs (NavSystem.observations at the row; the first run's schedule)."""
+    lay = system.layout
+    ref = ins.InsState(truth.lat_rad[row:row + 1], truth.lon_rad[row:row + 1], truth.h_m[row:row + 1],
+                       truth.v_ned[row:row + 1], ins.cbn_from_quaternion(truth.q_nb[row:row + 1]), np.zeros(1))
+    c_bn = ref.c_bn[0]
+    f_ned = c_bn @ truth.f_body[row]
+    noise = system.noise(obs.get("gnss_el"))
+    F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ned, c_bn, noise,
+                        system.loop_gains())
+    dt = 1.0 / system.nav.aiding_rate_hz
+    phi, qd = em.discretize(F, Qc, dt)
+    r_ref = ins.position_ecef(ref)[0]
+    x0 = np.zeros(lay.n)
+    fs0 = system.filter.init(x0, P0)
+    t = float(truth.t_s[row])
+    rows = [b(x0) for b in system._measurements(ref, 0, r_ref, fs0, system._reference_obs(obs, 0, ref, r_ref), t)]
+    P = np.array(P0, dtype=float)
+    eye = np.eye(lay.n)
+    for _ in range(int(round(converge_s / dt))):
+        P = phi @ P @ phi.T + qd  # P- = Phi P+ Phi' + Qd
+        for m in rows:
+            Ph = P @ m.h
+            K = Ph / float(m.h @ Ph + m.r)  # K = P h (h' P h + r)^-1
+            A = eye - np.outer(K, m.h)
+            P = A @ P @ A.T + m.r * np.outer(K, K)  # Joseph form
+        P = 0.5 * (P + P.T)
+    return P
+
+
+def sensor_vector(layout: em.StateLayout, states: SensorStates, P0: Array) -> tuple[Array, Array]:
+    """(s,) indices of the sensor states with a nonzero prior and (N, s) their realized values.
+
+    Every layout group that is not an INS state (NAV_GROUPS) must be realized by `states`
+    (sensors/states.py); a group with no realization is an error, not a silent zero."""
+    idx, vals = [], []
+    prior = np.diag(P0)
+    for g in layout.groups:
+        if g in NAV_GROUPS:
+            continue
+        sl = layout.index[g]
+        v = states.group(g) if g in STATE_GROUPS else None
+        if v is None:
+            if np.all(prior[sl] == 0.0):
+                continue
+            raise ValueError(f"converged start: no realized sensor value for filter state group {g!r} "
+                             "(add it to sensors/states.py _EXTRACT)")
+        if v.shape[1] != sl.stop - sl.start:
+            raise ValueError(f"converged start: state group {g!r} has {v.shape[1]} values, the filter "
+                             f"{sl.stop - sl.start}")
+        keep = prior[sl] > 0.0
+        idx.append(np.arange(sl.start, sl.stop)[keep])
+        vals.append(v[:, keep])
+    if not idx:
+        return np.zeros(0, dtype=int), np.zeros((states.runs, 0))
+    return np.concatenate(idx), np.concatenate(vals, axis=1)
+
+
+def condition(P_conv: Array, Pi_ss: Array, s: Array, x_s: Array, z: Array) -> tuple[Array, float]:
+    """Estimation errors e (N, n) given the realized sensor states x_s (N, s) at indices s, from standard
+    normals z (N, n): e = P_conv[:, s] Pi^-1 x_s + L z, L L' = P_conv - P_conv[:, s] Pi^-1 P_conv[s, :];
+    and the excess max(lambda) - 1 >= 0 of the check below.
+
+    Check Pi_ss >= P_conv[s, s]: the eigenvalues lambda of W = D P_conv[s, s] D, D = diag(Pi_ss)^-1/2, must not
+    exceed 1. Where they do (the filter's random-walk bias model grown past the sensors' stationary prior), the
+    prior is raised to P_conv in those directions only, Pi = D^-1 V max(Lambda, 1) V' D^-1: the draw takes
+    e = x there and the conditional covariance stays positive (its Schur complement)."""
+    n = P_conv.shape[0]
+    if not s.size:
+        mean, C, excess = np.zeros((z.shape[0], n)), P_conv, 0.0
+    else:
+        d = 1.0 / np.sqrt(np.diag(Pi_ss))
+        lam, V = np.linalg.eigh(d[:, None] * P_conv[np.ix_(s, s)] * d[None, :])
+        excess = max(float(lam.max()) - 1.0, 0.0)
+        Pi = Pi_ss
+        if excess > _PSD_TOL:
+            w = np.sqrt(np.maximum(lam, 1.0))
+            Pi = (V * w[None, :]) @ (V * w[None, :]).T / (d[:, None] * d[None, :])
+        G = np.linalg.solve(Pi, P_conv[s, :]).T  # P_conv[:, s] Pi^-1  (n, s)
+        mean = np.stack([G @ xi for xi in x_s]) if len(x_s) else np.zeros((0, n))  # row by row (below)
+        C = P_conv - G @ P_conv[s, :]
+    C = 0.5 * (C + C.T)
+    w, V = np.linalg.eigh(C)
+    scale = max(float(np.max(np.abs(w))), 1e-300)
+    if w.min() < -1e-9 * scale:
+        raise ValueError(f"converged start: conditional covariance not positive ({w.min():.3g})")
+    L = V * np.sqrt(np.clip(w, 0.0, None))[None, :]
+    # one matrix-vector product per run: a run's draw must not depend on the batch it shares (no
+    # batch-size-dependent BLAS path; the campaign relies on it)
+    return mean + np.stack([L @ zi for zi in z]).reshape(mean.shape), excess
+
+
+def draw(system: Any, truth: Any, obs: dict[str, Any], states: SensorStates, rngs: list[np.random.Generator],
+         row: int, P0: Array) -> tuple[Array, Array, Array]:
+    """(e (N, n) the estimation errors, x_hat (N, n) the filter's start estimates, P_conv (n, n)) of the runs
+    (rngs: each run's "nav" stream, n standard normals each)."""
+    lay = system.layout
+    if states.runs != len(rngs):
+        raise ValueError(f"converged start: {states.runs} runs of sensor states for {len(rngs)} runs")
+    P_conv = converged_covariance(system, truth, obs, row, P0, system.nav.initial_error.converge_s)
+    s, x_s = sensor_vector(lay, states, P0)
+    z = np.stack([g.standard_normal(lay.n) for g in rngs])
+    e, _ = condition(P_conv, P0[np.ix_(s, s)], s, x_s, z)
+    x_hat = np.zeros_like(e)
+    x_hat[:, s] = x_s - e[:, s]  # the INS states' estimate is 0 (reset); x_hat_s = x_s - e_s
+    return e, x_hat, P_conv

@@ -1,0 +1,194 @@
+"""A run's realized sensor errors at one truth row, in the units and sign of the navigation filter's error states.
+
+    errors = suite.draw(truth.t_s, seed, runs)
+    records = suite.apply(truth, errors)
+    states = start_states(suite, truth, errors, row=0)        # SensorStates, run axis first
+
+Each field is one filter state group (nav/errormodel.py StateLayout names), the value the filter would have to
+estimate exactly at `row`; None when the suite has no such sensor. Signs follow the measurement rows
+(nav/measurements.py): every state is the error the sensor *adds* to its measurement.
+
+    gse  (N, 24) m    clock/ephemeris + F(el) iono + M(el) tropo of each GPS channel (receiver.py), el at `row`
+    gmp  (N, 24) m    multipath of each channel
+    clk  (N, 2)       receiver clock bias (m) and drift (m/s) (clock.py; shared by GPS and pseudolites)
+    bb   (N,)   m     baro Gauss-Markov bias; sb (N,) its scale factor (baro.py, h_B = h (1 + S) + B + v)
+    bg   (N, 3) rad/s gyro bias in body axes as the INS sees it over the increment after `row`: turn-on +
+                      Gauss-Markov + (S + M) w_ib (scale factor / misalignment at the true rate, imu.py)
+    ba   (N, 3) m/s^2 the same for the accelerometers with (S + M) f_body (the filter's ba lumps them, P0)
+    pmp  (N, p) m     pseudolite multipath; ptr (N, p) tropo residual as a fraction of the range
+    pclk (N, 2p)      pseudolite transmitter clock bias (m) and drift (m/s) pairs (zero when synchronized)
+
+The sample of each sensor taken for `row` is the last one at or before it (the IMU: the increment starting at
+it). White noise (code, baro, IMU ARW / VRW) is not a state and is left out. A new state group is one field
+here and one entry in `_EXTRACT`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, fields, replace
+from typing import Any
+
+import numpy as np
+
+from approachsim.sensors import base
+from approachsim.sensors.gnss.constellation import look_angles
+from approachsim.sensors.gnss.receiver import iono_obliquity, tropo_mapping
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class SensorStates:
+    """Realized sensor error states of N runs at truth row `row` (module docstring: fields, units, signs)."""
+
+    row: int
+    gse: Array | None = None
+    gmp: Array | None = None
+    clk: Array | None = None
+    bb: Array | None = None
+    sb: Array | None = None
+    bg: Array | None = None
+    ba: Array | None = None
+    pmp: Array | None = None
+    ptr: Array | None = None
+    pclk: Array | None = None
+
+    @property
+    def runs(self) -> int:
+        """Number of runs N."""
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, np.ndarray):
+                return int(v.shape[0])
+        return 0
+
+    def group(self, name: str) -> Array | None:
+        """(N, k) values of state group `name` (None when not realized: no such sensor or no such group)."""
+        v = getattr(self, name, None) if name in STATE_GROUPS else None
+        return None if v is None else np.asarray(v, dtype=float).reshape(v.shape[0], -1)
+
+    def take(self, i: int) -> SensorStates:
+        """The states of run i alone (run axis kept, length 1)."""
+        kw = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "row"}
+        return SensorStates(self.row, **{k: None if v is None else v[i:i + 1] for k, v in kw.items()})
+
+
+STATE_GROUPS = tuple(f.name for f in fields(SensorStates) if f.name != "row")
+"""The filter state groups a SensorStates can carry."""
+
+
+@dataclass(frozen=True)
+class _At:
+    """What an extractor sees: the suite, the truth, the drawn errors (batched) and the start row."""
+
+    suite: Any
+    truth: Any
+    errors: Any
+    row: int
+
+    def sample(self, name: str) -> tuple[base.SensorErrors, int] | None:
+        """(errors of sensor `name`, its sample index for the row), or None without that sensor."""
+        e = self.errors.sensors.get(name) if name != "clock" else self.errors.clock
+        if e is None:
+            return None
+        if not e.batched:  # one run drawn alone (the closed loop): give it the run axis
+            e = replace(e, series={k: v[None] for k, v in e.series.items()},
+                        constants={k: np.asarray(v)[None] for k, v in e.constants.items()}, batched=True)
+        j = int(np.searchsorted(e.rows, self.row, side="right")) - 1
+        if name == "imu":
+            j = int(np.searchsorted(e.rows, self.row + 1))  # the increment (row, row + 1]
+        return e, min(max(j, 0), len(e) - 1)
+
+
+def _series(at: _At, sensor: str, key: str) -> Array | None:
+    s = at.sample(sensor)
+    if s is None:
+        return None
+    e, j = s
+    return np.asarray(e.series[key])[:, j]
+
+
+def _gse(at: _At) -> Array | None:
+    s = at.sample("gnss")
+    if s is None:
+        return None
+    e, j = s
+    rx = at.suite.sensors["gnss"]
+    r = at.truth.r_ecef[e.rows[j]][None]
+    _, _, el, _ = look_angles(r, rx.constellation.positions_ecef(e.t_s[j:j + 1]))
+    el = el[0]
+    ser = e.series
+    return (np.asarray(ser["clock_ephemeris"])[:, j] + iono_obliquity(el) * np.asarray(ser["iono_zenith"])[:, j]
+            + tropo_mapping(el) * np.asarray(ser["tropo_zenith"])[:, j])
+
+
+def _clk(at: _At) -> Array | None:
+    s = at.sample("clock")
+    if s is None:
+        return None
+    e, j = s
+    return np.stack([np.asarray(e.series["bias"])[:, j], np.asarray(e.series["drift"])[:, j]], axis=-1)
+
+
+def _imu(at: _At, kind: str) -> Array | None:
+    s = at.sample("imu")
+    if s is None:
+        return None
+    e, j = s
+    inc = at.truth.w_ib_body[at.row] if kind == "gyro" else at.truth.f_body[at.row]
+    m = np.asarray(e.constants[f"{kind}_m"])  # (N, 3, 3) scale factor + misalignment
+    return (np.asarray(e.constants[f"{kind}_bias0"]) + np.asarray(e.series[f"{kind}_bias"])[:, j]
+            + np.einsum("nij,j->ni", m, inc))
+
+
+def _baro_sf(at: _At) -> Array | None:
+    s = at.sample("baro")
+    return None if s is None else np.asarray(s[0].constants["scale_factor"], dtype=float).reshape(-1)
+
+
+def _ptr(at: _At) -> Array | None:
+    s = at.sample("pseudolite")
+    return None if s is None else 1e-6 * np.asarray(s[0].constants["tropo_ppm"])
+
+
+def _pclk(at: _At) -> Array | None:
+    s = at.sample("pseudolite")
+    if s is None:
+        return None
+    e, j = s
+    b, d = np.asarray(e.series["pl_clock"])[:, j], np.asarray(e.series["pl_clock_drift"])[:, j]
+    return np.stack([b, d], axis=-1).reshape(b.shape[0], -1)  # (bias, drift) pairs per transmitter
+
+
+_EXTRACT: dict[str, Callable[[_At], Array | None]] = {
+    "gse": _gse,
+    "gmp": lambda at: _series(at, "gnss", "multipath"),
+    "clk": _clk,
+    "bb": lambda at: _series(at, "baro", "bias"),
+    "sb": _baro_sf,
+    "bg": lambda at: _imu(at, "gyro"),
+    "ba": lambda at: _imu(at, "accel"),
+    "pmp": lambda at: _series(at, "pseudolite", "multipath"),
+    "ptr": _ptr,
+    "pclk": _pclk,
+}
+"""Filter state group -> its realized value from the drawn errors (one entry per group)."""
+
+
+def start_states(suite: Any, truth: Any, errors: Any, row: int = 0) -> SensorStates:
+    """The realized sensor error states at truth row `row` of the runs in `errors` (SuiteErrors from
+    SensorSuite.draw; run axis first, length 1 when drawn for one run)."""
+    at = _At(suite, truth, errors, int(row))
+    return SensorStates(int(row), **{g: _EXTRACT[g](at) for g in STATE_GROUPS})
+
+
+
+
+
+def measure_with_states(suite: Any, truth: Any, seed: int, runs: Any, row: int = 0) -> tuple[dict[str, Any],
+                                                                                            SensorStates]:
+    """(suite.measure(truth, seed, runs), start_states at `row`) from one draw: what NavSystem.run needs."""
+    errors = suite.draw(truth.t_s, seed, runs)
+    return suite.apply(truth, errors), start_states(suite, truth, errors, row)
+__all__ = ["STATE_GROUPS", "SensorStates", "measure_with_states", "start_states"]

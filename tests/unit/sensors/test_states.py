@@ -1,0 +1,79 @@
+"""sensors/states.py: a run's drawn errors mapped to the filter's sensor states reproduce the realized measurement
+errors at the start row (pseudorange error = gse + gmp + clk + noise, baro error = bb + sb h + noise, IMU
+increment error = b dt with zero noise, pseudolite error = ptr range + pmp + pclk + clk + noise)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from approachsim import synthetic
+from approachsim.profile import load_profile
+from approachsim.sensors.config import PseudoliteConfig
+from approachsim.sensors.imu import true_increments
+from approachsim.sensors.states import start_states
+from approachsim.sensors.suite import SensorSuite, SuiteErrors
+
+PROFILE = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+
+
+def _setup(row: int = 0):
+    cfg = replace(PROFILE.sensors, baro=replace(PROFILE.sensors.baro, scale_factor_sigma=1e-3),
+                  pseudolite=PseudoliteConfig(synchronized=False, positions_rwy=((0.0, -150.0, 10.0),
+                                                                                 (300.0, 150.0, 10.0))))
+    suite = SensorSuite.from_config(cfg, PROFILE.runway.frame, PROFILE.environment.setting_pa)
+    truth = synthetic.glidepath_descent(PROFILE.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 20.0,
+                                        ground_speed_mps=70.0)
+    errors = suite.draw(truth.t_s, 4, [0, 1, 2])
+    # zero-noise IMU: only the biases and the scale factor / misalignment remain in the increments
+    imu = errors.sensors["imu"]
+    imu = replace(imu, series={**imu.series, "gyro_noise": 0.0 * imu.series["gyro_noise"],
+                               "accel_noise": 0.0 * imu.series["accel_noise"]})
+    errors = SuiteErrors({**errors.sensors, "imu": imu}, errors.clock)
+    zero = SuiteErrors({k: v.zeroed() for k, v in errors.sensors.items()}, errors.clock.zeroed())
+    return suite, truth, errors, suite.apply(truth, errors), suite.apply(truth, zero), start_states(suite, truth,
+                                                                                                    errors, row)
+
+
+def test_mapped_states_reproduce_the_realized_measurement_errors():
+    suite, truth, errors, rec, exact, st = _setup()
+    assert st.runs == 3
+    g, ge = rec["gnss"], errors.sensors["gnss"]
+    ok = g.valid[:, 0]
+    assert ok.sum() >= 12  # four channels in each of the three runs
+    pr_err = g.pseudorange_m[:, 0] - exact["gnss"].pseudorange_m[:, 0]  # exact: geometric range, zero clock
+    model = st.gse + st.gmp + st.clk[:, :1] + ge.series["noise"][:, 0]
+    np.testing.assert_allclose(pr_err[ok], model[ok], atol=1e-6)
+    # the clock state is the receiver clock of the record (bias, m) and its drift (m/s)
+    np.testing.assert_allclose(st.clk[:, 0], g.clock_bias_m[:, 0], atol=1e-9)
+    np.testing.assert_allclose(st.clk[:, 1], g.clock_drift_mps[:, 0], atol=1e-12)
+    # baro: h_B - h_ind = B + S h_ind + v
+    b = errors.sensors["baro"]
+    h_ind = exact["baro"].h_baro_m[:, 0]
+    np.testing.assert_allclose(rec["baro"].h_baro_m[:, 0] - h_ind, st.bb + st.sb * h_ind + b.series["noise"][:, 0],
+                               atol=1e-9)
+    assert np.all(np.abs(st.sb) > 0.0)
+    # IMU, zero noise: the first increment's error is the body-axis bias the filter's bg / ba states mean
+    dth_t, dv_t, dt = true_increments(truth, np.array([1]))
+    np.testing.assert_allclose((rec["imu"].dtheta_body[:, 0] - dth_t[0]) / dt, st.bg, rtol=1e-9, atol=1e-15)
+    np.testing.assert_allclose((rec["imu"].dv_body[:, 0] - dv_t[0]) / dt, st.ba, rtol=1e-9, atol=1e-12)
+    # pseudolites: rho - |r_pl,true - r| - clk - noise = T |r_pl,true - r| + m + b_PL
+    p, pe = rec["pseudolite"], errors.sensors["pseudolite"]
+    r = truth.r_ecef[0]
+    true_pl = suite.sensors["pseudolite"].r_published_ecef[None] + pe.constants["survey"]
+    rng = np.linalg.norm(true_pl - r, axis=-1)
+    lhs = p.pseudorange_m[:, 0] - rng - st.clk[:, :1] - pe.series["noise"][:, 0]
+    np.testing.assert_allclose(lhs, st.ptr * rng + st.pmp + st.pclk[:, 0::2], atol=1e-6)
+    assert np.all(np.abs(st.pclk[:, 1::2]) > 0.0)  # unsynchronized: their drift is realized too
+
+
+def test_one_run_drawn_alone_gets_the_run_axis_and_the_same_values():
+    suite, truth, errors, _, _, st = _setup()
+    one = suite.draw(truth.t_s, 4, 1)
+    alone = start_states(suite, truth, one)
+    assert alone.runs == 1
+    np.testing.assert_array_equal(alone.gse, st.gse[1:2])
+    np.testing.assert_array_equal(alone.clk, st.clk[1:2])
+    np.testing.assert_array_equal(alone.bb, st.bb[1:2])
