@@ -29,10 +29,12 @@ from approachsim import geo
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import measurements as meas
+from approachsim.nav import terrain_db as tdb
 from approachsim.nav import vertical_loop as vl
 from approachsim.nav.base import FilterState, NavFilter, UpdateStatus
 from approachsim.nav.config import DEFAULT_NAV, NavConfig
 from approachsim.records import NavSolution, Truth
+from approachsim.seeding import substream
 from approachsim.sensors.config import DEFAULT_SENSORS, SensorsConfig
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.receiver import CODE_PRESETS, iono_obliquity, tropo_mapping
@@ -97,6 +99,8 @@ class _Run:
     statuses: list
     bg_fb: Array
     ba_fb: Array
+    terrain_h: Any = None
+    """This run's terrain database (None: the NavSystem's, without a database error)."""
 
 
 @dataclass
@@ -133,6 +137,16 @@ class _SharedCov:
         return [(c, [int(i) for i in np.flatnonzero(self.of_run == c)]) for c in range(len(self.P))]
 
 
+def _radalt_states(sensors: SensorsConfig, nav: NavConfig) -> dict[str, bool]:
+    """StateLayout flags of the radalt / database error states: present with the radar altimeter only, each when
+    its error model is not zero."""
+    r, d = sensors.radalt, nav.terrain_database
+    if r is None:
+        return {}
+    return {"radalt_bias": r.bias_sigma_m > 0.0 or d.bias_sigma_m > 0.0, "radalt_markov": r.markov_sigma_m > 0.0,
+            "terrain_db": d.correlated}
+
+
 def _epoch_index(t_rec: Array, t: float, tol: float) -> int | None:
     """Index of the record sample at time t (within tol), or None."""
     i = int(np.searchsorted(t_rec, t - tol))
@@ -144,15 +158,19 @@ def _epoch_index(t_rec: Array, t: float, tol: float) -> int | None:
 @dataclass(frozen=True)
 class TerrainDatabase:
     """The filter's terrain: ellipsoid height (m) at ECEF points (..., 3) from the profile's Terrain along the
-    runway x axis (flat at the threshold height when terrain is None). A picklable callable."""
+    runway x axis (flat at the threshold height when terrain is None), plus one run's database error
+    (nav/terrain_db.py: a function of the along-track x) when given. A picklable callable."""
 
     runway: geo.RunwayFrame
     terrain: Any = None
+    error: Any = None
 
     def __call__(self, r_ecef: Array) -> Array:
-        if self.terrain is None:
+        if self.terrain is None and self.error is None:
             return np.full(np.shape(r_ecef)[:-1], self.runway.threshold_h_m)
-        return self.terrain.height_at(self.runway.from_ecef(r_ecef)[..., 0])
+        x = self.runway.from_ecef(r_ecef)[..., 0]
+        t = np.full(np.shape(x), self.runway.threshold_h_m) if self.terrain is None else self.terrain.height_at(x)
+        return t if self.error is None else t + self.error(x)
 
 
 @dataclass(frozen=True)
@@ -186,6 +204,7 @@ class NavSystem:
             n_sv=n_sv,
             n_pl=n_pl,
             pl_clock=n_pl > 0 and not sensors.pseudolite.synchronized,
+            **_radalt_states(sensors, nav),
         )
         return cls(nav=nav, sensors=sensors, runway=rwy, terrain_h=terrain_h, filter=nav.make_filter(),
                    layout=layout)
@@ -227,6 +246,9 @@ class NavSystem:
                 pc = ClockModel.named("ocxo", 30.0, 0.03)
                 q = pc.q(1.0)
                 kw.update(pclk_sf=q[0, 0] - q[1, 1] / 3.0, pclk_sg=q[1, 1])
+        if self.sensors.radalt is not None:
+            kw.update(ram_sigma_m=self.sensors.radalt.markov_sigma_m, ram_tau_s=self.sensors.radalt.markov_tau_s,
+                      tdb_correlation_m=self.nav.terrain_database.correlation_m)
         q1 = clk.q(1.0)  # Q(1 s) = [[S_f + S_g / 3, S_g / 2], [., S_g]]
         return em.ErrorNoise(
             gyro_arw_rad_sqrts=g.gyro_arw_rad_sqrts,
@@ -271,6 +293,7 @@ class NavSystem:
             d[lay.index["ptr"]] = (p.tropo_ppm_sigma * 1e-6) ** 2
             if lay.has("pclk"):
                 d[lay.index["pclk"]] = np.tile([30.0**2, 0.03**2], lay.n_pl)
+        self._radalt_p0(d)
         return np.diag(d)
 
     # --- one pass ------------------------------------------------------------------------------------------
@@ -288,6 +311,7 @@ class NavSystem:
         e = np.stack([sd * g.standard_normal(9) for g in rngs])  # INS errors after alignment + cruise
         s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
         runs = [_Run(self.filter.init(np.zeros(self.layout.n), P0), [], np.zeros(3), np.zeros(3)) for _ in rngs]
+        self._attach_terrain(runs, rngs)
         return s, runs
 
     def loop_slopes(self, fs: FilterState, h_m: float, noise: em.ErrorNoise) -> vl.LoopGains | None:
@@ -346,7 +370,7 @@ class NavSystem:
                                 noise, gains)
             phi, qd = em.discretize(F, Qc, dt_epoch)
             fs = self.filter.predict(run.fs, phi, qd)
-            for m in self._measurements(s, i, r_ins[i], fs, obs, t):
+            for m in self._measurements(s, i, r_ins[i], fs, obs, t, terrain_h=run.terrain_h):
                 fs, st = self.filter.update(fs, m(fs.x))
                 run.statuses.append(st)
             run.fs = fs
@@ -407,7 +431,8 @@ class NavSystem:
                 Ph = P @ h0
                 S = float(h0 @ Ph + r)  # S = h' P h + r (shared)
                 K = Ph / S  # K = P h S^-1 (shared)
-                nu = self._innovations(m0.name, X[idx], idx, s, r_ins[idx], c_en, obs)  # z - g(x_hat_i)
+                nu = self._innovations(m0.name, X[idx], idx, s, r_ins[idx], c_en, obs,
+                                       terrain=[runs[i].terrain_h for i in members])  # z - g(x_hat_i)
                 X[idx] = X[idx] + nu[:, None] * K[None, :]  # x+ = x- + K nu (row by row)
                 for i, v in zip(members, nu.tolist(), strict=True):
                     runs[i].statuses.append(UpdateStatus(m0.name, t, v, S, v * v / S, 1.0, True))
@@ -422,10 +447,11 @@ class NavSystem:
         return s
 
     def _innovations(self, name: str, X: Array, idx: Array, s: ins.InsState, r_ins: Array, c_en: Array,
-                     obs: Mapping[str, Any]) -> Array:
+                     obs: Mapping[str, Any], terrain: list | None = None) -> Array:
         """Innovations nu = z - g(x_hat) (m) of measurement `name` for runs idx at once, X (M, n) their
         estimates: the exact differences of nav.measurements (baro, radalt, pseudorange) evaluated at each
-        run's x_hat, elementwise (a run's value does not depend on the others')."""
+        run's x_hat, elementwise (a run's value does not depend on the others'). terrain: each run's terrain
+        database (None entries or None: the NavSystem's)."""
         lay = self.layout
         h_ins = s.h_m[idx]
         if name == "baro":
@@ -436,8 +462,9 @@ class NavSystem:
         dp = X[:, lay.index["dp"]]
         # corrected position r_hat = r_ins - C_ne dp_hat, written out (C_ne = C_en'): no batch-size-dependent path
         r_hat = r_ins - (c_en[:, 0, :] * dp[:, 0:1] + c_en[:, 1, :] * dp[:, 1:2] + c_en[:, 2, :] * dp[:, 2:3])
-        if name == "radalt":  # (h_ins - T(ins) - h_R) - g(x_hat) = (h_ins + dp_D) - T(r_hat) - h_R
-            return (h_ins + dp[:, 2]) - self.terrain_h(r_hat) - obs["radalt_h"][idx]
+        if name == "radalt":  # (h_ins - T(ins) - h_R) - g(x_hat) = (h_ins + dp_D) - T(r_hat) - h_R + rab + ram + s tdb
+            return ((h_ins + dp[:, 2]) - self._terrain_rows(r_hat, terrain) - obs["radalt_h"][idx]
+                    + self._radalt_state_terms(X, r_ins))
         if name.startswith("gps"):
             k = int(name[3:])
             d = r_hat - obs["gnss_rsv"][k]
@@ -492,8 +519,9 @@ class NavSystem:
         return out
 
     def _measurements(self, s: ins.InsState, i: int, r_ins: Array, fs: FilterState, obs: Mapping[str, Any],
-                      t: float) -> list[Callable[[Array], Any]]:
-        """Row builders for run i at this epoch (each takes the current x_hat: sequential relinearization)."""
+                      t: float, terrain_h: Callable[[Array], Array] | None = None) -> list[Callable[[Array], Any]]:
+        """Row builders for run i at this epoch (each takes the current x_hat: sequential relinearization);
+        terrain_h: run i's terrain database (None: the NavSystem's)."""
         lay = self.layout
         lat, lon, h = float(s.lat_rad[i]), float(s.lon_rad[i]), float(s.h_m[i])
         out: list[Callable[[Array], Any]] = []
@@ -503,7 +531,9 @@ class NavSystem:
         if "radalt_h" in obs and np.isfinite(obs["radalt_h"][i]):
             hr = float(obs["radalt_h"][i])
             sr = float(np.sqrt((self.sensors.radalt.percent_sigma * hr) ** 2 + self.sensors.radalt.floor_m**2))
-            out.append(lambda x: meas.radalt(lay, x, lat, lon, h, hr, sr, self.terrain_h, t))
+            th = self.terrain_h if terrain_h is None else terrain_h
+            ts = float(self._tdb_sigma(r_ins))
+            out.append(lambda x: meas.radalt(lay, x, lat, lon, h, hr, sr, th, t, tdb_sigma_m=ts))
         c_en = geo.c_ecef_to_ned(lat, lon)
         if "gnss_rho" in obs and self.nav.gps_coupling == "loose":
             fix = meas.gps_fix(r_ins, obs["gnss_rsv"], obs["gnss_rho"][i], obs["gnss_sigma"])
@@ -532,6 +562,51 @@ class NavSystem:
                     sk = float(obs["pl_sigma"][k])
                 out.append(lambda x, k=k, sk=sk, rk=float(rho[k]), rp=r_pl[k]: meas.pseudorange(
                     lay, x, r_ins, c_en, rp, rk, sk, t, f"pl{k}", pl=int(k) if lay.has("pmp") else None))
+        return out
+
+    # --- radar altimeter and terrain database errors (rab, ram, tdb) ------------------------------------------
+
+    def _radalt_p0(self, d: Array) -> None:
+        """P0 of the radalt / database states into the diagonal d (in place): rab the altimeter and database bias
+        variances summed, ram the Markov variance (stationary), tdb 1 (unit Gauss-Markov)."""
+        lay = self.layout
+        if lay.has("rab"):
+            d[lay.i("rab")] = self.sensors.radalt.bias_sigma_m**2 + self.nav.terrain_database.bias_sigma_m**2
+        if lay.has("ram"):
+            d[lay.i("ram")] = self.sensors.radalt.markov_sigma_m**2
+        if lay.has("tdb"):
+            d[lay.i("tdb")] = 1.0
+
+    def _attach_terrain(self, runs: list[_Run], rngs: list[np.random.Generator]) -> None:
+        """Each run's terrain database: the truth terrain + its own error realization, drawn from the child stream
+        "terrain_db" of its nav stream (the nav stream's own draws are untouched). No radar altimeter or a zero
+        error model: the NavSystem's database."""
+        cfg = self.nav.terrain_database
+        if self.sensors.radalt is None or cfg.zero or not isinstance(self.terrain_h, TerrainDatabase):
+            return
+        for r, g in zip(runs, rngs, strict=True):
+            r.terrain_h = replace(self.terrain_h, error=tdb.draw(cfg, substream(g, "terrain_db")))
+
+    def _tdb_sigma(self, r_ecef: Array) -> Array:
+        """The database's correlated 1-sigma (m) at ECEF points (..., 3): the H coefficient of the tdb state."""
+        return self.nav.terrain_database.sigma_at(self.runway.from_ecef(r_ecef)[..., 0])
+
+    def _terrain_rows(self, r_ecef: Array, terrain: list | None) -> Array:
+        """Terrain database heights (M,) at r_ecef (M, 3), each row from its run's database when given."""
+        if terrain is None or all(f is None for f in terrain):
+            return self.terrain_h(r_ecef)
+        return np.array([float((self.terrain_h if f is None else f)(r)) for f, r in zip(terrain, r_ecef, strict=True)])
+
+    def _radalt_state_terms(self, X: Array, r_ins: Array) -> Array:
+        """rab + ram + sigma_db(x) tdb (M,) of estimates X (M, n): what the radalt innovation adds back."""
+        lay = self.layout
+        out = np.zeros(X.shape[0])
+        if lay.has("rab"):
+            out = out + X[:, lay.i("rab")]
+        if lay.has("ram"):
+            out = out + X[:, lay.i("ram")]
+        if lay.has("tdb"):
+            out = out + self._tdb_sigma(r_ins) * X[:, lay.i("tdb")]
         return out
 
     def _feedback(self, s: ins.InsState, runs: list[_Run]) -> ins.InsState:
