@@ -55,10 +55,12 @@ def radalt(
     t_s: float,
     name: str = "radalt",
     tdb_sigma_m: float = 0.0,
+    db_error_m: float = 0.0,
 ) -> ScalarMeasurement:
     """Radar altimeter: INS height above the terrain database minus the measured height above terrain.
 
-    terrain_h(r_ecef (..., 3)) -> terrain ellipsoid height (...,), m (the filter's database). The terrain gradient
+    terrain_h(r_ecef (..., 3)) -> terrain ellipsoid height (...,), m; the filter's database at the INS position
+    is terrain_h(r_ins) + db_error_m (the run's database error there, nav/terrain_db.py). The terrain gradient
     enters through the horizontal position error (central differences over 10 m). The correlated errors enter
     linearly: -1 at rab (altimeter + database bias) and ram (altimeter Markov), -tdb_sigma_m (the database's
     correlated 1-sigma at the aircraft, m) at tdb (its unit Gauss-Markov), where the layout has them.
@@ -72,7 +74,7 @@ def radalt(
     grad = np.array([(t4[0] - t4[1]) / 20.0, (t4[2] - t4[3]) / 20.0])  # dT/dN, dT/dE, m/m
     t_ins = float(terrain_h(r_ins))
     t_hat = float(terrain_h(r_hat))
-    z = (h_ins_m - t_ins) - h_agl_m
+    z = (h_ins_m - t_ins - db_error_m) - h_agl_m
     g_hat = (h_ins_m - t_ins) - ((h_ins_m + dp_hat[2]) - t_hat)  # exact difference at x_hat
     h = _row(layout)
     h[layout.i("dp", 0)] = -grad[0]

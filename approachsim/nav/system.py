@@ -99,8 +99,8 @@ class _Run:
     statuses: list
     bg_fb: Array
     ba_fb: Array
-    terrain_h: Any = None
-    """This run's terrain database (None: the NavSystem's, without a database error)."""
+    db_error: tdb.TerrainDbError | None = None
+    """This run's terrain-database error (None: the database is the truth terrain)."""
 
 
 @dataclass
@@ -158,19 +158,16 @@ def _epoch_index(t_rec: Array, t: float, tol: float) -> int | None:
 @dataclass(frozen=True)
 class TerrainDatabase:
     """The filter's terrain: ellipsoid height (m) at ECEF points (..., 3) from the profile's Terrain along the
-    runway x axis (flat at the threshold height when terrain is None), plus one run's database error
-    (nav/terrain_db.py: a function of the along-track x) when given. A picklable callable."""
+    runway x axis (flat at the threshold height when terrain is None). A picklable callable. Each run's
+    database adds its own error realization to it (nav/terrain_db.py, `_Run.db_error`)."""
 
     runway: geo.RunwayFrame
     terrain: Any = None
-    error: Any = None
 
     def __call__(self, r_ecef: Array) -> Array:
-        if self.terrain is None and self.error is None:
+        if self.terrain is None:
             return np.full(np.shape(r_ecef)[:-1], self.runway.threshold_h_m)
-        x = self.runway.from_ecef(r_ecef)[..., 0]
-        t = np.full(np.shape(x), self.runway.threshold_h_m) if self.terrain is None else self.terrain.height_at(x)
-        return t if self.error is None else t + self.error(x)
+        return self.terrain.height_at(self.runway.from_ecef(r_ecef)[..., 0])
 
 
 @dataclass(frozen=True)
@@ -370,7 +367,7 @@ class NavSystem:
                                 noise, gains)
             phi, qd = em.discretize(F, Qc, dt_epoch)
             fs = self.filter.predict(run.fs, phi, qd)
-            for m in self._measurements(s, i, r_ins[i], fs, obs, t, terrain_h=run.terrain_h):
+            for m in self._measurements(s, i, r_ins[i], fs, obs, t, db_error=run.db_error):
                 fs, st = self.filter.update(fs, m(fs.x))
                 run.statuses.append(st)
             run.fs = fs
@@ -432,7 +429,7 @@ class NavSystem:
                 S = float(h0 @ Ph + r)  # S = h' P h + r (shared)
                 K = Ph / S  # K = P h S^-1 (shared)
                 nu = self._innovations(m0.name, X[idx], idx, s, r_ins[idx], c_en, obs,
-                                       terrain=[runs[i].terrain_h for i in members])  # z - g(x_hat_i)
+                                       db_error=[runs[i].db_error for i in members])  # z - g(x_hat_i)
                 X[idx] = X[idx] + nu[:, None] * K[None, :]  # x+ = x- + K nu (row by row)
                 for i, v in zip(members, nu.tolist(), strict=True):
                     runs[i].statuses.append(UpdateStatus(m0.name, t, v, S, v * v / S, 1.0, True))
@@ -447,11 +444,11 @@ class NavSystem:
         return s
 
     def _innovations(self, name: str, X: Array, idx: Array, s: ins.InsState, r_ins: Array, c_en: Array,
-                     obs: Mapping[str, Any], terrain: list | None = None) -> Array:
+                     obs: Mapping[str, Any], db_error: list | None = None) -> Array:
         """Innovations nu = z - g(x_hat) (m) of measurement `name` for runs idx at once, X (M, n) their
         estimates: the exact differences of nav.measurements (baro, radalt, pseudorange) evaluated at each
-        run's x_hat, elementwise (a run's value does not depend on the others'). terrain: each run's terrain
-        database (None entries or None: the NavSystem's)."""
+        run's x_hat, elementwise (a run's value does not depend on the others'). db_error: each run's
+        terrain-database error (None: none)."""
         lay = self.layout
         h_ins = s.h_m[idx]
         if name == "baro":
@@ -462,9 +459,10 @@ class NavSystem:
         dp = X[:, lay.index["dp"]]
         # corrected position r_hat = r_ins - C_ne dp_hat, written out (C_ne = C_en'): no batch-size-dependent path
         r_hat = r_ins - (c_en[:, 0, :] * dp[:, 0:1] + c_en[:, 1, :] * dp[:, 1:2] + c_en[:, 2, :] * dp[:, 2:3])
-        if name == "radalt":  # (h_ins - T(ins) - h_R) - g(x_hat) = (h_ins + dp_D) - T(r_hat) - h_R + rab + ram + s tdb
-            return ((h_ins + dp[:, 2]) - self._terrain_rows(r_hat, terrain) - obs["radalt_h"][idx]
-                    + self._radalt_state_terms(X, r_ins))
+        if name == "radalt":  # (h_ins - T_db(ins) - h_R) - g(x_hat): T_db(ins) = T(ins) + e(x_ins),
+            # g = (h_ins - T(ins)) - (h_ins + dp_D - T(r_hat)) - rab - ram - s tdb
+            return ((h_ins + dp[:, 2]) - self.terrain_h(r_hat) - self._db_offsets(r_ins, db_error)
+                    - obs["radalt_h"][idx] + self._radalt_state_terms(X, r_ins))
         if name.startswith("gps"):
             k = int(name[3:])
             d = r_hat - obs["gnss_rsv"][k]
@@ -519,9 +517,9 @@ class NavSystem:
         return out
 
     def _measurements(self, s: ins.InsState, i: int, r_ins: Array, fs: FilterState, obs: Mapping[str, Any],
-                      t: float, terrain_h: Callable[[Array], Array] | None = None) -> list[Callable[[Array], Any]]:
+                      t: float, db_error: tdb.TerrainDbError | None = None) -> list[Callable[[Array], Any]]:
         """Row builders for run i at this epoch (each takes the current x_hat: sequential relinearization);
-        terrain_h: run i's terrain database (None: the NavSystem's)."""
+        db_error: run i's terrain-database error (None: the database is the truth terrain)."""
         lay = self.layout
         lat, lon, h = float(s.lat_rad[i]), float(s.lon_rad[i]), float(s.h_m[i])
         out: list[Callable[[Array], Any]] = []
@@ -531,9 +529,11 @@ class NavSystem:
         if "radalt_h" in obs and np.isfinite(obs["radalt_h"][i]):
             hr = float(obs["radalt_h"][i])
             sr = float(np.sqrt((self.sensors.radalt.percent_sigma * hr) ** 2 + self.sensors.radalt.floor_m**2))
-            th = self.terrain_h if terrain_h is None else terrain_h
-            ts = float(self._tdb_sigma(r_ins))
-            out.append(lambda x: meas.radalt(lay, x, lat, lon, h, hr, sr, th, t, tdb_sigma_m=ts))
+            along = float(self.runway.from_ecef(r_ins)[0])
+            ts = float(self.nav.terrain_database.sigma_at(along))
+            de = 0.0 if db_error is None else float(db_error(along))
+            out.append(lambda x: meas.radalt(lay, x, lat, lon, h, hr, sr, self.terrain_h, t, tdb_sigma_m=ts,
+                                             db_error_m=de))
         c_en = geo.c_ecef_to_ned(lat, lon)
         if "gnss_rho" in obs and self.nav.gps_coupling == "loose":
             fix = meas.gps_fix(r_ins, obs["gnss_rsv"], obs["gnss_rho"][i], obs["gnss_sigma"])
@@ -578,24 +578,28 @@ class NavSystem:
             d[lay.i("tdb")] = 1.0
 
     def _attach_terrain(self, runs: list[_Run], rngs: list[np.random.Generator]) -> None:
-        """Each run's terrain database: the truth terrain + its own error realization, drawn from the child stream
-        "terrain_db" of its nav stream (the nav stream's own draws are untouched). No radar altimeter or a zero
-        error model: the NavSystem's database."""
+        """Each run's terrain database = the truth terrain + its own error realization e(x), drawn from the child
+        stream "terrain_db" of its nav stream (the nav stream's own draws are untouched). No radar altimeter or a
+        zero error model: no error. The filter looks its database up at the INS position: e enters the radalt
+        difference as e(x_ins), carried by the rab / tdb states (its own along-track gradient, not differentiable
+        for a Gauss-Markov field, is not linearized: the INS's slowly varying along-track error only shifts where
+        the field is sampled, which leaves u(x_ins(t)) a Gauss-Markov of the same time constant)."""
         cfg = self.nav.terrain_database
-        if self.sensors.radalt is None or cfg.zero or not isinstance(self.terrain_h, TerrainDatabase):
+        if self.sensors.radalt is None or cfg.zero:
             return
         for r, g in zip(runs, rngs, strict=True):
-            r.terrain_h = replace(self.terrain_h, error=tdb.draw(cfg, substream(g, "terrain_db")))
+            r.db_error = tdb.draw(cfg, substream(g, "terrain_db"))
 
     def _tdb_sigma(self, r_ecef: Array) -> Array:
         """The database's correlated 1-sigma (m) at ECEF points (..., 3): the H coefficient of the tdb state."""
         return self.nav.terrain_database.sigma_at(self.runway.from_ecef(r_ecef)[..., 0])
 
-    def _terrain_rows(self, r_ecef: Array, terrain: list | None) -> Array:
-        """Terrain database heights (M,) at r_ecef (M, 3), each row from its run's database when given."""
-        if terrain is None or all(f is None for f in terrain):
-            return self.terrain_h(r_ecef)
-        return np.array([float((self.terrain_h if f is None else f)(r)) for f, r in zip(terrain, r_ecef, strict=True)])
+    def _db_offsets(self, r_ins: Array, db_error: list | None) -> Array:
+        """Each run's terrain-database error (M,) at its INS position r_ins (M, 3), m (0 without one)."""
+        if db_error is None or all(e is None for e in db_error):
+            return np.zeros(r_ins.shape[0])
+        x = self.runway.from_ecef(r_ins)[:, 0]
+        return np.array([0.0 if e is None else float(e(xi)) for e, xi in zip(db_error, x, strict=True)])
 
     def _radalt_state_terms(self, X: Array, r_ins: Array) -> Array:
         """rab + ram + sigma_db(x) tdb (M,) of estimates X (M, n): what the radalt innovation adds back."""

@@ -81,6 +81,10 @@ class TerrainDbConfig:
         return GRID_X_M[0] + dx * np.arange(n)
 
 
+EXACT = TerrainDbConfig(bias_sigma_m=0.0, sigma_m=0.0, outer_sigma_m=0.0)
+"""No database error: the filter's database is the truth terrain (the model before the realism defaults)."""
+
+
 @dataclass(frozen=True)
 class TerrainDbError:
     """One run's database error: T_db - T (m) as a function of along-track x (m)."""
