@@ -14,11 +14,11 @@ datum-wide offset and the point-to-point error, so the Area 4 variance is split 
 both areas: one vertical reference), Area 4 correlated 0.430 m; Area 2 correlated sqrt(1.824^2 - 0.430^2) =
 1.772 m. Beyond the threshold (runway, Area 3: 0.5 m at 90 %) the Area 4 figure is kept (conservative).
 
-Correlation length L = 300 m (argued, not sourced): DEM error studies (Rolstad et al. 2009; Hugonnet et al.,
-"Uncertainty analysis of digital elevation models by spatial inference from stable terrain", 2022) find a
-short-range correlation of a few to about ten post spacings plus a long-range part; ten Area 2 post spacings
-(1 arc second, about 30 m) give 300 m, and the long-range part is the bias. It is a third of Area 4's length, so
-the database error near the threshold is not averaged away over the last 900 m.
+Correlation length L = 300 m (argued, not sourced): DEM errors are correlated over several ranges at once, from
+a few grid spacings up to kilometres (Hugonnet et al., "Uncertainty analysis of digital elevation models by
+spatial inference from stable terrain", 2022). We keep one short range, ten Area 2 post spacings (1 arc second,
+about 30 m) = 300 m, and let the bias stand for the long-range part. It is a third of Area 4's length, so the
+database error near the threshold is not averaged away over the last 900 m.
 
 The realization is tabulated on a fixed along-track grid (GRID_X_M, spacing min(5 m, L / 20), exact
 discretization exp(-dx / L)) and interpolated linearly; it is held constant outside the grid. Drawn per run from
