@@ -22,6 +22,12 @@
     category = "CAT II"            # whose continuity budget sets the false-alert allocation
     window = 20                    # epochs of the w-test moving sum (gradual failures)
     rollback_epochs = 30           # epochs re-run without the excluded source after an exclusion
+    [nav.terrain_database]         # the filter's terrain database = truth + bias + along-track Gauss-Markov
+    bias_sigma_m = 0.430           #   (nav/terrain_db.py: ICAO Annex 15 Area 4 / Area 2 accuracies); all zero:
+    sigma_m = 0.430                #   the truth terrain exactly
+    outer_sigma_m = 1.772
+    area4_length_m = 900.0
+    correlation_m = 300.0
 
 A bad key or value raises ProfileError naming the field; an unknown filter fails here, at load.
 """
@@ -34,6 +40,7 @@ from typing import Any
 from approachsim.config import ProfileError, Section
 from approachsim.integrity.requirements import REQUIREMENTS
 from approachsim.nav import registry
+from approachsim.nav import terrain_db as tdb
 from approachsim.nav import vertical_loop as vl
 from approachsim.nav.fde import FdeConfig
 
@@ -73,6 +80,7 @@ class NavConfig:
     baro_loop_b_per_m: float = 0.5
     initial_error: InitialError = field(default_factory=InitialError)
     fde: FdeConfig = field(default_factory=FdeConfig)
+    terrain_database: tdb.TerrainDbConfig = field(default_factory=tdb.TerrainDbConfig)
 
     def make_filter(self) -> Any:
         """The filter object named by `filter`, with its tuning."""
@@ -124,11 +132,12 @@ def parse_nav(s: Section) -> NavConfig:
         rollback_epochs=fs.integer("rollback_epochs", 30, lo=0, hi=600),
     )
     fs.done()
+    terrain_database = tdb.parse(s.section("terrain_database"))
     s.done()
     cfg = NavConfig(
         filter=name, filter_tuning=tuple(sorted(tuning.items())), aiding_rate_hz=rate, feedback=feedback,
         gps_coupling=coupling, channel_states=channel, baro_loop=loop, baro_loop_tau_s=tau,
-        baro_loop_b_per_m=b, initial_error=init, fde=fde,
+        baro_loop_b_per_m=b, initial_error=init, fde=fde, terrain_database=terrain_database,
     )
     try:
         cfg.make_filter()  # unknown filter or bad tuning fails at load, not an hour into a campaign

@@ -17,6 +17,10 @@ States (a `StateLayout` says which are present and where):
     pmp  (p)  per-pseudolite multipath, m, Gauss-Markov
     ptr  (p)  per-pseudolite tropospheric residual, fraction of the range (random constant)
     pclk (2p) per-pseudolite transmitter clock bias and drift (unsynchronized pseudolites only)
+    rab  (1)  radar-altimeter bias + terrain-database bias, m (random constant: both enter the radalt row as -1)
+    ram  (1)  radar-altimeter Markov error, m (Gauss-Markov, seed 000 eq. 5)
+    tdb  (1)  terrain-database along-track error, unit Gauss-Markov u (the error is sigma(x) u, nav/terrain_db.py)
+              in time with tau = L / ground speed (exact for a constant speed along the track)
 
 The channel states are what make the filter honest about time-correlated range errors: seed 002's 2-state
 GPS model absorbed them in a tuned R; here they are carried (and decoupled, so discretized exactly).
@@ -62,6 +66,10 @@ class StateLayout:
     """Pseudolites with their own error states (0: none)."""
     pl_clock: bool = False
     """Pseudolites carry their own clock (unsynchronized)."""
+    radalt_bias: bool = False
+    radalt_markov: bool = False
+    terrain_db: bool = False
+    """Radar-altimeter / terrain-database error states rab, ram, tdb (module docstring)."""
     index: dict[str, slice] = field(init=False, compare=False)
     n: int = field(init=False, compare=False)
 
@@ -79,6 +87,8 @@ class StateLayout:
             sizes += [("pmp", self.n_pl), ("ptr", self.n_pl)]
             if self.pl_clock:
                 sizes.append(("pclk", 2 * self.n_pl))
+        sizes += [(g, 1) for g, on in (("rab", self.radalt_bias), ("ram", self.radalt_markov),
+                                       ("tdb", self.terrain_db)) if on]
         index, i = {}, 0
         for name, k in sizes:
             index[name] = slice(i, i + k)
@@ -131,6 +141,10 @@ class ErrorNoise:
     pmp_tau_s: float = 30.0
     pclk_sf: float = 0.0
     pclk_sg: float = 0.0
+    ram_sigma_m: float = 0.0
+    ram_tau_s: float = 10.0
+    tdb_correlation_m: float = 300.0
+    """Along-track correlation length of the terrain-database error, m (tau = L / max(ground speed, 1 m/s))."""
 
 
 def _markov(F: Array, Qc: Array, sl: slice, sigma: float | Array, tau_s: float) -> None:
@@ -241,6 +255,10 @@ def dynamics(
             F[ic, ic + 1] = 1.0
             Qc[ic, ic] = noise.pclk_sf
             Qc[ic + 1, ic + 1] = noise.pclk_sg
+    if layout.has("ram"):
+        _markov(F, Qc, ix["ram"], noise.ram_sigma_m, noise.ram_tau_s)
+    if layout.has("tdb"):
+        _markov(F, Qc, ix["tdb"], 1.0, noise.tdb_correlation_m / max(float(np.hypot(vn, ve)), 1.0))
     if layout.has("ac"):
         if loop is None:
             raise ValueError("layout has the loop state 'ac' but no loop gains were given")

@@ -9,7 +9,8 @@ row is an EKF linearization about the current estimate x_hat: with g(x) the exac
 
 Rows (index names from errormodel.StateLayout):
     baro      z = h_ins - h_baro        = -dp_D - bb - h sb + v                      (seed 002; seed 003 eq. 6)
-    radalt    z = (h_ins - T(ins)) - h_R = -dp_D - grad T . dp_h + v, R = (0.01 h)^2 + floor^2 (seed 002)
+    radalt    z = (h_ins - T(ins)) - h_R = -dp_D - grad T . dp_h - rab - ram - sigma_db(x) tdb + v,
+              R = (0.01 h)^2 + floor^2 (seed 002; rab, ram, tdb: errormodel, nav/terrain_db.py)
     range     z = |r_ins - r_tx| - rho  = e . dp - clk - gse - gmp (+ pseudolite terms) + v   (seed 002 sec. 6)
     position  z = p_ins - p_gps (NED, per axis)  (loosely-coupled option)
 """
@@ -53,11 +54,16 @@ def radalt(
     terrain_h: Callable[[Array], Array],
     t_s: float,
     name: str = "radalt",
+    tdb_sigma_m: float = 0.0,
+    db_error_m: float = 0.0,
 ) -> ScalarMeasurement:
     """Radar altimeter: INS height above the terrain database minus the measured height above terrain.
 
-    terrain_h(r_ecef (..., 3)) -> terrain ellipsoid height (...,), m. The terrain gradient enters through
-    the horizontal position error (central differences over 10 m).
+    terrain_h(r_ecef (..., 3)) -> terrain ellipsoid height (...,), m; the filter's database at the INS position
+    is terrain_h(r_ins) + db_error_m (the run's database error there, nav/terrain_db.py). The terrain gradient
+    enters through the horizontal position error (central differences over 10 m). The correlated errors enter
+    linearly: -1 at rab (altimeter + database bias) and ram (altimeter Markov), -tdb_sigma_m (the database's
+    correlated 1-sigma at the aircraft, m) at tdb (its unit Gauss-Markov), where the layout has them.
     """
     c_ne = geo.c_ecef_to_ned(lat_rad, lon_rad).T
     r_ins = geo.geodetic_to_ecef(lat_rad, lon_rad, h_ins_m)
@@ -68,12 +74,16 @@ def radalt(
     grad = np.array([(t4[0] - t4[1]) / 20.0, (t4[2] - t4[3]) / 20.0])  # dT/dN, dT/dE, m/m
     t_ins = float(terrain_h(r_ins))
     t_hat = float(terrain_h(r_hat))
-    z = (h_ins_m - t_ins) - h_agl_m
+    z = (h_ins_m - t_ins - db_error_m) - h_agl_m
     g_hat = (h_ins_m - t_ins) - ((h_ins_m + dp_hat[2]) - t_hat)  # exact difference at x_hat
     h = _row(layout)
     h[layout.i("dp", 0)] = -grad[0]
     h[layout.i("dp", 1)] = -grad[1]
     h[layout.i("dp", 2)] = -1.0
+    for g, c in (("rab", -1.0), ("ram", -1.0), ("tdb", -tdb_sigma_m)):
+        if layout.has(g):
+            h[layout.i(g)] = c
+            g_hat += c * float(x_hat[layout.i(g)])  # linear in the correlated-error states
     return ScalarMeasurement(z=float(z - g_hat + h @ x_hat), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
 
 

@@ -34,11 +34,13 @@ from approachsim import geo
 from approachsim.nav import errormodel as em
 from approachsim.nav import initial, ins
 from approachsim.nav import measurements as meas
+from approachsim.nav import terrain_db as tdb
 from approachsim.nav import vertical_loop as vl
 from approachsim.nav.base import FilterState, NavFilter, UpdateStatus
 from approachsim.nav.config import DEFAULT_NAV, NavConfig
 from approachsim.nav.fde import RESET_GROUPS, FdeState
 from approachsim.records import NavSolution, Truth
+from approachsim.seeding import substream
 from approachsim.sensors.config import DEFAULT_SENSORS, SensorsConfig
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.receiver import iono_obliquity, tropo_mapping
@@ -106,6 +108,8 @@ class _Run:
     ba_fb: Array
     fde: FdeState | None = None
     """Online fault detection and exclusion ([nav.fde] enabled), else None."""
+    db_error: tdb.TerrainDbError | None = None
+    """This run's terrain-database error (None: the database is the truth terrain)."""
 
 
 @dataclass
@@ -148,6 +152,16 @@ class _SharedCov:
         return [(c, [int(i) for i in np.flatnonzero(self.of_run == c)]) for c in range(len(self.P))]
 
 
+def _radalt_states(sensors: SensorsConfig, nav: NavConfig) -> dict[str, bool]:
+    """StateLayout flags of the radalt / database error states: present with the radar altimeter only, each when
+    its error model is not zero."""
+    r, d = sensors.radalt, nav.terrain_database
+    if r is None:
+        return {}
+    return {"radalt_bias": r.bias_sigma_m > 0.0 or d.bias_sigma_m > 0.0, "radalt_markov": r.markov_sigma_m > 0.0,
+            "terrain_db": d.correlated}
+
+
 def _epoch_index(t_rec: Array, t: float, tol: float) -> int | None:
     """Index of the record sample at time t (within tol), or None."""
     i = int(np.searchsorted(t_rec, t - tol))
@@ -159,7 +173,8 @@ def _epoch_index(t_rec: Array, t: float, tol: float) -> int | None:
 @dataclass(frozen=True)
 class TerrainDatabase:
     """The filter's terrain: ellipsoid height (m) at ECEF points (..., 3) from the profile's Terrain along the
-    runway x axis (flat at the threshold height when terrain is None). A picklable callable."""
+    runway x axis (flat at the threshold height when terrain is None). A picklable callable. Each run's
+    database adds its own error realization to it (nav/terrain_db.py, `_Run.db_error`)."""
 
     runway: geo.RunwayFrame
     terrain: Any = None
@@ -201,6 +216,7 @@ class NavSystem:
             n_sv=n_sv,
             n_pl=n_pl,
             pl_clock=n_pl > 0 and not sensors.pseudolite.synchronized,
+            **_radalt_states(sensors, nav),
         )
         return cls(nav=nav, sensors=sensors, runway=rwy, terrain_h=terrain_h, filter=nav.make_filter(),
                    layout=layout)
@@ -244,6 +260,9 @@ class NavSystem:
                 pc = ClockModel.named("ocxo", 30.0, 0.03)
                 q = pc.q(1.0)
                 kw.update(pclk_sf=q[0, 0] - q[1, 1] / 3.0, pclk_sg=q[1, 1])
+        if self.sensors.radalt is not None:
+            kw.update(ram_sigma_m=self.sensors.radalt.markov_sigma_m, ram_tau_s=self.sensors.radalt.markov_tau_s,
+                      tdb_correlation_m=self.nav.terrain_database.correlation_m)
         q1 = clk.q(1.0)  # Q(1 s) = [[S_f + S_g / 3, S_g / 2], [., S_g]]
         return em.ErrorNoise(
             gyro_arw_rad_sqrts=g.gyro_arw_rad_sqrts,
@@ -288,6 +307,7 @@ class NavSystem:
             d[lay.index["ptr"]] = (p.tropo_ppm_sigma * 1e-6) ** 2
             if lay.has("pclk"):
                 d[lay.index["pclk"]] = np.tile([30.0**2, 0.03**2], lay.n_pl)
+        self._radalt_p0(d)
         return np.diag(d)
 
     # --- one pass ------------------------------------------------------------------------------------------
@@ -313,11 +333,14 @@ class NavSystem:
             s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
             runs = [_Run(self.filter.init(np.zeros(self.layout.n), P0), [], np.zeros(3), np.zeros(3), self._fde())
                     for _ in rngs]
+            self._attach_terrain(runs, rngs)
             return s, runs
         if obs is None or states is None:
             raise ValueError("the converged start ([nav.initial_error] start = 'converged') needs the "
                              "observations and the realized sensor states at the start row "
                              "(SensorSuite.draw + sensors.states.start_states)")
+        dbs = self._terrain_errors(rngs)
+        states = self._with_database_states(states, dbs, truth, row)
         if obs.get("gnss_sky"):  # each run its own GPS sky: its own P0 and converged covariance
             draws = [initial.draw(self, truth, self._run_obs(obs, i), states.take(i), [g], row,
                                   self.initial_covariance(np.asarray(obs["gnss_el"])[i])) for i, g in enumerate(rngs)]
@@ -330,7 +353,7 @@ class NavSystem:
         s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
         if self.layout.has("ac"):
             s = replace(s, a_comp_mps2=e[:, self.layout.i("ac")])  # ac error = the INS compensator (truth 0)
-        runs = [_Run(self.filter.init(x_hat[i], P_convs[i]), [], np.zeros(3), np.zeros(3), self._fde())
+        runs = [_Run(self.filter.init(x_hat[i], P_convs[i]), [], np.zeros(3), np.zeros(3), self._fde(), dbs[i])
                 for i in range(n)]
         return s, runs
 
@@ -414,12 +437,13 @@ class NavSystem:
             phi, qd = em.discretize(F, Qc, dt_epoch)
             if run.fde is not None:  # predict, test, exclude, update (nav/fde.py)
                 run.fs, sts = run.fde.epoch(self.filter, run.fs, phi, qd,
-                                            self._measurements(s, i, r_ins[i], run.fs, obs, t), t,
+                                            self._measurements(s, i, r_ins[i], run.fs, obs, t,
+                                                               db_error=run.db_error), t,
                                             self.runway.from_ecef(r_ins[i]))
                 run.statuses.extend(sts)
                 continue
             fs = self.filter.predict(run.fs, phi, qd)
-            for m in self._measurements(s, i, r_ins[i], fs, obs, t):
+            for m in self._measurements(s, i, r_ins[i], fs, obs, t, db_error=run.db_error):
                 fs, st = self.filter.update(fs, m(fs.x))
                 run.statuses.append(st)
             run.fs = fs
@@ -484,7 +508,8 @@ class NavSystem:
                 Ph = P @ h0
                 S = float(h0 @ Ph + r)  # S = h' P h + r (shared)
                 K = Ph / S  # K = P h S^-1 (shared)
-                nu = self._innovations(m0.name, X[idx], idx, s, r_ins[idx], c_en, obs)  # z - g(x_hat_i)
+                nu = self._innovations(m0.name, X[idx], idx, s, r_ins[idx], c_en, obs,
+                                       db_error=[runs[i].db_error for i in members])  # z - g(x_hat_i)
                 X[idx] = X[idx] + nu[:, None] * K[None, :]  # x+ = x- + K nu (row by row)
                 for i, v in zip(members, nu.tolist(), strict=True):
                     runs[i].statuses.append(UpdateStatus(m0.name, t, v, S, v * v / S, 1.0, True))
@@ -512,10 +537,11 @@ class NavSystem:
         return q
 
     def _innovations(self, name: str, X: Array, idx: Array, s: ins.InsState, r_ins: Array, c_en: Array,
-                     obs: Mapping[str, Any]) -> Array:
+                     obs: Mapping[str, Any], db_error: list | None = None) -> Array:
         """Innovations nu = z - g(x_hat) (m) of measurement `name` for runs idx at once, X (M, n) their
         estimates: the exact differences of nav.measurements (baro, radalt, pseudorange) evaluated at each
-        run's x_hat, elementwise (a run's value does not depend on the others')."""
+        run's x_hat, elementwise (a run's value does not depend on the others'). db_error: each run's
+        terrain-database error (None: none)."""
         lay = self.layout
         h_ins = s.h_m[idx]
         if name == "baro":
@@ -526,8 +552,10 @@ class NavSystem:
         dp = X[:, lay.index["dp"]]
         # corrected position r_hat = r_ins - C_ne dp_hat, written out (C_ne = C_en'): no batch-size-dependent path
         r_hat = r_ins - (c_en[:, 0, :] * dp[:, 0:1] + c_en[:, 1, :] * dp[:, 1:2] + c_en[:, 2, :] * dp[:, 2:3])
-        if name == "radalt":  # (h_ins - T(ins) - h_R) - g(x_hat) = (h_ins + dp_D) - T(r_hat) - h_R
-            return (h_ins + dp[:, 2]) - self.terrain_h(r_hat) - obs["radalt_h"][idx]
+        if name == "radalt":  # (h_ins - T_db(ins) - h_R) - g(x_hat): T_db(ins) = T(ins) + e(x_ins),
+            # g = (h_ins - T(ins)) - (h_ins + dp_D - T(r_hat)) - rab - ram - s tdb
+            return ((h_ins + dp[:, 2]) - self.terrain_h(r_hat) - self._db_offsets(r_ins, db_error)
+                    - obs["radalt_h"][idx] + self._radalt_state_terms(X, r_ins))
         if name.startswith("gps"):
             k = int(name[3:])
             d = r_hat - (obs["gnss_rsv"][idx, k] if obs.get("gnss_sky") else obs["gnss_rsv"][k])
@@ -585,8 +613,9 @@ class NavSystem:
         return out
 
     def _measurements(self, s: ins.InsState, i: int, r_ins: Array, fs: FilterState, obs: Mapping[str, Any],
-                      t: float) -> list[Callable[[Array], Any]]:
-        """Row builders for run i at this epoch (each takes the current x_hat: sequential relinearization)."""
+                      t: float, db_error: tdb.TerrainDbError | None = None) -> list[Callable[[Array], Any]]:
+        """Row builders for run i at this epoch (each takes the current x_hat: sequential relinearization);
+        db_error: run i's terrain-database error (None: the database is the truth terrain)."""
         lay = self.layout
         lat, lon, h = float(s.lat_rad[i]), float(s.lon_rad[i]), float(s.h_m[i])
         out: list[Callable[[Array], Any]] = []
@@ -596,7 +625,11 @@ class NavSystem:
         if "radalt_h" in obs and np.isfinite(obs["radalt_h"][i]):
             hr = float(obs["radalt_h"][i])
             sr = float(np.sqrt((self.sensors.radalt.percent_sigma * hr) ** 2 + self.sensors.radalt.floor_m**2))
-            out.append(lambda x: meas.radalt(lay, x, lat, lon, h, hr, sr, self.terrain_h, t))
+            along = float(self.runway.from_ecef(r_ins)[0])
+            ts = float(self.nav.terrain_database.sigma_at(along))
+            de = 0.0 if db_error is None else float(db_error(along))
+            out.append(lambda x: meas.radalt(lay, x, lat, lon, h, hr, sr, self.terrain_h, t, tdb_sigma_m=ts,
+                                             db_error_m=de))
         c_en = geo.c_ecef_to_ned(lat, lon)
         sky = bool(obs.get("gnss_sky"))
         if "gnss_rho" in obs and self.nav.gps_coupling == "loose":
@@ -627,6 +660,75 @@ class NavSystem:
                     sk = float(obs["pl_sigma"][k])
                 out.append(lambda x, k=k, sk=sk, rk=float(rho[k]), rp=r_pl[k]: meas.pseudorange(
                     lay, x, r_ins, c_en, rp, rk, sk, t, f"pl{k}", pl=int(k) if lay.has("pmp") else None))
+        return out
+
+    # --- radar altimeter and terrain database errors (rab, ram, tdb) ------------------------------------------
+
+    def _radalt_p0(self, d: Array) -> None:
+        """P0 of the radalt / database states into the diagonal d (in place): rab the altimeter and database bias
+        variances summed, ram the Markov variance (stationary), tdb 1 (unit Gauss-Markov)."""
+        lay = self.layout
+        if lay.has("rab"):
+            d[lay.i("rab")] = self.sensors.radalt.bias_sigma_m**2 + self.nav.terrain_database.bias_sigma_m**2
+        if lay.has("ram"):
+            d[lay.i("ram")] = self.sensors.radalt.markov_sigma_m**2
+        if lay.has("tdb"):
+            d[lay.i("tdb")] = 1.0
+
+    def _attach_terrain(self, runs: list[_Run], rngs: list[np.random.Generator]) -> None:
+        """Each run's terrain database = the truth terrain + its own error realization e(x), drawn from the child
+        stream "terrain_db" of its nav stream (the nav stream's own draws are untouched). No radar altimeter or a
+        zero error model: no error. The filter looks its database up at the INS position: e enters the radalt
+        difference as e(x_ins), carried by the rab / tdb states (its own along-track gradient, not differentiable
+        for a Gauss-Markov field, is not linearized: the INS's slowly varying along-track error only shifts where
+        the field is sampled, which leaves u(x_ins(t)) a Gauss-Markov of the same time constant)."""
+        for r, e in zip(runs, self._terrain_errors(rngs), strict=True):
+            r.db_error = e
+
+    def _terrain_errors(self, rngs: list[np.random.Generator]) -> list[tdb.TerrainDbError | None]:
+        """Each run's terrain-database error realization (`_attach_terrain`); None entries without one."""
+        cfg = self.nav.terrain_database
+        if self.sensors.radalt is None or cfg.zero:
+            return [None] * len(rngs)
+        return [tdb.draw(cfg, substream(g, "terrain_db")) for g in rngs]
+
+    def _with_database_states(self, states: SensorStates, dbs: list, truth: Truth, row: int) -> SensorStates:
+        """The realized radalt-difference states with the database's part added: rab = altimeter bias +
+        database bias (both enter the difference with the same sign), tdb = the database's unit Gauss-Markov
+        u at the start's along-track position (nav/terrain_db.py)."""
+        if all(d is None for d in dbs):
+            return states
+        n = len(dbs)
+        kw: dict[str, Array] = {}
+        if self.layout.has("rab"):
+            base_ = np.zeros(n) if states.rab is None else np.asarray(states.rab, dtype=float).reshape(n)
+            kw["rab"] = base_ + np.array([0.0 if d is None else d.bias_m for d in dbs])
+        if self.layout.has("tdb"):
+            x0 = float(self.runway.from_ecef(truth.r_ecef[row])[0])
+            kw["tdb"] = np.array([0.0 if d is None else float(np.interp(x0, d.x_m, d.u)) for d in dbs])
+        return replace(states, **kw)
+
+    def _tdb_sigma(self, r_ecef: Array) -> Array:
+        """The database's correlated 1-sigma (m) at ECEF points (..., 3): the H coefficient of the tdb state."""
+        return self.nav.terrain_database.sigma_at(self.runway.from_ecef(r_ecef)[..., 0])
+
+    def _db_offsets(self, r_ins: Array, db_error: list | None) -> Array:
+        """Each run's terrain-database error (M,) at its INS position r_ins (M, 3), m (0 without one)."""
+        if db_error is None or all(e is None for e in db_error):
+            return np.zeros(r_ins.shape[0])
+        x = self.runway.from_ecef(r_ins)[:, 0]
+        return np.array([0.0 if e is None else float(e(xi)) for e, xi in zip(db_error, x, strict=True)])
+
+    def _radalt_state_terms(self, X: Array, r_ins: Array) -> Array:
+        """rab + ram + sigma_db(x) tdb (M,) of estimates X (M, n): what the radalt innovation adds back."""
+        lay = self.layout
+        out = np.zeros(X.shape[0])
+        if lay.has("rab"):
+            out = out + X[:, lay.i("rab")]
+        if lay.has("ram"):
+            out = out + X[:, lay.i("ram")]
+        if lay.has("tdb"):
+            out = out + self._tdb_sigma(r_ins) * X[:, lay.i("tdb")]
         return out
 
     def _feedback(self, s: ins.InsState, runs: list[_Run]) -> ins.InsState:

@@ -28,6 +28,7 @@ from approachsim.sensors.gnss.receiver import (
     make_budget,
 )
 from approachsim.sensors.presets import PRESETS
+from approachsim.sensors.radalt import RADALT_CORRELATED_1SIGMA_M
 
 SENSOR_NAMES = ("imu", "baro", "radalt", "gnss", "pseudolite")
 """Sensor names: profile tables, random-stream names and record names."""
@@ -56,14 +57,16 @@ class BaroConfig:
 
 @dataclass(frozen=True)
 class RadaltConfig:
-    """[sensors.radalt]: seed 002 noise, optional seed 000 Markov error, maximum range (m)."""
+    """[sensors.radalt]: seed 002 noise, seed 000 Markov error and a per-run bias (sensors/radalt.py gives the
+    budget), maximum range (m)."""
 
     rate_hz: float = 1.0
     max_range_m: float = 3000.0 * units.FT
     percent_sigma: float = 0.01
     floor_m: float = 0.5
-    markov_sigma_m: float = 0.0
-    markov_tau_s: float = 100.0
+    markov_sigma_m: float = RADALT_CORRELATED_1SIGMA_M
+    markov_tau_s: float = 10.0
+    bias_sigma_m: float = RADALT_CORRELATED_1SIGMA_M
 
 
 @dataclass(frozen=True)
@@ -177,8 +180,9 @@ def parse_sensors(s: Section) -> SensorsConfig:
             max_range_m=r.number("max_range_ft", 3000.0, lo=100.0, hi=10000.0, unit="ft") * units.FT,
             percent_sigma=r.number("percent_of_height", 1.0, lo=0.0, hi=10.0, unit="%") / 100.0,
             floor_m=r.number("floor_m", 0.5, lo=0.0, hi=10.0, unit="m"),
-            markov_sigma_m=r.number("markov_sigma_m", 0.0, lo=0.0, unit="m"),
-            markov_tau_s=r.number("markov_tau_s", 100.0, lo=0.0, lo_open=True, unit="s"),
+            markov_sigma_m=r.number("markov_sigma_m", RADALT_CORRELATED_1SIGMA_M, lo=0.0, hi=100.0, unit="m"),
+            markov_tau_s=r.number("markov_tau_s", 10.0, lo=0.0, lo_open=True, hi=1e5, unit="s"),
+            bias_sigma_m=r.number("bias_sigma_m", RADALT_CORRELATED_1SIGMA_M, lo=0.0, hi=100.0, unit="m"),
         )
     r.done()
 

@@ -17,6 +17,10 @@ estimate exactly at `row`; None when the suite has no such sensor. Signs follow 
     ba   (N, 3) m/s^2 the same for the accelerometers with (S + M) f_body (the filter's ba lumps them, P0)
     pmp  (N, p) m     pseudolite multipath; ptr (N, p) tropo residual as a fraction of the range
     pclk (N, 2p)      pseudolite transmitter clock bias (m) and drift (m/s) pairs (zero when synchronized)
+    rab  (N,)   m     radar-altimeter bias (radalt.py); NavSystem.start adds the terrain database's bias
+    ram  (N,)   m     radar-altimeter Gauss-Markov error
+    tdb  (N,)         the terrain database's unit along-track Gauss-Markov at the start (NavSystem.start: the
+                      database error is the navigation system's own draw, nav/terrain_db.py)
 
 The sample of each sensor taken for `row` is the last one at or before it (the IMU: the increment starting at
 it). White noise (code, baro, IMU ARW / VRW) is not a state and is left out. A new state group is one field
@@ -53,6 +57,9 @@ class SensorStates:
     pmp: Array | None = None
     ptr: Array | None = None
     pclk: Array | None = None
+    rab: Array | None = None
+    ram: Array | None = None
+    tdb: Array | None = None
 
     @property
     def runs(self) -> int:
@@ -116,8 +123,11 @@ def _gse(at: _At) -> Array | None:
     e, j = s
     rx = at.suite.sensors["gnss"]
     r = at.truth.r_ecef[e.rows[j]][None]
-    _, _, el, _ = look_angles(r, rx.constellation.positions_ecef(e.t_s[j:j + 1]))
-    el = el[0]
+    off = e.constants.get("epoch_offset_s")  # each run its own sky (receiver.py): elevations per run
+    offs = np.zeros(1) if off is None else np.atleast_1d(np.asarray(off, dtype=float))
+    el = np.stack([look_angles(r, rx.geometry_constellation(o).positions_ecef(e.t_s[j:j + 1]))[2][0] for o in offs])
+    if off is None:
+        el = el[0]
     ser = e.series
     return (np.asarray(ser["clock_ephemeris"])[:, j] + iono_obliquity(el) * np.asarray(ser["iono_zenith"])[:, j]
             + tropo_mapping(el) * np.asarray(ser["tropo_zenith"])[:, j])
@@ -172,6 +182,10 @@ _EXTRACT: dict[str, Callable[[_At], Array | None]] = {
     "pmp": lambda at: _series(at, "pseudolite", "multipath"),
     "ptr": _ptr,
     "pclk": _pclk,
+    "rab": lambda at: None if at.sample("radalt") is None else np.asarray(
+        at.sample("radalt")[0].constants["bias"], dtype=float).reshape(-1),
+    "ram": lambda at: _series(at, "radalt", "markov"),
+    "tdb": lambda at: None,  # filled by NavSystem.start from its database draw
 }
 """Filter state group -> its realized value from the drawn errors (one entry per group)."""
 

@@ -57,7 +57,7 @@ def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterab
         r = cfg.radalt
         out["radalt"] = RadarAltimeter(rate_hz=r.rate_hz, max_range_m=r.max_range_m, percent_sigma=r.percent_sigma,
                                        floor_m=r.floor_m, markov_sigma_m=r.markov_sigma_m,
-                                       markov_tau_s=r.markov_tau_s)
+                                       markov_tau_s=r.markov_tau_s, bias_sigma_m=r.bias_sigma_m)
     gnss_rate = 1.0
     if cfg.gnss is not None:
         g = cfg.gnss

@@ -5,7 +5,10 @@ least 90 % of the epochs (Bar-Shalom, Li & Kirubarajan sec. 5.4). A filter that 
 have fails here.
 
 The default start is the converged pre-approach state (nav/initial.py): the first epochs are checked on their own
-too, since an independent diagonal prior would make them easy and a wrong conditioning shows there first."""
+too, since an independent diagonal prior would make them easy and a wrong conditioning shows there first.
+The default profile carries the radar altimeter's bias and Markov error and a terrain database that differs from
+the truth terrain (bias + along-track Gauss-Markov, crossing the Area 4 boundary 900 m before the threshold);
+the filter models them with its rab / ram / tdb states, and the bounds must still hold."""
 
 from __future__ import annotations
 
@@ -31,6 +34,8 @@ SEED = 1
 @pytest.fixture(scope="module")
 def runs():
     prof = load_profile(PROFILES / "default.toml")
+    ra, db = prof.sensors.radalt, prof.nav.terrain_database
+    assert ra.bias_sigma_m > 0 and ra.markov_sigma_m > 0 and db.bias_sigma_m > 0 and db.correlated  # not white
     truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 90.0,
                                         ground_speed_mps=70.0)
     assert prof.nav.initial_error.start == "converged"

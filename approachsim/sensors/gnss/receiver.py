@@ -234,12 +234,16 @@ class GnssReceiver:
         """The receiver clock at this receiver's samples: series bias (m,) m and drift (m,) m/s."""
         return draw_receiver_clock(self.clock, t_s, self.rate_hz, rng)
 
+    def geometry_constellation(self, epoch_offset_s: float = 0.0) -> Constellation:
+        """The constellation epoch_offset_s (s) after the receiver's epoch (a run's own sky)."""
+        if epoch_offset_s == 0.0:
+            return self.constellation
+        return replace(self.constellation, epoch_s=self.constellation.epoch_s + float(epoch_offset_s))
+
     def geometry(self, truth: Truth, rows: Array, t_s: Array, epoch_offset_s: float = 0.0) -> dict[str, Array]:
         """Satellite positions, ranges, lines of sight, look angles, visibility, selection and DOPs, with the
         constellation epoch_offset_s (s) after the receiver's epoch (the run's own sky)."""
-        const = self.constellation
-        if epoch_offset_s != 0.0:
-            const = replace(const, epoch_s=const.epoch_s + float(epoch_offset_s))
+        const = self.geometry_constellation(epoch_offset_s)
         r_rx = truth.r_ecef[rows]
         r_sv = const.positions_ecef(t_s)
         rng_m, u, el, az = look_angles(r_rx, r_sv)

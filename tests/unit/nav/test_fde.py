@@ -41,6 +41,7 @@ def _profile(faults=(), *, fde=True, nmi=5.0, selection="all", feedback=False, p
     d["sensors"]["gnss"].pop("epoch_window_h", None)
     d["runway"]["start_distance_nmi"] = nmi
     d["nav"]["feedback"] = feedback
+    d["nav"].setdefault("initial_error", {})["start"] = "prior"  # FDE alone (these runs call NavSystem.run directly)
     d["nav"]["fde"] = {"enabled": fde, **fde_kw}
     d["faults"] = list(faults)
     return parse_profile(d, source=DEFAULT)

@@ -84,3 +84,41 @@ def test_loose_position_rows():
     assert [m.name for m in ms] == ["gps_N", "gps_E", "gps_D"]
     assert [m.r for m in ms] == [4.0, 4.0, 16.0]
     assert all(m.h[LAY.i("dp", k)] == 1.0 and m.h.sum() == 1.0 for k, m in enumerate(ms))
+
+
+LAY_RA = em.StateLayout(baro_scale=True, clock=True, n_sv=2, radalt_bias=True, radalt_markov=True, terrain_db=True)
+
+
+def test_radalt_correlated_error_columns_are_the_jacobian_and_innovation_exact():
+    """rab (altimeter + database bias), ram, tdb (unit Gauss-Markov scaled by the database sigma there): h is
+    the central-difference derivative of the exact difference g(x), and z - h x_hat is z - g(x_hat)."""
+    lay = LAY_RA
+    rwy = geo.RunwayFrame(LAT, LON, 0.0, np.radians(90.0))
+    s_db = 1.772  # the database's correlated 1-sigma at the aircraft, m
+
+    def terrain(r):
+        return 0.02 * rwy.from_ecef(r)[..., 0] - 0.01 * rwy.from_ecef(r)[..., 1]  # planar: the 10 m steps are exact
+
+    def g(x):  # exact (h_ins - T(r_ins)) - h_R for error state x; the database error is in rab and tdb
+        r_true = R_INS - C_EN.T @ x[lay.index["dp"]]
+        h_true = H + x[lay.i("dp", 2)]
+        h_r = h_true - float(terrain(r_true)) + x[lay.i("rab")] + x[lay.i("ram")] + s_db * x[lay.i("tdb")]
+        return (H - float(terrain(R_INS))) - h_r
+
+    rng = np.random.default_rng(11)
+    x_true = np.zeros(lay.n)
+    x_true[lay.index["dp"]] = [3.0, 20.0, -1.0]
+    x_true[lay.i("rab")], x_true[lay.i("ram")], x_true[lay.i("tdb")] = 0.5, -0.2, 0.7
+    # the world: the altimeter bias 0.3 m, the database bias 0.2 m (rab = 0.5) and error s u at the INS position
+    db_err = 0.2 + s_db * 0.7
+    r_true = R_INS - C_EN.T @ x_true[lay.index["dp"]]
+    h_agl = (H + x_true[lay.i("dp", 2)]) - float(terrain(r_true)) + 0.3 - 0.2  # altimeter: truth + bias + Markov
+    x_hat = x_true + rng.normal(size=lay.n) * 0.05
+    m = meas.radalt(lay, x_hat, LAT, LON, H, h_agl, 1.0, terrain, 0.0, tdb_sigma_m=s_db, db_error_m=db_err)
+    z = (H - float(terrain(R_INS)) - db_err) - h_agl
+    assert z == pytest.approx(g(x_true), abs=1e-9)  # the model reproduces the world's measurement
+    assert m.z - m.h @ x_hat == pytest.approx(z - g(x_hat), abs=1e-6)
+    eps = 1e-3
+    num = np.array([(g(x_hat + eps * e) - g(x_hat - eps * e)) / (2 * eps) for e in np.eye(lay.n)])
+    np.testing.assert_allclose(m.h, num, atol=2e-5)
+    assert m.h[lay.i("rab")] == -1.0 and m.h[lay.i("ram")] == -1.0 and m.h[lay.i("tdb")] == -s_db

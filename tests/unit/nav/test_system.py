@@ -12,6 +12,7 @@ from scipy.stats import chi2
 
 from approachsim import geo, synthetic
 from approachsim.nav import ins
+from approachsim.nav import terrain_db as tdb
 from approachsim.nav.config import InitialError
 from approachsim.nav.registry import FILTERS
 from approachsim.nav.system import NavSystem
@@ -39,7 +40,8 @@ def _system(**nav_kw):
 def test_noiseless_sensors_and_no_initial_error_stay_within_1cm(feedback):
     truth = _truth()
     recs = SensorSuite.from_profile(PROFILE).measure(truth, seed=3, runs=0, noise=False)
-    nav = _system(initial_error=InitialError(0.0, 0.0, 0.0, 0.0, start="prior"), feedback=feedback)
+    nav = _system(initial_error=InitialError(0.0, 0.0, 0.0, 0.0, start="prior"), feedback=feedback,
+                  terrain_database=tdb.EXACT)
     run = nav.run(truth, recs, stream(3, 0, "nav"))
     sol = run.solution
     lat, lon, h = geo.ecef_to_geodetic(sol.r_ecef)

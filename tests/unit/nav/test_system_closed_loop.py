@@ -20,12 +20,18 @@ from approachsim.sensors.suite import SensorSuite
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 
 
-@pytest.mark.parametrize(("quantized", "feedback"), [(False, False), (True, False), (False, True)])
-def test_step_by_step_equals_open_loop_pass(quantized, feedback):
+@pytest.mark.parametrize(("quantized", "feedback", "realistic"),
+                         [(False, False, False), (True, False, False), (False, True, False), (False, False, True)])
+def test_step_by_step_equals_open_loop_pass(quantized, feedback, realistic):
     """quantized: the IMU is not affine in the truth, so the source applies every sample (the other path);
-    feedback: the estimate is fed back into the INS and the bias estimates into the increments."""
+    feedback: the estimate is fed back into the INS and the bias estimates into the increments; realistic: the
+    radar altimeter's bias and Markov error and the terrain-database error at their defaults (the paper's
+    profile zeroes them), so the closed loop sees the same database realization as the open-loop pass."""
     path = PROFILES / "gray-maybeck.toml"  # baro, radalt, GPS and a pseudolite
     data = tomllib.loads(path.read_text(encoding="utf-8"))
+    if realistic:
+        data["sensors"]["radalt"] = {"max_range_ft": 3000.0}
+        data["nav"].pop("terrain_database")
     if quantized:
         data.setdefault("sensors", {}).setdefault("imu", {})["gyro_quant_rad"] = 1e-7
     data.setdefault("nav", {})["feedback"] = feedback
@@ -36,6 +42,8 @@ def test_step_by_step_equals_open_loop_pass(quantized, feedback):
     assert (src._imu_affine is None) == quantized
     r_rwy = np.array([src.step(k, truth)[0] for k in range(len(truth))])
     closed = src.result(truth)
+    assert (src.runs[0].db_error is not None) == realistic
+    assert all(src.nav.layout.has(g) == realistic for g in ("rab", "ram", "tdb"))
     recs, st = measure_with_states(SensorSuite.from_profile(prof), truth, seed=4, runs=2)
     open_ = NavSystem.from_profile(prof).run(truth, recs, stream(4, 2, "nav"), states=st)
     np.testing.assert_allclose(closed.solution.r_ecef, open_.solution.r_ecef, rtol=0, atol=1e-6)
