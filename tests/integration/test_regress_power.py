@@ -1,8 +1,9 @@
 """`regress`'s paired test on the real pipeline: a degraded sensor is caught, a reshuffle of the draws is not.
 
-Against the committed default baseline (open loop, 20 runs, seed 7): the radar altimeter noise
-(percent_of_height and floor) scaled by 1.1 and by 2, and the unchanged profile on seed 8 (new, independent
-draws of the same model). Measured figures are in approachsim/campaign/regress.py.
+Against the committed default baseline (open loop, 20 runs, seed 7): the radar altimeter's whole error model
+(white noise: percent_of_height and floor; correlated: bias and Markov sigmas) scaled by 1.1 and by 2, and the
+unchanged profile on seed 8 (new, independent draws of the same model). Measured figures are in
+approachsim/campaign/regress.py.
 """
 
 from __future__ import annotations
@@ -21,12 +22,19 @@ ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.slow
 
 
+RADALT_KEYS = ("percent_of_height", "floor_m", "bias_sigma_m", "markov_sigma_m")
+
+
 def _variant(tmp_path: Path, name: str, scale: float) -> Path:
     text = (ROOT / "profiles" / "default.toml").read_text()
-    text, k1 = re.subn(r"^percent_of_height = 1\.0", f"percent_of_height = {1.0 * scale}", text, flags=re.M)
-    text, k2 = re.subn(r"^floor_m = 0\.5", f"floor_m = {0.5 * scale}", text, flags=re.M)
-    assert k1 == k2 == 1, "profiles/default.toml no longer sets the radar altimeter noise as this test expects"
+    head, sep, rest = text.partition("[sensors.radalt]")
+    section, nxt, tail = rest.partition("\n[")
+    for key in RADALT_KEYS:  # every sigma of the radar altimeter's section, whatever its value
+        section, k = re.subn(rf"^{key} = ([0-9.eE+-]+)", lambda m, key=key: f"{key} = {float(m.group(1)) * scale:.6g}",
+                             section, flags=re.M)
+        assert k == 1, f"profiles/default.toml no longer sets sensors.radalt.{key} as this test expects"
     p = tmp_path / f"{name}.toml"
+    text = head + sep + section + nxt + tail
     p.write_text(text)
     return p
 

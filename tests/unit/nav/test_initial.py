@@ -86,13 +86,18 @@ def test_prior_raised_only_where_P_conv_exceeds_it():
         initial.condition(P, P0[np.ix_(s, s)], s, np.zeros((1, 3)), np.zeros((1, 7)))  # wrong shapes
 
 
-def _start_default(runs=(0, 1, 2)):
-    truth = synthetic.glidepath_descent(PROFILE.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 5.0,
+FIXED = replace(PROFILE, sensors=replace(
+    PROFILE.sensors, gnss=replace(PROFILE.sensors.gnss, epoch="fixed")))
+"""The default profile on one sky for every run (the default draws each run's own epoch)."""
+
+
+def _start_default(runs=(0, 1, 2), prof=FIXED):
+    truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 5.0,
                                         ground_speed_mps=70.0)
-    recs, st = measure_with_states(SensorSuite.from_profile(PROFILE), truth, seed=2, runs=list(runs))
-    nav = NavSystem.from_profile(PROFILE)
+    recs, st = measure_with_states(SensorSuite.from_profile(prof), truth, seed=2, runs=list(runs))
+    nav = NavSystem.from_profile(prof)
     obs = nav.observations(recs, float(truth.t_s[0]), 0.025, True)
-    el = recs["gnss"].elevation_rad[0]
+    el = recs["gnss"].elevation_rad[0] if not recs["gnss"].per_run_sky else recs["gnss"].elevation_rad[0, 0]
     s, fl = nav.start(truth, [stream(2, r, "nav") for r in runs], 0, elevation_rad=el, obs=obs, states=st)
     return nav, truth, recs, st, s, fl, nav.initial_covariance(el)
 
@@ -122,6 +127,20 @@ def test_converged_start_of_the_default_profile():
     assert all(abs(r.fs.x[j]) > 0.0 for r in fl)
 
 
+def test_per_run_skies_get_their_own_converged_covariance():
+    """Each run's own GPS sky (the default): its own P0 and P_conv, each a valid covariance, equal to the run
+    started alone."""
+    nav, truth, recs, st, s, fl, _ = _start_default(prof=PROFILE)
+    assert recs["gnss"].per_run_sky
+    assert not np.array_equal(fl[0].fs.P, fl[1].fs.P)
+    for r in fl:
+        assert np.all(np.linalg.eigvalsh(r.fs.P) > -1e-9 * np.max(np.diag(r.fs.P)))
+    _, _, _, _, s1, alone, _ = _start_default(runs=(1,), prof=PROFILE)
+    np.testing.assert_array_equal(alone[0].fs.P, fl[1].fs.P)
+    np.testing.assert_array_equal(alone[0].fs.x, fl[1].fs.x)
+    np.testing.assert_array_equal(s1.h_m, s.h_m[1:2])
+
+
 def test_prior_start_keeps_todays_draws():
     truth = synthetic.glidepath_descent(PROFILE.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 5.0,
                                         ground_speed_mps=70.0)
@@ -147,11 +166,11 @@ def test_profile_key_start_is_checked():
 
 def test_zero_segment_is_the_prior_start_in_distribution():
     """converge_s = 0: P_conv = P0, every sensor state keeps its prior (estimate 0, e_s = x_s)."""
-    truth = synthetic.glidepath_descent(PROFILE.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 5.0,
+    truth = synthetic.glidepath_descent(FIXED.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 5.0,
                                         ground_speed_mps=70.0)
-    recs, st = measure_with_states(SensorSuite.from_profile(PROFILE), truth, seed=2, runs=[0, 1])
-    cfg = replace(PROFILE.nav, initial_error=replace(PROFILE.nav.initial_error, converge_s=0.0))
-    nav = NavSystem.build(cfg, PROFILE.sensors, PROFILE.runway.frame, PROFILE.terrain)
+    recs, st = measure_with_states(SensorSuite.from_profile(FIXED), truth, seed=2, runs=[0, 1])
+    cfg = replace(FIXED.nav, initial_error=replace(FIXED.nav.initial_error, converge_s=0.0))
+    nav = NavSystem.build(cfg, FIXED.sensors, FIXED.runway.frame, FIXED.terrain)
     el = recs["gnss"].elevation_rad[0]
     _, fl = nav.start(truth, [stream(2, r, "nav") for r in (0, 1)], 0, elevation_rad=el,
                       obs=nav.observations(recs, float(truth.t_s[0]), 0.025, True), states=st)
