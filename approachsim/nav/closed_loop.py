@@ -160,7 +160,7 @@ class NavInTheLoop:
                 self._epoch(k, truth)
         if self.gains is not None and (b := self._apply("baro", k, truth)) is not None:
             self.h_baro_hold = float(np.ravel(b.h_baro_m)[0])
-            if k == 0:
+            if k == 0 and nav.nav.initial_error.start == "prior":  # the converged start's height error stands
                 self.x[0, 2] = self.h_baro_hold
                 self.s = ins.unpack(self.x)
         self.rows[k] = self.x[0]
