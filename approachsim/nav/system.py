@@ -710,13 +710,20 @@ class NavSystem:
 
     def _tdb_sigma(self, r_ecef: Array) -> Array:
         """The database's correlated 1-sigma (m) at ECEF points (..., 3): the H coefficient of the tdb state."""
-        return self.nav.terrain_database.sigma_at(self.runway.from_ecef(r_ecef)[..., 0])
+        return self.nav.terrain_database.sigma_at(self._along_m(r_ecef))
+
+    def _along_m(self, r_ecef: Array) -> Array:
+        """Runway-frame along-track distance (m) of ECEF points (..., 3), one point at a time: a run's value must
+        not depend on the batch it shares (no batch-size-dependent matrix product)."""
+        r = np.asarray(r_ecef, dtype=float)
+        flat = [float(self.runway.from_ecef(ri)[0]) for ri in r.reshape(-1, 3)]
+        return np.array(flat).reshape(r.shape[:-1])
 
     def _db_offsets(self, r_ins: Array, db_error: list | None) -> Array:
         """Each run's terrain-database error (M,) at its INS position r_ins (M, 3), m (0 without one)."""
         if db_error is None or all(e is None for e in db_error):
             return np.zeros(r_ins.shape[0])
-        x = self.runway.from_ecef(r_ins)[:, 0]
+        x = self._along_m(r_ins)
         return np.array([0.0 if e is None else float(e(xi)) for e, xi in zip(db_error, x, strict=True)])
 
     def _radalt_state_terms(self, X: Array, r_ins: Array) -> Array:

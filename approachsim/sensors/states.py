@@ -116,18 +116,36 @@ def _series(at: _At, sensor: str, key: str) -> Array | None:
     return np.asarray(e.series[key])[:, j]
 
 
-def _gse(at: _At) -> Array | None:
-    s = at.sample("gnss")
-    if s is None:
-        return None
-    e, j = s
+def _gnss_el(at: _At, e: base.SensorErrors, j: int) -> Array:
+    """Elevations (rad) of the 24 channels at sample j: (24,) on one sky, (N, 24) on per-run skies."""
     rx = at.suite.sensors["gnss"]
     r = at.truth.r_ecef[e.rows[j]][None]
     off = e.constants.get("epoch_offset_s")  # each run its own sky (receiver.py): elevations per run
     offs = np.zeros(1) if off is None else np.atleast_1d(np.asarray(off, dtype=float))
     el = np.stack([look_angles(r, rx.geometry_constellation(o).positions_ecef(e.t_s[j:j + 1]))[2][0] for o in offs])
-    if off is None:
-        el = el[0]
+    return el[0] if off is None else el
+
+
+def _gmp(at: _At) -> Array | None:
+    """Multipath of each channel, m: the drawn series, scaled by sigma_mp(el) under the do253 model (its series
+    is unit-sigma, receiver.py)."""
+    s = at.sample("gnss")
+    if s is None:
+        return None
+    e, j = s
+    mp = np.asarray(e.series["multipath"])[:, j]
+    b = at.suite.sensors["gnss"].budget
+    if b.multipath_model != "do253":
+        return mp
+    return mp * b.multipath_sigma_m(_gnss_el(at, e, j))
+
+
+def _gse(at: _At) -> Array | None:
+    s = at.sample("gnss")
+    if s is None:
+        return None
+    e, j = s
+    el = _gnss_el(at, e, j)
     ser = e.series
     return (np.asarray(ser["clock_ephemeris"])[:, j] + iono_obliquity(el) * np.asarray(ser["iono_zenith"])[:, j]
             + tropo_mapping(el) * np.asarray(ser["tropo_zenith"])[:, j])
@@ -173,7 +191,7 @@ def _pclk(at: _At) -> Array | None:
 
 _EXTRACT: dict[str, Callable[[_At], Array | None]] = {
     "gse": _gse,
-    "gmp": lambda at: _series(at, "gnss", "multipath"),
+    "gmp": _gmp,
     "clk": _clk,
     "bb": lambda at: _series(at, "baro", "bias"),
     "sb": _baro_sf,

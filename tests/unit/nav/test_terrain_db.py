@@ -16,7 +16,9 @@ from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream, substream
 
-PROFILE = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+_DEFAULT = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+PROFILE = replace(_DEFAULT, nav=replace(_DEFAULT.nav, initial_error=replace(_DEFAULT.nav.initial_error, start="prior")))
+"""The default profile with the prior start: these tests call NavSystem.start alone (no sensor states)."""
 N = 2000  # realizations: the relative sd of a sigma estimate is 1 / sqrt(2 N) = 1.6 %; bounds below are 5 sd
 
 
@@ -95,7 +97,7 @@ def test_filter_p0_and_dynamics_of_the_radalt_states():
     assert P0[lay.i("ram"), lay.i("ram")] == pytest.approx(r.markov_sigma_m**2)
     assert P0[lay.i("tdb"), lay.i("tdb")] == 1.0
     v = np.array([60.0, -30.0, 3.5])
-    F, Qc = em.dynamics(lay, 0.65, 100.0, v, np.array([0.0, 0.0, -9.8]), np.eye(3), nav.noise())
+    F, Qc = em.dynamics(lay, 0.65, 100.0, v, np.array([0.0, 0.0, -9.8]), np.eye(3), nav.noise(), nav.loop_gains())
     tau = c.correlation_m / np.hypot(60.0, -30.0)  # the along-track correlation length at the ground speed
     i, j, k = lay.i("rab"), lay.i("ram"), lay.i("tdb")
     assert F[i, i] == 0.0 and Qc[i, i] == 0.0
