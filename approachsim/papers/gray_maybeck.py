@@ -394,10 +394,11 @@ def category_claim(number: int, ours: dict) -> dict:
     the paper's answer is still indeterminate at this run count)."""
     order = ("CAT I", "CAT II", "CAT III")
     paper = PAPER_BEST[number]
-    need_meet = order[: order.index(paper) + 1] if paper else ()
-    need_fail = order[order.index(paper) + 1] if paper != "CAT III" else None
     if paper is None:
-        need_fail = "CAT I"
+        need_meet, need_fail = (), "CAT I"
+    else:
+        k = order.index(paper)
+        need_meet, need_fail = order[: k + 1], (order[k + 1] if k + 1 < len(order) else None)
     verdicts = {c: ours["categories"][c]["verdict"] for c in order}
     decided = [verdicts[c] for c in need_meet] + ([verdicts[need_fail]] if need_fail else [])
     want = ["meets"] * len(need_meet) + (["fails"] if need_fail else [])
