@@ -171,3 +171,11 @@ def test_reproduce_gray_maybeck_end_to_end(tmp_path: Path) -> None:
     assert "seed 002" not in md and "## Table 6" in md and "Tables 7-8" in md
     assert (tmp_path / "gray-maybeck_cases.png").is_file()
     assert (tmp_path / "cases" / "XVI" / "summary.json").is_file()
+
+
+def test_failure_reasons_are_counted_by_kind() -> None:
+    f = {"3": "RuntimeError: failed approach: unstabilized at 145 ft: glidepath deviation -1.00 dots",
+         "4": "RuntimeError: failed approach: unstabilized at 473 ft: glidepath deviation -1.00 dots",
+         "9": "RunScoreError: navigation solution is not finite at the CAT I decision height (diverged)"}
+    assert gm.failure_reasons(f) == {"failed approach: unstabilized": 2,
+                                     "navigation solution is not finite": 1}
