@@ -179,3 +179,14 @@ def test_failure_reasons_are_counted_by_kind() -> None:
          "9": "RunScoreError: navigation solution is not finite at the CAT I decision height (diverged)"}
     assert gm.failure_reasons(f) == {"failed approach: unstabilized": 2,
                                      "navigation solution is not finite": 1}
+
+
+def test_pseudolite_line_of_sight_shares() -> None:
+    """Glidepath point at 200 ft: 2862 ft before the threshold (3 deg, TCH 50 ft); the pseudolite 1000 ft past it,
+    500 ft left, 30 ft up: range sqrt(3862^2 + 500^2 + 170^2) ft, cross share 500 / range."""
+    g = gm.pseudolite_geometry(gm.case_profile(gm.CASES[9]), heights_ft=(200.0,))[0]
+    x = 150.0 / math.tan(math.radians(3.0))
+    r = math.sqrt((1000.0 + x) ** 2 + 500.0**2 + 170.0**2)
+    assert g["range_ft"] == pytest.approx(r, rel=1e-6)
+    assert g["cross_share"] == pytest.approx(500.0 / r, rel=1e-6)
+    assert gm.pseudolite_geometry(gm.case_profile(gm.CASES[0])) is None
