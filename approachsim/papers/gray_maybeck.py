@@ -431,6 +431,15 @@ def gps_implied(profile: Any, geometry: dict | None) -> dict:
     return out
 
 
+def _clock_q_sigma_ft(profile: Any, dt_s: float) -> float:
+    """1-sigma (ft) of the receiver clock bias process noise over dt_s (the two-state clock's Q[0, 0])."""
+    from approachsim.sensors.gnss.clock import ClockModel
+
+    g = profile.sensors.gnss
+    q = ClockModel.named(g.oscillator, g.clock_bias0_sigma_m, g.clock_drift0_sigma_mps).q(dt_s)
+    return float(math.sqrt(q[0, 0]) / units.FT)
+
+
 def pseudolite_geometry(profile: Any, heights_ft: Sequence[float] = (1000.0, 200.0, 100.0)) -> list[dict] | None:
     """Line of sight to the (first) pseudolite from the glidepath at each height above the threshold: distance
     (ft) and the share of the range along the cross-track axis (|cross| / range: how much a range measures the
@@ -487,6 +496,7 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
             "gps_implied": gps_implied(prof, geom),
             "pseudolite_geometry": pseudolite_geometry(prof),
             "runway_heading_rad": prof.runway.heading_rad,
+            "clock_q60_bias_sigma_ft": _clock_q_sigma_ft(prof, 60.0),
             "failure_reasons": failure_reasons(ev.details.get("failures", {})),
             "wall_s": ev.wall_s,
         }
@@ -577,11 +587,44 @@ def _difference_reason(state: str, group: Sequence[str], result: dict) -> str:
                     f"vertical RMS at the CAT I decision height is {dh_s} ft, so the time average is made high on "
                     f"the approach, where the GPS vertical ({g['vertical_ft']:.1f} ft, a near-constant bias per run: "
                     "clock/ephemeris correlated over 2 h) competes with a 10-30 ft radar altimeter and our filter, "
-                    "without channel states, weighs that GPS bias as white noise (R = its full variance, no tuning)")
+                    "without channel states, weighs that GPS bias as white noise (R = its full variance, no tuning)"
+                    + _outage_altitude_evidence(result))
+        failed = [result["cases"][k]["failed_runs"] for k in group]
+        lost = ""
+        if any(failed):
+            lost = (f"; {', '.join(str(n) for n in failed)} of {c0['runs']} runs of these cases failed (unstabilized "
+                    "approach: closed loop, the autopilot flies the vertical error) and are not in the average, "
+                    "which so leaves out the largest vertical errors")
         return (f"GPS-limited: UERE {g['uere_zenith_m']:.2f} m x VDOP {g['vdop']:.2f} = {g['vertical_ft']:.1f} ft "
-                f"against the paper's 5 m = {g['paper_vertical_ft']:.1f} ft; the 100 ft baro bias adds nothing")
+                f"against the paper's 5 m = {g['paper_vertical_ft']:.1f} ft (the baro, with its 100 ft bias, cannot "
+                f"correct it){lost}")
+    out_s = [result["cases"][k]["gps_outages"] for k in group]
+    if any(out_s):
+        q = c0.get("clock_q60_bias_sigma_ft")
+        return ("the receiver clock free-runs through each 60 s GPS outage (no range measures it): our TCXO's "
+                f"clock-bias process noise over 60 s is {q:.0f} ft 1-sigma, so the error grows until GPS returns; "
+                "the paper's clock error does not move in its Table 6, its oscillator model is in the thesis, "
+                "not the paper")
     return ("the receiver clock estimate absorbs the part of the satellites' range errors common to the used "
             f"channels (UERE {g['uere_zenith_m']:.2f} m); the paper's clock error is of the same order")
+
+
+def _outage_altitude_evidence(result: dict) -> str:
+    """Case VI vs XVI altitude (same INS and radar altimeter; XVI loses GPS for 120 s): the measured effect of
+    taking the GPS out of the vertical, when both cases ran."""
+    cs = result["cases"]
+    if "VI" not in cs or "XVI" not in cs:
+        return ""
+    a, b = cs["VI"]["time_averaged_rms_ft"]["altitude"], cs["XVI"]["time_averaged_rms_ft"]["altitude"]
+    if a is None or b is None:
+        return ""
+    return (f"; measured: case XVI, which loses GPS for 120 s, has altitude {b:.2f} ft against case VI's {a:.2f} ft "
+            f"({compare_words(b, a)})")
+
+
+def compare_words(x: float, y: float) -> str:
+    """'lower' / 'higher' / 'equal' for x against y."""
+    return "lower" if x < y else "higher" if x > y else "equal"
 
 
 def note(result: dict, figures: Sequence[str]) -> str:
@@ -630,6 +673,9 @@ def note(result: dict, figures: Sequence[str]) -> str:
         o, p = t["ours"], t["paper"]
         a, b = "-".join(t["a_cases"]), "-".join(t["b_cases"])
         lines += ["", f"## Table {tid}: {t['title']}", "",
+                  f"Ours over the {o['runs']} runs that completed in every case of the table (common random "
+                  "numbers: the same run index in each case), so a group can differ from the per-case figures "
+                  "above when some cases lost runs.", "",
                   f"| error state | paper {a} (ft) | ours {a} (ft) | paper {b} (ft) | ours {b} (ft) | paper % change "
                   "| ours % change | direction | paper's % inside our bounds |",
                   "|---|---|---|---|---|---|---|---|---|"]
@@ -710,8 +756,19 @@ def _category_reason(c: dict) -> str:
         why = ", ".join(f"{n} {k}" for k, n in c.get("failure_reasons", {}).items())
         fails = (f"; {c['failed_runs']} of {c['runs']} runs failed ({why}): closed loop, the autopilot flies the "
                  "navigation error, and a failed run blocks `meets` (evaluation.max_failure_fraction = 0)")
+    g = c["gps_implied"]
+    lateral = ""
+    if "hdop" in g:
+        lateral = (f"; lateral set by GPS: our budget gives {g['per_axis_horizontal_ft']:.1f} ft per horizontal axis "
+                   f"(the paper's 4 m horizontal would give {g['paper_per_axis_horizontal_ft']:.1f} ft, itself above "
+                   "the CAT II 8.6 ft)")
+        geo_pl = c.get("pseudolite_geometry")
+        if geo_pl:
+            shares = ", ".join(f"{x['cross_share']:.2f} at {x['height_ft']:g} ft" for x in geo_pl)
+            lateral += (f", and the pseudolite's line of sight is nearly along the approach (cross-track share "
+                        f"{shares}), so it does not bring the lateral error under 8.6 ft")
     return (f"case {c['case']} (paper: {cl['paper_best'] or 'none'}; ours: {cl['our_best'] or 'none'}, "
-            f"{cl['status']}): vertical set by the {aid}; " + "; ".join(parts) + fails + ".")
+            f"{cl['status']}): vertical set by the {aid}; " + "; ".join(parts) + fails + lateral + ".")
 
 
 def headline(result: dict) -> list[str]:
