@@ -594,7 +594,7 @@ def _difference_reason(state: str, group: Sequence[str], result: dict) -> str:
         if any(failed):
             lost = (f"; {', '.join(str(n) for n in failed)} of {c0['runs']} runs of these cases failed (unstabilized "
                     "approach: closed loop, the autopilot flies the vertical error) and are not in the average, "
-                    "which so leaves out the largest vertical errors")
+                    "which leaves out the largest vertical errors")
         return (f"GPS-limited: UERE {g['uere_zenith_m']:.2f} m x VDOP {g['vdop']:.2f} = {g['vertical_ft']:.1f} ft "
                 f"against the paper's 5 m = {g['paper_vertical_ft']:.1f} ft (the baro, with its 100 ft bias, cannot "
                 f"correct it){lost}")
