@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import inspect
 import json
 from collections.abc import Callable
 from pathlib import Path
@@ -23,10 +24,12 @@ PAPERS = {
     "manero-hajiyev": ("approachsim.papers.manero_hajiyev", "approachsim.report.papers_manero_hajiyev"),
     "sokolovic": ("approachsim.papers.sokolovic", "approachsim.report.papers_sokolovic"),
     "chernodarov": ("approachsim.papers.chernodarov", "approachsim.report.papers_chernodarov"),
+    "gray-maybeck": ("approachsim.papers.gray_maybeck", "approachsim.report.papers_gray_maybeck"),
 }
 """Paper name -> (module that computes, module that draws)."""
 
 DEFAULT_RUNS = 100
+"""Runs when --runs is not given and the paper module has no DEFAULT_RUNS of its own."""
 
 
 def _figure_writer(name: str) -> Callable[[Any, Path], list[str]]:
@@ -41,13 +44,22 @@ def _figure_writer(name: str) -> Callable[[Any, Path], list[str]]:
     return lambda d, out: rep.write_figures(d, out)
 
 
-def reproduce(name: str, out_dir: Path, *, seed: int, runs: int) -> dict:
+def reproduce(name: str, out_dir: Path, *, seed: int, runs: int, cases: list[str] | None = None) -> dict:
     """Compute paper `name`'s reproduction, draw its figures, write DIR/<name>.json and DIR/<name>.md; return
-    the JSON content (with the figure names under "figures")."""
+    the JSON content (with the figure names under "figures"). A paper whose compute() takes out_dir (its
+    campaigns' run stores) and cases (a subset of its cases) gets them."""
     paper = importlib.import_module(PAPERS[name][0])
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    result, data = paper.compute(seed=seed, runs=runs)
+    params = inspect.signature(paper.compute).parameters
+    extra: dict[str, Any] = {}
+    if "out_dir" in params:
+        extra["out_dir"] = out_dir
+    if cases:
+        if "cases" not in params:
+            raise ProfileError(f"--cases: {name} has no cases to choose from (gray-maybeck has)")
+        extra["cases"] = cases
+    result, data = paper.compute(seed=seed, runs=runs, **extra)
     figures = _figure_writer(name)(data, out_dir)
     result["figures"] = figures
     (out_dir / f"{name}.json").write_text(json.dumps(result, indent=2))
@@ -65,14 +77,20 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "note: our tables beside the paper's, every finding chosen from the computed numbers), "
                     "DIR/PAPER.json and the figures; prints the headline findings. Papers: hajiyev-saltoglu "
                     "(Hajiyev & Saltoglu), manero-hajiyev (Manero Contreras & Hajiyev), sokolovic (Sokolovic, "
-                    "Dikic & Stancic), chernodarov (Chernodarov).",
+                    "Dikic & Stancic), chernodarov (Chernodarov), gray-maybeck (Gray & Maybeck, An integrated "
+                    "GPS/INS/Baro and radar altimeter system for aircraft precision approach landings: the 16 cases "
+                    "of its Table 2, closed loop, 15 runs each by default).",
         examples=["approachsim reproduce sokolovic --out out/sokolovic",
-                  "approachsim reproduce hajiyev-saltoglu --out out/hs --runs 200 --seed 3"],
+                  "approachsim reproduce hajiyev-saltoglu --out out/hs --runs 200 --seed 3",
+                  "approachsim reproduce gray-maybeck --out out/gm --cases II,X --runs 5"],
     )
     p.add_argument("paper", help=f"one of: {', '.join(PAPERS)}")
     p.add_argument("--out", required=True, type=Path, help="output directory")
     p.add_argument("--seed", type=int, default=1, help="campaign seed (default 1)")
-    p.add_argument("--runs", type=int, default=DEFAULT_RUNS, help=f"Monte Carlo runs (default {DEFAULT_RUNS})")
+    p.add_argument("--runs", type=int, default=None,
+                   help=f"Monte Carlo runs (default: the paper's, gray-maybeck 15 per case; else {DEFAULT_RUNS})")
+    p.add_argument("--cases", default=None,
+                   help="gray-maybeck only: comma-separated subset of Table 2's cases, e.g. II,X (default all 16)")
     p.set_defaults(func=run)
 
 
@@ -80,13 +98,15 @@ def run(args: argparse.Namespace) -> int:
     """Run one reproduction; print its headline findings and where the files went."""
     if args.paper not in PAPERS:
         raise ProfileError(f"paper: must be one of {', '.join(PAPERS)}; got {args.paper!r}")
-    if args.runs < 1:
-        raise ProfileError(f"--runs: must be >= 1, got {args.runs}")
+    paper = importlib.import_module(PAPERS[args.paper][0])
+    runs = args.runs if args.runs is not None else getattr(paper, "DEFAULT_RUNS", DEFAULT_RUNS)
+    if runs < 1:
+        raise ProfileError(f"--runs: must be >= 1, got {runs}")
     if args.seed < 0:
         raise ProfileError(f"--seed: must be >= 0, got {args.seed}")
-    result = reproduce(args.paper, args.out, seed=args.seed, runs=args.runs)
-    paper = importlib.import_module(PAPERS[args.paper][0])
-    print(f"{args.paper}: {args.runs} runs, seed {args.seed}")
+    cases = [c for c in args.cases.split(",") if c.strip()] if args.cases else None
+    result = reproduce(args.paper, args.out, seed=args.seed, runs=runs, cases=cases)
+    print(f"{args.paper}: {runs} runs, seed {args.seed}")
     for line in paper.headline(result):
         print(f"  {line}")
     print(f"wrote {args.out / (args.paper + '.md')} (the note), {args.out / (args.paper + '.json')} (all numbers) "
