@@ -136,6 +136,11 @@ PINNED: tuple[tuple[str, Any], ...] = (
     ("nav.initial_error.velocity_mps", 0.05),
     ("nav.initial_error.tilt_mrad", 0.05),
     ("nav.initial_error.heading_mrad", 0.5),
+    ("nav.initial_error.start", "prior"),  # the paper's initial errors, drawn independently of the sensors'
+    # the filter's terrain database is the (flat) truth terrain: the paper's flat-earth radar altimeter
+    ("nav.terrain_database.bias_sigma_m", 0.0),
+    ("nav.terrain_database.sigma_m", 0.0),
+    ("nav.terrain_database.outer_sigma_m", 0.0),
     # calm air, flat terrain (assumption 11: the base profile has no [terrain] table), FAA table
     ("environment.wind_speed_kt", 0.0),
     ("environment.turbulence", "none"),
@@ -154,6 +159,7 @@ PINNED_RADALT: tuple[tuple[str, Any], ...] = (
     ("sensors.radalt.percent_of_height", 1.0),
     ("sensors.radalt.floor_m", 0.5),
     ("sensors.radalt.markov_sigma_m", 0.0),
+    ("sensors.radalt.bias_sigma_m", 0.0),
 )
 """Pinned on the cases with the radar altimeter (a sensor that is not fitted takes no keys)."""
 
