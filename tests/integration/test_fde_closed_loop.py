@@ -28,6 +28,7 @@ def _fly(fde: bool):
     d = tomllib.loads(DEFAULT.read_text(encoding="utf-8"))
     d["runway"]["start_distance_nmi"] = 3.0
     d["sensors"]["gnss"]["selection"] = "all"
+    d["sensors"]["gnss"]["epoch"] = "fixed"  # PRN 16 is used at the default epoch_utc
     d["nav"]["fde"] = {"enabled": fde}
     d["faults"] = [{"sensor": "gnss", "kind": "ramp", "channel": PRN, "start_s": ONSET_S, "rate": 2.0,
                     "target": "pseudorange"}]
