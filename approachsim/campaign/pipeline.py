@@ -80,9 +80,10 @@ def spec_for(profile: Any, mode: str) -> PipelineSpec:
 
 
 def _score(
-    profile: Any, run: int, truth: Any, nav: Any, clock_true: Any, gnss: Any = None, flight: Any = None
+    profile: Any, run: int, truth: Any, nav: Any, clock_true: Any, gnss: Any = None, flight: Any = None,
+    seed: int | None = None,
 ) -> RunResult:
-    from approachsim.evaluate.score import score_run
+    from approachsim.evaluate.score import HEIGHT_GRID_FT, score_run
 
     cfg = profile.evaluation
     fte = {}
@@ -96,7 +97,16 @@ def _score(
         scalars.update(_geometry_at_dh(gnss, scalars))
     if series is not None and gnss is not None:
         series = {**series, **_geometry_series(gnss, series["t_s"])}
-    return RunResult(run=run, ok=True, scalars=scalars, arrays=arrays, series=series)
+    counts = {}
+    if cfg.integrity_on and gnss is not None and seed is not None:
+        # the solution-separation bank, open loop on this run's (flown) truth with its own sensor draws
+        from approachsim import units
+        from approachsim.integrity.campaign import score_with_bank
+
+        s_int, counts, a_int = score_with_bank(profile, truth, seed, run, nav, HEIGHT_GRID_FT * units.FT)
+        scalars.update(s_int)
+        arrays = {**arrays, **a_int}
+    return RunResult(run=run, ok=True, scalars=scalars, arrays=arrays, series=series, counts=counts)
 
 
 def _geometry_series(gnss: Any, t_s: Any) -> dict:
@@ -215,7 +225,7 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
         try:
             g = records.get("gnss")
             out.append(_score(profile, i, truth, nr.solution, _clock_truth(records, k, truth.t_s),
-                              None if g is None else g.run(k)))
+                              None if g is None else g.run(k), seed=seed))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out
@@ -241,7 +251,7 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunR
             nav = source.result(truth).solution
             clk = source.errors.clock
             clock_true = None if clk is None else np.interp(truth.t_s, clk.t_s, np.asarray(clk.series["bias"]))
-            out.append(_score(profile, i, truth, nav, clock_true, _gnss_closed_loop(source, truth), flight))
+            out.append(_score(profile, i, truth, nav, clock_true, _gnss_closed_loop(source, truth), flight, seed))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out
