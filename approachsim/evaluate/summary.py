@@ -59,14 +59,13 @@ def verdicts(
         out.append(category_verdict(
             cat, cfg.dh_ft[cat], lat, ver, cfg.verdict, runs=runs, failed_runs=failed_runs,
             max_failure_fraction=cfg.max_failure_fraction, confidence=cfg.confidence, groups=groups,
-            integrity=integrity_criterion(columns, cat, cfg) if cat in cfg.integrity else None,
+            integrity=integrity_criterion(columns, cat, cfg) if cat in cfg.integrity and bank else None,
         ))
     return out
 
 
 def integrity_criterion(columns: Mapping[str, np.ndarray], category: str, cfg: EvaluationConfig) -> IntegrityVerdict:
-    """The integrity criterion of `category` from the bank's per-run columns (integrity.campaign); without
-    them (no GNSS receiver: no bank) the criterion is indeterminate with no run count that would decide it."""
+    """The integrity criterion of `category` from the bank's per-run columns (integrity.campaign)."""
     from approachsim.integrity.requirements import REQUIREMENTS
 
     key = CATEGORY_KEYS[category]
