@@ -50,7 +50,10 @@ def verdicts(
 
     runs / failed_runs: the campaign's run count and its failed runs, which count against every category.
     groups: the shared-truth (flight) group of each completed run in open loop; None: independent runs.
+    Integrity joins the verdict of the categories in cfg.integrity when the runs carry the bank's columns (no
+    GPS receiver: no fault modes to separate, no bank, and the verdict is the accuracy one alone).
     """
+    bank = any(f"{k}_int_epochs" in columns for k in CATEGORY_KEYS.values())
     out = []
     for cat in CATEGORIES:
         key = CATEGORY_KEYS[cat]

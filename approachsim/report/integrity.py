@@ -71,7 +71,7 @@ def fig_integrity_stanford(det: dict) -> Figure:
             ax.text(al / 4, al / 200, f"normal\n{cnt['normal']}", **kw)
             ax.text(np.sqrt(al * lo) / 3, np.sqrt(al * lo) * 1.5, f"MI\n{cnt['mi']}", **kw)
             ax.text(np.sqrt(al * lo) / 3, np.sqrt(al * hi) * 3, f"HMI\n{cnt['hmi']}", **kw)
-            ax.text(np.sqrt(al * hi) * 3, np.sqrt(al * lo) * 3, f"unavailable\n{cnt['unavailable']}", **kw)
+            ax.text(np.sqrt(al * hi) * 3, np.sqrt(al * hi) * 3, f"unavailable\n{cnt['unavailable']}", **kw)
             ax.set_xlabel(f"{label} protection level, m")
             ax.set_ylabel(f"{label} |error|, m")
             ax.set_title(f"{cat} {label}: AL {al:g} m at DH (red), {e['epochs']} epochs, {e['runs']} runs",
