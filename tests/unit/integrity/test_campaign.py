@@ -163,3 +163,42 @@ def test_integrity_blocks_meets_and_decides_runs_needed():
     assert r.verdict == "fails"
     r = category_verdict("CAT I", 200, lat, ver, integrity=integrity_verdict(400, 400, 0, 100000, 0.99, 1e-3))
     assert r.verdict == "meets"
+
+
+def test_run_result_counts_round_trip_sparse():
+    import json
+
+    from approachsim.campaign.result import RunResult
+    from approachsim.integrity.campaign import sum_counts
+
+    h = np.zeros(NB * NB)
+    h[[3, 700, 1599]] = [2.0, 5.0, 1.0]
+    r = RunResult(run=4, ok=True, scalars={"x": 1.0}, counts={"cat1_stanford_v": h})
+    line = r.json_line()
+    assert len(json.loads(line)["counts"]["cat1_stanford_v"]["index"]) == 3  # sparse on disk
+    back = RunResult.from_record(json.loads(line))
+    assert back.same_as(r) and np.array_equal(back.counts["cat1_stanford_v"], h)
+    assert "counts" not in RunResult(run=1, ok=True, scalars={"x": 1.0}).record()  # integrity off: unchanged
+    total = sum_counts([r, back, RunResult.failed(5, "x")])
+    assert np.array_equal(total["cat1_stanford_v"], 2 * h)
+
+
+@pytest.mark.parametrize(("value", "expected"), [
+    (None, ("CAT II", "CAT III")), (True, ("CAT I", "CAT II", "CAT III")), (False, ()),
+    (["CAT III", "CAT I"], ("CAT I", "CAT III")),
+])
+def test_evaluation_integrity_key(value, expected):
+    from approachsim.config import Section
+    from approachsim.evaluate.config import parse_evaluation
+
+    cfg = parse_evaluation(Section({} if value is None else {"integrity": value}, "evaluation"))
+    assert cfg.integrity == expected and cfg.integrity_on == bool(expected)
+
+
+@pytest.mark.parametrize("value", ["CAT II", ["CAT IV"], ["CAT I", "CAT I"], 1])
+def test_evaluation_integrity_bad_value_names_the_field(value):
+    from approachsim.config import ProfileError, Section
+    from approachsim.evaluate.config import parse_evaluation
+
+    with pytest.raises(ProfileError, match=r"evaluation\.integrity"):
+        parse_evaluation(Section({"integrity": value}, "evaluation"))
