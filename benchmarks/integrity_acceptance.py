@@ -25,8 +25,10 @@ import numpy as np
 
 from approachsim import units
 from approachsim.campaign.pipeline import _approach
+from approachsim.campaign.result import RunResult
 from approachsim.integrity.campaign import campaign_integrity, score_with_bank
 from approachsim.profile import load_profile
+from approachsim.report.integrity import fig_integrity_tta
 from approachsim.seeding import stream
 from approachsim.sensors.faults import FaultSpec
 from approachsim.sensors.suite import SensorSuite
@@ -46,7 +48,7 @@ def main() -> None:
     kind, rate = KINDS[a.kind]
     size = base.evaluation.flight_group
     truths: dict[int, object] = {}
-    rows, cols = [], {}
+    rows, cols, results = [], {}, []
     t_start = time.time()
     for i in range(a.runs):
         first = (i // size) * size
@@ -69,6 +71,7 @@ def main() -> None:
         s, _, _ = score_with_bank(prof, truth, a.seed, i)
         for k, v in s.items():
             cols.setdefault(k, []).append(v)
+        results.append(RunResult(run=i, ok=True, scalars=s))
         rows.append({"run": i, "onset_s": onset, "prn": prn, "channel": ch, "step_m": mag,
                      **{k: (s[k] if math.isfinite(s[k]) else str(s[k])) for k in s
                         if k.startswith("cat2_int_") and k[9:11] not in ("v_", "l_")}})
@@ -84,6 +87,10 @@ def main() -> None:
     text = json.dumps(res, indent=1, allow_nan=False)
     if a.out is not None:
         a.out.write_text(text + "\n")
+        fig = fig_integrity_tta(results, {"integrity": out})
+        if fig is not None:
+            fig.suptitle(f"Time to alert, {a.kind}, {a.runs} runs (open loop, default profile)", fontsize=11)
+            fig.savefig(a.out.with_suffix(".png"), dpi=100)
     for cat, c in out["categories"].items():
         print(cat, json.dumps(c.get("time_to_alert")), "MI", c["mi"]["count"], "HMI", c["hmi"]["count"])
 
