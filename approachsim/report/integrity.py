@@ -121,15 +121,26 @@ def fig_integrity_tta(results: list[RunResult], det: dict) -> Figure | None:
     fig = Figure(figsize=(10, 6.5), constrained_layout=True)
     axes = fig.subplots(2, 1)
     ok = [r for r in results if r.ok]
+
+    def values(key: str) -> np.ndarray:
+        return np.array([r.scalars.get(key, np.nan) for r in ok])
+
+    bins = {}
+    for ax_i, name in ((0, "tta_s"), (1, "delay_s")):
+        allv = np.concatenate([values(f"{CATEGORY_KEYS[c]}_int_{name}") for c in cats])
+        allv = allv[np.isfinite(allv)]
+        lo, hi = (float(allv.min()), float(allv.max())) if allv.size else (0.0, 1.0)
+        bins[ax_i] = np.linspace(np.floor(lo) - 0.5, np.ceil(hi) + 0.5, int(min(60, np.ceil(hi) - np.floor(lo) + 2)))
     for cat in cats:
         key = CATEGORY_KEYS[cat]
         tta = np.array([r.scalars.get(f"{key}_int_tta_s", np.nan) for r in ok])
         delay = np.array([r.scalars.get(f"{key}_int_delay_s", np.nan) for r in ok])
         t_req = det["integrity"]["categories"][cat]["time_to_alert"]["tta_required_s"]
-        for ax, x in ((axes[0], tta), (axes[1], delay)):
+        for i, (ax, x) in enumerate(((axes[0], tta), (axes[1], delay))):
             fin = x[np.isfinite(x)]
             if fin.size:
-                ax.hist(fin, bins=30, histtype="step", lw=1.8, color=COLORS[cat], label=f"{cat} ({fin.size} runs)")
+                ax.hist(fin, bins=bins[i], histtype="step", lw=3 - CATEGORIES.index(cat), ls=LINES[cat],
+                        color=COLORS[cat], label=f"{cat} ({fin.size} runs)")
         axes[0].axvline(t_req, color=COLORS[cat], ls="--", lw=1)
         missed = int(np.sum(tta == np.inf))
         if missed:

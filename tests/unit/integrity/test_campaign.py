@@ -202,3 +202,26 @@ def test_evaluation_integrity_bad_value_names_the_field(value):
 
     with pytest.raises(ProfileError, match=r"evaluation\.integrity"):
         parse_evaluation(Section({"integrity": value}, "evaluation"))
+
+
+def test_integrity_figures_from_a_constructed_faulted_campaign():
+    from approachsim.campaign.result import RunResult
+    from approachsim.report.integrity import integrity_figures, integrity_rows
+
+    n = 100
+    e0 = np.zeros((n, 2))
+    e0[30:, 0] = 0.5 * (np.arange(n - 30) + 1)
+    ek = np.repeat(e0[:, None, :], 4, axis=1)
+    ek[:, 2, :] = 0.0
+    grid = np.arange(600.0, -1.0, -6.0)
+    s, counts, arrays = run_integrity(_epochs(e0=e0, ek=ek), CFG, epoch_hz=1.0, t0_s=0.0, onset_s=30.0,
+                                      fault_ch=5, height_grid_m=grid)
+    results = [RunResult(run=i, ok=True, scalars=s, arrays=arrays, counts=counts) for i in range(3)]
+    cols = {k: np.full(3, v) for k, v in s.items()}
+    det = {"integrity": campaign_integrity(cols, {k: 3 * v for k, v in counts.items()}, CFG)}
+    tt = det["integrity"]["categories"]["CAT II"]["time_to_alert"]
+    assert tt["detected"] == 3 and tt["within_tta"] == 3 and tt["missed_detections"] == 0
+    figs = integrity_figures(results, det)
+    assert set(figs) == {"integrity_stanford", "integrity_availability", "integrity_tta"}
+    assert len(figs["integrity_stanford"].axes) == 7  # 2 axes x 3 categories + the colour bar
+    assert len(integrity_rows(det)) == 3
