@@ -39,7 +39,9 @@ def evaluate_results(
     summary = contract_summary(
         res, profile=profile, runs=len(results), seed=seed, closed_loop=closed_loop, failed_runs=failed
     )
-    det = details(cols, res, cfg)
+    from approachsim.integrity.campaign import sum_counts
+
+    det = details(cols, res, cfg, sum_counts(results))
     det["failures"] = {str(r.run): r.error for r in results if not r.ok}
     geom = gnss_geometry([r.run for r in results if r.ok], cols)
     if geom is not None:
@@ -109,6 +111,21 @@ def verdict_table(summary: dict, det: dict) -> str:
             "open loop: runs of one group share one flown truth (evaluation.flight_group); "
             + _shared_truth_note(det)
             + "; closed loop gives every run its own flight"
+        )
+    for cat, e in det.get("integrity", {}).get("categories", {}).items():
+        a, h = e["availability_dh"], e["hmi"]
+        fa = e.get("false_alert")
+        tt = e.get("time_to_alert")
+        lines.append(
+            f"integrity {cat}{' (in verdict: ' + e['verdict'] + ')' if e['in_verdict'] else ''}: available at DH "
+            f"{a['available']}/{a['runs']} (bounds {_f(a['lower'], '.3f').strip()}-{_f(a['upper'], '.3f').strip()}, "
+            f"required {e['requirement']['availability']:g}), MI {e['mi']['count']}, HMI {h['count']} of "
+            f"{e['epochs']} epochs (rate upper {_f(h['rate_per_epoch_upper'], '.1e').strip()}, allowed "
+            f"{h['rate_per_epoch_allowed']:.1e})"
+            + (f", false alerts {fa['alerts']} (upper {_f(fa['rate_per_15s_upper'], '.1e').strip()} / 15 s, "
+               f"allocation {fa['allocation_per_15s']:.0e})" if fa else "")
+            + (f", TTA <= {tt['tta_required_s']:g} s in {tt['within_tta']}/{tt['exceeded_pl']} runs whose error "
+               f"exceeded the PL, {tt['missed_detections']} missed" if tt else "")
         )
     ta = det.get("time_averaged_rms_ft", {})
     if ta:

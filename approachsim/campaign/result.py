@@ -22,6 +22,19 @@ def _empty() -> dict:
     return {}
 
 
+def _sparse(v: Array) -> dict:
+    """{"size": n, "index": [...], "count": [...]} of the nonzero cells of a (n,) count array."""
+    v = np.asarray(v, dtype=float)
+    i = np.flatnonzero(v)
+    return {"size": int(v.size), "index": [int(x) for x in i], "count": [float(x) for x in v[i]]}
+
+
+def _dense(d: Mapping) -> Array:
+    out = np.zeros(int(d["size"]))
+    out[np.asarray(d["index"], dtype=int)] = np.asarray(d["count"], dtype=float)
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class RunResult:
     """One run's outcome. run: index in the campaign; ok False means error says why (and nothing was scored)."""
@@ -35,6 +48,9 @@ class RunResult:
     """Small (k,) float arrays of the same length for every run (stored in the results table)."""
     series: Mapping[str, Array] | None = None
     """Time series kept for this run (equal-length (n,) arrays, written to their own file), or None."""
+    counts: Mapping[str, Array] = field(default_factory=_empty)
+    """Histograms summed over the campaign (integrity: (error, protection level) cells per category and axis,
+    integrity.campaign), stored sparse in the JSON line; empty when integrity is off."""
 
     @classmethod
     def failed(cls, run: int, error: str) -> RunResult:
@@ -49,6 +65,7 @@ class RunResult:
             "error": self.error,
             "scalars": {k: float(v) for k, v in self.scalars.items()},
             "arrays": {k: [float(x) for x in np.asarray(v, dtype=float)] for k, v in self.arrays.items()},
+            **({"counts": {k: _sparse(v) for k, v in self.counts.items()}} if self.counts else {}),
         }
 
     def json_line(self) -> str:
@@ -64,6 +81,7 @@ class RunResult:
             error=d.get("error"),
             scalars={k: float(v) for k, v in d.get("scalars", {}).items()},
             arrays={k: np.asarray(v, dtype=float) for k, v in d.get("arrays", {}).items()},
+            counts={k: _dense(v) for k, v in d.get("counts", {}).items()},
         )
 
     def same_as(self, other: RunResult) -> bool:
@@ -78,6 +96,10 @@ class RunResult:
                 return False
             if math.copysign(1.0, v) != math.copysign(1.0, w):
                 return False
+        if list(self.counts) != list(other.counts) or any(
+            not np.array_equal(v, other.counts[k]) for k, v in self.counts.items()
+        ):
+            return False
         return all(
             np.array_equal(np.asarray(v).view(np.uint64), np.asarray(other.arrays[k]).view(np.uint64))
             for k, v in self.arrays.items()

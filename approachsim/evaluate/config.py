@@ -21,6 +21,19 @@ from approachsim.config import ProfileError, Section
 from approachsim.evaluate.limits import CATEGORIES, DEFAULT_DH_FT, K_H_PA, K_V_PA
 
 VERDICTS = ("faa", "faa+icao")
+DEFAULT_INTEGRITY = ("CAT II", "CAT III")
+"""Categories with integrity in the verdict by default (issue 11: on for CAT II / III)."""
+
+
+def _integrity(s: Section) -> tuple[str, ...]:
+    """evaluation.integrity: true (every category), false (none) or a list of category names."""
+    v = s.raw("integrity", list(DEFAULT_INTEGRITY))
+    if isinstance(v, bool):
+        return tuple(CATEGORIES) if v else ()
+    if not isinstance(v, list) or any(c not in CATEGORIES for c in v) or len(set(v)) != len(v):
+        raise ProfileError(f"{s.path}.integrity: must be true, false or a list of distinct categories "
+                           f"({', '.join(CATEGORIES)}); got {v!r}")
+    return tuple(c for c in CATEGORIES if c in v)
 
 
 @dataclass(frozen=True)
@@ -42,6 +55,15 @@ class EvaluationConfig:
     """Confidence level of each one-sided bound the verdict is decided on (evaluate/verdict.py)."""
     max_failure_fraction: float = 0.0
     """Failure probability a category tolerates; 0: any failed run fails every category (evaluate/verdict.py)."""
+    integrity: tuple[str, ...] = DEFAULT_INTEGRITY
+    """Categories whose verdict includes the integrity criterion (evaluate/verdict.py); when any is listed, every
+    run is scored by the solution-separation bank (integrity/campaign.py) and details.json carries `integrity`
+    for every category."""
+
+    @property
+    def integrity_on(self) -> bool:
+        """Whether the campaign runs the integrity bank (any category listed)."""
+        return bool(self.integrity)
 
     @property
     def dh_ft(self) -> dict[str, float]:
@@ -70,8 +92,10 @@ def parse_evaluation(s: Section) -> EvaluationConfig:
     settle = s.number("timeavg_settle_s", 10.0, lo=0.0, hi=600.0, unit="s")
     confidence = s.number("confidence", 0.95, lo=0.5, hi=0.9999)
     max_fail = s.number("max_failure_fraction", 0.0, lo=0.0, hi=0.5)
+    integrity = _integrity(s)
     s.done()
     return EvaluationConfig(
         *dh.values(), verdict=verdict, k_v=k_v, k_h=k_h, series_runs=series_runs, flight_group=flight_group,
         timeavg_settle_s=settle, confidence=confidence, max_failure_fraction=max_fail,
+        integrity=integrity,
     )

@@ -20,7 +20,13 @@ from approachsim.evaluate.limits import CATEGORIES
 from approachsim.evaluate.score import CATEGORY_KEYS
 from approachsim.evaluate.stats import error_stats
 from approachsim.evaluate.timeavg import STATES, campaign_rms_ft
-from approachsim.evaluate.verdict import CategoryResult, best_category, category_verdict
+from approachsim.evaluate.verdict import (
+    CategoryResult,
+    IntegrityVerdict,
+    best_category,
+    category_verdict,
+    integrity_verdict,
+)
 
 SCHEMA = "approachsim.summary/1"
 
@@ -44,7 +50,10 @@ def verdicts(
 
     runs / failed_runs: the campaign's run count and its failed runs, which count against every category.
     groups: the shared-truth (flight) group of each completed run in open loop; None: independent runs.
+    Integrity joins the verdict of the categories in cfg.integrity when the runs carry the bank's columns (no
+    GPS receiver: no fault modes to separate, no bank, and the verdict is the accuracy one alone).
     """
+    bank = any(f"{k}_int_epochs" in columns for k in CATEGORY_KEYS.values())
     out = []
     for cat in CATEGORIES:
         key = CATEGORY_KEYS[cat]
@@ -53,8 +62,24 @@ def verdicts(
         out.append(category_verdict(
             cat, cfg.dh_ft[cat], lat, ver, cfg.verdict, runs=runs, failed_runs=failed_runs,
             max_failure_fraction=cfg.max_failure_fraction, confidence=cfg.confidence, groups=groups,
+            integrity=integrity_criterion(columns, cat, cfg) if cat in cfg.integrity and bank else None,
         ))
     return out
+
+
+def integrity_criterion(columns: Mapping[str, np.ndarray], category: str, cfg: EvaluationConfig) -> IntegrityVerdict:
+    """The integrity criterion of `category` from the bank's per-run columns (integrity.campaign)."""
+    from approachsim.integrity.requirements import REQUIREMENTS
+
+    key = CATEGORY_KEYS[category]
+    req = REQUIREMENTS[category]
+    dh = _col(columns, f"{key}_int_avail_dh")
+    dh = dh[np.isfinite(dh)]
+    return integrity_verdict(
+        int(dh.sum()), int(dh.size), int(np.nansum(_col(columns, f"{key}_int_hmi"))),
+        int(np.nansum(_col(columns, f"{key}_int_epochs"))), req.availability, req.hmi_rate_per_epoch(1.0),
+        cfg.confidence,
+    )
 
 
 def contract_summary(
@@ -93,7 +118,8 @@ def _stats_ft(x_m: np.ndarray) -> dict:
     return {k: _num(v) for k, v in asdict(error_stats(x_m).scaled(1.0 / units.FT)).items()}
 
 
-def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cfg: EvaluationConfig) -> dict:
+def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cfg: EvaluationConfig,
+            counts: Mapping[str, np.ndarray] | None = None) -> dict:
     """Everything beside the contract: bounds, ICAO limits, failures, integrity, FTE / TSE, time-averaged RMS."""
     cats = {}
     for r in results:
@@ -121,23 +147,45 @@ def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cf
         comps = ("along", "lateral", "vertical", "gpdev", "vpl", "hpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert")
         for comp in comps:
             entry[f"{comp}_ft"] = _stats_ft(_col(columns, f"{key}_{comp}_m"))
-        for axis, name in (("v", "vertical"), ("h", "horizontal")):
-            entry[f"stanford_{name}"] = {
-                reg: int(np.nansum(_col(columns, f"{key}_{axis}_{reg}"))) for reg in REGIONS
-            }
-        av = _col(columns, f"{key}_availability")
-        entry["availability"] = _num(float(np.mean(av))) if av.size else None
+        if f"{key}_int_epochs" in columns:  # the solution-separation bank's (integrity on)
+            for c_name, name in (("vpl_dh_m", "vpl"), ("lpl_dh_m", "lpl")):
+                entry[f"{name}_ft"] = _stats_ft(_col(columns, f"{key}_int_{c_name}"))
+            entry.pop("hpl_ft")
+            for axis, name in (("v", "vertical"), ("l", "lateral")):
+                entry[f"stanford_{name}"] = {
+                    reg: int(np.nansum(_col(columns, f"{key}_int_{axis}_{reg}")))
+                    for reg in ("normal", "mi", "hmi", "unavailable")
+                }
+            n_ep = float(np.nansum(_col(columns, f"{key}_int_epochs")))
+            entry["availability"] = _num(float(np.nansum(_col(columns, f"{key}_int_avail_epochs")) / n_ep))
+        else:  # integrity off: the covariance K_V / K_H levels (no fault hypothesis; not integrity evidence)
+            for axis, name in (("v", "vertical"), ("h", "horizontal")):
+                entry[f"stanford_{name}"] = {
+                    reg: int(np.nansum(_col(columns, f"{key}_{axis}_{reg}"))) for reg in REGIONS
+                }
+            av = _col(columns, f"{key}_availability")
+            entry["availability"] = _num(float(np.mean(av))) if av.size else None
+        if r.integrity is not None:
+            entry["integrity_verdict"] = r.integrity.verdict
         cats[r.category] = entry
     ta = campaign_rms_ft({s: _col(columns, f"ta_{s}_ft2") for s in STATES})
-    return {
+    bank = any(f"{CATEGORY_KEYS[c]}_int_epochs" in columns for c in CATEGORIES)
+    out = {
         "verdict_limits": cfg.verdict,
         "confidence": cfg.confidence,
         "max_failure_fraction": cfg.max_failure_fraction,
-        "k_v": cfg.k_v,
-        "k_h": cfg.k_h,
         "categories": cats,
         "time_averaged_rms_ft": {k: _num(v) for k, v in ta.items()},
     }
+    if bank:
+        from approachsim.integrity.campaign import campaign_integrity
+
+        out["protection_levels"] = "solution-separation bank (integrity.campaign)"
+        out["integrity"] = campaign_integrity(
+            columns, counts or {}, cfg, verdicts={r.category: r.integrity for r in results if r.integrity})
+    else:
+        out.update({"protection_levels": "covariance K_V / K_H", "k_v": cfg.k_v, "k_h": cfg.k_h})
+    return out
 
 
 GEOMETRY_PERCENTILES = (5, 25, 50, 75, 95)

@@ -19,6 +19,15 @@ Each criterion is judged on one-sided confidence bounds at the profile's evaluat
   one-sided bounds of the failure probability decide: upper <= f passes, lower > f fails, else
   indeterminate.
 
+* Integrity (categories listed in evaluation.integrity; integrity_verdict): availability at the decision
+  height (runs whose protection levels were inside the alert limits at their last epoch before the DH) meets
+  when its Clopper-Pearson lower bound reaches the category's requirement (0.99, the lower end of ICAO
+  Annex 10 Vol I Table 3.7.2.4-1's range; integrity.requirements) and fails when its upper bound is below it;
+  hazardously misleading information meets when there is none and the upper bound of its per-epoch rate is
+  within the allowed rate (the integrity risk spread over the exposure's epochs), fails when the lower
+  bound exceeds it (any HMI epoch at the run counts a campaign reaches), and is indeterminate otherwise
+  (no HMI, but too few epochs to bound a 1e-9 risk: the usual outcome; its runs_needed says how many).
+
 The category fails when any criterion fails, meets when all meet, and is indeterminate otherwise.
 runs_needed (indeterminate only): the completed-run count at which the bounds would likely decide it if
 the point estimates stayed where they are: towards `fails` when a point estimate is beyond its limit,
@@ -70,6 +79,56 @@ class AxisVerdict:
 
 
 @dataclass(frozen=True)
+class IntegrityVerdict:
+    """The integrity criterion of one category: availability at the DH and HMI (module docstring)."""
+
+    availability_verdict: str
+    hmi_verdict: str
+    verdict: str
+    runs_needed: int | None
+    availability_dh_lower: float
+    availability_dh_upper: float
+    hmi_rate_upper: float
+
+
+def _runs_for_availability(k: int, n: int, required: float, level: float) -> int | None:
+    """Runs at which the availability's lower bound would reach `required` at the same observed fraction."""
+    if n <= 0 or k / n < required:
+        return None
+    frac = k / n
+    for m in (int(x) for x in np.unique(np.geomspace(max(n, 1), 1e7, 600).astype(int))):
+        if clopper_pearson(int(math.floor(frac * m)), m, level)[0] >= required:
+            return m
+    return None
+
+
+def integrity_verdict(available_dh: int, runs_dh: int, hmi: int, epochs: int, required_availability: float,
+                      allowed_hmi_rate: float, level: float = 0.95) -> IntegrityVerdict:
+    """The integrity criterion (module docstring) from the runs available at the DH (of runs_dh) and the HMI
+    epochs (of all epochs). runs_needed: runs at which the bounds would decide towards meets at the same
+    observed rates (the HMI part: epochs / (epochs per run) to bound the allowed rate with none observed)."""
+    a_lo, a_hi = clopper_pearson(available_dh, runs_dh, level)
+    av = "meets" if runs_dh > 0 and a_lo >= required_availability else (
+        "fails" if runs_dh > 0 and a_hi < required_availability else "indeterminate")
+    h_lo, h_hi = clopper_pearson(hmi, epochs, level)
+    hv = "fails" if hmi > 0 and h_lo > allowed_hmi_rate else (
+        "meets" if hmi == 0 and epochs > 0 and h_hi <= allowed_hmi_rate else "indeterminate")
+    v = _combine([av, hv])
+    need = None
+    if v == "indeterminate":
+        needs = []
+        if av == "indeterminate":
+            needs.append(_runs_for_availability(available_dh, runs_dh, required_availability, level))
+        if hv == "indeterminate":
+            per_run = epochs / runs_dh if runs_dh else 0.0
+            # zero events: the upper bound is 1 - (1 - level)^(1/N) ~ -ln(1 - level) / N
+            n_ep = -math.log(1.0 - level) / allowed_hmi_rate
+            needs.append(int(math.ceil(n_ep / per_run)) if hmi == 0 and per_run > 0 else None)
+        need = None if not needs or any(x is None for x in needs) else max(needs)
+    return IntegrityVerdict(av, hv, v, need, a_lo, a_hi, h_hi)
+
+
+@dataclass(frozen=True)
 class CategoryResult:
     """The scored errors of one category at its decision height, ft, and its verdict."""
 
@@ -87,6 +146,8 @@ class CategoryResult:
     verdict: str
     runs_needed: int | None
     confidence: float
+    integrity: IntegrityVerdict | None = None
+    """The integrity criterion when the category has integrity on (evaluation.integrity), else None."""
 
     @property
     def meets(self) -> bool:
@@ -175,11 +236,13 @@ def category_verdict(
     max_failure_fraction: float = 0.0,
     confidence: float = 0.95,
     groups: np.ndarray | None = None,
+    integrity: IntegrityVerdict | None = None,
 ) -> CategoryResult:
     """Score one category from the per-run errors (ft) at its decision height of the completed runs.
 
     runs: all runs of the campaign (completed + failed_runs; default the completed count + failed_runs).
     groups: the shared-truth group of each completed run (open loop), aligned with the error arrays.
+    integrity: the category's integrity criterion (integrity_verdict) when it has integrity on, else None.
     """
     lim = LIMITS[category]
     lat = error_stats(lateral_ft, confidence)
@@ -190,7 +253,7 @@ def category_verdict(
     total = (min(lat.n, ver.n) + failed_runs) if runs is None else int(runs)
     fv = failure_verdict(failed_runs, total, max_failure_fraction, confidence)
     f_hi = clopper_pearson(failed_runs, total, confidence)[1]
-    v = _combine([la.verdict, va.verdict, fv])
+    v = _combine([la.verdict, va.verdict, fv] + ([integrity.verdict] if integrity is not None else []))
     need = None
     if v == "indeterminate":
         axes = [a for a in (la, va) if a.verdict == "indeterminate"]
@@ -203,9 +266,11 @@ def category_verdict(
             needs = [a.runs_needed for a in axes]
             if fv == "indeterminate":
                 needs.append(_runs_for_failures(failed_runs, total, max_failure_fraction, confidence))
+            if integrity is not None and integrity.verdict == "indeterminate":
+                needs.append(integrity.runs_needed)  # the deciding one when the accuracy is decided
             need = None if not needs or any(x is None for x in needs) else max(needs)
     return CategoryResult(
-        category, height_ft, lat, ver, lim, la, va, total, failed_runs, fv, f_hi, v, need, confidence
+        category, height_ft, lat, ver, lim, la, va, total, failed_runs, fv, f_hi, v, need, confidence, integrity
     )
 
 

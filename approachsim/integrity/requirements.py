@@ -61,6 +61,14 @@ class IntegrityRequirement:
     """True: the alert limits grow with distance / height as Annex 10 App. B Tables B-68 / B-69."""
     p_fault_per_sat: float = 1e-5
     """Prior probability of a satellite fault over an approach (ARAIM ISM P_sat, [S])."""
+    availability: float = 0.99
+    """Availability the category must reach at the decision height: the lower end of ICAO Annex 10 Vol I
+    Table 3.7.2.4-1's 0.99 to 0.99999 range (APV and CAT I [V]; the same range is used for CAT II / III)."""
+
+    def hmi_rate_per_epoch(self, epoch_hz: float) -> float:
+        """Allowed rate of hazardously misleading epochs: the integrity risk over the exposure spread over its
+        epochs, integrity_risk / (exposure_s epoch_hz) (union bound: any misleading epoch is an event)."""
+        return self.integrity_risk / max(1.0, self.exposure_s * epoch_hz)
 
     @property
     def n_es(self) -> float:

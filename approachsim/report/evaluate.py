@@ -12,6 +12,10 @@ Figures (PNG files in DIR and embedded as base64 in DIR/report.html):
   against height;
 * sky_dop.png (when the series carry GPS geometry): sky plot of the satellites and PDOP of one run.
 
+With integrity on (evaluation.integrity), stanford.png and availability.png (covariance K_V / K_H levels) give
+way to report/integrity.py's solution-separation figures (integrity_stanford, integrity_availability,
+integrity_tta).
+
 Uses matplotlib's object API (Figure, no pyplot state), so it is safe in workers and threads.
 """
 
@@ -32,6 +36,8 @@ from approachsim.campaign.outputs import verdict_table
 from approachsim.campaign.result import RunResult
 from approachsim.evaluate.limits import CATEGORIES, LIMITS
 from approachsim.evaluate.score import CATEGORY_KEYS, HEIGHT_GRID_FT
+from approachsim.report.integrity import CAPTIONS as INTEGRITY_CAPTIONS
+from approachsim.report.integrity import INTEGRITY_HEADER, integrity_figures, integrity_rows
 
 COLORS = {"CAT I": "tab:green", "CAT II": "tab:orange", "CAT III": "tab:red"}
 
@@ -313,9 +319,13 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
     imgs = {
         "errors_vs_height": fig_errors_vs_height(results, dh_ft),
         "histograms_dh": fig_histograms(results, dh_ft),
-        "stanford": fig_stanford(_series(out_dir), det, dh_ft),
-        "availability": fig_availability(results),
     }
+    integ_figs = integrity_figures(results, det)
+    if integ_figs:  # integrity on: the solution-separation levels replace the covariance K_V / K_H ones
+        imgs.update(integ_figs)
+    else:
+        imgs["stanford"] = fig_stanford(_series(out_dir), det, dh_ft)
+        imgs["availability"] = fig_availability(results)
     sky = next((x for x in _series(out_dir) if "pdop" in x), None)
     if sky is not None:
         imgs["sky_dop"] = fig_sky(sky)
@@ -330,14 +340,16 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
         ])
     detail_rows = []
     for cat, c in det["categories"].items():
-        for comp in ("lateral", "vertical", "along", "vpl", "hpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert"):
+        for comp in ("lateral", "vertical", "along", "vpl", "hpl", "lpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert"):
+            if f"{comp}_ft" not in c:
+                continue
             s = c[f"{comp}_ft"]
             detail_rows.append([cat, comp, s["n"], s["rms"], s["rms_lo"], s["rms_hi"], s["mean"], s["std"], s["p95"],
                                 s["p95_lo"], s["p95_hi"]])
     integ_rows = [
         [cat, axis, *(c[f"stanford_{axis}"][k] for k in ("normal", "mi", "hmi", "unavailable")), c["availability"]]
         for cat, c in det["categories"].items()
-        for axis in ("vertical", "horizontal")
+        for axis in ("vertical", "lateral", "horizontal") if f"stanford_{axis}" in c
     ]
     ta = det["time_averaged_rms_ft"]
     failures = det.get("failures", {})
@@ -363,13 +375,14 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
         f"at least {_P95_HI_MIN_RUNS} runs).</p>",
         "<h2>Integrity (epochs over the approach down to each DH)</h2>",
         _table(["category", "axis", "normal", "MI", "HMI", "unavailable", "availability"], integ_rows),
+        *([_table(INTEGRITY_HEADER, integrity_rows(det))] if "integrity" in det else []),
         "<h2>Time-averaged RMS over the approach (Gray &amp; Maybeck Tables 3-6 quantity), ft</h2>",
         _table(list(ta), [list(ta.values())]),
     ]
     if failures:
         parts.append("<h2>Failed runs</h2>" + _table(["run", "reason"], [[k, v] for k, v in failures.items()]))
     for k in imgs:
-        title, caption = FIGURE_CAPTIONS[k]
+        title, caption = FIGURE_CAPTIONS.get(k) or INTEGRITY_CAPTIONS[k]
         parts.append(f"<h2>{html.escape(title)}</h2><figure><img alt='{k}' src='data:image/png;base64,{b64[k]}'>"
                      f"<figcaption>{html.escape(caption)} (file {k}.png)</figcaption></figure>")
     parts.append("</body></html>")

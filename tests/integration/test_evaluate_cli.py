@@ -121,8 +121,10 @@ def test_open_loop_evaluation_end_to_end(tmp_path, capsys):
         assert e["lateral_1sigma_ft"] == pytest.approx(np.sqrt(np.mean(lat**2)), rel=1e-12)
         assert e["vertical_1sigma_upper_ft"] == pytest.approx(
             e["vertical_1sigma_ft"] * rms_upper_factor(2, bias_ratio(ver)), rel=1e-9)
-        # 2 runs < MIN_RUNS: no category is decided on 2 runs, whatever the point estimates say
-        assert 2 < MIN_RUNS and e["verdict"] == "indeterminate" and not e["meets"], (cat, e)
+        # 2 runs < MIN_RUNS: no category meets on 2 runs, whatever the point estimates say (CAT II / III may
+        # fail on integrity: 2 of 2 runs unavailable at the DH put the availability's upper bound, 0.78, below 0.99)
+        assert 2 < MIN_RUNS and not e["meets"], (cat, e)
+        assert e["verdict"] == "indeterminate" if cat == "CAT I" else e["verdict"] in ("indeterminate", "fails")
         # tolerance from the statistics: the filter is consistent on this flight (issue 4: NEES inside its 95 %
         # bounds), so per axis sum_runs e^2 / sigma^2 ~ chi2(2), sigma from the protection levels it reports
         # (VPL = k_v sigma_v; the lateral sigma is at most the major semi-axis HPL / k_h): each of the 6 sums is
@@ -146,8 +148,28 @@ def test_open_loop_evaluation_end_to_end(tmp_path, capsys):
             assert 1.0 < p < 20.0 and p == pytest.approx(math.hypot(h, v), rel=1e-9)
         assert dist["pdop"]["min"] <= dist["pdop"]["p50"] <= dist["pdop"]["max"] == max(pr["pdop"])
         assert dist["fraction_used_lt4"] == 0.0 and dist["fraction_visible_lt5"] == 0.0
+    # integrity (on by default for CAT II / III): the bank's counts per category, at filter epochs, and figures
+    det = json.loads((out / "details.json").read_text())
+    integ = det["integrity"]
+    assert integ["categories_in_verdict"] == ["CAT II", "CAT III"] and "k_v" not in det
+    for cat, key in (("CAT I", "cat1"), ("CAT II", "cat2"), ("CAT III", "cat3")):
+        e = integ["categories"][cat]
+        n_ep = sum(r[f"{key}_int_epochs"] for r in recs)
+        # 1 Hz filter epochs over a 10 nmi approach (about 250 s per run), not 120 Hz samples
+        assert e["epochs"] == n_ep and 300 < n_ep < 800, (cat, n_ep)
+        assert e["availability"]["fraction"] == pytest.approx(sum(r[f"{key}_int_avail_epochs"] for r in recs) / n_ep)
+        for axis in ("vertical", "lateral"):
+            assert sum(e["stanford"][axis].values()) == n_ep
+            assert sum(c for *_, c in e["stanford_hist"][axis]) == n_ep
+        assert e["hmi"]["count"] == 0 and e["false_alert"]["allocation_per_15s"] == 8e-6
+        assert e["in_verdict"] == (cat != "CAT I") and ("verdict" in e) == (cat != "CAT I")
+        assert det["categories"][cat]["stanford_lateral"] == e["stanford"]["lateral"]
+    # CAT II / III cannot be shown to meet integrity on 2 runs: never `meets`
+    assert integ["categories"]["CAT II"]["verdict"] in ("indeterminate", "fails")
+    assert (out / "integrity_stanford.png").is_file() and (out / "integrity_availability.png").is_file()
+    assert not (out / "stanford.png").exists()
     printed = capsys.readouterr().out
-    assert "best category: none" in printed and "CAT III" in printed and "indeterminate" in printed
+    assert "best category: none" in printed and "CAT III" in printed
     # the same campaign resumed (nothing rerun) as a CI gate: CAT I is not `meets` on 2 runs, so exit 1
     assert main(["evaluate", DEFAULT, "--runs", "2", "--seed", "3", "--mode", "open", "--out", str(out),
                  "--resume", "--no-report", "--require", "CAT I"]) == 1

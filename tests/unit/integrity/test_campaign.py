@@ -1,0 +1,227 @@
+"""Integrity scoring on constructed bank epochs and constructed campaign columns: known PLs, errors and alert
+limits give known availability, MI / HMI counts and Stanford regions; the campaign bounds are the
+Clopper-Pearson / Poisson ones; the verdict's integrity criterion blocks `meets` and decides `fails`."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats as sps
+
+from approachsim.evaluate.config import EvaluationConfig
+from approachsim.evaluate.verdict import category_verdict, integrity_verdict
+from approachsim.integrity.bank import BankEpochs
+from approachsim.integrity.campaign import (
+    NB,
+    STANFORD_EDGES_M,
+    campaign_integrity,
+    poisson_upper,
+    run_integrity,
+    stanford_counts,
+    stanford_hist,
+)
+from approachsim.integrity.requirements import REQUIREMENTS
+
+CFG = EvaluationConfig(timeavg_settle_s=0.0)
+
+
+def _epochs(n=100, sig_main=1.0, sig_sub=1.2, e0=None, ek=None, k=4):
+    """n epochs at 1 Hz descending from 1000 m to 0 along a 3 deg path; constant variances."""
+    t = np.arange(n, dtype=float)
+    h = np.linspace(300.0, 0.0, n)
+    along = -h / math.tan(math.radians(3.0))
+    e0 = np.zeros((n, 2)) if e0 is None else e0
+    ek = np.zeros((n, k, 2)) if ek is None else ek
+    return BankEpochs(t, e0, np.full((n, 2), sig_main**2), ek, np.full((n, k, 2), sig_sub**2),
+                      np.arange(k) + 3, along, h)
+
+
+def test_stanford_counts_and_hist_on_known_points():
+    err = np.array([0.5, 2.0, 20.0, 5.0, 50.0])
+    pl = np.array([1.0, 1.0, 1.0, 30.0, 30.0])
+    al = np.full(5, 10.0)
+    assert stanford_counts(err, pl, al) == {"normal": 1, "mi": 1, "hmi": 1, "unavailable": 2}
+    h = stanford_hist(err, pl).reshape(NB, NB)
+    assert h.sum() == 5
+    i = np.searchsorted(STANFORD_EDGES_M, 20.0, side="right") - 1
+    j = np.searchsorted(STANFORD_EDGES_M, 1.0, side="right") - 1
+    assert h[i, j] == 1
+
+
+def test_fault_free_constructed_run_counts():
+    ep = _epochs()
+    s, counts, _ = run_integrity(ep, CFG, epoch_hz=1.0, t0_s=0.0)
+    req = REQUIREMENTS["CAT I"]
+    # PL_H1 = K_fa sigma_ss + K_md sigma_k, sigma_ss = sqrt(1.44 - 1)
+    k_fa = req.k_fa(1.0, 2 * 4)
+    pl_h1 = k_fa * math.sqrt(0.44) + req.k_md() * 1.2
+    assert s["cat1_int_vpl_dh_m"] == pytest.approx(max(pl_h1, req.k_ff() * 1.0))
+    n1 = int(np.sum(ep.height_m >= 200 * 0.3048))
+    assert s["cat1_int_epochs"] == n1
+    # CAT I VAL 10 m at the DH: PL ~ 7.8 m < 10 m on both axes (LAL 40 m): every epoch available
+    assert s["cat1_int_avail_epochs"] == n1 and s["cat1_int_avail_dh"] == 1.0
+    assert s["cat1_int_mi"] == 0 and s["cat1_int_hmi"] == 0 and s["cat1_int_detect_events"] == 0
+    assert counts["cat1_stanford_v"].sum() == n1
+    assert "cat1_int_onset_s" not in s
+
+
+def test_misleading_and_hazardous_epochs_are_counted_at_epochs():
+    n = 100
+    e0 = np.zeros((n, 2))
+    e0[10:13, 0] = 9.0  # > PL (7.8 m), < VAL (10 m): MI, not HMI (sub-solutions carry the same error)
+    e0[76:78, 0] = 14.0  # > VAL (about 10.9 m at 225 ft, Table B-69) while available: HMI (and MI)
+    ek = np.repeat(e0[:, None, :], 4, axis=1)  # every sub-solution has it: no separation, no detection
+    s, _, _ = run_integrity(_epochs(e0=e0, ek=ek), CFG, epoch_hz=1.0, t0_s=0.0)
+    assert s["cat1_int_mi"] == 5 and s["cat1_int_hmi"] == 2
+    assert s["cat1_int_v_mi"] == 3 and s["cat1_int_v_hmi"] == 2
+    assert s["cat1_int_detect_epochs"] == 0
+
+
+def test_fault_detected_excluded_and_time_to_alert():
+    n = 100
+    e0 = np.zeros((n, 2))
+    e0[30:, 0] = 0.5 * (np.arange(n - 30) + 1)  # 0.5 m/s ramp in the main solution from t = 30 s
+    ek = np.repeat(e0[:, None, :], 4, axis=1)
+    ek[:, 2, :] = 0.0  # sub-filter 2 leaves the faulted channel out: it stays clean
+    s, _, _ = run_integrity(_epochs(e0=e0, ek=ek), CFG, epoch_hz=1.0, t0_s=0.0, onset_s=30.0, fault_ch=5)
+    req = REQUIREMENTS["CAT I"]
+    thr = req.k_fa(1.0, 8) * math.sqrt(0.44)  # detection when |Delta| = ramp > K_fa sigma_ss
+    t_det = 30 + math.floor(thr / 0.5)
+    assert s["cat1_int_t_detect_s"] == t_det
+    assert s["cat1_int_delay_s"] == t_det - 30
+    assert s["cat1_int_excluded_channel"] == 5 and s["cat1_int_right"] == 1.0
+    # the main error passes its PL (max(PL_H0, PL_H1)) after the detection: detected before (tta < 0)
+    pl = max(req.k_ff(), thr + req.k_md() * 1.2)
+    t_exceed = 30 + math.floor(pl / 0.5)
+    assert s["cat1_int_tta_s"] == pytest.approx(t_det - t_exceed)
+    assert s["cat1_int_exceeded"] == 1.0 and s["cat1_int_missed"] == 0.0
+    assert s["cat1_int_mi"] == 0  # the output after the exclusion is the clean sub-solution
+
+
+def _columns(runs=400, avail_dh=None, hmi=0, detect=0):
+    cols = {}
+    for key in ("cat1", "cat2", "cat3"):
+        cols[f"{key}_int_epochs"] = np.full(runs, 250.0)
+        cols[f"{key}_int_avail_epochs"] = np.full(runs, 240.0)
+        dh = np.ones(runs) if avail_dh is None else avail_dh
+        cols[f"{key}_int_avail_dh"] = dh
+        cols[f"{key}_int_mi"] = np.zeros(runs)
+        h = np.zeros(runs)
+        h[:hmi] = 1.0
+        cols[f"{key}_int_hmi"] = h
+        d = np.zeros(runs)
+        d[:detect] = 1.0
+        cols[f"{key}_int_detect_events"] = d
+    return cols
+
+
+def test_campaign_bounds_are_clopper_pearson_and_poisson():
+    cols = _columns(runs=400, detect=2)
+    out = campaign_integrity(cols, {}, CFG)["categories"]["CAT II"]
+    n_ep = 400 * 250
+    assert out["availability"]["fraction"] == pytest.approx(240 / 250)
+    assert out["availability"]["lower"] == pytest.approx(sps.beta.ppf(0.05, 400 * 240, n_ep - 400 * 240 + 1))
+    assert out["availability_dh"]["lower"] == pytest.approx(0.05 ** (1 / 400))  # all 400 available
+    assert out["hmi"]["count"] == 0
+    assert out["hmi"]["rate_per_epoch_upper"] == pytest.approx(1 - 0.05 ** (1 / n_ep))
+    fa = out["false_alert"]
+    windows = n_ep / 15.0
+    assert fa["alerts"] == 2 and fa["rate_per_15s"] == pytest.approx(2 / windows)
+    assert fa["rate_per_15s_upper"] == pytest.approx(sps.chi2.ppf(0.95, 6) / 2 / windows)
+    assert poisson_upper(0, 0.95) == pytest.approx(-math.log(0.05))
+
+
+def test_integrity_verdict_cases():
+    allowed = REQUIREMENTS["CAT II"].hmi_rate_per_epoch(1.0)
+    # 20 runs all available at the DH, no HMI: lower bound 0.86 < 0.99 and 5000 epochs cannot bound 7e-11
+    v = integrity_verdict(20, 20, 0, 5000, 0.99, allowed)
+    assert (v.availability_verdict, v.hmi_verdict, v.verdict) == ("indeterminate", "indeterminate", "indeterminate")
+    assert v.runs_needed == math.ceil(-math.log(0.05) / allowed / 250)
+    # 5 of 20 available: upper bound below 0.99 -> fails
+    assert integrity_verdict(5, 20, 0, 5000, 0.99, allowed).verdict == "fails"
+    # any HMI epoch: the lower bound of its rate is far above 1e-9 -> fails
+    assert integrity_verdict(20, 20, 1, 5000, 0.99, allowed).hmi_verdict == "fails"
+    # a loose allowance a campaign can reach: meets
+    v = integrity_verdict(400, 400, 0, 100000, 0.99, 1e-3)
+    assert v.verdict == "meets" and v.runs_needed is None
+    # availability alone undecided: runs_needed is where 0.05^(1/n) reaches 0.99
+    v = integrity_verdict(100, 100, 0, 100000, 0.99, 1e-3)
+    assert v.availability_verdict == "indeterminate" and v.runs_needed == pytest.approx(299, abs=3)
+
+
+def test_integrity_blocks_meets_and_decides_runs_needed():
+    rng = np.random.default_rng(3)
+    lat, ver = rng.normal(0, 1.0, 200), rng.normal(0, 0.3, 200)  # far inside the CAT I limits (28.1 / 6.8 ft)
+    assert category_verdict("CAT I", 200, lat, ver).verdict == "meets"
+    undecided = integrity_verdict(100, 100, 0, 100000, 0.99, 1e-3)
+    r = category_verdict("CAT I", 200, lat, ver, integrity=undecided)
+    assert r.verdict == "indeterminate" and not r.meets
+    assert r.runs_needed == undecided.runs_needed  # the deciding criterion
+    r = category_verdict("CAT I", 200, lat, ver, integrity=integrity_verdict(5, 20, 0, 5000, 0.99, 1e-3))
+    assert r.verdict == "fails"
+    r = category_verdict("CAT I", 200, lat, ver, integrity=integrity_verdict(400, 400, 0, 100000, 0.99, 1e-3))
+    assert r.verdict == "meets"
+
+
+def test_run_result_counts_round_trip_sparse():
+    import json
+
+    from approachsim.campaign.result import RunResult
+    from approachsim.integrity.campaign import sum_counts
+
+    h = np.zeros(NB * NB)
+    h[[3, 700, 1599]] = [2.0, 5.0, 1.0]
+    r = RunResult(run=4, ok=True, scalars={"x": 1.0}, counts={"cat1_stanford_v": h})
+    line = r.json_line()
+    assert len(json.loads(line)["counts"]["cat1_stanford_v"]["index"]) == 3  # sparse on disk
+    back = RunResult.from_record(json.loads(line))
+    assert back.same_as(r) and np.array_equal(back.counts["cat1_stanford_v"], h)
+    assert "counts" not in RunResult(run=1, ok=True, scalars={"x": 1.0}).record()  # integrity off: unchanged
+    total = sum_counts([r, back, RunResult.failed(5, "x")])
+    assert np.array_equal(total["cat1_stanford_v"], 2 * h)
+
+
+@pytest.mark.parametrize(("value", "expected"), [
+    (None, ("CAT II", "CAT III")), (True, ("CAT I", "CAT II", "CAT III")), (False, ()),
+    (["CAT III", "CAT I"], ("CAT I", "CAT III")),
+])
+def test_evaluation_integrity_key(value, expected):
+    from approachsim.config import Section
+    from approachsim.evaluate.config import parse_evaluation
+
+    cfg = parse_evaluation(Section({} if value is None else {"integrity": value}, "evaluation"))
+    assert cfg.integrity == expected and cfg.integrity_on == bool(expected)
+
+
+@pytest.mark.parametrize("value", ["CAT II", ["CAT IV"], ["CAT I", "CAT I"], 1])
+def test_evaluation_integrity_bad_value_names_the_field(value):
+    from approachsim.config import ProfileError, Section
+    from approachsim.evaluate.config import parse_evaluation
+
+    with pytest.raises(ProfileError, match=r"evaluation\.integrity"):
+        parse_evaluation(Section({"integrity": value}, "evaluation"))
+
+
+def test_integrity_figures_from_a_constructed_faulted_campaign():
+    from approachsim.campaign.result import RunResult
+    from approachsim.report.integrity import integrity_figures, integrity_rows
+
+    n = 100
+    e0 = np.zeros((n, 2))
+    e0[30:, 0] = 0.5 * (np.arange(n - 30) + 1)
+    ek = np.repeat(e0[:, None, :], 4, axis=1)
+    ek[:, 2, :] = 0.0
+    grid = np.arange(600.0, -1.0, -6.0)
+    s, counts, arrays = run_integrity(_epochs(e0=e0, ek=ek), CFG, epoch_hz=1.0, t0_s=0.0, onset_s=30.0,
+                                      fault_ch=5, height_grid_m=grid)
+    results = [RunResult(run=i, ok=True, scalars=s, arrays=arrays, counts=counts) for i in range(3)]
+    cols = {k: np.full(3, v) for k, v in s.items()}
+    det = {"integrity": campaign_integrity(cols, {k: 3 * v for k, v in counts.items()}, CFG)}
+    tt = det["integrity"]["categories"]["CAT II"]["time_to_alert"]
+    assert tt["detected"] == 3 and tt["within_tta"] == 3 and tt["missed_detections"] == 0
+    figs = integrity_figures(results, det)
+    assert set(figs) == {"integrity_stanford", "integrity_availability", "integrity_tta"}
+    assert len(figs["integrity_stanford"].axes) == 7  # 2 axes x 3 categories + the colour bar
+    assert len(integrity_rows(det)) == 3
