@@ -55,6 +55,11 @@ def reproduce(name: str, out_dir: Path, *, seed: int, runs: int, cases: list[str
     extra: dict[str, Any] = {}
     if "out_dir" in params:
         extra["out_dir"] = out_dir
+    if "evaluate" in params:  # a paper that flies campaigns: the command hands it the campaign stage
+        from approachsim.campaign.evaluation import evaluate_profile
+        from approachsim.campaign.outputs import columns
+
+        extra.update(evaluate=evaluate_profile, columns=columns)
     if cases:
         if "cases" not in params:
             raise ProfileError(f"--cases: {name} has no cases to choose from (gray-maybeck has)")

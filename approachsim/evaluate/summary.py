@@ -8,7 +8,7 @@ time-averaged RMS, FTE / TSE) goes to the details dictionary.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict
 
 import numpy as np
@@ -119,8 +119,11 @@ def _stats_ft(x_m: np.ndarray) -> dict:
 
 
 def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cfg: EvaluationConfig,
-            counts: Mapping[str, np.ndarray] | None = None) -> dict:
-    """Everything beside the contract: bounds, ICAO limits, failures, integrity, FTE / TSE, time-averaged RMS."""
+            counts: Mapping[str, np.ndarray] | None = None, integrity_fn: Callable[..., dict] | None = None) -> dict:
+    """Everything beside the contract: bounds, ICAO limits, failures, integrity, FTE / TSE, time-averaged RMS.
+
+    integrity_fn: the campaign scoring of the solution-separation bank (integrity.campaign.campaign_integrity,
+    handed in by the campaign stage: the evaluator does not import the navigation system the bank runs)."""
     cats = {}
     for r in results:
         key = CATEGORY_KEYS[r.category]
@@ -177,11 +180,9 @@ def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cf
         "categories": cats,
         "time_averaged_rms_ft": {k: _num(v) for k, v in ta.items()},
     }
-    if bank:
-        from approachsim.integrity.campaign import campaign_integrity
-
+    if bank and integrity_fn is not None:
         out["protection_levels"] = "solution-separation bank (integrity.campaign)"
-        out["integrity"] = campaign_integrity(
+        out["integrity"] = integrity_fn(
             columns, counts or {}, cfg, verdicts={r.category: r.integrity for r in results if r.integrity})
     else:
         out.update({"protection_levels": "covariance K_V / K_H", "k_v": cfg.k_v, "k_h": cfg.k_h})

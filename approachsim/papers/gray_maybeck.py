@@ -467,13 +467,18 @@ def pseudolite_geometry(profile: Any, heights_ft: Sequence[float] = (1000.0, 200
 
 
 def compute(*, seed: int, runs: int, out_dir: Path | None = None,
-            cases: Sequence[str] | None = None, workers: int | None = None) -> tuple[dict, dict]:
+            cases: Sequence[str] | None = None, workers: int | None = None,
+            evaluate: Any = None, columns: Any = None) -> tuple[dict, dict]:
     """Run every selected case (runs each, closed loop, seed common to all) into out_dir/cases/<case>, then build
-    Tables 3-8; returns (the JSON result, the per-case data for the figures)."""
+    Tables 3-8; returns (the JSON result, the per-case data for the figures).
+
+    evaluate, columns: the campaign stage's campaign.evaluation.evaluate_profile and campaign.outputs.columns,
+    passed in by the command that composes the stages (a paper module never imports the flight stage)."""
     import tempfile
 
-    from approachsim.campaign.evaluation import evaluate_profile
-    from approachsim.campaign.outputs import columns
+    if evaluate is None or columns is None:
+        raise ValueError("gray-maybeck compute needs the campaign stage: evaluate=evaluate_profile, columns=columns")
+    evaluate_profile = evaluate
 
     chosen = select_cases(cases)
     root = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="gray-maybeck-"))
