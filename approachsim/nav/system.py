@@ -341,9 +341,14 @@ class NavSystem:
                              "(SensorSuite.draw + sensors.states.start_states)")
         dbs = self._terrain_errors(rngs)
         states = self._with_database_states(states, dbs, truth, row)
-        if obs.get("gnss_sky"):  # each run its own GPS sky: its own P0 and converged covariance
-            draws = [initial.draw(self, truth, self._run_obs(obs, i), states.take(i), [g], row,
-                                  self.initial_covariance(np.asarray(obs["gnss_el"])[i])) for i, g in enumerate(rngs)]
+        if obs.get("gnss_sky"):  # each run its own GPS sky: its own P0 and converged covariance, flown on the
+            # schedule of the first run with that sky (the integrity bank's copies share the main filter's start)
+            el0 = np.asarray(obs["gnss_el"])
+            first = {}
+            for i in range(n):
+                first.setdefault(el0[i].tobytes(), i)
+            draws = [initial.draw(self, truth, self._run_obs(obs, first[el0[i].tobytes()]), states.take(i), [g], row,
+                                  self.initial_covariance(el0[i])) for i, g in enumerate(rngs)]
             e = np.concatenate([d[0] for d in draws])
             x_hat = np.concatenate([d[1] for d in draws])
             P_convs = [d[2] for d in draws]
