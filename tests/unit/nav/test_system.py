@@ -32,7 +32,11 @@ def _truth(duration_s=60.0):
 
 
 def _system(**nav_kw):
+    """The default profile's navigation with nav_kw changed; no damping loop unless asked: a noise-free
+    altimeter still reads the ISA geopotential height (0.15 m below the geometric height at 1000 m, h^2 / R),
+    which the loop would pull an exactly started INS to."""
     nav = NavSystem.from_profile(PROFILE)
+    nav_kw.setdefault("baro_loop", "none")
     return NavSystem.build(replace(nav.nav, **nav_kw), PROFILE.sensors, PROFILE.runway.frame, PROFILE.terrain)
 
 
