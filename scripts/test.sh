@@ -9,7 +9,9 @@ lint-imports
 # docs/profiles.md is generated from the profile / study / aircraft parsers: fail when it is not current.
 python tools/gen_profiles_doc.py --check
 set +e
-python -m pytest -q "$@"
+# pytest-xdist: one worker per core (the suite is CPU-bound, single-threaded per test); --dist loadfile keeps a
+# module's tests on one worker, so a module's cached flights and campaigns are computed once
+python -m pytest -q -n "${PYTEST_WORKERS:-auto}" --dist loadfile "$@"
 status=$?
 set -e
 if [ "$status" -eq 5 ]; then

