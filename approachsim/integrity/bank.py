@@ -28,7 +28,7 @@ from approachsim.integrity.requirements import (
     lateral_alert_limit_m,
     vertical_alert_limit_m,
 )
-from approachsim.integrity.separation import SeparationResult, separation
+from approachsim.integrity.separation import SeparationResult, identify_statistic, separation
 
 Array = np.ndarray
 
@@ -72,6 +72,9 @@ class BankEpochs:
     """(e,) runway-frame x of the aircraft (negative before the threshold), m."""
     height_m: Array
     """(e,) height above the threshold, m."""
+    wtest: Array | None = None
+    """(e, K) the identification statistic of each fault mode over the 9 navigation states
+    (integrity.separation.identify_statistic); None: identify on the two approach axes only."""
 
 
 def _axes(heading_rad: float) -> Array:
@@ -94,7 +97,12 @@ def bank_epochs(main: Any, subs: list[Any], channels: Array, truth: Any, heading
     ek = np.stack([s[0] for s in subs_ep], axis=1) if subs_ep else np.zeros((t.size, 0, 2))
     pk = np.stack([s[1] for s in subs_ep], axis=1) if subs_ep else np.zeros((t.size, 0, 2))
     r = np.stack([np.interp(t, truth.t_s, truth.r_rwy[:, i]) for i in range(3)], axis=1)
-    return BankEpochs(t, e0, p0, ek, pk, np.asarray(channels), r[:, 0], r[:, 2])
+    w = None
+    if subs:  # full navigation-state separations e_k - e_0 (9 states) and their covariances P_k - P_0
+        d9 = np.stack([np.asarray(s.true_error_nav) - np.asarray(main.true_error_nav) for s in subs], axis=1)
+        p9 = np.stack([np.asarray(s.P_nav) - np.asarray(main.P_nav) for s in subs], axis=1)
+        w = identify_statistic(d9, p9)
+    return BankEpochs(t, e0, p0, ek, pk, np.asarray(channels), r[:, 0], r[:, 2], w)
 
 
 @dataclass(frozen=True)
@@ -145,7 +153,9 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
     excluded, t_det = -1, float("nan")
     if r.detected.any():  # exclude the suspect from the first detection on: its sub-solution is the output
         i = int(np.argmax(r.detected))
-        k = int(r.suspect[i])
+        # identification: the full navigation-state statistic (Baarda's w-test squared) where the bank has it,
+        # else the largest two-axis normalized separation
+        k = int(np.argmax(ep.wtest[sel][i])) if ep.wtest is not None else int(r.suspect[i])
         excluded, t_det = int(ep.channels[k]), float(t[i])
         err[i:] = np.abs(ep.ek[sel][i:, k])
         pl[i:] = req.k_ff() * np.sqrt(ep.pk[sel][i:, k])

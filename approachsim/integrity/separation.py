@@ -76,6 +76,20 @@ def identify(delta_full: Array, pss_full: Array) -> Array:
     return np.argmax(t, axis=1)
 
 
+def identify_statistic(delta_full: Array, pss_full: Array, rcond: float = 1e-10) -> Array:
+    """Delta_k' (P_ss,k)^+ Delta_k (epochs, modes) for delta_full (epochs, modes, n) and pss_full
+    (epochs, modes, n, n), computed on the correlation scale (each state divided by its separation sigma) so
+    that the pseudo-inverse's cut-off does not depend on the states' units (m, m/s, rad)."""
+    d = np.asarray(delta_full, float)
+    P = np.asarray(pss_full, float)
+    sd = np.sqrt(np.maximum(np.einsum("...ii->...i", P), 1e-300))
+    z = d / sd
+    W = P / (sd[..., :, None] * sd[..., None, :])
+    W = 0.5 * (W + np.swapaxes(W, -1, -2))
+    pinv = np.linalg.pinv(W, rcond=rcond, hermitian=True)
+    return np.einsum("...n,...nm,...m->...", z, pinv, z)
+
+
 def least_squares_bank(G: Array, w: Array) -> tuple[Array, Array]:
     """Snapshot weighted least squares with every measurement and leaving each one out: the estimator
     matrices S (modes + 1, n, m) (mode 0: all in view; mode k: measurement k - 1 out) and covariances

@@ -159,8 +159,12 @@ class NavInTheLoop:
                 self._snapshot()
                 self._epoch(k, truth)
         if self.gains is not None and (b := self._apply("baro", k, truth)) is not None:
-            self.h_baro_hold = float(np.ravel(b.h_baro_m)[0])
-            if k == 0 and nav.nav.initial_error.start == "prior":  # the converged start's height error stands
+            fde = self.runs[0].fde
+            # nan (an outage, or the baro excluded by FDE): the INS kernel's damping loop holds
+            held = (fde is not None and "baro" in fde.excluded) or not bool(np.ravel(b.valid)[0])
+            self.h_baro_hold = math.nan if held else float(np.ravel(b.h_baro_m)[0])
+            if k == 0 and nav.nav.initial_error.start == "prior" and math.isfinite(self.h_baro_hold):
+                # the converged start's height error stands
                 self.x[0, 2] = self.h_baro_hold
                 self.s = ins.unpack(self.x)
         self.rows[k] = self.x[0]

@@ -185,6 +185,7 @@ def dynamics(
     c_bn: Array,
     noise: ErrorNoise,
     loop: vl.LoopGains | None = None,
+    loop_held: bool = False,
 ) -> tuple[Array, Array]:
     """Continuous error dynamics F (n, n) and process-noise spectral density G Q G' (n, n) about a nav state.
 
@@ -271,13 +272,14 @@ def dynamics(
         e_row[i_bb] = -1.0
         if layout.has("sb"):
             e_row[layout.i("sb")] = -h_m
-        F[i_h, :] += lin.c1 * e_row  # dp_D' = -dh' gets +C1 e
-        F[i_v, :] += lin.c2 * e_row  # dv_D' = -dv_up' gets +C2 e + ac
         F[i_v, ia] += 1.0
-        F[ia, :] += lin.c3 * e_row  # ac' = C3 e
-        g = np.zeros(n)  # the baro white noise through the gains
-        g[i_h], g[i_v], g[ia] = -lin.c1, -lin.c2, -lin.c3
-        Qc += np.outer(g, g) * noise.baro_noise_sigma_m**2 / noise.baro_rate_hz
+        if not loop_held:  # held (no baro): the compensator stays as it is and only ac acts (kernels.strapdown)
+            F[i_h, :] += lin.c1 * e_row  # dp_D' = -dh' gets +C1 e
+            F[i_v, :] += lin.c2 * e_row  # dv_D' = -dv_up' gets +C2 e + ac
+            F[ia, :] += lin.c3 * e_row  # ac' = C3 e
+            g = np.zeros(n)  # the baro white noise through the gains
+            g[i_h], g[i_v], g[ia] = -lin.c1, -lin.c2, -lin.c3
+            Qc += np.outer(g, g) * noise.baro_noise_sigma_m**2 / noise.baro_rate_hz
     return F, Qc
 
 

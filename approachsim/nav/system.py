@@ -122,17 +122,10 @@ class _SharedCov:
     of_run: Array
     """(N,) class of each run."""
 
-    def predict(self, phi: Array, qd: Array) -> None:
-        """P- = Phi P+ Phi' + Qd for every class."""
-        for c, P in enumerate(self.P):
-            P = phi @ P @ phi.T + qd
-            self.P[c] = 0.5 * (P + P.T)
-
-    def predict_each(self, phi: Array, qds: list) -> None:
-        """P- = Phi P+ Phi' + Qd_c with class c's own Qd_c (classes on different GPS skies)."""
-        for c, P in enumerate(self.P):
-            P = phi @ P @ phi.T + qds[c]
-            self.P[c] = 0.5 * (P + P.T)
+    def predict_class(self, c: int, phi: Array, qd: Array) -> None:
+        """P- = Phi P+ Phi' + Qd for class c (its own model: GPS sky, damping loop held or not)."""
+        P = phi @ self.P[c] @ phi.T + qd
+        self.P[c] = 0.5 * (P + P.T)
 
     def split(self, schedule: Array) -> None:
         """Runs of one class whose schedules (rows of (N, k) bool) differ go to new classes (copies of P)."""
@@ -425,6 +418,16 @@ class NavSystem:
 
         return vl.LoopGains(slope(g.c1, g.b1_per_m), slope(g.c2, g.b2_per_m), g.c3)
 
+    def _loop_held(self, obs: Mapping[str, Any], run: _Run, i: int) -> bool:
+        """Whether run i's damping loop holds its compensator over the interval ending at this epoch: no baro
+        sample (an outage) or the baro excluded by the run's FDE (the INS kernel then gets no baro either)."""
+        if not self.layout.has("ac"):
+            return False
+        if run.fde is not None and "baro" in run.fde.excluded:
+            return True
+        hb = obs.get("baro_h")
+        return hb is None or not np.isfinite(np.asarray(hb)[i])
+
     def loop_gains(self) -> vl.LoopGains | None:
         """The INS damping-loop gains (None without a loop)."""
         return self.nav.loop_gains()
@@ -453,7 +456,7 @@ class NavSystem:
                 noise = self.noise(obs["gnss_el"][i])
             gains = self.loop_slopes(run.fs, float(s.h_m[i]), noise)
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
-                                noise, gains)
+                                noise, gains, loop_held=self._loop_held(obs, run, i))
             phi, qd = em.discretize(F, Qc, dt_epoch)
             if run.fde is not None:  # predict, test, exclude, update (nav/fde.py)
                 run.fs, sts = run.fde.epoch(self.filter, run.fs, phi, qd,
@@ -504,15 +507,21 @@ class NavSystem:
         lay = self.layout
         sky = bool(obs.get("gnss_sky"))  # per-run skies: every run is its own class (run()), Qd per class
         noise = self.noise(obs["gnss_el"][0] if sky else obs.get("gnss_el"))
-        F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ned_ref, ref.c_bn[0],
-                            noise, self.loop_gains())
-        phi, qd = em.discretize(F, Qc, dt_epoch)
-        X = np.stack([phi @ r.fs.x for r in runs])  # x- = Phi x+ (row by row: no batch-size-dependent BLAS path)
-        if sky:
-            cov.predict_each(phi, [self._channel_qd(qd, obs["gnss_el"][m[0]], dt_epoch) for _, m in cov.classes()])
-        else:
-            cov.predict(phi, qd)
+        # the damping loop holds in a run without baro at this epoch (kernels.strapdown): its own Phi, Qd. The baro's
+        # availability is part of the schedule, so every member of a class holds or none does; classes are split
+        # on this epoch's schedule first (splitting only copies P) and then predicted each with its model
+        held = [self._loop_held(obs, r, i) for i, r in enumerate(runs)]
+        models: dict[bool, tuple[Array, Array]] = {}
+        for h in sorted(set(held)):
+            F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ned_ref,
+                                ref.c_bn[0], noise, self.loop_gains(), loop_held=h)
+            models[h] = em.discretize(F, Qc, dt_epoch)
+        # x- = Phi x+ (row by row: no batch-size-dependent BLAS path)
+        X = np.stack([models[held[i]][0] @ r.fs.x for i, r in enumerate(runs)])
         cov.split(self._schedule(obs, len(runs)))
+        for c, members in cov.classes():
+            phi, qd = models[held[members[0]]]
+            cov.predict_class(c, phi, self._channel_qd(qd, obs["gnss_el"][members[0]], dt_epoch) if sky else qd)
         r_ins = ins.position_ecef(s)
         r_ref = ins.position_ecef(ref)[0]
         x0 = np.zeros(lay.n)
@@ -852,7 +861,9 @@ class NavSystem:
         baro = records.get("baro")
         hb_full = None
         if gains is not None and baro is not None:
-            hb = baro.h_baro_m if batched else baro.h_baro_m[None]
+            # an invalid sample (outage, a lost sensor) is no baro: nan, and the loop holds (kernels.strapdown)
+            hb = np.where(baro.valid, baro.h_baro_m, np.nan)
+            hb = hb if batched else hb[None]
             # zero-order hold of the latest baro sample at each IMU interval start (truth rows 0 .. m-1)
             idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
             hb_full = hb[:, idx]
@@ -903,6 +914,10 @@ class NavSystem:
                     s = self.aid(s, runs, t, t - t_last, f_sum / (t - t_last), obs)
                 f_sum[:] = 0.0
                 t_last = t
+                if hb_full is not None:  # a baro excluded by FDE no longer drives that run's damping loop
+                    for i, r in enumerate(runs):
+                        if r.fde is not None and "baro" in r.fde.excluded:
+                            hb_full[i, row:] = np.nan
                 snapshot()
                 o, P, x = self.output(s, runs)
                 t_ep.append(t)

@@ -92,14 +92,8 @@ def test_average_nees_inside_95_percent_bounds(runs):
     assert inside.mean() >= 0.9, (nees.mean(), inside.mean())
 
 
-GPS_NIS_FINDING = pytest.mark.xfail(strict=True, reason=(
-    "finding with the realistic GNSS defaults (per-run sky, DO-253 multipath with 100 s correlation, ARAIM 2.4 m "
-    "clock/ephemeris): the run-averaged pseudorange NIS is 0.962 on average and inside its 95 % bounds at 89.3 % "
-    "of the epochs (needs 90 %): slightly conservative, the NEES holds"))
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize("group", ["baro", "radalt", pytest.param("gps", marks=GPS_NIS_FINDING)])
+@pytest.mark.parametrize("group", ["baro", "radalt"])
 def test_average_nis_inside_95_percent_bounds(runs, group):
     by_epoch = nis_by_epoch(runs, group)
     # used at (almost) every 1 s filter epoch; the radar altimeter from 3000 ft AGL (~9.4 nmi) on
@@ -107,6 +101,24 @@ def test_average_nis_inside_95_percent_bounds(runs, group):
     assert min(len(v) for v in by_epoch.values()) >= RUNS  # every run contributes at every epoch
     inside = nis_inside(by_epoch)
     assert inside.mean() >= 0.9, (np.mean([np.mean(v) for v in by_epoch.values()]), inside.mean())
+
+
+@pytest.mark.slow
+def test_gps_nis_is_slightly_conservative(runs):
+    """A finding with the realistic GNSS defaults (per-run sky, DO-253 multipath with 100 s correlation, ARAIM
+    2.4 m clock/ephemeris), not a pass of the 90 % criterion: the run-averaged pseudorange NIS is 0.96 on average
+    (0.962 for the per-run EKF and the shared covariance alike) and sits on the 90 % line (of the 261 epochs
+    inside their bounds: per-run EKF 89.3-90.0 %, moving with the rounding of the converged start; shared
+    covariance 89.7 %), the epochs outside being mostly below the lower bound: the filter claims slightly more pseudorange error
+    than it sees. Checked: the mean in [0.93, 1.0], >= 85 % inside, more epochs below the bounds than above."""
+    by_epoch = nis_by_epoch(runs, "gps")
+    assert len(by_epoch) >= 0.9 * len(runs[0].true_error_nav)
+    means = np.array([np.mean(v) for v in by_epoch.values()])
+    lo = np.array([chi2.ppf(0.025, len(v)) / len(v) for v in by_epoch.values()])
+    hi = np.array([chi2.ppf(0.975, len(v)) / len(v) for v in by_epoch.values()])
+    assert 0.93 <= means.mean() <= 1.0, means.mean()
+    assert np.mean((means >= lo) & (means <= hi)) >= 0.85
+    assert np.sum(means < lo) > np.sum(means > hi)
 
 
 def nees_inside(nees: np.ndarray) -> np.ndarray:

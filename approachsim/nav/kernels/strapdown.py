@@ -13,6 +13,7 @@ Per interval j (increments dtheta, dv over (t_j, t_j + dt], body axes):
     position  trapezoid of v(-), v(+), radii at the midpoint
     baro loop (optional, seed 003 eq. 3 / 7): e = h(-) - h_baro, vD += (k2(e) + a_c) dt, a_c += C3 e dt,
               h += -k1(e) dt
+    with h_baro nan (no baro: an outage, or the baro excluded by FDE) the loop holds: vD += a_c dt only
 
 Each run is stepped on its own (the run loop is outside the time loop, so the 16 state numbers stay in
 registers): a run's numbers are the same in any batch, which the campaign's bit-identity needs. Vectorizing the
@@ -150,12 +151,16 @@ def strapdown(x: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, dt: float, bias
             v1d = vd + dfz + (gd - corz) * dt
             dh_loop = 0.0
             if form != LOOP_NONE:
-                e = h0 - h_baro[i, j]  # loop error e = h_ins - h_baro (seed 003 eq. 3)
-                k1 = _branch(form, loop[1], loop[4], e)
-                k2 = _branch(form, loop[2], loop[5], e)
-                v1d += (k2 + a_comp) * dt  # v_up' = ... - k2(e) - a_c  (v_D = -v_up)
-                a_comp = a_comp + loop[3] * e * dt  # a_c' = C3 e
-                dh_loop = -k1 * dt  # h' = v_up - k1(e)
+                hb = h_baro[i, j]
+                if hb == hb:
+                    e = h0 - hb  # loop error e = h_ins - h_baro (seed 003 eq. 3)
+                    k1 = _branch(form, loop[1], loop[4], e)
+                    k2 = _branch(form, loop[2], loop[5], e)
+                    v1d += (k2 + a_comp) * dt  # v_up' = ... - k2(e) - a_c  (v_D = -v_up)
+                    a_comp = a_comp + loop[3] * e * dt  # a_c' = C3 e
+                    dh_loop = -k1 * dt  # h' = v_up - k1(e)
+                else:  # no baro (nan: an outage, or excluded by FDE): the loop holds its compensator
+                    v1d += a_comp * dt
             # position: trapezoid of the velocity, radii at the midpoint
             vtn, vte, vtd = 0.5 * (vn + v1n), 0.5 * (ve + v1e), 0.5 * (vd + v1d)
             h1 = h0 - dt * vtd + dh_loop

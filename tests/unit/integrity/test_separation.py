@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.stats import binom, norm
 
-from approachsim.integrity.separation import identify, least_squares_bank, separation
+from approachsim.integrity.separation import identify, identify_statistic, least_squares_bank, separation
 
 EL = np.radians([80.0, 45.0, 30.0, 25.0, 15.0, 60.0, 35.0, 20.0])
 AZ = np.radians([10.0, 80.0, 160.0, 230.0, 300.0, 200.0, 120.0, 20.0])
@@ -73,3 +73,22 @@ def test_large_bias_detected_and_identified():
     # excluding it: the sub-solution without satellite 4 has an error at the noise level
     e_excl = xk[np.arange(len(z)), 4]
     assert np.sqrt(np.mean(e_excl**2)) < 5.0
+
+
+def test_identification_statistic_is_baardas_w_test_squared_in_any_units():
+    """Snapshot least squares: Delta_k' (P_k - P_0)^+ Delta_k equals Baarda's w-test squared of measurement k,
+    w_k = r_k / sqrt((R - G P_0 G')_kk) with r = z - G x_0; unchanged when a state is rescaled (metres to
+    millimetres), which a pseudo-inverse cut-off on the raw covariance would not guarantee."""
+    rng = np.random.default_rng(8)
+    z = rng.standard_normal((50, M))
+    z[:, 2] += 8.0
+    S, P = least_squares_bank(G, W)
+    x = np.einsum("knm,em->ekn", S, z)
+    d, pss = x[:, 1:] - x[:, :1], np.broadcast_to(P[1:] - P[:1], (len(z), M, 4, 4))
+    t = identify_statistic(d, pss)
+    r = z - x[:, 0] @ G.T
+    qr = np.diag(np.diag(1.0 / W) - G @ P[0] @ G.T)
+    np.testing.assert_allclose(t, r**2 / qr, rtol=1e-8)
+    scale = np.array([1e3, 1.0, 1.0, 1e-3])  # east in mm, clock in km
+    np.testing.assert_allclose(identify_statistic(d * scale, pss * np.outer(scale, scale)), t, rtol=1e-8)
+    assert np.mean(np.argmax(t, axis=1) == 2) > 0.95

@@ -31,7 +31,8 @@ ONSET_S = 30.0
 TTA_S = REQUIREMENTS["CAT II"].time_to_alert_s
 
 
-def _profile(faults=(), *, fde=True, nmi=5.0, selection="all", feedback=False, pseudolite=False, **fde_kw):
+def _profile(faults=(), *, fde=True, nmi=5.0, selection="all", feedback=False, pseudolite=False, baro_loop="none",
+             **fde_kw):
     d = tomllib.loads(DEFAULT.read_text(encoding="utf-8"))
     if pseudolite:  # one unit near the threshold (the default profile's commented example)
         d["sensors"]["pseudolite"] = {"enabled": True, "synchronized": True,
@@ -42,9 +43,8 @@ def _profile(faults=(), *, fde=True, nmi=5.0, selection="all", feedback=False, p
     d["runway"]["start_distance_nmi"] = nmi
     d["nav"]["feedback"] = feedback
     d["nav"].setdefault("initial_error", {})["start"] = "prior"  # FDE alone (these runs call NavSystem.run directly)
-    # no damping loop: an excluded baro still drives the INS loop (a known gap: with the loop a 30 m baro step
-    # corrupts the INS before the exclusion and GPS / radar altimeter are excluded after it)
-    d["nav"]["baro_loop"] = "none"
+    # FDE alone, without the damping loop unless asked (test_baro_step_excluded_with_the_damping_loop)
+    d["nav"]["baro_loop"] = baro_loop
     d["nav"]["fde"] = {"enabled": fde, **fde_kw}
     d["faults"] = list(faults)
     return parse_profile(d, source=DEFAULT)
@@ -185,6 +185,34 @@ def test_baro_step_excluded(truths, magnitude_m):
     c = _case(truths, [{"sensor": "baro", "kind": "step", "start_s": ONSET_S, "magnitude": magnitude_m}])
     t_x = _check_excluded(c, "baro")
     assert t_x - ONSET_S <= TTA_S
+
+
+@pytest.mark.parametrize("magnitude_m", [10.0, 30.0])
+def test_baro_step_excluded_with_the_damping_loop(truths, magnitude_m):
+    """With the 3rd-order loop (the default navigation) the excluded baro stops driving the INS: the loop holds
+    its compensator (kernels.strapdown, errormodel loop_held), nothing else is excluded after it, and the
+    vertical error stays inside its PL and near the fault-free one."""
+    faults = [{"sensor": "baro", "kind": "step", "start_s": ONSET_S, "magnitude": magnitude_m}]
+    c = _case(truths, faults, baro_loop="constant")
+    t_x = _check_excluded(c, "baro")
+    assert t_x - ONSET_S <= TTA_S
+    free = _case(truths, [], baro_loop="constant")
+    assert free.run.solution.exclusions == ()
+    after = c.run.t_epoch_s >= t_x
+    assert np.max(c.err[after, 0]) < np.max(free.err[:, 0]) + 1.0  # m: not the step's 10-30 m
+
+
+def test_baro_outage_with_the_damping_loop_keeps_a_finite_consistent_solution(truths):
+    """A baro outage (nan samples) holds the loop instead of feeding nan to the INS; the filter's error model
+    holds it too, so the vertical error stays within 3 sigma of the filter's own covariance."""
+    prof = _profile([{"sensor": "baro", "kind": "outage", "start_s": ONSET_S, "end_s": ONSET_S + 60.0}], fde=False,
+                    baro_loop="constant")
+    truth = truths[5.0]
+    run = NavSystem.from_profile(prof).run(truth, SensorSuite.from_profile(prof).measure(truth, seed=1, runs=0),
+                                           stream(1, 0, "nav"))
+    assert np.all(np.isfinite(run.solution.r_ecef))
+    sd = np.sqrt(run.P_nav[:, 2, 2])
+    assert np.all(np.abs(run.true_error_nav[:, 2]) < 4.0 * sd)
 
 
 @pytest.mark.parametrize("magnitude_m", [10.0, 30.0])
