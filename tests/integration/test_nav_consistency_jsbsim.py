@@ -110,7 +110,8 @@ def test_gps_nis_is_slightly_conservative(runs):
     (0.962 for the per-run EKF and the shared covariance alike) and sits on the 90 % line (of the 261 epochs
     inside their bounds: per-run EKF 89.3-90.0 %, moving with the rounding of the converged start; shared
     covariance 89.7 %), the epochs outside being mostly below the lower bound: the filter claims slightly more
-    pseudorange error than it sees. Checked: the mean in [0.93, 1.0], >= 85 % inside, more epochs below the bounds than above."""
+    pseudorange error than it sees. Checked: the mean in [0.93, 1.0], >= 85 % inside, more epochs below the
+    bounds than above."""
     by_epoch = nis_by_epoch(runs, "gps")
     assert len(by_epoch) >= 0.9 * len(runs[0].true_error_nav)
     means = np.array([np.mean(v) for v in by_epoch.values()])
