@@ -14,7 +14,8 @@ steps build a start with exactly that structure.
 
    H stacks the epoch's scalar rows valid at the start and R their (uncorrelated) noises: one batch update per
    epoch equals the filter's sequential scalar updates in exact arithmetic (to 1e-9 of the sigmas after 600 s,
-   tested) at a third of the cost (0.13 s against 0.35 s at the default profile's start).
+   tested; 1.5e-13 measured) at a third to a fifth of the cost (benchmarks/bench_start.py: 0.14 s against
+   0.66 s at the default profile's start).
 
    Why the recursion and not scipy.linalg.solve_discrete_are: the steady state does not exist here. Heading,
    the along-line-of-sight slow range errors against position, and the bias random walks are unobservable at
