@@ -211,7 +211,7 @@ def vertical_manoeuvre(
         t_air_k=t_air,
         h_agl_m=h - terr,
         r_rwy=np.column_stack([r_tan[:, 0], r_tan[:, 1], hat]),
-        gs_dev_m=hat - (tch - r_tan[:, 0] * math.tan(glidepath)),
+        gs_dev_m=geo.glidepath_deviation_m(r_tan[:, 0], hat, tch, math.tan(glidepath)),
         loc_dev_m=r_tan[:, 1].copy(),
         controls=np.zeros((n, 4)),
         airspeed_mps=np.linalg.norm(v_ned, axis=-1) * np.sqrt(rho / _RHO0),

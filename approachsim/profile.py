@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from approachsim import units
+from approachsim import geo, units
 from approachsim.config import ProfileError, Section
 from approachsim.evaluate.config import EvaluationConfig, parse_evaluation
 from approachsim.geo import RunwayFrame
@@ -51,7 +51,7 @@ class Runway:
 
     def glidepath_height_m(self, along_m: np.ndarray | float) -> np.ndarray | float:
         """Height above the threshold of the ideal glidepath at runway-frame x = along_m (negative before)."""
-        return self.tch_m - np.asarray(along_m) * math.tan(self.glidepath_rad)
+        return geo.glidepath_height_m(along_m, self.tch_m, math.tan(self.glidepath_rad))
 
 
 @dataclass(frozen=True)

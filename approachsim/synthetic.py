@@ -145,7 +145,7 @@ def _assemble(
     r_tan = runway.from_ecef(r_ecef)
     hat = runway.height_above_threshold(h)
     r_rwy = np.column_stack([r_tan[:, 0], r_tan[:, 1], hat])
-    gs_dev = hat - (tch_m - r_tan[:, 0] * math.tan(glidepath_rad))
+    gs_dev = geo.glidepath_deviation_m(r_tan[:, 0], hat, tch_m, math.tan(glidepath_rad))
     h_geo = atmosphere.geopotential_m(h)
     p = atmosphere.static_pressure_pa(h_geo, isa_dev_k, sea_level_pa)
     t_air = atmosphere.air_temperature_k(h_geo, isa_dev_k)

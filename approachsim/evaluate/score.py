@@ -9,8 +9,10 @@ fixed height grid (HEIGHT_GRID_FT), for the error-against-height figures. Series
 decimated per-epoch errors.
 
 TSE, FTE, NSE (ICAO PBN, without path definition error): TSE = true deviation from the desired path
-(truth loc_dev_m / gs_dev_m); NSE = estimate - truth; FTE = the deviation guidance flew on. When the flight
-gives what guidance flew on (fte_lat_m / fte_vert_m series) that is used; otherwise FTE = TSE + NSE.
+(truth loc_dev_m / gs_dev_m); e = estimate - truth (the navigation error; PBN's NSE is -e in path terms,
+docs/contract.md "Signs"); FTE = the deviation guidance flew on. When the flight gives what guidance flew on
+(fte_lat_m / fte_vert_m series) that is used; otherwise FTE = TSE + e in path terms (vertical: the
+glidepath-deviation error gpdev = e_vertical + e_along tan(gamma), as guidance would see it).
 
 Reference point (docs/contract.md): every error is the IMU point's, and the decision-height instant is the
 true IMU height's crossing. Glidepath-deviation error: the deviation from the glidepath is
@@ -101,7 +103,7 @@ def score_run(
             vals["tse_lat_m"] + vals["lateral_m"] if fte_lat_m is None else at_crossing(fte_lat_m[:n], cr)
         )
         vals["fte_vert_m"] = (
-            vals["tse_vert_m"] + vals["vertical_m"] if fte_vert_m is None else at_crossing(fte_vert_m[:n], cr)
+            vals["tse_vert_m"] + vals["gpdev_m"] if fte_vert_m is None else at_crossing(fte_vert_m[:n], cr)
         )
         for k, v in vals.items():
             scalars[f"{key}_{k}"] = float(v)

@@ -223,7 +223,8 @@ def path_deviation(r_rwy: Array, runway: Any) -> Array:
     """Deviation (..., 2) of runway-frame points from the desired path: (cross-track y, height above the
     ideal glidepath z - (tch - x tan gp)), m."""
     r = np.asarray(r_rwy, dtype=float)
-    return np.stack([r[..., 1], r[..., 2] - (runway.tch_m - r[..., 0] * math.tan(runway.glidepath_rad))], axis=-1)
+    return np.stack([r[..., 1], geo.glidepath_deviation_m(r[..., 0], r[..., 2], runway.tch_m,
+                                                          math.tan(runway.glidepath_rad))], axis=-1)
 
 
 def approach_errors(truth: Truth, guidance_r_rwy: Array, runway: Any) -> ApproachErrors:

@@ -63,3 +63,8 @@ def make_nav(
 def cross_axis_ned() -> np.ndarray:
     """Unit vector of the runway's cross-track (right) axis in NED."""
     return np.array([-math.sin(RWY.heading_rad), math.cos(RWY.heading_rad), 0.0])
+
+
+def along_axis_ned() -> np.ndarray:
+    """Unit vector of the runway's along-track (landing direction) axis in NED."""
+    return np.array([math.cos(RWY.heading_rad), math.sin(RWY.heading_rad), 0.0])

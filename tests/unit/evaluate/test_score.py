@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from evalpairs import cross_axis_ned, make_nav, make_truth
+from evalpairs import along_axis_ned, cross_axis_ned, make_nav, make_truth
 from scipy import stats as sps
 
 from approachsim import units
@@ -126,6 +126,11 @@ def test_fte_tse_identity():
     sc2, _, _ = score_run(truth, make_nav(truth, 2.0 * cross_axis_ned()), CFG, fte_lat_m=fte,
                           fte_vert_m=np.zeros(len(truth)))
     assert sc2["cat1_fte_lat_m"] == pytest.approx(12.0 + 0.01 * sc2["cat1_t_s"], abs=1e-9)
+    # vertically the deviation guidance would fly on includes the along-track error through the slope:
+    # FTE = TSE + gpdev, gpdev = e_vertical + e_along tan(gamma) (an along-track error alone moves it)
+    sc3, _, _ = score_run(truth, make_nav(truth, 30.0 * along_axis_ned()), CFG)
+    assert abs(sc3["cat1_gpdev_m"]) > 1.0
+    assert sc3["cat1_fte_vert_m"] == pytest.approx(sc3["cat1_tse_vert_m"] + sc3["cat1_gpdev_m"])
 
 
 def test_time_averaged_rms_in_feet():

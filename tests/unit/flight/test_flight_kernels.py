@@ -5,6 +5,7 @@ Euler angles' rotation, a pure lever arm on a steady turn gives the centripetal 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -157,3 +158,29 @@ def test_kernel_reproduces_the_flight_loop_rows(monkeypatch):
                          "loc_dev_m": (30, 1), "airspeed_mps": (35, 1)}.items():
         ref = np.asarray(arrays[name]).reshape(len(truth), w)
         _close(got[:, c:c + w], ref, name)
+
+
+def test_every_glidepath_formula_is_geo_glidepath_deviation():
+    """The compiled truth row (gs_dev), the autopilot's per-step deviation and the stability monitor's write the
+    glidepath d = h - (TCH - x tan gp) inline for speed; each equals geo.glidepath_deviation_m, the one source."""
+    from approachsim.flight.aircraft import load_aircraft
+    from approachsim.flight.autopilot import Autopilot, Geometry, Trim
+    from approachsim.flight.envelope import StabilityMonitor
+    from approachsim.profile import load_profile
+
+    rng = np.random.default_rng(21)
+    raw = _raw(50, rng)
+    const = fk.imu_point_constants([10.0, 0.4, -1.2], RWY.threshold_lat_rad, RWY, DT)
+    got, _ = _kernel_rows(raw, const, np.array([0.0]), np.array([4.0]), np.arange(50) * DT)
+    tan_gp = math.tan(RWY.glidepath_rad)
+    np.testing.assert_array_equal(got[:, 29], geo.glidepath_deviation_m(got[:, 26], got[:, 28], RWY.tch_m, tan_gp))
+    prof = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+    ap = Autopilot(load_aircraft(prof).gains, Trim(0.02, 0.47, 72.0),
+                   Geometry(0.3, RWY.glidepath_rad, RWY.tch_m, RWY.threshold_lat_rad), DT)
+    mon = StabilityMonitor(RWY.glidepath_rad, RWY.tch_m, 72.0, DT)
+    for x, z in zip(rng.uniform(-18000.0, 0.0, 20), rng.uniform(0.0, 1000.0, 20), strict=True):
+        ref = float(geo.glidepath_deviation_m(x, z, RWY.tch_m, tan_gp))
+        assert ap.deviations(x, 3.0, z, 70.0, 1.0, 3.0)[0] == ref
+        d_dots = mon.dots(x, 3.0, z)[0]
+        r_gp = max(mon._x_gp_m - min(x, mon._x_floor_m), 1.0)
+        assert d_dots == pytest.approx(ref / (r_gp * math.tan(mon._gs_dot_rad)), rel=1e-15)
