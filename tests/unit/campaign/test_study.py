@@ -14,6 +14,7 @@ from approachsim.campaign.result import RunResult
 from approachsim.campaign.study import comparison_table, load_study, run_study
 from approachsim.cli import main
 from approachsim.config import ProfileError
+from approachsim.profile import load_profile
 from approachsim.seeding import stream
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -136,3 +137,15 @@ def test_the_example_study_file_is_valid():
     s = load_study(ROOT / "studies" / "ins-grade-x-aids.toml")
     assert [v.profile.sensors.imu.grade for v in s.variants] == ["nav-0.4", "nav-2.0", "nav-4.0", "nav-2.0"]
     assert [v.profile.sensors.pseudolite is not None for v in s.variants] == [False, False, False, True]
+
+
+def test_every_shipped_study_file_is_valid():
+    """Every file in studies/ loads (each variant's profile validated); the realism study's last variant is the
+    default profile itself and its first the earlier error models."""
+    for p in sorted((ROOT / "studies").glob("*.toml")):
+        assert load_study(p).variants, p
+    s = load_study(ROOT / "studies" / "realism-defaults.toml")
+    assert [v.name[0] for v in s.variants] == list("ABCDEFGH")
+    base = load_profile(ROOT / "profiles" / "default.toml")
+    assert s.variants[-1].profile.sensors == base.sensors and s.variants[-1].profile.nav == base.nav
+    assert s.variants[0].profile.nav.baro_loop == "none" and s.variants[0].profile.sensors.gnss.epoch == "fixed"
