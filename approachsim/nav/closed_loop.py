@@ -71,6 +71,7 @@ class NavInTheLoop:
         # the kernels' inputs and outputs, allocated once (kernels/strapdown.py inloop_step, guidance)
         self._dth, self._dv = np.zeros((1, 1, 3)), np.zeros((1, 1, 3))
         self._bg, self._ba, self._hb = np.zeros((1, 3)), np.zeros((1, 3)), np.full((1, 1), math.nan)
+        self._hb_interval = np.full(self.epoch_rows, math.nan)  # the baro the kernel got over the epoch interval
         self._loop = ins.loop_vector(self.gains)
         self._guide = np.zeros(6)
         self.t_last = 0.0
@@ -144,6 +145,7 @@ class NavInTheLoop:
             if nav.nav.feedback:
                 self._bg[0], self._ba[0] = self.runs[0].bg_fb, self.runs[0].ba_fb
             self._hb[0, 0] = self.h_baro_hold
+            self._hb_interval[(k - 1) % self.epoch_rows] = self.h_baro_hold
             sk.inloop_step(k, truth.w_ib_body, truth.f_body, affine, m_g, m_a, c_g, c_a, self._dth, self._dv,
                            self.dt, self._bg, self._ba, self._hb, self._loop, self.x, self.f_sum)
             if k % self.epoch_rows == 0:
@@ -152,6 +154,9 @@ class NavInTheLoop:
                 recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite")
                         if (r := self._apply(name, k, truth)) is not None}
                 obs = nav.observations(recs, t, 0.25 * self.dt, False)
+                if self.gains is not None:  # the kernel's loop held over the interval (no baro, or excluded)
+                    obs["loop_held"] = np.array([not np.any(np.isfinite(self._hb_interval))])
+                    self._hb_interval[:] = np.nan
                 self.s = nav.aid(self.s, self.runs, t, t - self.t_last, self.f_sum / (t - self.t_last), obs)
                 self.x = ins.pack(self.s)  # feedback may have corrected it
                 self.f_sum[:] = 0.0

@@ -419,14 +419,17 @@ class NavSystem:
         return vl.LoopGains(slope(g.c1, g.b1_per_m), slope(g.c2, g.b2_per_m), g.c3)
 
     def _loop_held(self, obs: Mapping[str, Any], run: _Run, i: int) -> bool:
-        """Whether run i's damping loop holds its compensator over the interval ending at this epoch: no baro
-        sample (an outage) or the baro excluded by the run's FDE (the INS kernel then gets no baro either)."""
+        """Whether run i's damping loop held its compensator over the interval ending at this epoch: the INS kernel
+        had no baro over the whole interval (obs["loop_held"]: an outage, invalid samples) or the run's FDE has
+        excluded the baro."""
         if not self.layout.has("ac"):
             return False
         if run.fde is not None and "baro" in run.fde.excluded:
             return True
-        hb = obs.get("baro_h")
-        return hb is None or not np.isfinite(np.asarray(hb)[i])
+        # what the INS kernel was given over the interval (run / the closed loop put it in obs): a baro rate
+        # that does not fall on the epochs leaves obs without baro_h while the loop ran
+        held = obs.get("loop_held")
+        return bool(held[i]) if held is not None else False
 
     def loop_gains(self) -> vl.LoopGains | None:
         """The INS damping-loop gains (None without a loop)."""
@@ -904,6 +907,8 @@ class NavSystem:
                 t = float(truth.t_s[row])
                 s = ins.unpack(xk)
                 obs = self.observations(records, t, 0.25 * dt, batched)
+                if hb_full is not None:  # the loop held where the kernel had no baro over the whole interval
+                    obs["loop_held"] = np.all(np.isnan(hb_full[:, j0:j1]), axis=1)
                 if cov is not None:  # the per-run filters linearize about each run's INS (shared: the truth)
                     ref = ins.InsState(truth.lat_rad[row:row + 1], truth.lon_rad[row:row + 1],
                                        truth.h_m[row:row + 1], truth.v_ned[row:row + 1],
