@@ -1,6 +1,6 @@
 """Converged-start benchmark: the 600 s covariance recursion of nav/initial.py at the default profile's start,
 one batch Joseph update per epoch (what the code does) against the filter's sequential scalar updates (the
-former code, kept here as the reference), and their largest difference in units of the sigmas.
+former code, initial.converged_covariance_reference), and their largest difference in units of the sigmas.
 
     python benchmarks/bench_start.py [--repeat N]
 
@@ -18,37 +18,13 @@ from pathlib import Path
 import numpy as np
 
 from approachsim import synthetic
-from approachsim.nav import errormodel as em
-from approachsim.nav import initial, ins
+from approachsim.nav import initial
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def sequential(nav: NavSystem, truth, obs: dict, P0: np.ndarray, converge_s: float) -> np.ndarray:
-    """The recursion with one Joseph update per scalar row (the filter's own sequential form)."""
-    ref = ins.InsState(truth.lat_rad[:1], truth.lon_rad[:1], truth.h_m[:1], truth.v_ned[:1],
-                       ins.cbn_from_quaternion(truth.q_nb[:1]), np.zeros(1))
-    F, Qc = em.dynamics(nav.layout, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0],
-                        ref.c_bn[0] @ truth.f_body[0], ref.c_bn[0], nav.noise(obs.get("gnss_el")), nav.loop_gains())
-    dt = 1.0 / nav.nav.aiding_rate_hz
-    phi, qd = em.discretize(F, Qc, dt)
-    r_ref = ins.position_ecef(ref)[0]
-    x0 = np.zeros(nav.layout.n)
-    rows = [b(x0) for b in nav._measurements(ref, 0, r_ref, nav.filter.init(x0, P0),
-                                             nav._reference_obs(obs, 0, ref, r_ref), float(truth.t_s[0]))]
-    P, eye = P0.copy(), np.eye(nav.layout.n)
-    for _ in range(int(round(converge_s / dt))):
-        P = phi @ P @ phi.T + qd
-        for m in rows:
-            K = P @ m.h / float(m.h @ P @ m.h + m.r)
-            A = eye - np.outer(K, m.h)
-            P = A @ P @ A.T + m.r * np.outer(K, K)
-        P = 0.5 * (P + P.T)
-    return P
 
 
 def main() -> None:
@@ -71,7 +47,7 @@ def main() -> None:
         Pb = initial.converged_covariance(nav, truth, obs, 0, P0, converge_s)
         tb.append(time.perf_counter() - t0)
         t0 = time.perf_counter()
-        Ps = sequential(nav, truth, obs, P0, converge_s)
+        Ps = initial.converged_covariance_reference(nav, truth, obs, 0, P0, converge_s)
         ts.append(time.perf_counter() - t0)
     sd = np.sqrt(np.diag(Ps))
     print(f"load average {os.getloadavg()[0]:.2f}; {nav.layout.n} states, converge_s {converge_s:g} s")

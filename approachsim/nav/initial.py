@@ -75,10 +75,9 @@ _PSD_TOL = 1e-9
 """Relative tolerance of the Pi_ss >= P_conv[s, s] check (eigenvalues of Pi^-1/2 P_conv Pi^-1/2 above 1)."""
 
 
-def converged_covariance(system: Any, truth: Any, obs: dict[str, Any], row: int, P0: Array,
-                         converge_s: float) -> Array:
-    """P_conv (n, n): the optimal filter's covariance after converge_s (s) of aiding at truth row `row` from P0,
-    with the measurements available in obs (NavSystem.observations at the row; the first run's schedule)."""
+def _segment(system: Any, truth: Any, obs: dict[str, Any], row: int, P0: Array) -> tuple[Array, Array, list]:
+    """Phi, Qd over one aiding interval and the scalar measurement rows valid at truth row `row` (the segment
+    flown at the start state)."""
     lay = system.layout
     ref = ins.InsState(truth.lat_rad[row:row + 1], truth.lon_rad[row:row + 1], truth.h_m[row:row + 1],
                        truth.v_ned[row:row + 1], ins.cbn_from_quaternion(truth.q_nb[row:row + 1]), np.zeros(1))
@@ -87,28 +86,53 @@ def converged_covariance(system: Any, truth: Any, obs: dict[str, Any], row: int,
     noise = system.noise(obs.get("gnss_el"))
     F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ned, c_bn, noise,
                         system.loop_gains())
-    dt = 1.0 / system.nav.aiding_rate_hz
-    phi, qd = em.discretize(F, Qc, dt)
+    phi, qd = em.discretize(F, Qc, 1.0 / system.nav.aiding_rate_hz)
     r_ref = ins.position_ecef(ref)[0]
     x0 = np.zeros(lay.n)
     fs0 = system.filter.init(x0, P0)
     t = float(truth.t_s[row])
     rows = [b(x0) for b in system._measurements(ref, 0, r_ref, fs0, system._reference_obs(obs, 0, ref, r_ref), t)]
+    return phi, qd, rows
+
+
+def converged_covariance(system: Any, truth: Any, obs: dict[str, Any], row: int, P0: Array,
+                         converge_s: float) -> Array:
+    """P_conv (n, n): the optimal filter's covariance after converge_s (s) of aiding at truth row `row` from P0,
+    with the measurements available in obs (NavSystem.observations at the row; the first run's schedule)."""
+    phi, qd, rows = _segment(system, truth, obs, row, P0)
+    epochs = int(round(converge_s * system.nav.aiding_rate_hz))
     P = np.array(P0, dtype=float)
     if not rows:
-        for _ in range(int(round(converge_s / dt))):
+        for _ in range(epochs):
             P = phi @ P @ phi.T + qd
         return 0.5 * (P + P.T)
     H = np.stack([m.h for m in rows])  # (k, n): the epoch's scalar rows, uncorrelated noises r
     R = np.array([float(m.r) for m in rows])
-    eye = np.eye(lay.n)
-    for _ in range(int(round(converge_s / dt))):
+    eye = np.eye(P.shape[0])
+    for _ in range(epochs):
         P = phi @ P @ phi.T + qd  # P- = Phi P+ Phi' + Qd
         PHt = P @ H.T
         S = H @ PHt + np.diag(R)
         K = np.linalg.solve(S, PHt.T).T  # K = P H' (H P H' + R)^-1
         A = eye - K @ H
         P = A @ P @ A.T + (K * R[None, :]) @ K.T  # Joseph form, the whole epoch at once
+        P = 0.5 * (P + P.T)
+    return P
+
+
+def converged_covariance_reference(system: Any, truth: Any, obs: dict[str, Any], row: int, P0: Array,
+                                   converge_s: float) -> Array:
+    """converged_covariance with one Joseph update per scalar row, the filter's own sequential form: the test
+    oracle and the benchmark's reference (benchmarks/bench_start.py)."""
+    phi, qd, rows = _segment(system, truth, obs, row, P0)
+    P = np.array(P0, dtype=float)
+    eye = np.eye(P.shape[0])
+    for _ in range(int(round(converge_s * system.nav.aiding_rate_hz))):
+        P = phi @ P @ phi.T + qd
+        for m in rows:
+            K = P @ m.h / float(m.h @ P @ m.h + m.r)
+            A = eye - np.outer(K, m.h)
+            P = A @ P @ A.T + m.r * np.outer(K, K)
         P = 0.5 * (P + P.T)
     return P
 

@@ -129,30 +129,12 @@ def test_converged_start_of_the_default_profile():
 
 def test_batch_epoch_update_equals_the_sequential_scalar_recursion():
     """converged_covariance updates the epoch's rows at once; the filter's own recursion updates them one
-    scalar row at a time (Joseph form each). Equal to rounding over the whole 600 s segment."""
+    scalar row at a time (Joseph form each, converged_covariance_reference). Equal to rounding over the whole
+    600 s segment."""
     nav, truth, recs, st, s, fl, P0 = _start_default(runs=(0,))
     obs = nav.observations(recs, float(truth.t_s[0]), 0.025, True)
-    from approachsim.nav import errormodel as em
-    from approachsim.nav import ins
-    ref = ins.InsState(truth.lat_rad[:1], truth.lon_rad[:1], truth.h_m[:1], truth.v_ned[:1],
-                       ins.cbn_from_quaternion(truth.q_nb[:1]), np.zeros(1))
-    F, Qc = em.dynamics(nav.layout, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0],
-                        ref.c_bn[0] @ truth.f_body[0], ref.c_bn[0], nav.noise(obs.get("gnss_el")), nav.loop_gains())
-    phi, qd = em.discretize(F, Qc, 1.0 / nav.nav.aiding_rate_hz)
-    r_ref = ins.position_ecef(ref)[0]
-    x0 = np.zeros(nav.layout.n)
-    rows = [b(x0) for b in nav._measurements(ref, 0, r_ref, nav.filter.init(x0, P0),
-                                             nav._reference_obs(obs, 0, ref, r_ref), float(truth.t_s[0]))]
-    assert len(rows) >= 5
-    P = P0.copy()
-    eye = np.eye(nav.layout.n)
-    for _ in range(600):
-        P = phi @ P @ phi.T + qd
-        for m in rows:
-            K = P @ m.h / float(m.h @ P @ m.h + m.r)
-            A = eye - np.outer(K, m.h)
-            P = A @ P @ A.T + m.r * np.outer(K, K)
-        P = 0.5 * (P + P.T)
+    assert len(initial._segment(nav, truth, obs, 0, P0)[2]) >= 5  # rows to update
+    P = initial.converged_covariance_reference(nav, truth, obs, 0, P0, 600.0)
     Pb = initial.converged_covariance(nav, truth, obs, 0, P0, 600.0)
     sd = np.sqrt(np.diag(P))
     assert np.max(np.abs(Pb - P) / np.outer(sd, sd)) < 1e-9
