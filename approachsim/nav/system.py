@@ -510,9 +510,9 @@ class NavSystem:
         lay = self.layout
         sky = bool(obs.get("gnss_sky"))  # per-run skies: every run is its own class (run()), Qd per class
         noise = self.noise(obs["gnss_el"][0] if sky else obs.get("gnss_el"))
-        # the damping loop holds in a run without baro at this epoch (kernels.strapdown): its own Phi, Qd. The baro's
-        # availability is part of the schedule, so every member of a class holds or none does; classes are split
-        # on this epoch's schedule first (splitting only copies P) and then predicted each with its model
+        # the damping loop held in a run whose INS had no baro over the interval (kernels.strapdown): its own Phi,
+        # Qd. Classes are split on this epoch's schedule and the hold together (splitting only copies P), so every
+        # member of a class holds or none does, and then each class is predicted with its model
         held = [self._loop_held(obs, r, i) for i, r in enumerate(runs)]
         models: dict[bool, tuple[Array, Array]] = {}
         for h in sorted(set(held)):
@@ -521,7 +521,7 @@ class NavSystem:
             models[h] = em.discretize(F, Qc, dt_epoch)
         # x- = Phi x+ (row by row: no batch-size-dependent BLAS path)
         X = np.stack([models[held[i]][0] @ r.fs.x for i, r in enumerate(runs)])
-        cov.split(self._schedule(obs, len(runs)))
+        cov.split(np.column_stack([self._schedule(obs, len(runs)), np.array(held, dtype=bool)]))
         for c, members in cov.classes():
             phi, qd = models[held[members[0]]]
             cov.predict_class(c, phi, self._channel_qd(qd, obs["gnss_el"][members[0]], dt_epoch) if sky else qd)
