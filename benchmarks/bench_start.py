@@ -37,7 +37,7 @@ def main() -> None:
     recs, _ = measure_with_states(SensorSuite.from_profile(prof), truth, seed=2, runs=[0])
     nav = NavSystem.from_profile(prof)
     obs = nav.observations(recs, float(truth.t_s[0]), 0.025, True)
-    obs = nav._run_obs(obs, 0) if obs.get("gnss_sky") else obs
+    obs = obs.run(0) if obs.per_run_sky else obs
     el = recs["gnss"].elevation_rad[0, 0] if recs["gnss"].per_run_sky else recs["gnss"].elevation_rad[0]
     P0 = nav.initial_covariance(el)
     converge_s = prof.nav.initial_error.converge_s

@@ -23,8 +23,10 @@ import numpy as np
 from approachsim import geo
 from approachsim.nav import ins
 from approachsim.nav.kernels import strapdown as sk
-from approachsim.nav.system import NavRun, NavSystem, StatusLog
-from approachsim.records import ApproachErrors, NavSolution, Truth
+from approachsim.nav.navigator import Navigator, NavRun
+from approachsim.nav.observations import Observations
+from approachsim.nav.system import NavSystem
+from approachsim.records import ApproachErrors, Truth
 from approachsim.seeding import stream
 from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite, SuiteErrors
@@ -64,26 +66,19 @@ class NavInTheLoop:
         self.epoch_rows = max(1, int(round(self.profile.rates.imu_hz / self.nav.nav.aiding_rate_hz)))
         self.gains = self.nav.loop_gains()
         self._imu_affine = self._imu_error_terms()
-        self.s: ins.InsState | None = None
-        self.runs: list = []
+        self.navigator: Navigator | None = None
+        """The navigation step object (nav/navigator.py), made at row 0."""
         self.h_baro_hold = math.nan
-        self.f_sum = np.zeros((1, 3))
         # the kernels' inputs and outputs, allocated once (kernels/strapdown.py inloop_step, guidance)
         self._dth, self._dv = np.zeros((1, 1, 3)), np.zeros((1, 1, 3))
         self._bg, self._ba, self._hb = np.zeros((1, 3)), np.zeros((1, 3)), np.full((1, 1), math.nan)
         self._hb_interval = np.full(self.epoch_rows, math.nan)  # the baro the kernel got over the epoch interval
         self._loop = ins.loop_vector(self.gains)
         self._guide = np.zeros(6)
-        self.t_last = 0.0
-        n = self.t_s.shape[0]
-        self.rows = np.full((n, ins.NX), np.nan)  # the raw INS state at every truth row (packed, ins.pack)
-        self.snap = np.zeros(n, dtype=int)  # the filter snapshot in force at each row
-        self.snaps: list[tuple[Array, Array]] = []
         self.x_nav = np.zeros(9)
         self._c_rwy = np.ascontiguousarray(self.profile.runway.frame.c_ecef_to_rwy)
         self._o_rwy = np.ascontiguousarray(self.profile.runway.frame.origin_ecef)
         self._h_thr = float(self.profile.runway.elevation_m)
-        self.epochs: dict[str, list] = {"t": [], "x": [], "pd": [], "pnav": [], "err": []}
 
     def _imu_error_terms(self) -> tuple[Array, Array, Array, Array] | None:
         """The IMU error model is affine in the true increments (sensors/imu.py):
@@ -119,22 +114,28 @@ class NavInTheLoop:
         sub = SuiteErrors(MappingProxyType({name: one}), self.errors.clock)
         return self.suite.apply(truth, sub, names=[name])[name]
 
+    def _observations(self, k: int, truth: Truth) -> tuple[Observations, dict[str, Any]]:
+        """The aiding sensors' samples at truth row k (their pre-drawn errors applied to the row)."""
+        recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite") if (r := self._apply(name, k, truth))
+                is not None}
+        return Observations.at(recs, float(truth.t_s[k]), 0.25 * self.dt, False), recs
+
     def step(self, k: int, truth: Truth) -> tuple[Array, Array]:
         """Runway-frame position (m) and NED velocity (m/s) of the navigation output at truth row k.
 
         The IMU increment of (k-1, k] (the truth sample k-1 held, sensors/imu.py) and the INS step run in one
-        compiled call (kernels.strapdown.inloop_step); the filter runs at the aiding epochs."""
+        compiled call (kernels.strapdown.inloop_step); the filter runs at the aiding epochs (Navigator.epoch)."""
         nav = self.nav
         if k == 0:
-            recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite")
-                    if (r := self._apply(name, 0, truth)) is not None}
+            obs, recs = self._observations(0, truth)
             el = recs["gnss"].elevation_rad[0] if "gnss" in recs else None
-            obs = nav.observations(recs, float(truth.t_s[0]), 0.25 * self.dt, False)
-            self.s, self.runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el, obs=obs,
-                                          states=start_states(self.suite, truth, self.errors))
-            self.x = ins.pack(self.s)  # the INS state between epochs: packed (1, 16), stepped by the kernel
-            self._snapshot()
-        else:
+            s, runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el, obs=obs,
+                                states=start_states(self.suite, truth, self.errors))
+            self.navigator = Navigator(nav, s, runs, float(truth.t_s[0]), self.t_s.shape[0])
+            self.x_nav = np.array(runs[0].fs.x[0:9], dtype=float)
+        navigator = self.navigator
+        run = navigator.runs[0]
+        if k > 0:
             affine = self._imu_affine is not None
             if affine:
                 m_g, m_a, c_g, c_a = self._imu_affine
@@ -143,85 +144,33 @@ class NavInTheLoop:
                 self._dth[0, 0], self._dv[0, 0] = imu.dtheta_body.reshape(3), imu.dv_body.reshape(3)
                 m_g = m_a = c_g = c_a = _EMPTY
             if nav.nav.feedback:
-                self._bg[0], self._ba[0] = self.runs[0].bg_fb, self.runs[0].ba_fb
+                self._bg[0], self._ba[0] = run.bg_fb, run.ba_fb
             self._hb[0, 0] = self.h_baro_hold
             self._hb_interval[(k - 1) % self.epoch_rows] = self.h_baro_hold
             sk.inloop_step(k, truth.w_ib_body, truth.f_body, affine, m_g, m_a, c_g, c_a, self._dth, self._dv,
-                           self.dt, self._bg, self._ba, self._hb, self._loop, self.x, self.f_sum)
+                           self.dt, self._bg, self._ba, self._hb, self._loop, navigator.x, navigator.f_sum)
             if k % self.epoch_rows == 0:
-                self.s = ins.unpack(self.x)
-                t = float(truth.t_s[k])
-                recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite")
-                        if (r := self._apply(name, k, truth)) is not None}
-                obs = nav.observations(recs, t, 0.25 * self.dt, False)
+                obs, _ = self._observations(k, truth)
                 if self.gains is not None:  # the kernel's loop held over the interval (no baro, or excluded)
-                    obs["loop_held"] = np.array([not np.any(np.isfinite(self._hb_interval))])
+                    obs = obs.with_loop_held([not np.any(np.isfinite(self._hb_interval))])
                     self._hb_interval[:] = np.nan
-                self.s = nav.aid(self.s, self.runs, t, t - self.t_last, self.f_sum / (t - self.t_last), obs)
-                self.x = ins.pack(self.s)  # feedback may have corrected it
-                self.f_sum[:] = 0.0
-                self.t_last = t
-                self._snapshot()
-                self._epoch(k, truth)
+                navigator.epoch(k, float(truth.t_s[k]), obs, truth)
+                self.x_nav = np.array(run.fs.x[0:9], dtype=float)
         if self.gains is not None and (b := self._apply("baro", k, truth)) is not None:
-            fde = self.runs[0].fde
             # nan (an outage, or the baro excluded by FDE): the INS kernel's damping loop holds
-            held = (fde is not None and "baro" in fde.excluded) or not bool(np.ravel(b.valid)[0])
+            held = run.baro_excluded() or not bool(np.ravel(b.valid)[0])
             self.h_baro_hold = math.nan if held else float(np.ravel(b.h_baro_m)[0])
             if k == 0 and nav.nav.initial_error.start == "prior" and math.isfinite(self.h_baro_hold):
                 # the converged start's height error stands
-                self.x[0, 2] = self.h_baro_hold
-                self.s = ins.unpack(self.x)
-        self.rows[k] = self.x[0]
-        self.snap[k] = len(self.snaps) - 1
+                navigator.x[0, 2] = self.h_baro_hold
+        navigator.record_row(k)
         g = self._guide
-        sk.guidance(self.x, self.x_nav, self._c_rwy, self._o_rwy, self._h_thr, g)  # feed-forward INS - x_hat
+        sk.guidance(navigator.x, self.x_nav, self._c_rwy, self._o_rwy, self._h_thr, g)  # feed-forward INS - x_hat
         return g[0:3].copy(), g[3:6].copy()  # copies: the kernel's buffer is rewritten at the next step
-
-    def _snapshot(self) -> None:
-        """Keep the filter's x and P (the estimate in force until the next epoch)."""
-        fs = self.runs[0].fs
-        x = np.array(fs.x, dtype=float)
-        self.snaps.append((x, np.array(self.nav.filter.covariance(fs), dtype=float)))
-        self.x_nav = x[0:9]
-
-    def _epoch(self, k: int, truth: Truth) -> None:
-        o, P, x = self.nav.output(self.s, self.runs)
-        e = self.epochs
-        e["t"].append(float(truth.t_s[k]))
-        e["x"].append(x[0])
-        e["pd"].append(np.diag(P[0]))
-        e["pnav"].append(P[0, 0:9, 0:9])
-        e["err"].append(NavSystem._true_error(o, truth, k)[0])
 
     def result(self, truth: Truth) -> NavRun:
         """The navigation run over the flown truth (call after the flight)."""
-        n = len(truth)
-        raw = ins.unpack(self.rows[:n])
-        raw = ins.replace(raw, a_comp_mps2=np.zeros(n))
-        snap = self.snap[:n]
-        X = np.stack([x for x, _ in self.snaps])[snap]
-        PP = np.stack([p for _, p in self.snaps])  # per snapshot; index the small blocks per row only
-        o = ins.perturb(raw, -X[:, 0:3], -X[:, 3:6], -X[:, 6:9])
-        lay = self.nav.layout
-        clk = X[:, lay.i("clk")] if lay.has("clk") else np.full(n, np.nan)
-        clk_sd = np.sqrt(PP[:, lay.i("clk"), lay.i("clk")][snap]) if lay.has("clk") else np.full(n, np.nan)
-        sol = NavSolution(
-            t_s=np.asarray(truth.t_s[:n], dtype=float),
-            r_ecef=geo.geodetic_to_ecef(o.lat_rad, o.lon_rad, o.h_m),
-            v_ned=o.v_ned,
-            euler_rad=ins.euler_from_cbn(o.c_bn),
-            P_pos_ned=PP[:, 0:3, 0:3][snap],
-            clock_bias_m=clk,
-            clock_bias_sigma_m=clk_sd,
-            **(self.runs[0].fde.solution_fields(snap) if self.runs[0].fde is not None else {}),
-        )
-        e = self.epochs
-        return NavRun(
-            solution=sol, status=StatusLog.from_records(self.runs[0].statuses), t_epoch_s=np.array(e["t"]),
-            x=np.array(e["x"]), P_diag=np.array(e["pd"]), P_nav=np.array(e["pnav"]),
-            true_error_nav=np.array(e["err"]), layout=self.nav.layout,
-        )
+        return self.navigator.results(truth, len(truth))[0]
 
 
 def path_deviation(r_rwy: Array, runway: Any) -> Array:

@@ -41,10 +41,9 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy.optimize import brentq
@@ -57,7 +56,11 @@ from approachsim.integrity.requirements import (
     vertical_alert_limit_m,
 )
 from approachsim.nav.base import FilterState, NavFilter, ScalarMeasurement, UpdateStatus
+from approachsim.nav.observations import FIX, Source
 from approachsim.records import ExclusionEvent
+
+if TYPE_CHECKING:
+    from approachsim.nav.rows import Row
 
 Array = np.ndarray
 
@@ -92,23 +95,10 @@ class FdeConfig:
         return REQUIREMENTS[self.category]
 
 
-def source_of(name: str) -> str:
-    """The excludable source of a measurement name: loose-coupling position scalars gps_N/E/D -> "gnss"."""
-    return "gnss" if name.startswith("gps_") else name
-
-
-def _channel(source: str) -> int:
-    """Channel index of a GNSS ("gps07") or pseudolite ("pl1") source, -1 for the others."""
-    for prefix in ("gps", "pl"):
-        if source.startswith(prefix) and source[len(prefix):].isdigit():
-            return int(source[len(prefix):])
-    return -1
-
-
-def _ranging(sources: set[str]) -> int:
+def _ranging(sources: set[Source]) -> int:
     """Ranging sources among `sources` (a loose-coupling GNSS fix counts as a full fix)."""
-    n = sum(1 for s in sources if _channel(s) >= 0)
-    return n + (MIN_RANGING if "gnss" in sources else 0)
+    n = sum(1 for s in sources if s.ranging)
+    return n + (MIN_RANGING if any(s.kind == FIX for s in sources) else 0)
 
 
 @lru_cache(maxsize=4096)
@@ -131,6 +121,8 @@ class _Test:
     """The epoch's residual statistics (measurements in processing order)."""
 
     names: list[str]
+    """Measurement names (the moving sums' keys: the three axes of a loose fix are apart)."""
+    sources: list[Source]
     q: float
     w: Array
     s_inv_diag: Array
@@ -147,7 +139,7 @@ class _Epoch:
     """Filter state before this epoch's prediction."""
     phi: Array
     qd: Array
-    builders: list[Callable[[Array], ScalarMeasurement]]
+    rows: list[Row]
     correction: Array | None = None
     """Feedback: the error estimate the INS received after this epoch's updates (reset groups only)."""
 
@@ -181,18 +173,14 @@ class FdeState:
 
     # --- statistics -----------------------------------------------------------------------------------------
 
-    def _rows(self, builders: list[Callable[[Array], ScalarMeasurement]], x: Array) -> list[ScalarMeasurement]:
-        out = []
-        for b in builders:
-            m = b(x)
-            if source_of(m.name) not in self.excluded:
-                out.append(m)
-        return out
+    def _rows(self, rows: list[Row], x: Array) -> list[tuple[Source, ScalarMeasurement]]:
+        return [(r.source, r.build(x)) for r in rows if r.source.name not in self.excluded]
 
     @staticmethod
-    def _test(filt: NavFilter, fs: FilterState, ms: list[ScalarMeasurement]) -> _Test | None:
-        if not ms:
+    def _test(filt: NavFilter, fs: FilterState, built: list[tuple[Source, ScalarMeasurement]]) -> _Test | None:
+        if not built:
             return None
+        ms = [m for _, m in built]
         P = filt.covariance(fs)
         H = np.stack([m.h for m in ms])
         nu = np.array([m.z for m in ms]) - H @ fs.x
@@ -201,7 +189,7 @@ class FdeState:
         s_inv = np.linalg.inv(0.5 * (S + S.T))
         a = s_inv @ nu
         d = np.diag(s_inv)
-        return _Test([m.name for m in ms], float(nu @ a), a / np.sqrt(d), d, PH @ s_inv)
+        return _Test([m.name for m in ms], [src for src, _ in built], float(nu @ a), a / np.sqrt(d), d, PH @ s_inv)
 
     def _sums(self, k: int, test: _Test) -> Array:
         """Moving-sum statistic M_j of each measurement of the epoch, with its current w_j."""
@@ -220,19 +208,19 @@ class FdeState:
             win = self.windows.setdefault(name, deque(maxlen=self.config.window))
             win.append((k, w))
 
-    def _detect(self, k: int, test: _Test) -> tuple[str, str, float, float] | None:
-        """(measurement, test, statistic, threshold) of a detection, or None."""
+    def _detect(self, k: int, test: _Test) -> tuple[Source, str, float, float] | None:
+        """(source of the measurement, test, statistic, threshold) of a detection, or None."""
         m = len(test.names)
         t_q = _chi2_threshold(self._p_fa_q, m)
         if test.q > t_q:
             j = int(np.argmax(np.abs(test.w)))
-            return test.names[j], "chi2", test.q, t_q
+            return test.sources[j], "chi2", test.q, t_q
         if self.config.window > 1:
             k_m = float(norm.isf(self.config.requirement.p_fa(self.epoch_hz, 2 * m) / 2.0))
             sums = self._sums(k, test)
             j = int(np.argmax(sums))
             if sums[j] > k_m:
-                return test.names[j], "sum", float(sums[j]), k_m
+                return test.sources[j], "sum", float(sums[j]), k_m
         return None
 
     # --- the epoch --------------------------------------------------------------------------------------------
@@ -248,18 +236,17 @@ class FdeState:
                                        maxlen=self.config.window)
         for e, nxt in zip(hist[:-1], hist[1:], strict=True):
             fs = filt.predict(fs, e.phi, e.qd)
-            self._commit(e.index, self._test(filt, fs, self._rows(e.builders, fs.x)))
-            for b in e.builders:
-                m = b(fs.x)
-                if source_of(m.name) not in self.excluded:
-                    fs, _ = filt.update(fs, m)
+            self._commit(e.index, self._test(filt, fs, self._rows(e.rows, fs.x)))
+            for r in e.rows:
+                if r.source.name not in self.excluded:
+                    fs, _ = filt.update(fs, r.build(fs.x))
             if e.correction is not None:  # the INS was corrected by c_e then: y+ = y - c_e
                 fs = FilterState(x=fs.x - e.correction, P=fs.P, U=fs.U, d=fs.d, memory=fs.memory)
             nxt.fs_prev = fs
         return fs
 
     def epoch(self, filt: NavFilter, fs_prev: FilterState, phi: Array, qd: Array,
-              builders: list[Callable[[Array], ScalarMeasurement]], t_s: float, r_rwy_m: Array
+              rows: list[Row], t_s: float, r_rwy_m: Array
               ) -> tuple[FilterState, list[UpdateStatus]]:
         """Predict, test, exclude (rolling back), update with the remaining measurements, protect.
 
@@ -268,28 +255,27 @@ class FdeState:
         ones with weight 0, not accepted)."""
         k = self.count
         self.count += 1
-        self.history.append(_Epoch(k, fs_prev, phi, qd, builders))
+        self.history.append(_Epoch(k, fs_prev, phi, qd, rows))
         fs = filt.predict(fs_prev, phi, qd)
         unprotectable = False
         while True:
-            test = self._test(filt, fs, self._rows(builders, fs.x))
+            test = self._test(filt, fs, self._rows(rows, fs.x))
             hit = None if test is None else self._detect(k, test)
             if hit is None:
                 break
-            name, kind, stat, thr = hit
-            src = source_of(name)
-            if len({source_of(n) for n in test.names}) <= 1:  # nothing left to compare it with
+            src, kind, stat, thr = hit
+            if len(set(test.sources)) <= 1:  # nothing left to compare it with
                 unprotectable = True
                 break
-            self.excluded.add(src)
-            self.events.append(ExclusionEvent(t_s, src, _channel(src), kind, stat, thr))
+            self.excluded.add(src.name)
+            self.events.append(ExclusionEvent(t_s, src.name, src.channel, kind, stat, thr))
             fs = filt.predict(self._rollback(filt), phi, qd)
         self._commit(k, test)
         statuses: list[UpdateStatus] = []
-        used: set[str] = set()
-        for b in builders:
-            m = b(fs.x)
-            if source_of(m.name) in self.excluded:
+        used: set[Source] = set()
+        for r in rows:
+            m = r.build(fs.x)
+            if r.source.name in self.excluded:
                 P = filt.covariance(fs)
                 nu = float(m.z - m.h @ fs.x)
                 s = float(m.h @ P @ m.h + m.r)
@@ -297,7 +283,7 @@ class FdeState:
                 continue
             fs, st = filt.update(fs, m)
             statuses.append(st)
-            used.add(source_of(m.name))
+            used.add(r.source)
         pl = self._protection(filt, fs, test)
         al = np.array([float(vertical_alert_limit_m(self.config.requirement, r_rwy_m[2])),
                        float(lateral_alert_limit_m(self.config.requirement, r_rwy_m[0]))])

@@ -64,6 +64,7 @@ import numpy as np
 
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
+from approachsim.nav.observations import Observations
 from approachsim.sensors.states import STATE_GROUPS, SensorStates
 
 Array = np.ndarray
@@ -75,7 +76,7 @@ _PSD_TOL = 1e-9
 """Relative tolerance of the Pi_ss >= P_conv[s, s] check (eigenvalues of Pi^-1/2 P_conv Pi^-1/2 above 1)."""
 
 
-def _segment(system: Any, truth: Any, obs: dict[str, Any], row: int, P0: Array) -> tuple[Array, Array, list]:
+def _segment(system: Any, truth: Any, obs: Observations, row: int, P0: Array) -> tuple[Array, Array, list]:
     """Phi, Qd over one aiding interval and the scalar measurement rows valid at truth row `row` (the segment
     flown at the start state)."""
     lay = system.layout
@@ -83,19 +84,19 @@ def _segment(system: Any, truth: Any, obs: dict[str, Any], row: int, P0: Array) 
                        truth.v_ned[row:row + 1], ins.cbn_from_quaternion(truth.q_nb[row:row + 1]), np.zeros(1))
     c_bn = ref.c_bn[0]
     f_ned = c_bn @ truth.f_body[row]
-    noise = system.noise(obs.get("gnss_el"))
+    noise = system.noise(obs.elevations(0))
     F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ned, c_bn, noise,
                         system.loop_gains())
     phi, qd = em.discretize(F, Qc, 1.0 / system.nav.aiding_rate_hz)
     r_ref = ins.position_ecef(ref)[0]
     x0 = np.zeros(lay.n)
-    fs0 = system.filter.init(x0, P0)
     t = float(truth.t_s[row])
-    rows = [b(x0) for b in system._measurements(ref, 0, r_ref, fs0, system._reference_obs(obs, 0, ref, r_ref), t)]
+    ref_obs = system.rows.reference_obs(obs, 0, float(ref.h_m[0]), r_ref)
+    rows = [r.build(x0) for r in system.rows.epoch(ref, 0, r_ref, ref_obs, t)]
     return phi, qd, rows
 
 
-def converged_covariance(system: Any, truth: Any, obs: dict[str, Any], row: int, P0: Array,
+def converged_covariance(system: Any, truth: Any, obs: Observations, row: int, P0: Array,
                          converge_s: float) -> Array:
     """P_conv (n, n): the optimal filter's covariance after converge_s (s) of aiding at truth row `row` from P0,
     with the measurements available in obs (NavSystem.observations at the row; the first run's schedule)."""
@@ -120,7 +121,7 @@ def converged_covariance(system: Any, truth: Any, obs: dict[str, Any], row: int,
     return P
 
 
-def converged_covariance_reference(system: Any, truth: Any, obs: dict[str, Any], row: int, P0: Array,
+def converged_covariance_reference(system: Any, truth: Any, obs: Observations, row: int, P0: Array,
                                    converge_s: float) -> Array:
     """converged_covariance with one Joseph update per scalar row, the filter's own sequential form: the test
     oracle and the benchmark's reference (benchmarks/bench_start.py)."""
@@ -199,7 +200,7 @@ def condition(P_conv: Array, Pi_ss: Array, s: Array, x_s: Array, z: Array) -> tu
     return mean + np.stack([L @ zi for zi in z]).reshape(mean.shape), excess
 
 
-def draw(system: Any, truth: Any, obs: dict[str, Any], states: SensorStates, rngs: list[np.random.Generator],
+def draw(system: Any, truth: Any, obs: Observations, states: SensorStates, rngs: list[np.random.Generator],
          row: int, P0: Array) -> tuple[Array, Array, Array]:
     """(e (N, n) the estimation errors, x_hat (N, n) the filter's start estimates, P_conv (n, n)) of the runs
     (rngs: each run's "nav" stream, n standard normals each)."""

@@ -20,6 +20,8 @@ from approachsim import synthetic
 from approachsim.config import ProfileError
 from approachsim.integrity.requirements import REQUIREMENTS
 from approachsim.nav.fde import FdeConfig
+from approachsim.nav.navigator import RunFilter, loop_held
+from approachsim.nav.observations import Observations
 from approachsim.nav.system import NavSystem
 from approachsim.profile import parse_profile
 from approachsim.seeding import stream
@@ -228,11 +230,8 @@ def test_baro_off_the_epochs_does_not_hold_the_loop(truths):
     assert np.sum(run.status.name == "baro") < 0.5 * len(run.t_epoch_s)  # most epochs without a baro update
     sd = np.sqrt(run.P_nav[:, 2, 2])
     assert np.all(np.abs(run.true_error_nav[:, 2]) < 4.0 * sd)
-    assert not nav._loop_held({}, _Run_like(), 0)  # no baro at the epoch alone is not a held loop
-
-
-class _Run_like:
-    fde = None
+    # no baro at the epoch alone is not a held loop
+    assert not loop_held(nav.layout, RunFilter(None, [], np.zeros(3), np.zeros(3)), Observations(0.0, 1), 0)
 
 
 @pytest.mark.parametrize("magnitude_m", [10.0, 30.0])

@@ -34,7 +34,7 @@ def test_per_class_channel_qd_equals_the_discretized_model_at_that_sky():
     phi2, qd2 = qd_at(el2)
     np.testing.assert_array_equal(phi1, phi2)  # the sky changes only the noise
     assert not np.allclose(qd1, qd2)
-    np.testing.assert_allclose(nav._channel_qd(qd1, el2, 1.0), qd2, rtol=1e-12, atol=0.0)
+    np.testing.assert_allclose(nav.noise_model.channel_qd(qd1, el2, 1.0), qd2, rtol=1e-12, atol=0.0)
     k = np.arange(lay.index["gmp"].start, lay.index["gmp"].stop)
     tau = nav.sensors.gnss.budget().multipath_tau_s
     np.testing.assert_allclose(qd2[k, k], do253_multipath_sigma_m(el2) ** 2 * -np.expm1(-2.0 / tau), rtol=1e-12)

@@ -42,7 +42,7 @@ def test_step_by_step_equals_open_loop_pass(quantized, feedback, realistic):
     assert (src._imu_affine is None) == quantized
     r_rwy = np.array([src.step(k, truth)[0] for k in range(len(truth))])
     closed = src.result(truth)
-    assert (src.runs[0].db_error is not None) == realistic
+    assert (src.navigator.runs[0].db_error is not None) == realistic
     assert all(src.nav.layout.has(g) == realistic for g in ("rab", "ram", "tdb"))
     recs, st = measure_with_states(SensorSuite.from_profile(prof), truth, seed=4, runs=2)
     open_ = NavSystem.from_profile(prof).run(truth, recs, stream(4, 2, "nav"), states=st)

@@ -1,0 +1,304 @@
+"""The navigation step object: one pass of the navigation system over N runs, used by both the open-loop pass
+over whole records (NavSystem.run) and the closed loop (closed_loop.NavInTheLoop).
+
+    nav = Navigator(system, s0, runs, t0_s, n_rows)   # INS states (N runs) + each run's filter, from NavSystem.start
+    nav.propagate(dtheta, dv, dt_s, h_baro, row0)     # the compiled INS over rows row0+1 .. row0+m (open loop)
+    nav.x, nav.record_row(k)                          # or: the caller steps nav.x (packed INS) itself (closed loop)
+    nav.epoch(row, t_s, obs, truth)                   # the filter at an aiding epoch (predict + updates)
+    runs = nav.results(truth)                         # NavRun per run: solution at every row, status log, history
+
+At an epoch every run's filter predicts with the discretized error model (errormodel.dynamics + discretize,
+linearized about the run's INS solution) and takes its available scalar rows in turn (nav/rows.py), each giving an
+UpdateStatus; with the online FDE ([nav.fde]) the run's FdeState runs the epoch (nav/fde.py). With `shared` (open
+loop on one truth, optimal filter) the covariance and gains are propagated along the truth once per measurement
+schedule instead (nav/shared.py). Output (seed 002 feed-forward) = INS - estimated error; with feedback the
+estimate is fed back into the INS (and the IMU bias estimates into the increments) and those states reset.
+
+The record kept for the output is light: the raw INS state at every row, and per filter snapshot the estimate,
+the 3x3 position block of P and the clock variance (a full (rows, n, n) P at 120 Hz would be gigabytes).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from approachsim import geo
+from approachsim.nav import errormodel as em
+from approachsim.nav import ins
+from approachsim.nav import terrain_db as tdb
+from approachsim.nav.base import FilterState, UpdateStatus
+from approachsim.nav.fde import FdeState
+from approachsim.nav.observations import BARO, Observations
+from approachsim.records import NavSolution, Truth
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class StatusLog:
+    """Every scalar measurement's status record of one run, in processing order (1-D arrays, length u)."""
+
+    t_s: Array
+    name: Array
+    """(u,) channel name ("baro", "radalt", "gps07", "pl0", ...), str."""
+    innovation: Array
+    variance: Array
+    """(u,) predicted innovation variance S = h' P h + r."""
+    test_ratio: Array
+    """(u,) nu^2 / S (the NIS of a scalar)."""
+    weight: Array
+    accepted: Array
+
+    @classmethod
+    def from_records(cls, recs: list[UpdateStatus]) -> StatusLog:
+        """Arrays from a list of UpdateStatus."""
+        return cls(
+            t_s=np.array([r.t_s for r in recs], dtype=float),
+            name=np.array([r.name for r in recs], dtype=str),
+            innovation=np.array([r.innovation for r in recs], dtype=float),
+            variance=np.array([r.variance for r in recs], dtype=float),
+            test_ratio=np.array([r.test_ratio for r in recs], dtype=float),
+            weight=np.array([r.weight for r in recs], dtype=float),
+            accepted=np.array([r.accepted for r in recs], dtype=bool),
+        )
+
+
+@dataclass(frozen=True)
+class NavRun:
+    """One run's navigation output: the solution at the IMU rate and the filter history at the epochs."""
+
+    solution: NavSolution
+    status: StatusLog
+    t_epoch_s: Array
+    """(e,) aiding epoch times, s."""
+    x: Array
+    """(e, n) estimated error state after the epoch's updates (feedback: the residual after the reset)."""
+    P_diag: Array
+    """(e, n) its variances."""
+    P_nav: Array
+    """(e, 9, 9) covariance of the navigation errors (dp, dv, psi) after the updates."""
+    true_error_nav: Array | None
+    """(e, 9) INS - truth error (dp NED m, dv m/s, psi rad) of the *output* at the epochs, when truth is given."""
+    layout: em.StateLayout = field(compare=False)
+
+
+@dataclass
+class RunFilter:
+    """One run's filter bookkeeping inside a pass (mutable; never leaves the navigation package)."""
+
+    fs: FilterState
+    statuses: list
+    bg_fb: Array
+    ba_fb: Array
+    fde: FdeState | None = None
+    """Online fault detection and exclusion ([nav.fde] enabled), else None."""
+    db_error: tdb.TerrainDbError | None = None
+    """This run's terrain-database error (None: the database is the truth terrain)."""
+
+    def baro_excluded(self) -> bool:
+        """The online FDE has excluded the baro."""
+        return self.fde is not None and BARO in self.fde.excluded
+
+
+def true_error(o: ins.InsState, truth: Truth, row: int) -> Array:
+    """(N, 9) output error (dp NED, dv, psi) against truth row `row`."""
+    dp = ins.position_error_ned(o.lat_rad, o.lon_rad, o.h_m, truth.lat_rad[row], truth.lon_rad[row],
+                                truth.h_m[row])
+    dv = o.v_ned - truth.v_ned[row]
+    psi = ins.attitude_error(o.c_bn, ins.cbn_from_quaternion(truth.q_nb[row]))
+    return np.concatenate([dp, dv, psi], axis=-1)
+
+
+def loop_held(layout: em.StateLayout, run: RunFilter, obs: Observations, i: int) -> bool:
+    """Whether run i's damping loop held its compensator over the interval ending at this epoch: the INS kernel
+    had no baro over the whole interval (obs.loop_held: an outage, invalid samples) or the run's FDE has
+    excluded the baro."""
+    if not layout.has("ac"):
+        return False
+    if run.baro_excluded():
+        return True
+    # what the INS kernel was given over the interval (run / the closed loop put it in obs): a baro rate
+    # that does not fall on the epochs leaves obs without a baro value while the loop ran
+    return bool(obs.loop_held[i]) if obs.loop_held is not None else False
+
+
+class Navigator:
+    """One pass of the navigation system over N runs (module docstring)."""
+
+    def __init__(self, system: Any, s0: ins.InsState, runs: list[RunFilter], t0_s: float, n_rows: int,
+                 *, shared: Any = None) -> None:
+        self.system = system
+        self.layout: em.StateLayout = system.layout
+        self.runs = runs
+        self.shared = shared
+        """nav/shared.py SharedCovariance, or None (per-run filters)."""
+        self.x = ins.pack(s0)
+        """(N, 16) the packed INS state (kernels/strapdown.py), stepped by `propagate` or by the caller."""
+        n = len(runs)
+        self.rows = np.full((n, n_rows, ins.NX), np.nan)
+        self.rows[:, 0] = self.x
+        self.snap = np.zeros(n_rows, dtype=int)
+        self._snaps: list[tuple[Array, Array, Array]] = []
+        self.f_sum = np.zeros((n, 3))
+        """C_bn dv accumulated since the last epoch (NED, m/s): the mean specific force of the interval."""
+        self.t_last = float(t0_s)
+        self._ic = self.layout.i("clk") if self.layout.has("clk") else 0
+        self._hist: dict[str, list] = {"t": [], "x": [], "pd": [], "pnav": [], "err": []}
+        self._snapshot()
+
+    @property
+    def n_runs(self) -> int:
+        return len(self.runs)
+
+    @property
+    def x_nav(self) -> Array:
+        """(N, 9) the estimated navigation errors in force (dp NED m, dv m/s, psi rad)."""
+        return np.stack([r.fs.x[0:9] for r in self.runs])
+
+    # --- the INS between epochs -----------------------------------------------------------------------------
+
+    def bias_feedback(self) -> tuple[Array, Array]:
+        """(N, 3) gyro and accelerometer bias estimates fed back into the increments (zeros feed-forward)."""
+        if not self.system.nav.feedback:
+            z = np.zeros((self.n_runs, 3))
+            return z, z
+        return np.stack([r.bg_fb for r in self.runs]), np.stack([r.ba_fb for r in self.runs])
+
+    def propagate(self, dtheta: Array, dv: Array, dt_s: float, h_baro: Array | None, row0: int) -> None:
+        """Step every run's INS over the m IMU intervals of dtheta, dv (N, m, 3) from row row0 (the compiled
+        mechanization: all runs over all rows in one call), recording rows row0 + 1 .. row0 + m; h_baro (N, m)
+        the baro held at each interval start (with the damping loop)."""
+        m = dtheta.shape[1]
+        bg, ba = self.bias_feedback()
+        ins.propagate(self.x, dtheta, dv, dt_s, bias_g=bg, bias_a=ba, h_baro_m=h_baro,
+                      loop=self.system.loop_gains(), f_sum=self.f_sum, out=self.rows, row0=row0)
+        self.snap[row0 + 1:row0 + m + 1] = len(self._snaps) - 1
+
+    def record_row(self, k: int) -> None:
+        """Keep the current INS state as row k (closed loop: the caller stepped `x` into row k)."""
+        self.rows[:, k] = self.x
+        self.snap[k] = len(self._snaps) - 1
+
+    # --- the filter at an epoch --------------------------------------------------------------------------------
+
+    def epoch(self, row: int, t_s: float, obs: Observations, truth: Truth) -> None:
+        """The aiding epoch at truth row `row` (time t_s): predict over the interval since the last epoch and
+        update every run with obs; feedback corrects `x`. The truth is read at `row` only: as the reference
+        trajectory of the shared covariance, and for the error history."""
+        s = ins.unpack(self.x)
+        dt = t_s - self.t_last
+        if self.shared is not None:
+            s = self.shared.aid(self, s, t_s, dt, row, obs, truth)
+        else:
+            s = self._aid(s, t_s, dt, self.f_sum / dt, obs)
+        if self.system.nav.feedback:
+            s = self._feedback(s)
+        self.f_sum[:] = 0.0
+        self.t_last = t_s
+        self.x[:] = ins.pack(s)
+        self._snapshot()
+        self.record_row(row)
+        o, P, x = self._output(s)
+        h = self._hist
+        h["t"].append(t_s)
+        h["x"].append(x)
+        h["pd"].append(np.diagonal(P, axis1=1, axis2=2))
+        h["pnav"].append(P[:, 0:9, 0:9])
+        h["err"].append(true_error(o, truth, row))
+
+    def loop_held(self, obs: Observations, i: int) -> bool:
+        """Whether run i's damping loop held over the interval ending at this epoch (`loop_held`)."""
+        return loop_held(self.layout, self.runs[i], obs, i)
+
+    def _aid(self, s: ins.InsState, t: float, dt_epoch: float, f_ned_mean: Array, obs: Observations
+             ) -> ins.InsState:
+        """Per-run filters: each run linearized about its own INS solution (f_ned_mean (N, 3): the mean specific
+        force over the interval, NED m/s^2)."""
+        system = self.system
+        lay = self.layout
+        filt = system.filter
+        noise = None if obs.per_run_sky else system.noise(obs.elevations())
+        r_ins = ins.position_ecef(s)
+        for i, run in enumerate(self.runs):
+            if obs.per_run_sky:
+                noise = system.noise(obs.elevations(i))
+            gains = system.loop_slopes(run.fs, float(s.h_m[i]), noise)
+            F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
+                                noise, gains, loop_held=self.loop_held(obs, i))
+            phi, qd = em.discretize(F, Qc, dt_epoch)
+            rows = system.rows.epoch(s, i, r_ins[i], obs, t, db_error=run.db_error)
+            if run.fde is not None:  # predict, test, exclude, update (nav/fde.py)
+                run.fs, sts = run.fde.epoch(filt, run.fs, phi, qd, rows, t, system.runway.from_ecef(r_ins[i]))
+                run.statuses.extend(sts)
+                continue
+            fs = filt.predict(run.fs, phi, qd)
+            for row in rows:
+                fs, st = filt.update(fs, row.build(fs.x))
+                run.statuses.append(st)
+            run.fs = fs
+        return s
+
+    def _feedback(self, s: ins.InsState) -> ins.InsState:
+        """Closed-loop correction: INS -= estimated nav error; bias estimates go to the increments; reset."""
+        lay = self.layout
+        x = np.stack([r.fs.x for r in self.runs])
+        s = ins.perturb(s, -x[:, 0:3], -x[:, 3:6], -x[:, 6:9])
+        for i, r in enumerate(self.runs):
+            r.bg_fb = r.bg_fb + x[i, lay.index["bg"]]
+            r.ba_fb = r.ba_fb + x[i, lay.index["ba"]]
+            xn = x[i].copy()
+            for g in ("dp", "dv", "psi", "bg", "ba"):
+                xn[lay.index[g]] = 0.0
+            r.fs = replace(r.fs, x=xn)
+        return s
+
+    # --- output --------------------------------------------------------------------------------------------
+
+    def _output(self, s: ins.InsState) -> tuple[ins.InsState, Array, Array]:
+        """Corrected solution (feed-forward: INS - x_hat) and each run's P (N, n, n) and x_hat (N, n)."""
+        x = np.stack([r.fs.x for r in self.runs])
+        P = np.stack([self.system.filter.covariance(r.fs) for r in self.runs])
+        return ins.perturb(s, -x[:, 0:3], -x[:, 3:6], -x[:, 6:9]), P, x
+
+    def _snapshot(self) -> None:
+        """Keep x, the position block of P and the clock variance: the estimate in force until the next epoch."""
+        P = np.stack([self.system.filter.covariance(r.fs) for r in self.runs])
+        ic = self._ic
+        self._snaps.append((np.stack([r.fs.x for r in self.runs]), P[:, 0:3, 0:3].copy(), P[:, ic, ic].copy()))
+
+    def results(self, truth: Truth, n_rows: int | None = None) -> list[NavRun]:
+        """Each run's NavRun over the first n_rows rows (default: all): the solution at every row (INS - x_hat
+        of the snapshot in force), the status log and the epoch history."""
+        n = self.rows.shape[1] if n_rows is None else int(n_rows)
+        snap = self.snap[:n]
+        X = np.stack([x for x, _, _ in self._snaps])[snap]  # (n, runs, n_states)
+        PP = np.stack([p for _, p, _ in self._snaps])  # (snaps, runs, 3, 3)
+        PC = np.stack([c for _, _, c in self._snaps])  # (snaps, runs)
+        lay = self.layout
+        has_clk = lay.has("clk")
+        ic = self._ic
+        h = self._hist
+        out = []
+        for i, r in enumerate(self.runs):
+            xi = X[:, i]
+            o = ins.perturb(ins.unpack(self.rows[i, :n]), -xi[:, 0:3], -xi[:, 3:6], -xi[:, 6:9])
+            sol = NavSolution(
+                t_s=np.asarray(truth.t_s[:n], dtype=float),
+                r_ecef=geo.geodetic_to_ecef(o.lat_rad, o.lon_rad, o.h_m),
+                v_ned=o.v_ned,
+                euler_rad=ins.euler_from_cbn(o.c_bn),
+                P_pos_ned=PP[:, i][snap],
+                clock_bias_m=xi[:, ic] if has_clk else np.full(n, np.nan),
+                clock_bias_sigma_m=np.sqrt(PC[:, i][snap]) if has_clk else np.full(n, np.nan),
+                **(r.fde.solution_fields(snap) if r.fde is not None else {}),
+            )
+            out.append(NavRun(
+                solution=sol, status=StatusLog.from_records(r.statuses), t_epoch_s=np.array(h["t"]),
+                x=np.array([x[i] for x in h["x"]]), P_diag=np.array([p[i] for p in h["pd"]]),
+                P_nav=np.array([p[i] for p in h["pnav"]]), true_error_nav=np.array([e[i] for e in h["err"]]),
+                layout=lay,
+            ))
+        return out

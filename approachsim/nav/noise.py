@@ -1,0 +1,158 @@
+"""The filter's noise model: process noise and the prior covariance P0, built from the error budgets the sensors
+declare (the IMU grade's preset, the baro, the GNSS code budget and receiver clock, the pseudolites, the radar
+altimeter) and the navigation configuration (initial INS errors, terrain database).
+
+    model = NoiseModel(sensors_config, nav_config, layout)
+    model.noise(elevation_rad)              # errormodel.ErrorNoise, GPS channel noise at their elevations
+    model.initial_covariance(elevation_rad) # P0 (n, n)
+
+The filter knows the sensors' error budgets, not their realizations: the same budgets the sensor models draw from
+(sensors/presets.py, sensors/gnss/receiver.py, sensors/gnss/clock.py), so a consistent filter is the default.
+The GPS channel states' noise depends on each channel's elevation (iono obliquity, tropo mapping, DO-253
+multipath); `noise` is a pure function of the configuration and the elevations and is cached per elevation vector.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from approachsim.nav import errormodel as em
+from approachsim.nav.config import NavConfig
+from approachsim.sensors.config import SensorsConfig
+from approachsim.sensors.gnss.clock import ClockModel
+from approachsim.sensors.gnss.receiver import iono_obliquity, tropo_mapping
+from approachsim.sensors.presets import PRESETS
+
+Array = np.ndarray
+
+_CACHE_MAX = 512
+"""Elevation vectors kept by `NoiseModel.noise` (one sky's epochs x runs at most)."""
+
+PSEUDOLITE_CLOCK = ("ocxo", 30.0, 0.03)
+"""An unsynchronized pseudolite's transmitter clock: oscillator, bias and drift 1-sigma at the start (m, m/s)."""
+
+
+@dataclass(frozen=True)
+class NoiseModel:
+    """Process noise and P0 of a navigation configuration (module docstring)."""
+
+    sensors: SensorsConfig
+    nav: NavConfig
+    layout: em.StateLayout
+    _cache: dict = field(default_factory=dict, init=False, compare=False, repr=False)
+
+    def clock(self) -> ClockModel:
+        """The receiver clock model (the GNSS receiver's oscillator; a default clock without GNSS)."""
+        g = self.sensors.gnss
+        if g is not None:
+            return ClockModel.named(g.oscillator, g.clock_bias0_sigma_m, g.clock_drift0_sigma_mps)
+        return ClockModel()
+
+    def noise(self, elevation_rad: Array | None = None) -> em.ErrorNoise:
+        """Process noise with the GPS channels at elevations elevation_rad (k,), rad (None: 30 deg); cached per
+        elevation vector, its arrays read-only (shared between callers)."""
+        key = None if elevation_rad is None else np.asarray(elevation_rad, dtype=float).tobytes()
+        nz = self._cache.get(key)
+        if nz is None:
+            if len(self._cache) > _CACHE_MAX:
+                self._cache.clear()
+            nz = self._build(elevation_rad)
+            for v in vars(nz).values():
+                if isinstance(v, np.ndarray):
+                    v.flags.writeable = False
+            self._cache[key] = nz
+        return nz
+
+    def _build(self, elevation_rad: Array | None) -> em.ErrorNoise:
+        g = PRESETS[self.sensors.imu.grade]
+        b = self.sensors.baro
+        kw: dict[str, Any] = {}
+        if self.sensors.gnss is not None:
+            bud = self.sensors.gnss.budget()
+            el = np.full(24, np.radians(30.0)) if elevation_rad is None else np.nan_to_num(elevation_rad, nan=0.5)
+            el = np.maximum(el, np.radians(2.0))
+            kw.update(
+                gse_sigma_m=np.sqrt(bud.clock_ephemeris_m**2 + (bud.iono_zenith_m * iono_obliquity(el)) ** 2
+                                    + (bud.tropo_zenith_m * tropo_mapping(el)) ** 2),
+                gse_tau_s=min(bud.clock_ephemeris_tau_s, bud.iono_tau_s, bud.tropo_tau_s),
+                # per channel at its elevation under do253 (the sensor's sigma_mp), one value under nrc1995
+                gmp_sigma_m=(bud.multipath_sigma_m(el) if bud.multipath_model == "do253" else bud.multipath_m),
+                gmp_tau_s=bud.multipath_tau_s,
+            )
+        if self.sensors.pseudolite is not None:
+            p = self.sensors.pseudolite
+            kw.update(pmp_sigma_m=p.multipath_m, pmp_tau_s=p.multipath_tau_s)
+            if not p.synchronized:
+                q = ClockModel.named(*PSEUDOLITE_CLOCK).q(1.0)
+                kw.update(pclk_sf=q[0, 0] - q[1, 1] / 3.0, pclk_sg=q[1, 1])
+        if self.sensors.radalt is not None:
+            kw.update(ram_sigma_m=self.sensors.radalt.markov_sigma_m, ram_tau_s=self.sensors.radalt.markov_tau_s,
+                      tdb_correlation_m=self.nav.terrain_database.correlation_m)
+        q1 = self.clock().q(1.0)  # Q(1 s) = [[S_f + S_g / 3, S_g / 2], [., S_g]]
+        return em.ErrorNoise(
+            gyro_arw_rad_sqrts=g.gyro_arw_rad_sqrts,
+            accel_vrw_mps_sqrts=g.accel_vrw_mps_sqrts,
+            gyro_bias_rw=np.sqrt(2.0 * g.gyro_bi_radps**2 / g.gyro_bi_tau_s),
+            accel_bias_rw=np.sqrt(2.0 * g.accel_bi_mps2**2 / g.accel_bi_tau_s),
+            baro_bias_sigma_m=b.bias_sigma_m if b is not None else 1.0,
+            baro_bias_tau_s=b.bias_tau_s if b is not None else 100.0,
+            baro_noise_sigma_m=b.noise_sigma_m if b is not None else 1.0,
+            baro_rate_hz=b.rate_hz if b is not None else 10.0,
+            clock_sf=float(q1[0, 0] - q1[1, 1] / 3.0),
+            clock_sg=float(q1[1, 1]),
+            **kw,
+        )
+
+    def channel_qd(self, qd: Array, el_rad: Array, dt_s: float) -> Array:
+        """Qd with the GPS channel states' (gse, gmp: decoupled first-order Markov) entries at elevations el_rad
+        (k,): sigma^2 (1 - exp(-2 dt / tau)), the closed form errormodel.discretize uses for them."""
+        lay = self.layout
+        if not lay.has("gse"):
+            return qd
+        nz = self.noise(el_rad)
+        q = qd.copy()
+        for grp, sig, tau in (("gse", nz.gse_sigma_m, nz.gse_tau_s), ("gmp", nz.gmp_sigma_m, nz.gmp_tau_s)):
+            k = np.arange(lay.index[grp].start, lay.index[grp].stop)
+            q[k, k] = np.broadcast_to(np.asarray(sig, dtype=float), k.shape) ** 2 * -np.expm1(-2.0 * dt_s / tau)
+        return q
+
+    def initial_covariance(self, elevation_rad: Array | None = None) -> Array:
+        """P0: the profile's initial INS errors, the IMU grade's biases, the sensors' error budgets (the GPS
+        channels' slow errors at their elevations elevation_rad (k,), rad, when given)."""
+        lay, ie = self.layout, self.nav.initial_error
+        g = PRESETS[self.sensors.imu.grade]
+        nz = self.noise(elevation_rad)
+        d = np.zeros(lay.n)
+        d[lay.index["dp"]] = ie.position_m**2
+        d[lay.index["dv"]] = ie.velocity_mps**2
+        d[lay.index["psi"]] = [ie.tilt_rad**2, ie.tilt_rad**2, ie.heading_rad**2]
+        d[lay.index["bg"]] = g.gyro_bias_radps**2 + g.gyro_bi_radps**2
+        # scale factor and misalignment under 1 g look like a bias to a level accelerometer triad
+        d[lay.index["ba"]] = (g.accel_bias_mps2**2 + g.accel_bi_mps2**2
+                              + (9.8 * g.accel_misalign_rad) ** 2 + (9.8 * g.accel_sf) ** 2)
+        d[lay.i("bb")] = nz.baro_bias_sigma_m**2
+        if lay.has("sb"):
+            d[lay.i("sb")] = self.sensors.baro.scale_factor_sigma**2
+        if lay.has("clk"):
+            c = self.clock()
+            d[lay.index["clk"]] = [c.bias0_sigma_m**2, c.drift0_sigma_mps**2]
+        if lay.has("gse"):
+            d[lay.index["gse"]] = np.broadcast_to(nz.gse_sigma_m, (lay.n_sv,)) ** 2
+            d[lay.index["gmp"]] = nz.gmp_sigma_m**2
+        if lay.has("pmp"):
+            p = self.sensors.pseudolite
+            d[lay.index["pmp"]] = p.multipath_m**2
+            d[lay.index["ptr"]] = (p.tropo_ppm_sigma * 1e-6) ** 2
+            if lay.has("pclk"):
+                _, b0, d0 = PSEUDOLITE_CLOCK
+                d[lay.index["pclk"]] = np.tile([b0**2, d0**2], lay.n_pl)
+        if lay.has("rab"):  # altimeter and database biases summed (both enter the radalt row as -1)
+            d[lay.i("rab")] = self.sensors.radalt.bias_sigma_m**2 + self.nav.terrain_database.bias_sigma_m**2
+        if lay.has("ram"):
+            d[lay.i("ram")] = self.sensors.radalt.markov_sigma_m**2
+        if lay.has("tdb"):
+            d[lay.i("tdb")] = 1.0  # unit Gauss-Markov
+        return np.diag(d)

@@ -1,0 +1,132 @@
+"""Shared covariance: open-loop runs on one truth with the optimal filter propagate one covariance and gain per
+measurement schedule, linearized along the truth, instead of one per run (NavSystem.run(..., shared_covariance)).
+
+Runs whose available measurements (and damping-loop hold) have been the same at every epoch share one covariance;
+a run whose schedule departs (a fault, an outage, a lost channel) gets its own copy from then on (`split`). A run's
+covariance is thus a function of the truth and its own schedule only, and its numbers do not depend on the runs it
+shares a batch with. With per-run GPS skies every run is its own class from the start (a covariance is shared only
+within one sky). Phi and Qd are built once per epoch along the truth (and per hold state); each class takes the
+reference rows (the measurement model at the truth, nav/rows.py) for its gains, and each run its own innovation
+nu_i = z_i - g(x_hat_i) from its own rows at its own INS solution and estimate: the same measurement functions as
+the per-run filters.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from approachsim.nav import errormodel as em
+from approachsim.nav import ins
+from approachsim.nav.base import FilterState, UpdateStatus
+from approachsim.nav.observations import Observations
+from approachsim.records import Truth
+
+Array = np.ndarray
+
+
+@dataclass
+class SharedCovariance:
+    """One P per measurement-schedule class (module docstring); mutable, lives inside one pass."""
+
+    P: list
+    """(n, n) covariance of each class."""
+    of_run: Array
+    """(N,) class of each run."""
+    f_ned_ref: Array
+    """(rows, 3) the truth's specific force in NED at every row (the reference trajectory's), m/s^2."""
+    epoch_rows: int
+
+    @classmethod
+    def start(cls, runs: list, truth: Truth, m: int, epoch_rows: int, per_run_sky: bool) -> SharedCovariance:
+        """Classes at the start: one per run with per-run skies, else one for all (the runs' start covariance)."""
+        n = len(runs)
+        f_ref = np.einsum("nij,nj->ni", ins.cbn_from_quaternion(truth.q_nb[:m]), truth.f_body[:m])
+        if per_run_sky:
+            return cls([r.fs.P for r in runs], np.arange(n), f_ref, epoch_rows)
+        return cls([runs[0].fs.P], np.zeros(n, dtype=int), f_ref, epoch_rows)
+
+    def predict_class(self, c: int, phi: Array, qd: Array) -> None:
+        """P- = Phi P+ Phi' + Qd for class c (its own model: GPS sky, damping loop held or not)."""
+        P = phi @ self.P[c] @ phi.T + qd
+        self.P[c] = 0.5 * (P + P.T)
+
+    def split(self, schedule: Array) -> None:
+        """Runs of one class whose schedules (rows of (N, k) bool) differ go to new classes (copies of P)."""
+        keys: dict[tuple[int, bytes], int] = {}
+        new_P: list = []
+        of_run = np.empty_like(self.of_run)
+        for i, c in enumerate(self.of_run):
+            k = (int(c), schedule[i].tobytes())
+            if k not in keys:
+                keys[k] = len(new_P)
+                new_P.append(self.P[int(c)])
+            of_run[i] = keys[k]
+        self.P, self.of_run = new_P, of_run
+
+    def classes(self) -> list[tuple[int, list[int]]]:
+        """(class, its runs) for every class."""
+        return [(c, [int(i) for i in np.flatnonzero(self.of_run == c)]) for c in range(len(self.P))]
+
+    def aid(self, nav: Any, s: ins.InsState, t: float, dt_epoch: float, row: int, obs: Observations,
+            truth: Truth) -> ins.InsState:
+        """One epoch of every run (nav: the Navigator; s its INS states): the classes' covariances and gains along
+        the truth row `row` (its mean specific force over the interval), each run's state with its own
+        innovations. Returns s (feedback is the Navigator's)."""
+        system = nav.system
+        runs = nav.runs
+        lay = system.layout
+        ref = ins.InsState(truth.lat_rad[row:row + 1], truth.lon_rad[row:row + 1], truth.h_m[row:row + 1],
+                           truth.v_ned[row:row + 1], ins.cbn_from_quaternion(truth.q_nb[row:row + 1]), np.zeros(1))
+        f_ref = self.f_ned_ref[row - self.epoch_rows:row].mean(axis=0)
+        noise = system.noise(obs.elevations(0))
+        # the damping loop held in a run whose INS had no baro over the interval (kernels.strapdown): its own Phi,
+        # Qd. Classes are split on this epoch's schedule and the hold together (splitting only copies P), so every
+        # member of a class holds or none does, and then each class is predicted with its model
+        held = [nav.loop_held(obs, i) for i in range(len(runs))]
+        models: dict[bool, tuple[Array, Array]] = {}
+        for h in sorted(set(held)):
+            F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ref, ref.c_bn[0],
+                                noise, system.loop_gains(), loop_held=h)
+            models[h] = em.discretize(F, Qc, dt_epoch)
+        # x- = Phi x+ (row by row: no batch-size-dependent BLAS path)
+        X = np.stack([models[held[i]][0] @ r.fs.x for i, r in enumerate(runs)])
+        self.split(np.column_stack([obs.schedule(), np.array(held, dtype=bool)]))
+        for c, members in self.classes():
+            phi, qd = models[held[members[0]]]
+            self.predict_class(c, phi, system.noise_model.channel_qd(qd, obs.elevations(members[0]), dt_epoch)
+                               if obs.per_run_sky else qd)
+        r_ins = ins.position_ecef(s)
+        r_ref = ins.position_ecef(ref)[0]
+        x0 = np.zeros(lay.n)
+        eye = np.eye(lay.n)
+        for c, members in self.classes():
+            i0 = members[0]
+            ref_rows = system.rows.epoch(ref, 0, r_ref, system.rows.reference_obs(obs, i0, float(ref.h_m[0]), r_ref),
+                                         t)
+            own = {i: system.rows.epoch(s, i, r_ins[i], obs, t, db_error=runs[i].db_error) for i in members}
+            P = self.P[c]
+            for j, rr in enumerate(ref_rows):
+                m0 = rr.build(x0)
+                h0, r = m0.h, m0.r
+                Ph = P @ h0
+                S = float(h0 @ Ph + r)  # S = h' P h + r (shared)
+                K = Ph / S  # K = P h S^-1 (shared)
+                for i in members:
+                    row_i = own[i][j]
+                    if row_i.source != rr.source:
+                        raise RuntimeError(f"shared covariance: run {i} has {row_i.source.name} where its class "
+                                           f"has {rr.source.name}")
+                    m = row_i.build(X[i])
+                    v = float(m.z - m.h @ X[i])  # nu_i = z_i - g(x_hat_i): the run's own exact difference
+                    X[i] = X[i] + v * K  # x+ = x- + K nu
+                    runs[i].statuses.append(UpdateStatus(m0.name, t, v, S, v * v / S, 1.0, True))
+                A = eye - np.outer(K, h0)
+                P = A @ P @ A.T + r * np.outer(K, K)  # Joseph form
+                P = 0.5 * (P + P.T)
+            self.P[c] = P
+        for i, run in enumerate(runs):
+            run.fs = FilterState(x=X[i], P=self.P[self.of_run[i]], memory=run.fs.memory)
+        return s
