@@ -208,6 +208,7 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int) -> tuple[BankEpochs,
     nav = NavSystem.from_profile(profile)
     # every copy starts from the main filter's converged state (the first copy's schedule: all channels)
     navs = nav.run(truth, recs, [stream(seed, run, "nav") for _ in range(copies)],
-                   shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors))
+                   shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors),
+                   copies=not nav.nav.feedback)
     ep = bank_epochs(navs[0], navs[1:], channels, truth, profile.runway.heading_rad)
     return ep, navs[0]

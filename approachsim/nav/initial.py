@@ -201,13 +201,15 @@ def condition(P_conv: Array, Pi_ss: Array, s: Array, x_s: Array, z: Array) -> tu
 
 
 def draw(system: Any, truth: Any, obs: Observations, states: SensorStates, rngs: list[np.random.Generator],
-         row: int, P0: Array) -> tuple[Array, Array, Array]:
+         row: int, P0: Array, P_conv: Array | None = None) -> tuple[Array, Array, Array]:
     """(e (N, n) the estimation errors, x_hat (N, n) the filter's start estimates, P_conv (n, n)) of the runs
-    (rngs: each run's "nav" stream, n standard normals each)."""
+    (rngs: each run's "nav" stream, n standard normals each). P_conv: the converged covariance when already
+    computed for this start (it depends on the start row, its sky and schedule and P0 only), else computed."""
     lay = system.layout
     if states.runs != len(rngs):
         raise ValueError(f"converged start: {states.runs} runs of sensor states for {len(rngs)} runs")
-    P_conv = converged_covariance(system, truth, obs, row, P0, system.nav.initial_error.converge_s)
+    if P_conv is None:
+        P_conv = converged_covariance(system, truth, obs, row, P0, system.nav.initial_error.converge_s)
     s, x_s = sensor_vector(lay, states, P0)
     z = np.stack([g.standard_normal(lay.n) for g in rngs])
     e, _ = condition(P_conv, P0[np.ix_(s, s)], s, x_s, z)

@@ -31,6 +31,7 @@ from approachsim.nav import ins
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import FilterState, UpdateStatus
 from approachsim.nav.fde import FdeState
+from approachsim.nav.kernels import output as ko
 from approachsim.nav.observations import BARO, Observations
 from approachsim.records import NavSolution, Truth
 
@@ -70,7 +71,8 @@ class StatusLog:
 class NavRun:
     """One run's navigation output: the solution at the IMU rate and the filter history at the epochs."""
 
-    solution: NavSolution
+    solution: NavSolution | None
+    """The solution at every row (None: not assembled, NavSystem.run(..., copies=True)'s sub-filters)."""
     status: StatusLog
     t_epoch_s: Array
     """(e,) aiding epoch times, s."""
@@ -129,15 +131,22 @@ class Navigator:
     """One pass of the navigation system over N runs (module docstring)."""
 
     def __init__(self, system: Any, s0: ins.InsState, runs: list[RunFilter], t0_s: float, n_rows: int,
-                 *, shared: Any = None) -> None:
+                 *, shared: Any = None, ins_of: Array | None = None) -> None:
         self.system = system
         self.layout: em.StateLayout = system.layout
         self.runs = runs
         self.shared = shared
         """nav/shared.py SharedCovariance, or None (per-run filters)."""
         self.x = ins.pack(s0)
-        """(N, 16) the packed INS state (kernels/strapdown.py), stepped by `propagate` or by the caller."""
-        n = len(runs)
+        """(M, 16) the packed INS states (kernels/strapdown.py), stepped by `propagate` or by the caller."""
+        n = self.x.shape[0]
+        self.ins_of = np.arange(len(runs)) if ins_of is None else np.asarray(ins_of, dtype=int)
+        """(N,) the INS each run's filter aids: the identity, or copies of one run sharing one INS (the integrity
+        bank's sub-filters, feed-forward: their INS is the same, only the filters differ)."""
+        if self.ins_of.shape != (len(runs),) or self.ins_of.max(initial=0) >= n:
+            raise ValueError("Navigator: ins_of must map each run to one of the INS states")
+        if n != len(runs) and system.nav.feedback:
+            raise ValueError("Navigator: runs share an INS only feed-forward (feedback corrects each run's INS)")
         self.rows = np.full((n, n_rows, ins.NX), np.nan)
         self.rows[:, 0] = self.x
         self.snap = np.zeros(n_rows, dtype=int)
@@ -161,16 +170,16 @@ class Navigator:
     # --- the INS between epochs -----------------------------------------------------------------------------
 
     def bias_feedback(self) -> tuple[Array, Array]:
-        """(N, 3) gyro and accelerometer bias estimates fed back into the increments (zeros feed-forward)."""
+        """(M, 3) gyro and accelerometer bias estimates fed back into the increments (zeros feed-forward)."""
         if not self.system.nav.feedback:
-            z = np.zeros((self.n_runs, 3))
+            z = np.zeros((self.x.shape[0], 3))
             return z, z
         return np.stack([r.bg_fb for r in self.runs]), np.stack([r.ba_fb for r in self.runs])
 
     def propagate(self, dtheta: Array, dv: Array, dt_s: float, h_baro: Array | None, row0: int) -> None:
-        """Step every run's INS over the m IMU intervals of dtheta, dv (N, m, 3) from row row0 (the compiled
-        mechanization: all runs over all rows in one call), recording rows row0 + 1 .. row0 + m; h_baro (N, m)
-        the baro held at each interval start (with the damping loop)."""
+        """Step every INS over the m IMU intervals of dtheta, dv (M, m, 3) from row row0 (the compiled
+        mechanization: all over all rows in one call), recording rows row0 + 1 .. row0 + m; h_baro (M, m) the baro
+        held at each interval start (with the damping loop)."""
         m = dtheta.shape[1]
         bg, ba = self.bias_feedback()
         ins.propagate(self.x, dtheta, dv, dt_s, bias_g=bg, bias_a=ba, h_baro_m=h_baro,
@@ -188,17 +197,17 @@ class Navigator:
         """The aiding epoch at truth row `row` (time t_s): predict over the interval since the last epoch and
         update every run with obs; feedback corrects `x`. The truth is read at `row` only: as the reference
         trajectory of the shared covariance, and for the error history."""
-        s = ins.unpack(self.x)
+        s = ins.unpack(self.x[self.ins_of])  # each run's INS state
         dt = t_s - self.t_last
         if self.shared is not None:
             s = self.shared.aid(self, s, t_s, dt, row, obs, truth)
         else:
-            s = self._aid(s, t_s, dt, self.f_sum / dt, obs)
+            s = self._aid(s, t_s, dt, (self.f_sum / dt)[self.ins_of], obs)
         if self.system.nav.feedback:
             s = self._feedback(s)
+            self.x[:] = ins.pack(s)
         self.f_sum[:] = 0.0
         self.t_last = t_s
-        self.x[:] = ins.pack(s)
         self._snapshot()
         self.record_row(row)
         o, P, x = self._output(s)
@@ -269,12 +278,14 @@ class Navigator:
         ic = self._ic
         self._snaps.append((np.stack([r.fs.x for r in self.runs]), P[:, 0:3, 0:3].copy(), P[:, ic, ic].copy()))
 
-    def results(self, truth: Truth, n_rows: int | None = None) -> list[NavRun]:
+    def results(self, truth: Truth, n_rows: int | None = None, solutions: Any = True) -> list[NavRun]:
         """Each run's NavRun over the first n_rows rows (default: all): the solution at every row (INS - x_hat
-        of the snapshot in force), the status log and the epoch history."""
+        of the snapshot in force, kernels/output.py), the status log and the epoch history. solutions: True, or a
+        set of run indices whose solution is assembled (the others get None: the integrity bank's sub-filters
+        need only their epoch history)."""
         n = self.rows.shape[1] if n_rows is None else int(n_rows)
         snap = self.snap[:n]
-        X = np.stack([x for x, _, _ in self._snaps])[snap]  # (n, runs, n_states)
+        XS = np.stack([x for x, _, _ in self._snaps])  # (snaps, runs, n_states)
         PP = np.stack([p for _, p, _ in self._snaps])  # (snaps, runs, 3, 3)
         PC = np.stack([c for _, _, c in self._snaps])  # (snaps, runs)
         lay = self.layout
@@ -283,18 +294,20 @@ class Navigator:
         h = self._hist
         out = []
         for i, r in enumerate(self.runs):
-            xi = X[:, i]
-            o = ins.perturb(ins.unpack(self.rows[i, :n]), -xi[:, 0:3], -xi[:, 3:6], -xi[:, 6:9])
-            sol = NavSolution(
-                t_s=np.asarray(truth.t_s[:n], dtype=float),
-                r_ecef=geo.geodetic_to_ecef(o.lat_rad, o.lon_rad, o.h_m),
-                v_ned=o.v_ned,
-                euler_rad=ins.euler_from_cbn(o.c_bn),
-                P_pos_ned=PP[:, i][snap],
-                clock_bias_m=xi[:, ic] if has_clk else np.full(n, np.nan),
-                clock_bias_sigma_m=np.sqrt(PC[:, i][snap]) if has_clk else np.full(n, np.nan),
-                **(r.fde.solution_fields(snap) if r.fde is not None else {}),
-            )
+            sol = None
+            if solutions is True or i in solutions:
+                xs = XS[:, i]
+                r_ecef, v_ned, euler = ko.corrected(self.rows[self.ins_of[i], :n], xs, snap)
+                sol = NavSolution(
+                    t_s=np.asarray(truth.t_s[:n], dtype=float),
+                    r_ecef=r_ecef,
+                    v_ned=v_ned,
+                    euler_rad=euler,
+                    P_pos_ned=PP[:, i][snap],
+                    clock_bias_m=xs[snap, ic] if has_clk else np.full(n, np.nan),
+                    clock_bias_sigma_m=np.sqrt(PC[:, i][snap]) if has_clk else np.full(n, np.nan),
+                    **(r.fde.solution_fields(snap) if r.fde is not None else {}),
+                )
             out.append(NavRun(
                 solution=sol, status=StatusLog.from_records(r.statuses), t_epoch_s=np.array(h["t"]),
                 x=np.array([x[i] for x in h["x"]]), P_diag=np.array([p[i] for p in h["pd"]]),

@@ -205,10 +205,15 @@ class NavSystem:
         if obs.per_run_sky:  # each run its own GPS sky: its own P0 and converged covariance, flown on the
             # schedule of the first run with that sky (the integrity bank's copies share the main filter's start)
             first: dict[bytes, int] = {}
-            for i in range(n):
-                first.setdefault(obs.elevations(i).tobytes(), i)
-            draws = [initial.draw(self, truth, obs.run(first[obs.elevations(i).tobytes()]), states.take(i), [g], row,
-                                  self.initial_covariance(obs.elevations(i))) for i, g in enumerate(rngs)]
+            p_conv: dict[bytes, Array] = {}  # one converged covariance per sky (bank copies share their run's)
+            draws = []
+            for i, g in enumerate(rngs):
+                key = obs.elevations(i).tobytes()
+                i0 = first.setdefault(key, i)
+                d = initial.draw(self, truth, obs.run(i0), states.take(i), [g], row,
+                                 self.initial_covariance(obs.elevations(i)), p_conv.get(key))
+                p_conv[key] = d[2]
+                draws.append(d)
             e = np.concatenate([d[0] for d in draws])
             x_hat = np.concatenate([d[1] for d in draws])
             P_convs = [d[2] for d in draws]
@@ -267,7 +272,8 @@ class NavSystem:
         return Observations.at(records, t, tol, batched)
 
     def run(self, truth: Truth, records: Mapping[str, Any], rngs: np.random.Generator | list[np.random.Generator],
-            *, shared_covariance: bool = False, states: SensorStates | None = None) -> NavRun | list[NavRun]:
+            *, shared_covariance: bool = False, states: SensorStates | None = None, copies: bool = False
+            ) -> NavRun | list[NavRun]:
         """Navigate over whole records (open loop: the truth is only read at row 0, at the epochs for the error
         history and, with the shared covariance, as the reference trajectory).
 
@@ -275,7 +281,9 @@ class NavSystem:
         (run axis first, rngs a list). Returns one NavRun, or a list. shared_covariance (several runs, optimal
         'ekf' only): one covariance and gain per measurement schedule (nav/shared.py), several times faster.
         states: the runs' realized sensor errors at truth row 0 (sensors.states.start_states), needed by the
-        converged start.
+        converged start. copies: the runs are copies of one run (the same IMU and baro records and start draws:
+        the integrity bank's sub-filters, which differ only in the measurements they use): the INS is integrated
+        once for all of them (feed-forward only; checked).
         """
         if shared_covariance and not self.shares_covariance():
             raise ValueError("shared_covariance needs the optimal 'ekf' filter (robust filters gate per run), "
@@ -298,7 +306,15 @@ class NavSystem:
                              states=states, elevation_per_run=el0 if sky else None)
         shared = (SharedCovariance.start(runs, truth, m, epoch_rows, obs0.per_run_sky) if shared_covariance
                   else None)
-        nav = Navigator(self, s, runs, float(truth.t_s[0]), m + 1, shared=shared)
+        ins_of = None
+        if copies:  # one INS for all: every copy must start from the same INS state on the same increments
+            x0 = ins.pack(s)
+            if self.nav.feedback or not (np.all(x0 == x0[:1]) and np.all(dth == dth[:1]) and np.all(dvb == dvb[:1])):
+                raise ValueError("run(copies=True): the runs are not copies of one feed-forward run (their start, "
+                                 "increments or feedback differ)")
+            s, ins_of = ins.unpack(x0[:1]), np.zeros(len(gens), dtype=int)
+            dth, dvb = dth[:1], dvb[:1]
+        nav = Navigator(self, s, runs, float(truth.t_s[0]), m + 1, shared=shared, ins_of=ins_of)
         baro = records.get("baro")
         hb_full = None
         if self.loop_gains() is not None and baro is not None:
@@ -308,6 +324,10 @@ class NavSystem:
             # zero-order hold of the latest baro sample at each IMU interval start (truth rows 0 .. m-1)
             idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
             hb_full = hb[:, idx]
+            if copies:
+                if not np.all((hb_full == hb_full[:1]) | (np.isnan(hb_full) & np.isnan(hb_full[:1]))):
+                    raise ValueError("run(copies=True): the copies' baro records differ")
+                hb_full = hb_full[:1]
         # the compiled INS steps every run over the rows between two epochs in one call; a run's numbers do not
         # depend on the batch it shares (the campaign relies on it: kernels/strapdown.py)
         j0 = 0
@@ -317,12 +337,14 @@ class NavSystem:
             if j1 % epoch_rows == 0:
                 obs = Observations.at(records, float(truth.t_s[j1]), tol, batched)
                 if hb_full is not None:  # the loop held where the kernel had no baro over the whole interval
-                    obs = obs.with_loop_held(np.all(np.isnan(hb_full[:, j0:j1]), axis=1))
+                    obs = obs.with_loop_held(np.all(np.isnan(hb_full[:, j0:j1]), axis=1)[nav.ins_of])
                 nav.epoch(j1, float(truth.t_s[j1]), obs, truth)
                 if hb_full is not None:  # a baro excluded by FDE no longer drives that run's damping loop
                     for i, r in enumerate(runs):
                         if r.baro_excluded():
+                            if copies:
+                                raise ValueError("run(copies=True): a copy's FDE excluded the baro (its INS differs)")
                             hb_full[i, j1:] = np.nan
             j0 = j1
-        results = nav.results(truth)
+        results = nav.results(truth, solutions={0} if copies else True)  # copies: the main filter's solution only
         return results if batched else results[0]

@@ -147,3 +147,26 @@ def test_closed_loop_steps_equal_the_open_loop_pass_to_rounding(feedback):
     r_rwy = prof.runway.frame.from_ecef(open_.solution.r_ecef)
     np.testing.assert_allclose(guide[:, 0:2], r_rwy[:, 0:2], rtol=0, atol=1e-6)
     np.testing.assert_allclose(guide[:, 3:6], open_.solution.v_ned, rtol=0, atol=1e-9)
+
+
+def test_output_kernel_equals_perturb_ecef_and_euler():
+    """kernels/output.corrected (the NavSolution of every row: INS - x_hat of the snapshot in force) against the
+    numpy path it replaced: ins.perturb with -x_hat, geo.geodetic_to_ecef, ins.euler_from_cbn."""
+    rng = np.random.default_rng(11)
+    s = _states(500, rng)
+    rows = ins.pack(s)
+    X = np.concatenate([rng.normal(0.0, 5.0, (40, 3)), rng.normal(0.0, 0.1, (40, 3)),
+                        rng.normal(0.0, 1e-3, (40, 3)), rng.normal(0.0, 1.0, (40, 4))], axis=1)
+    X[0, 6:9] = 1e-9  # tiny attitude correction: the Rodrigues series branch
+    snap = rng.integers(0, 40, 500)
+    from approachsim.nav.kernels import output as ko
+
+    r, v, e = ko.corrected(rows, X, snap)
+    xs = X[snap]
+    o = ins.perturb(s, -xs[:, 0:3], -xs[:, 3:6], -xs[:, 6:9])
+    _close(r, geo.geodetic_to_ecef(o.lat_rad, o.lon_rad, o.h_m), "r_ecef")
+    _close(v, o.v_ned, "v_ned")
+    eu = ins.euler_from_cbn(o.c_bn)
+    d = np.abs(e - eu)
+    d[:, 2] = np.minimum(d[:, 2], 2.0 * np.pi - d[:, 2])  # heading wraps at 2 pi
+    assert np.max(d) < 1e-12

@@ -1,0 +1,57 @@
+"""The navigation output at every IMU row as a compiled kernel (numba, cache=True): the feed-forward correction
+of the raw INS rows by the filter estimate in force at each row, to ECEF position, NED velocity and Euler angles.
+
+For row j with the packed INS state y_j (kernels/strapdown.py layout) and the estimate x = X[snap[j]] (error =
+INS - truth: dp NED m, dv m/s, psi rad), the output is INS - x (nav/ins.py `perturb` with -x):
+
+    lat = lat_ins - dp_N / (R_N + h),  lon = lon_ins - dp_E / ((R_E + h) cos lat_ins),  h = h_ins + dp_D
+    v = v_ins - dv,   C_bn = Exp([psi x]) C_ins  (C_ins = (I - [psi x]) C_true)
+    r_ecef = geodetic_to_ecef(lat, lon, h),  roll = atan2(C21, C22), pitch = -asin(C20), heading = atan2(C10, C00)
+    (heading in [0, 2 pi))
+
+The numpy oracle is ins.perturb + geo.geodetic_to_ecef + ins.euler_from_cbn (tests/unit/nav/test_nav_kernels.py).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from approachsim.nav.kernels import geodesy as gk
+from approachsim.nav.kernels.strapdown import _mm, rotation_exp
+
+_TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True)
+def corrected_rows(rows: np.ndarray, X: np.ndarray, snap: np.ndarray, r_ecef: np.ndarray, v_ned: np.ndarray,
+                   euler: np.ndarray) -> None:
+    """Fill r_ecef, v_ned, euler (m, 3) (m, m/s, rad) from the raw INS rows (m, 16) and the estimates X (s, >= 9)
+    in force at each row (snap (m,) int, indices into X): the module docstring's equations."""
+    for j in range(rows.shape[0]):
+        x = X[snap[j]]
+        lat, lon, h = rows[j, 0], rows[j, 1], rows[j, 2]
+        r_n, r_e = gk.radii(lat)
+        lat_c = lat - x[0] / (r_n + h)
+        lon_c = lon - x[1] / ((r_e + h) * math.cos(lat))
+        h_c = h + x[2]
+        ex, ey, ez = gk.geodetic_to_ecef(lat_c, lon_c, h_c)
+        r_ecef[j, 0], r_ecef[j, 1], r_ecef[j, 2] = ex, ey, ez
+        v_ned[j, 0], v_ned[j, 1], v_ned[j, 2] = rows[j, 3] - x[3], rows[j, 4] - x[4], rows[j, 5] - x[5]
+        c0 = (rows[j, 6], rows[j, 7], rows[j, 8], rows[j, 9], rows[j, 10], rows[j, 11], rows[j, 12], rows[j, 13],
+              rows[j, 14])
+        c = _mm(rotation_exp(x[6], x[7], x[8]), c0)
+        euler[j, 0] = math.atan2(c[7], c[8])
+        euler[j, 1] = -math.asin(min(max(c[6], -1.0), 1.0))
+        euler[j, 2] = math.atan2(c[3], c[0]) % _TWO_PI
+
+
+def corrected(rows: np.ndarray, X: np.ndarray, snap: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(r_ecef, v_ned, euler) (m, 3) of `corrected_rows` for raw INS rows (m, 16), estimates X (s, n), snap (m,)."""
+    m = rows.shape[0]
+    r, v, e = np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 3))
+    corrected_rows(np.ascontiguousarray(rows, dtype=float), np.ascontiguousarray(X, dtype=float),
+                   np.ascontiguousarray(snap, dtype=np.int64), r, v, e)
+    return r, v, e
