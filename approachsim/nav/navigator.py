@@ -25,7 +25,6 @@ from typing import Any
 
 import numpy as np
 
-from approachsim import geo
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import terrain_db as tdb
