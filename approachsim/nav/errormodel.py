@@ -177,8 +177,8 @@ def kernel_noise(noise: ErrorNoise, n_sv: int) -> tuple[Array, Array, Array]:
     cache = noise._kernel_arrays
     if n_sv not in cache:
         q = np.array([float(getattr(noise, f)) for f in ek.Q_FIELDS])
-        per = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), (n_sv,))) for a in
-               (noise.gse_sigma_m, noise.gmp_sigma_m)]
+        per = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), (n_sv,))) if n_sv else np.zeros(0)
+               for a in (noise.gse_sigma_m, noise.gmp_sigma_m)]
         cache[n_sv] = (q, per[0], per[1])
     return cache[n_sv]
 

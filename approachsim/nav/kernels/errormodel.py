@@ -344,7 +344,7 @@ def _square(phi: np.ndarray, qd: np.ndarray, W: np.ndarray, P2: np.ndarray, ptr:
 def van_loan(F: np.ndarray, Qc: np.ndarray, dt: float, phi: np.ndarray, qd: np.ndarray) -> bool:
     """Phi = expm(F dt) and Qd = int_0^dt Phi(s) Qc Phi(s)' ds (m, m) into phi, qd by Van Loan's method with
     errormodel._expm's Taylor series and scaling (module docstring). False (phi, qd untouched) when the 1-norm
-    of M = [[-F, Qc], [0, F']] dt exceeds EXPM_MAX_NORM: the caller falls back to scipy's expm."""
+    of M = [[-F, Qc], [0, F']] dt exceeds EXPM_MAX_NORM or is not finite: the caller falls back to the numpy path."""
     m = F.shape[0]
     norm = 0.0
     for j in range(m):  # column sums of |M|: column j of [-F; 0] and column j of [Qc; F']
@@ -355,9 +355,9 @@ def van_loan(F: np.ndarray, Qc: np.ndarray, dt: float, phi: np.ndarray, qd: np.n
             s2 += abs(Qc[i, j]) * dt
         for i in range(m):
             s2 += abs(F[j, i]) * dt
+        if not (s1 <= EXPM_MAX_NORM and s2 <= EXPM_MAX_NORM):  # too large, or not finite
+            return False
         norm = max(norm, s1, s2)
-    if norm > EXPM_MAX_NORM:
-        return False
     s = max(0, int(math.ceil(math.log2(max(norm, 1e-300) / EXPM_THETA))))
     t0 = dt / 2.0**s
     A = F * t0

@@ -5,7 +5,7 @@ model (Phi is block diagonal with a diagonal tail; h has a handful of nonzeros).
 
 Every kernel works on arrays the caller owns; the scratch space is one tuple from `workspace(n)`:
 
-    ws = (W (n, n), v (n,), val (n * n,), ptr (n + 1,) int64, col (n * n,) int64, idx (n,) int64)
+    ws = (W (n, n), v (n,), val (n * n,), ptr (n + 1,) int64, col (n * n,) int64)
 
 Equations (textbook symbols; the dense numpy forms in nav/base.py, predict_reference / joseph_reference, are the
 test oracle, tests/unit/nav/test_epoch_kernels.py):
@@ -30,7 +30,7 @@ from numba import njit
 def workspace(n: int) -> tuple[np.ndarray, ...]:
     """Scratch arrays for the kernels of an n-state filter (module docstring): allocate once per filter size."""
     return (np.empty((n, n)), np.empty(n), np.empty(n * n), np.empty(n + 1, dtype=np.int64),
-            np.empty(n * n, dtype=np.int64), np.empty(n, dtype=np.int64))
+            np.empty(n * n, dtype=np.int64))
 
 
 @njit(cache=True)
@@ -52,7 +52,7 @@ def csr(A: np.ndarray, ptr: np.ndarray, col: np.ndarray, val: np.ndarray) -> Non
 @njit(cache=True)
 def _predict_cov(P: np.ndarray, qd: np.ndarray, W: np.ndarray, ptr: np.ndarray, col: np.ndarray,
                  val: np.ndarray) -> None:
-    """P <- Phi P Phi' + Qd (upper triangle computed, mirrored), Phi given row-compressed (ptr, col, val)."""
+    """P <- Phi P Phi' + Qd (its upper triangle mirrored), Phi given row-compressed (ptr, col, val)."""
     n = P.shape[0]
     for i in range(n):  # W = Phi P
         for j in range(n):
@@ -67,15 +67,15 @@ def _predict_cov(P: np.ndarray, qd: np.ndarray, W: np.ndarray, ptr: np.ndarray, 
             t = W[i, j]
             W[i, j] = W[j, i]
             W[j, i] = t
-    for i in range(n):  # P = Phi W' + Qd, j >= i
-        for j in range(i, n):
+    for i in range(n):  # P = Phi W' + Qd
+        for j in range(n):
             P[i, j] = qd[i, j]
         for p in range(ptr[i], ptr[i + 1]):
             a = val[p]
             l = col[p]
-            for j in range(i, n):
+            for j in range(n):
                 P[i, j] += a * W[l, j]
-    for i in range(n):
+    for i in range(n):  # the upper triangle, mirrored
         for j in range(i + 1, n):
             P[j, i] = P[i, j]
 
@@ -84,7 +84,7 @@ def _predict_cov(P: np.ndarray, qd: np.ndarray, W: np.ndarray, ptr: np.ndarray, 
 def predict(x: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, ws: tuple) -> None:
     """x <- Phi x ; P <- Phi P Phi' + Qd, in place (x (n,), P (n, n) symmetric, Phi, Qd (n, n) over the epoch,
     the states' units). Products over the nonzeros of Phi: O(nnz(Phi) n)."""
-    W, v, val, ptr, col, _ = ws
+    W, v, val, ptr, col = ws
     n = x.shape[0]
     csr(phi, ptr, col, val)
     for i in range(n):
@@ -100,15 +100,15 @@ def predict(x: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, ws: t
 @njit(cache=True)
 def predict_cov(P: np.ndarray, phi: np.ndarray, qd: np.ndarray, ws: tuple) -> None:
     """P <- Phi P Phi' + Qd in place (P (n, n) symmetric): `predict` without a state (a shared covariance)."""
-    W, _, val, ptr, col, _ = ws
+    W, _, val, ptr, col = ws
     csr(phi, ptr, col, val)
     _predict_cov(P, qd, W, ptr, col, val)
 
 
 @njit(cache=True)
 def gain(P: np.ndarray, h: np.ndarray, r: float, b: np.ndarray) -> float:
-    """b = P h (n,) and returns S = h' P h + r, for a measurement row h (n,) (mostly zeros) of noise variance r.
-    P symmetric: b is summed from P's rows at h's nonzeros."""
+    """b = P h (n,) and returns S = h' P h + r, for a measurement row h (n,) (mostly zeros) of noise variance r:
+    b summed over P's columns at h's nonzeros."""
     n = P.shape[0]
     for i in range(n):
         b[i] = 0.0
@@ -116,7 +116,7 @@ def gain(P: np.ndarray, h: np.ndarray, r: float, b: np.ndarray) -> float:
         c = h[l]
         if c != 0.0:
             for i in range(n):
-                b[i] += c * P[l, i]
+                b[i] += P[i, l] * c
     hb = 0.0
     for l in range(n):
         if h[l] != 0.0:
@@ -125,27 +125,18 @@ def gain(P: np.ndarray, h: np.ndarray, r: float, b: np.ndarray) -> float:
 
 
 @njit(cache=True)
-def _joseph_cov(P: np.ndarray, b: np.ndarray, S: float, c: float, kc: np.ndarray, idx: np.ndarray) -> None:
-    """P <- P - Kc b' - b Kc' + S Kc Kc', Kc = c b / S, over the rows and columns where b is nonzero."""
+def _joseph_cov(P: np.ndarray, b: np.ndarray, S: float, c: float, kc: np.ndarray) -> None:
+    """P <- P - Kc b' - b Kc' + S Kc Kc', Kc = c b / S, on the rows where b is nonzero (elsewhere the change is
+    zero: the other rows keep their entries, and in the rows updated the columns where b = 0 add exact zeros)."""
     n = P.shape[0]
-    m = 0
     for i in range(n):
         kc[i] = c * (b[i] / S)
-        if b[i] != 0.0:
-            idx[m] = i
-            m += 1
-    if m == n:
-        for i in range(n):
-            ki, bi = kc[i], b[i]
+    for i in range(n):
+        bi = b[i]
+        if bi != 0.0:
+            ki = kc[i]
             for j in range(n):
                 P[i, j] = P[i, j] - (ki * b[j] + bi * kc[j]) + (ki * kc[j]) * S
-        return
-    for a in range(m):
-        i = idx[a]
-        ki, bi = kc[i], b[i]
-        for e in range(m):
-            j = idx[e]
-            P[i, j] = P[i, j] - (ki * b[j] + bi * kc[j]) + (ki * kc[j]) * S
 
 
 @njit(cache=True)
@@ -154,13 +145,13 @@ def joseph(x: np.ndarray, P: np.ndarray, b: np.ndarray, S: float, nu: float, w: 
     """The scalar update after `gain` (b = P h, S), in place: x <- x + w K nu, K = b / S;
     P <- P - Kc b' - b Kc' + S Kc Kc', Kc = c K (c = 1 - sqrt(1 - psi'); module docstring). nu = z - h' x (the
     innovation, the row's units)."""
-    _, kc, _, _, _, idx = ws
+    kc = ws[1]
     n = x.shape[0]
     if w != 0.0:
         for i in range(n):
             x[i] = x[i] + w * (b[i] / S) * nu
     if c != 0.0:
-        _joseph_cov(P, b, S, c, kc, idx)
+        _joseph_cov(P, b, S, c, kc)
 
 
 @njit(cache=True)
@@ -178,7 +169,7 @@ def shared_update(X: np.ndarray, nu: np.ndarray, P: np.ndarray, h: np.ndarray, r
     """One optimal scalar update of a covariance P (n, n) shared by M runs, in place: K = P h / S from the
     shared P; each run m's state X[m] (M, n) takes its own innovation nu[m] (its z - g(x_hat_m)):
     X[m] <- X[m] + nu[m] K, row by row (a run's numbers do not depend on M); P Joseph as `update`. Returns S."""
-    _, kc, _, _, _, idx = ws
+    kc = ws[1]
     S = gain(P, h, r, b)
     n = P.shape[0]
     for i in range(n):
@@ -186,7 +177,7 @@ def shared_update(X: np.ndarray, nu: np.ndarray, P: np.ndarray, h: np.ndarray, r
     for m in range(X.shape[0]):
         for i in range(n):
             X[m, i] = X[m, i] + nu[m] * kc[i]
-    _joseph_cov(P, b, S, 1.0, kc, idx)
+    _joseph_cov(P, b, S, 1.0, kc)
     return S
 
 
@@ -242,12 +233,11 @@ def riccati(P: np.ndarray, phi: np.ndarray, qd: np.ndarray, H: np.ndarray, R: np
     csr(pr, ptr, col, val)
     b = np.empty(m)
     kc = np.empty(m)
-    ix = np.empty(m, dtype=np.int64)
     for _ in range(epochs):
         _predict_cov(Pr, qr, W, ptr, col, val)
         for k in range(H.shape[0]):
             S = gain(Pr, Hr[k], R[k], b)
-            _joseph_cov(Pr, b, S, 1.0, kc, ix)
+            _joseph_cov(Pr, b, S, 1.0, kc)
     for a in range(m):
         for c in range(m):
             P[idx[a], idx[c]] = Pr[a, c]

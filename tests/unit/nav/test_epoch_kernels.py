@@ -107,6 +107,11 @@ def test_packed_layout_and_noise_hold_every_group_and_field():
     np.testing.assert_array_equal(gse, np.broadcast_to(noise.gse_sigma_m, 2))
     np.testing.assert_array_equal(gmp, noise.gmp_sigma_m)
     assert em.kernel_noise(noise, 2)[0] is q  # packed once per object
+    # a layout without channel states ignores the noise's per-channel sigmas (a loosely coupled GPS)
+    noise24 = _noise(24, np.random.default_rng(1))
+    args = (LAYOUTS["minimal"], 0.6, 100.0, np.array([50.0, 3.0, 2.0]), np.array([0.0, 0.1, -9.8]), np.eye(3), noise24)
+    for a, b in zip(em.dynamics(*args), em.dynamics_reference(*args), strict=True):
+        assert _rel_entrywise(a, b) <= RTOL
     with pytest.raises(ValueError, match="loop gains"):
         em.dynamics(LAYOUTS["loop"], 0.6, 100.0, np.zeros(3), np.zeros(3), np.eye(3), noise)
 
@@ -149,7 +154,7 @@ def test_discretize_kernel_equals_reference(name, dt_s):
 
 def test_discretize_falls_back_to_scipy_beyond_the_taylor_range():
     """A Van Loan matrix of 1-norm > 1e3 (a 500 s interval) goes to discretize_reference (scipy's expm): the
-    same result exactly; below it the kernel, equal to 1e-12."""
+    same result exactly; a nan in F goes there too (which refuses it)."""
     _, _, args = next(_cases(1, seed=3))
     F, Qc = em.dynamics_reference(*args)
     n = F.shape[0]
@@ -158,6 +163,10 @@ def test_discretize_falls_back_to_scipy_beyond_the_taylor_range():
     p0, q0 = em.discretize_reference(F, Qc, 500.0)
     np.testing.assert_array_equal(phi, p0)
     np.testing.assert_array_equal(qd, q0)
+    F[3, 7] = np.nan  # a linearization gone wrong: the numpy path's error, not nan matrices
+    assert not ek.discretize(F, Qc, 1.0, np.empty((n, n)), np.empty((n, n)))
+    with pytest.raises(ValueError):
+        em.discretize(F, Qc, 1.0)
 
 
 def test_van_loan_kernel_on_a_clock_closed_form():
