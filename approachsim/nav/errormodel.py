@@ -37,11 +37,17 @@ With the baro loop (seed 003 eq. 3, linearized gains C1, C2, C3, loop error e = 
 and the baro white noise v_b enters the process noise through the gains.
 
 Discretization over the aiding interval: Phi = expm(F dt) and Qd from Van Loan's method (scipy.linalg.expm).
+
+`dynamics` and `discretize` run the compiled kernels of nav/kernels/errormodel.py on plain arrays (the layout and
+the noise packed once per frozen object: `StateLayout.packed`, `kernel_noise`); `dynamics_reference` and
+`discretize_reference` are the readable numpy versions, kept as the kernels' test oracle
+(tests/unit/nav/test_epoch_kernels.py: F, Qc equal, Phi, Qd to 1e-12 relative).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property, lru_cache
 
 import numpy as np
 from scipy.linalg import expm
@@ -49,6 +55,7 @@ from scipy.linalg import expm
 from approachsim import geo
 from approachsim.nav import ins
 from approachsim.nav import vertical_loop as vl
+from approachsim.nav.kernels import errormodel as ek
 
 Array = np.ndarray
 
@@ -109,6 +116,17 @@ class StateLayout:
         """State group names in order."""
         return tuple(self.index)
 
+    @cached_property
+    def packed(self) -> Array:
+        """The layout as kernels.errormodel's int64 array: lay[L_N] = n, lay[L_<group>] its first index (-1
+        absent), lay[L_NSV], lay[L_NPL] the channel counts (built once per layout object: do not modify)."""
+        lay = np.full(ek.LAY_SIZE, -1, dtype=np.int64)
+        lay[ek.L_N], lay[ek.L_NSV], lay[ek.L_NPL] = self.n, self.n_sv, self.n_pl
+        for k, g in enumerate(ek.LAY_GROUPS):
+            if g in self.index:
+                lay[1 + k] = self.index[g].start
+        return lay
+
 
 @dataclass(frozen=True)
 class ErrorNoise:
@@ -145,6 +163,47 @@ class ErrorNoise:
     ram_tau_s: float = 10.0
     tdb_correlation_m: float = 300.0
     """Along-track correlation length of the terrain-database error, m (tau = L / max(ground speed, 1 m/s))."""
+
+    @cached_property
+    def _kernel_arrays(self) -> dict[int, tuple[Array, Array, Array]]:
+        """kernel_noise's cache, by channel count (the object is frozen: its arrays are packed once)."""
+        return {}
+
+
+def kernel_noise(noise: ErrorNoise, n_sv: int) -> tuple[Array, Array, Array]:
+    """The noise as kernels.errormodel's arrays: q (Q_SIZE,) the scalars at ek.Q_*, and the per-channel
+    gse_sigma_m, gmp_sigma_m broadcast to (n_sv,), m. Cached on the noise object (its arrays, like the cached
+    ones, are not to be modified: the object is frozen)."""
+    cache = noise._kernel_arrays
+    if n_sv not in cache:
+        q = np.array([float(getattr(noise, f)) for f in ek.Q_FIELDS])
+        per = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), (n_sv,))) if n_sv else np.zeros(0)
+               for a in (noise.gse_sigma_m, noise.gmp_sigma_m)]
+        cache[n_sv] = (q, per[0], per[1])
+    return cache[n_sv]
+
+
+_NO_LOOP = np.zeros(ek.LOOP_SIZE)
+
+
+@lru_cache(maxsize=64)
+def kernel_loop(loop: vl.LoopGains | None) -> Array:
+    """The damping loop as kernels.errormodel's (LOOP_SIZE,) array (1, C1, C2, C3) of its linearized gains;
+    zeros without a loop."""
+    if loop is None:
+        return _NO_LOOP
+    lin = loop.linearized()
+    return np.array([1.0, lin.c1, lin.c2, lin.c3])
+
+
+def kernel_inputs(layout: StateLayout, noise: ErrorNoise, loop: vl.LoopGains | None = None
+                  ) -> tuple[Array, Array, Array, Array, Array]:
+    """(lay, q, gse_sigma, gmp_sigma, loop) for kernels.errormodel.dynamics, from the frozen objects (cached):
+    what a compiled per-run loop passes with the nav state and its preallocated F, Qc."""
+    if layout.has("ac") and loop is None:
+        raise ValueError("layout has the loop state 'ac' but no loop gains were given")
+    q, gse, gmp = kernel_noise(noise, layout.n_sv)
+    return layout.packed, q, gse, gmp, kernel_loop(loop if layout.has("ac") else None)
 
 
 def _markov(F: Array, Qc: Array, sl: slice, sigma: float | Array, tau_s: float) -> None:
@@ -190,7 +249,35 @@ def dynamics(
     """Continuous error dynamics F (n, n) and process-noise spectral density G Q G' (n, n) about a nav state.
 
     lat_rad, h_m, v_ned (3,), f_ned (3,) specific force in NED (m/s^2), c_bn (3, 3): the INS solution
-    (the best available linearization point). The module docstring gives the equations.
+    (the best available linearization point). The module docstring gives the equations; computed by the
+    compiled kernel (kernels.errormodel.dynamics), equal to `dynamics_reference`.
+    """
+    lay, q, gse, gmp, lv = kernel_inputs(layout, noise, loop)
+    n = layout.n
+    F = np.empty((n, n))
+    Qc = np.empty((n, n))
+    ek.dynamics(lay, q, gse, gmp, float(lat_rad), float(h_m), np.ascontiguousarray(v_ned, dtype=float),
+                np.ascontiguousarray(f_ned, dtype=float), np.ascontiguousarray(c_bn, dtype=float), lv,
+                bool(loop_held), F, Qc)
+    return F, Qc
+
+
+def dynamics_reference(
+    layout: StateLayout,
+    lat_rad: float,
+    h_m: float,
+    v_ned: Array,
+    f_ned: Array,
+    c_bn: Array,
+    noise: ErrorNoise,
+    loop: vl.LoopGains | None = None,
+    loop_held: bool = False,
+) -> tuple[Array, Array]:
+    """Continuous error dynamics F (n, n) and process-noise spectral density G Q G' (n, n) about a nav state.
+
+    lat_rad, h_m, v_ned (3,), f_ned (3,) specific force in NED (m/s^2), c_bn (3, 3): the INS solution
+    (the best available linearization point). The module docstring gives the equations. The readable numpy
+    version: `dynamics`'s test oracle.
     """
     n = layout.n
     F = np.zeros((n, n))
@@ -319,7 +406,21 @@ def van_loan(F: Array, Qc: Array, dt_s: float) -> tuple[Array, Array]:
 
 def discretize(F: Array, Qc: Array, dt_s: float) -> tuple[Array, Array]:
     """Phi, Qd over dt_s: decoupled scalar states (first-order Markov / random constants) in closed form,
-    the coupled rest by Van Loan. Same result as van_loan(F, Qc, dt_s), much cheaper with channel states."""
+    the coupled rest by Van Loan, one connected component at a time (the compiled kernels.errormodel.discretize;
+    `discretize_reference` when a component's Van Loan matrix is too large for its Taylor series)."""
+    n = F.shape[0]
+    phi = np.empty((n, n))
+    qd = np.empty((n, n))
+    if ek.discretize(np.ascontiguousarray(F, dtype=float), np.ascontiguousarray(Qc, dtype=float), float(dt_s),
+                     phi, qd):
+        return phi, qd
+    return discretize_reference(F, Qc, dt_s)
+
+
+def discretize_reference(F: Array, Qc: Array, dt_s: float) -> tuple[Array, Array]:
+    """Phi, Qd over dt_s: decoupled scalar states (first-order Markov / random constants) in closed form,
+    the coupled rest by Van Loan. Same result as van_loan(F, Qc, dt_s), much cheaper with channel states.
+    The readable numpy version: `discretize`'s test oracle."""
     n = F.shape[0]
     off = (F != 0.0) | (Qc != 0.0)
     np.fill_diagonal(off, False)

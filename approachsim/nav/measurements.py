@@ -13,19 +13,48 @@ Rows (index names from errormodel.StateLayout):
               R = (0.01 h)^2 + floor^2 (seed 002; rab, ram, tdb: errormodel, nav/terrain_db.py)
     range     z = |r_ins - r_tx| - rho  = e . dp - clk - gse - gmp (+ pseudolite terms) + v   (seed 002 sec. 6)
     position  z = p_ins - p_gps (NED, per axis)  (loosely-coupled option)
+
+The baro, radalt and range rows have compiled versions in nav/kernels/measurements.py that write h into a buffer
+and return the innovation nu = z - g(x_hat) (for a per-run loop, and over runs for the shared covariance); the
+functions here are their test oracle. `terrain_arrays` and `database_arrays` give the kernels the terrain
+database as arrays.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
 from approachsim import geo
 from approachsim.nav.base import ScalarMeasurement
 from approachsim.nav.errormodel import StateLayout
+from approachsim.nav.terrain_db import TerrainDbConfig, TerrainDbError
 
 Array = np.ndarray
+
+
+def terrain_arrays(runway: geo.RunwayFrame, terrain: Any = None) -> tuple[Array, Array, Array]:
+    """The filter's terrain for kernels.measurements: (tx (k,) runway-frame along-track x, m; th (k,) ellipsoid
+    height, m; rwy (6,) the frame's ECEF origin (m) and ECEF -> along-track row). terrain: a profile.Terrain
+    (along_m, height_m), or None for flat at the threshold height (one point)."""
+    if terrain is None:
+        tx, th = np.zeros(1), np.array([float(runway.threshold_h_m)])
+    else:
+        tx, th = np.array(terrain.along_m, dtype=float), np.array(terrain.height_m, dtype=float)
+    rwy = np.concatenate([runway.origin_ecef, runway.c_ecef_to_rwy[0]])
+    return tx, th, rwy
+
+
+def database_arrays(config: TerrainDbConfig, error: TerrainDbError | None) -> tuple[Array, Array, Array]:
+    """A run's terrain-database error for kernels.measurements: (dbp (4,) = (bias m, sigma_m, outer_sigma_m,
+    area4_length_m), db_x (k,) the realization's grid (m; empty without one), db_u (k,) its unit Gauss-Markov)."""
+    bias = 0.0 if error is None else float(error.bias_m)
+    dbp = np.array([bias, config.sigma_m, config.outer_sigma_m, config.area4_length_m], dtype=float)
+    if error is None:
+        return dbp, np.zeros(0), np.zeros(0)
+    return dbp, np.ascontiguousarray(error.x_m, dtype=float), np.ascontiguousarray(error.u, dtype=float)
 
 
 def _row(layout: StateLayout) -> Array:

@@ -6,7 +6,23 @@ has a readable numpy version elsewhere in the package that serves as its test or
 test_nav_kernels.py checks they agree to 1e-12 relative). The stages import these modules; the kernels import
 nothing of the stages (import-linter contract in pyproject.toml).
 
-    geodesy    WGS-84 radii, geodetic -> ECEF, the simulated world's gravity (geo.py's equations, scalar)
-    strapdown  the strapdown INS mechanization over many runs and many IMU intervals (nav/ins.py's `step`)
-    imu        the IMU error application (sensors/imu.py's `apply`)
+    geodesy       WGS-84 radii, geodetic -> ECEF, the simulated world's gravity (geo.py's equations, scalar)
+    strapdown     the strapdown INS mechanization over many runs and many IMU intervals (nav/ins.py's `step`)
+    imu           the IMU error application (sensors/imu.py's `apply`)
+    errormodel    the error model's F, Qc and their discretization Phi, Qd (nav/errormodel.py's
+                  dynamics_reference, discretize_reference)
+    kalman        the filter epoch: sparse predict, O(n^2) scalar Joseph update, shared-covariance update, the
+                  Riccati segment of the converged start (nav/base.py's predict_reference, joseph_reference;
+                  nav/initial.py's converged_covariance_reference)
+    measurements  the baro, radar-altimeter and pseudorange rows with their innovations (nav/measurements.py)
+
+One aiding epoch of one run from preallocated arrays (what a compiled per-run loop calls; the arrays of the
+frozen objects from errormodel.kernel_inputs, measurements.terrain_arrays / database_arrays, and the scratch
+from kalman.workspace(n)):
+
+    errormodel.dynamics(lay, q, gse, gmp, lat, h, v_ned, f_ned, c_bn, loop, held, F, Qc)
+    errormodel.discretize(F, Qc, dt, phi, qd)      # False: too large for the Taylor series, use the numpy path
+    kalman.predict(x, P, phi, qd, ws)
+    nu, r = measurements.pseudorange(lay, x, r_ins, c_en, r_sv, rho, sigma, sv, -1, h)   # or baro, radalt
+    S = kalman.update(x, P, h, nu, r, b, ws)       # optimal; kalman.gain + kalman.joseph with a gain policy
 """
