@@ -76,6 +76,7 @@ def bench_ratios(repeat: int) -> None:
     from approachsim.nav.system import NavSystem
     from approachsim.profile import load_profile
     from approachsim.seeding import stream, stream_int
+    from approachsim.sensors.states import measure_with_states
     from approachsim.sensors.suite import SensorSuite
 
     print(f"ratios: {load()}")
@@ -100,9 +101,9 @@ def bench_ratios(repeat: int) -> None:
         for _ in range(len(r.truth) - 1):
             step()
         raw.append(time.perf_counter() - t0)
-        recs = SensorSuite.from_profile(prof).measure(r.truth, seed=1, runs=i)
+        recs, st = measure_with_states(SensorSuite.from_profile(prof), r.truth, seed=1, runs=i)
         t0 = time.perf_counter()
-        NavSystem.from_profile(prof).run(r.truth, recs, stream(1, i, "nav"))
+        NavSystem.from_profile(prof).run(r.truth, recs, stream(1, i, "nav"), states=st)
         nav.append((time.perf_counter() - t0) / len(r.truth))
     mn, md = min, statistics.median
     print(f"  default profile, {n} steps at {prof.rates.imu_hz:g} Hz; min / median of {repeat}")

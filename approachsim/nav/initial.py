@@ -58,12 +58,14 @@ steps build a start with exactly that structure.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
+from approachsim.nav.kernels import kalman as kk
 from approachsim.nav.observations import Observations
 from approachsim.sensors.states import STATE_GROUPS, SensorStates
 
@@ -99,25 +101,18 @@ def _segment(system: Any, truth: Any, obs: Observations, row: int, P0: Array) ->
 def converged_covariance(system: Any, truth: Any, obs: Observations, row: int, P0: Array,
                          converge_s: float) -> Array:
     """P_conv (n, n): the optimal filter's covariance after converge_s (s) of aiding at truth row `row` from P0,
-    with the measurements available in obs (NavSystem.observations at the row; the first run's schedule)."""
+    with the measurements available in obs (NavSystem.observations at the row; the first run's schedule).
+
+    The filter's own recursion, one scalar Joseph update per row, compiled (kernels/kalman.riccati: the states
+    never measured and not coupled evolve alone, an exact reduction); converged_covariance_reference is the same
+    recursion in numpy (the test oracle)."""
     phi, qd, rows = _segment(system, truth, obs, row, P0)
     epochs = int(round(converge_s * system.nav.aiding_rate_hz))
-    P = np.array(P0, dtype=float)
-    if not rows:
-        for _ in range(epochs):
-            P = phi @ P @ phi.T + qd
-        return 0.5 * (P + P.T)
-    H = np.stack([m.h for m in rows])  # (k, n): the epoch's scalar rows, uncorrelated noises r
+    n = P0.shape[0]
+    H = np.stack([m.h for m in rows]) if rows else np.zeros((0, n))  # (k, n): the epoch's scalar rows
     R = np.array([float(m.r) for m in rows])
-    eye = np.eye(P.shape[0])
-    for _ in range(epochs):
-        P = phi @ P @ phi.T + qd  # P- = Phi P+ Phi' + Qd
-        PHt = P @ H.T
-        S = H @ PHt + np.diag(R)
-        K = np.linalg.solve(S, PHt.T).T  # K = P H' (H P H' + R)^-1
-        A = eye - K @ H
-        P = A @ P @ A.T + (K * R[None, :]) @ K.T  # Joseph form, the whole epoch at once
-        P = 0.5 * (P + P.T)
+    P = np.array(P0, dtype=float)
+    kk.riccati(P, np.ascontiguousarray(phi), np.ascontiguousarray(qd), np.ascontiguousarray(H), R, epochs)
     return P
 
 
@@ -166,10 +161,29 @@ def sensor_vector(layout: em.StateLayout, states: SensorStates, P0: Array) -> tu
     return np.concatenate(idx), np.concatenate(vals, axis=1)
 
 
-def condition(P_conv: Array, Pi_ss: Array, s: Array, x_s: Array, z: Array) -> tuple[Array, float]:
-    """Estimation errors e (N, n) given the realized sensor states x_s (N, s) at indices s, from standard
-    normals z (N, n): e = P_conv[:, s] Pi^-1 x_s + L z, L L' = P_conv - P_conv[:, s] Pi^-1 P_conv[s, :];
-    and the excess max(lambda) - 1 >= 0 of the check below.
+@dataclass(frozen=True)
+class Conditioner:
+    """The conditional law of the estimation error given the realized sensor states (`conditioner`): the mean
+    operator G = P_conv[:, s] Pi^-1 (n, s), the symmetric square root L (n, n) of the conditional covariance, the
+    sensor-state indices s and the excess of the Pi_ss >= P_conv[s, s] check."""
+
+    G: Array
+    L: Array
+    s: Array
+    excess: float
+
+    def apply(self, x_s: Array, z: Array) -> Array:
+        """Errors e (N, n) = G x_s + L z of the runs (x_s (N, s), standard normals z (N, n)), one matrix-vector
+        product per run: a run's draw must not depend on the batch it shares (no batch-size-dependent BLAS path;
+        the campaign relies on it)."""
+        n = self.L.shape[0]
+        mean = (np.stack([self.G @ xi for xi in x_s]) if len(x_s) and self.s.size
+                else np.zeros((z.shape[0], n)))
+        return mean + np.stack([self.L @ zi for zi in z]).reshape(mean.shape)
+
+
+def conditioner(P_conv: Array, Pi_ss: Array, s: Array) -> Conditioner:
+    """The law of e given x_s: e = P_conv[:, s] Pi^-1 x_s + L z, L L' = P_conv - P_conv[:, s] Pi^-1 P_conv[s, :].
 
     Check Pi_ss >= P_conv[s, s]: the eigenvalues lambda of W = D P_conv[s, s] D, D = diag(Pi_ss)^-1/2, must not
     exceed 1. Where they do (the filter's random-walk bias model grown past the sensors' stationary prior), the
@@ -177,7 +191,7 @@ def condition(P_conv: Array, Pi_ss: Array, s: Array, x_s: Array, z: Array) -> tu
     e = x there and the conditional covariance stays positive (its Schur complement)."""
     n = P_conv.shape[0]
     if not s.size:
-        mean, C, excess = np.zeros((z.shape[0], n)), P_conv, 0.0
+        G, C, excess = np.zeros((n, 0)), P_conv, 0.0
     else:
         d = 1.0 / np.sqrt(np.diag(Pi_ss))
         lam, V = np.linalg.eigh(d[:, None] * P_conv[np.ix_(s, s)] * d[None, :])
@@ -187,32 +201,52 @@ def condition(P_conv: Array, Pi_ss: Array, s: Array, x_s: Array, z: Array) -> tu
             w = np.sqrt(np.maximum(lam, 1.0))
             Pi = (V * w[None, :]) @ (V * w[None, :]).T / (d[:, None] * d[None, :])
         G = np.linalg.solve(Pi, P_conv[s, :]).T  # P_conv[:, s] Pi^-1  (n, s)
-        mean = np.stack([G @ xi for xi in x_s]) if len(x_s) else np.zeros((0, n))  # row by row (below)
         C = P_conv - G @ P_conv[s, :]
     C = 0.5 * (C + C.T)
     w, V = np.linalg.eigh(C)
     scale = max(float(np.max(np.abs(w))), 1e-300)
     if w.min() < -1e-9 * scale:
         raise ValueError(f"converged start: conditional covariance not positive ({w.min():.3g})")
-    L = V * np.sqrt(np.clip(w, 0.0, None))[None, :]
-    # one matrix-vector product per run: a run's draw must not depend on the batch it shares (no
-    # batch-size-dependent BLAS path; the campaign relies on it)
-    return mean + np.stack([L @ zi for zi in z]).reshape(mean.shape), excess
+    # the symmetric square root L = V sqrt(Lambda) V' (L L' = C): unique, so continuous in C. A factor V sqrt(Lambda)
+    # alone depends on the eigenvector basis, which rounding rotates freely within (near-)repeated eigenvalues:
+    # a rounding-level change of P_conv would then redraw the run
+    L = (V * np.sqrt(np.clip(w, 0.0, None))[None, :]) @ V.T
+    return Conditioner(G, L, np.asarray(s), excess)
+
+
+def condition(P_conv: Array, Pi_ss: Array, s: Array, x_s: Array, z: Array) -> tuple[Array, float]:
+    """Estimation errors e (N, n) given the realized sensor states x_s (N, s) at indices s, from standard
+    normals z (N, n) (`conditioner` then `Conditioner.apply`), and the excess max(lambda) - 1 >= 0."""
+    c = conditioner(P_conv, Pi_ss, s)
+    if c.s.size and x_s.shape[1:] != (c.s.size,):
+        raise ValueError(f"converged start: sensor states of shape {x_s.shape}, {c.s.size} expected per run")
+    return c.apply(x_s, z), c.excess
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """What the runs of one start (row, sky, schedule, P0) share: P_conv and its Conditioner."""
+
+    P_conv: Array
+    cond: Conditioner
 
 
 def draw(system: Any, truth: Any, obs: Observations, states: SensorStates, rngs: list[np.random.Generator],
-         row: int, P0: Array, P_conv: Array | None = None) -> tuple[Array, Array, Array]:
-    """(e (N, n) the estimation errors, x_hat (N, n) the filter's start estimates, P_conv (n, n)) of the runs
-    (rngs: each run's "nav" stream, n standard normals each). P_conv: the converged covariance when already
-    computed for this start (it depends on the start row, its sky and schedule and P0 only), else computed."""
+         row: int, P0: Array, prepared: Prepared | None = None) -> tuple[Array, Array, Prepared]:
+    """(e (N, n) the estimation errors, x_hat (N, n) the filter's start estimates, the start's Prepared (P_conv
+    (n, n) and the conditioner)) of the runs (rngs: each run's "nav" stream, n standard normals each). prepared:
+    when already made for this start (it depends on the start row, its sky and schedule and P0 only)."""
     lay = system.layout
     if states.runs != len(rngs):
         raise ValueError(f"converged start: {states.runs} runs of sensor states for {len(rngs)} runs")
-    if P_conv is None:
-        P_conv = converged_covariance(system, truth, obs, row, P0, system.nav.initial_error.converge_s)
     s, x_s = sensor_vector(lay, states, P0)
+    if prepared is None:
+        P_conv = converged_covariance(system, truth, obs, row, P0, system.nav.initial_error.converge_s)
+        prepared = Prepared(P_conv, conditioner(P_conv, P0[np.ix_(s, s)], s))
+    if not np.array_equal(prepared.cond.s, s):
+        raise ValueError("converged start: the prepared start has other sensor states than these runs")
     z = np.stack([g.standard_normal(lay.n) for g in rngs])
-    e, _ = condition(P_conv, P0[np.ix_(s, s)], s, x_s, z)
+    e = prepared.cond.apply(x_s, z)
     x_hat = np.zeros_like(e)
     x_hat[:, s] = x_s - e[:, s]  # the INS states' estimate is 0 (reset); x_hat_s = x_s - e_s
-    return e, x_hat, P_conv
+    return e, x_hat, prepared

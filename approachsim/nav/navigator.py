@@ -29,6 +29,7 @@ from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import FilterState, UpdateStatus
+from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer
 from approachsim.nav.fde import FdeState
 from approachsim.nav.kernels import output as ko
 from approachsim.nav.observations import BARO, Observations
@@ -51,6 +52,11 @@ class StatusLog:
     """(u,) nu^2 / S (the NIS of a scalar)."""
     weight: Array
     accepted: Array
+
+    @classmethod
+    def from_buffer(cls, buf: StatusBuffer) -> StatusLog:
+        """Arrays from a run's StatusBuffer (nav/engine.py)."""
+        return cls(**buf.arrays())
 
     @classmethod
     def from_records(cls, recs: list[UpdateStatus]) -> StatusLog:
@@ -91,13 +97,18 @@ class RunFilter:
     """One run's filter bookkeeping inside a pass (mutable; never leaves the navigation package)."""
 
     fs: FilterState
-    statuses: list
+    statuses: StatusBuffer
+    """Every scalar measurement's status record (a list given here becomes a StatusBuffer)."""
     bg_fb: Array
     ba_fb: Array
     fde: FdeState | None = None
     """Online fault detection and exclusion ([nav.fde] enabled), else None."""
     db_error: tdb.TerrainDbError | None = None
     """This run's terrain-database error (None: the database is the truth terrain)."""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.statuses, StatusBuffer):
+            self.statuses = StatusBuffer(self.statuses)
 
     def baro_excluded(self) -> bool:
         """The online FDE has excluded the baro."""
@@ -154,6 +165,10 @@ class Navigator:
         """C_bn dv accumulated since the last epoch (NED, m/s): the mean specific force of the interval."""
         self.t_last = float(t0_s)
         self._ic = self.layout.i("clk") if self.layout.has("clk") else 0
+        self.engine = EpochEngine.of(system)
+        """The compiled epoch (nav/engine.py), or None: the generic path."""
+        self.dbs = ([RunDatabase.of(system.nav.terrain_database, r.db_error) for r in runs]
+                    if self.engine is not None else None)
         self._hist: dict[str, list] = {"t": [], "x": [], "pd": [], "pnav": [], "err": []}
         self._snapshot()
 
@@ -237,6 +252,12 @@ class Navigator:
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
                                 noise, gains, loop_held=self.loop_held(obs, i))
             phi, qd = em.discretize(F, Qc, dt_epoch)
+            if self.engine is not None and run.fde is None:  # the compiled epoch (nav/engine.py)
+                X, P = run.fs.x.copy()[None], np.array(run.fs.P, dtype=float)
+                y = self.x[self.ins_of[i]:self.ins_of[i] + 1]
+                self.engine.epoch(X, P, phi, qd, True, y[0], y, obs, [i], t, [run.statuses], [self.dbs[i]])
+                run.fs = FilterState(x=X[0], P=P, memory=run.fs.memory)
+                continue
             rows = system.rows.epoch(s, i, r_ins[i], obs, t, db_error=run.db_error)
             if run.fde is not None:  # predict, test, exclude, update (nav/fde.py)
                 run.fs, sts = run.fde.epoch(filt, run.fs, phi, qd, rows, t, system.runway.from_ecef(r_ins[i]))
@@ -308,7 +329,7 @@ class Navigator:
                     **(r.fde.solution_fields(snap) if r.fde is not None else {}),
                 )
             out.append(NavRun(
-                solution=sol, status=StatusLog.from_records(r.statuses), t_epoch_s=np.array(h["t"]),
+                solution=sol, status=StatusLog.from_buffer(r.statuses), t_epoch_s=np.array(h["t"]),
                 x=np.array([x[i] for x in h["x"]]), P_diag=np.array([p[i] for p in h["pd"]]),
                 P_nav=np.array([p[i] for p in h["pnav"]]), true_error_nav=np.array([e[i] for e in h["err"]]),
                 layout=lay,

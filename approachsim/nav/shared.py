@@ -91,9 +91,12 @@ class SharedCovariance:
             F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ref, ref.c_bn[0],
                                 noise, system.loop_gains(), loop_held=h)
             models[h] = em.discretize(F, Qc, dt_epoch)
+        self.split(np.column_stack([obs.schedule(), np.array(held, dtype=bool)]))
+        if nav.engine is not None:  # the compiled epoch, class by class (nav/engine.py)
+            self._aid_engine(nav, ref, t, dt_epoch, obs, held, models)
+            return s
         # x- = Phi x+ (row by row: no batch-size-dependent BLAS path)
         X = np.stack([models[held[i]][0] @ r.fs.x for i, r in enumerate(runs)])
-        self.split(np.column_stack([obs.schedule(), np.array(held, dtype=bool)]))
         for c, members in self.classes():
             phi, qd = models[held[members[0]]]
             self.predict_class(c, phi, system.noise_model.channel_qd(qd, obs.elevations(members[0]), dt_epoch)
@@ -130,3 +133,25 @@ class SharedCovariance:
         for i, run in enumerate(runs):
             run.fs = FilterState(x=X[i], P=self.P[self.of_run[i]], memory=run.fs.memory)
         return s
+
+    def _aid_engine(self, nav: Any, ref: ins.InsState, t: float, dt_epoch: float, obs: Observations, held: list,
+                    models: dict) -> None:
+        """`aid`'s predict and updates by kernels/epoch.class_epoch in shared mode (rows at the truth), one call
+        per class; the classes are already split."""
+        system = nav.system
+        runs = nav.runs
+        ref_y = ins.pack(ref)
+        r_ref = ins.position_ecef(ref)[0]
+        ref_agl = float(ref.h_m[0] - system.terrain_h(r_ref))
+        for c, members in self.classes():
+            phi, qd = models[held[members[0]]]
+            if obs.per_run_sky:
+                qd = system.noise_model.channel_qd(qd, obs.elevations(members[0]), dt_epoch)
+            X = np.stack([runs[i].fs.x for i in members])
+            P = np.array(self.P[c], dtype=float)  # a copy: classes split from one share their P object
+            ins_y = nav.x[nav.ins_of[members]]
+            nav.engine.epoch(X, P, phi, qd, False, ref_y[0], ins_y, obs, members, t,
+                             [runs[i].statuses for i in members], [nav.dbs[i] for i in members], ref_agl)
+            self.P[c] = P
+            for j, i in enumerate(members):
+                runs[i].fs = FilterState(x=X[j], P=P, memory=runs[i].fs.memory)

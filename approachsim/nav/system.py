@@ -205,22 +205,22 @@ class NavSystem:
         if obs.per_run_sky:  # each run its own GPS sky: its own P0 and converged covariance, flown on the
             # schedule of the first run with that sky (the integrity bank's copies share the main filter's start)
             first: dict[bytes, int] = {}
-            p_conv: dict[bytes, Array] = {}  # one converged covariance per sky (bank copies share their run's)
+            prep: dict[bytes, initial.Prepared] = {}  # one converged start per sky (bank copies share their run's)
             draws = []
             for i, g in enumerate(rngs):
                 key = obs.elevations(i).tobytes()
                 i0 = first.setdefault(key, i)
                 d = initial.draw(self, truth, obs.run(i0), states.take(i), [g], row,
-                                 self.initial_covariance(obs.elevations(i)), p_conv.get(key))
-                p_conv[key] = d[2]
+                                 self.initial_covariance(obs.elevations(i)), prep.get(key))
+                prep[key] = d[2]
                 draws.append(d)
             e = np.concatenate([d[0] for d in draws])
             x_hat = np.concatenate([d[1] for d in draws])
-            P_convs = [d[2] for d in draws]
+            P_convs = [d[2].P_conv for d in draws]
         else:
-            e, x_hat, P_conv = initial.draw(self, truth, obs, states, list(rngs), row,
-                                            self.initial_covariance(elevation_rad))
-            P_convs = [P_conv] * n
+            e, x_hat, prepared = initial.draw(self, truth, obs, states, list(rngs), row,
+                                              self.initial_covariance(elevation_rad))
+            P_convs = [prepared.P_conv] * n
         s = ins.perturb(s, e[:, 0:3], e[:, 3:6], e[:, 6:9])
         if self.layout.has("ac"):
             s = replace(s, a_comp_mps2=e[:, self.layout.i("ac")])  # ac error = the INS compensator (truth 0)

@@ -1,0 +1,187 @@
+"""One aiding epoch of the optimal filter as one compiled call (numba, cache=True): the prediction and every
+scalar update of the epoch, for one run or for the runs of a shared-covariance class.
+
+    n_rows = class_epoch(X, P, phi, qd, lay, own, ref, ins, <observations>, codes, nu_out, S_out, h, b, ws)
+
+Order of the rows (nav/rows.py): baro, radar altimeter, each GNSS channel in channel order, each pseudolite in
+unit order; a row exists when member 0's value is finite (a class shares one schedule: nav/shared.py).
+
+    predict    x_m <- Phi x_m (each member),  P <- Phi P Phi' + Qd                      (kernels/kalman.py)
+    each row   own (one run, the per-run EKF): h and nu = z - g(x_hat) at the run's own INS and current x_hat
+               (sequential relinearization, as nav/navigator.py's per-run filters);
+               shared (M runs): h and r at the reference trajectory `ref` with x_hat = 0 (the truth: nav/shared.py),
+               nu_m of each member at its own INS and current x_hat_m
+               S = h' P h + r ; K = P h / S ; x_m <- x_m + K nu_m ; P Joseph (O(n^2), kernels/kalman.py)
+
+Rows and innovations are kernels/measurements.py's. The numpy paths (nav/navigator.py with nav/rows.py, and
+nav/shared.py) are the test oracle (tests/unit/nav/test_epoch_engine.py: equal to 1e-12 relative norm-wise).
+
+Codes of the rows written to `codes`: CODE_BARO, CODE_RADALT, CODE_GPS + channel, CODE_PL + unit.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from approachsim.nav.kernels import geodesy as gk
+from approachsim.nav.kernels import kalman as kk
+from approachsim.nav.kernels import measurements as km
+
+CODE_BARO, CODE_RADALT, CODE_GPS, CODE_PL = 0, 1, 100, 200
+"""Row codes (module docstring)."""
+
+
+@njit(cache=True)
+def _c_en(lat: float, lon: float, c: np.ndarray) -> None:
+    """ECEF -> NED rotation at (lat, lon), rad (geo.c_ecef_to_ned), into c (3, 3)."""
+    sl, cl, so, co = math.sin(lat), math.cos(lat), math.sin(lon), math.cos(lon)
+    c[0, 0], c[0, 1], c[0, 2] = -sl * co, -sl * so, cl
+    c[1, 0], c[1, 1], c[1, 2] = -so, co, 0.0
+    c[2, 0], c[2, 1], c[2, 2] = -cl * co, -cl * so, -sl
+
+
+@njit(cache=True)
+def _ecef(y: np.ndarray, r: np.ndarray) -> None:
+    """ECEF position (m) of the packed INS state y (16,) into r (3,)."""
+    r[0], r[1], r[2] = gk.geodetic_to_ecef(y[0], y[1], y[2])
+
+
+@njit(cache=True)
+def _apply(X: np.ndarray, P: np.ndarray, h: np.ndarray, r: float, nu: np.ndarray, b: np.ndarray,
+           kc: np.ndarray) -> float:
+    """S = h' P h + r; x_m += K nu_m (K = P h / S); P Joseph (c = 1). Returns S."""
+    S = kk.gain(P, h, r, b)
+    n = P.shape[0]
+    for m in range(X.shape[0]):
+        v = nu[m]
+        for i in range(n):
+            X[m, i] = X[m, i] + (b[i] / S) * v
+    kk._joseph_cov(P, b, S, 1.0, kc)
+    return S
+
+
+@njit(cache=True)
+def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, lay: np.ndarray, own: bool,
+                ref: np.ndarray, ins: np.ndarray,
+                baro_h: np.ndarray, baro_r: float,
+                radalt_h: np.ndarray, ra_pct: float, ra_floor: float, ref_agl: float,
+                tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
+                db_u: np.ndarray,
+                rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
+                pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
+                codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray,
+                h: np.ndarray, b: np.ndarray, ws: tuple) -> int:
+    """Predict and update the M members of a class in place (module docstring); returns the number of rows.
+
+    X (M, n) estimates; P (n, n) the class covariance; phi, qd (n, n) the epoch's model; lay the state layout
+    (kernels.errormodel); own: the per-run EKF (M = 1; ref unused) else shared rows at `ref`; ref (16,), ins
+    (M, 16) packed INS states (kernels.strapdown layout). Observations of the members: baro_h (M,) m (nan: none)
+    with noise variance baro_r m^2; radalt_h (M,) m with sigma = sqrt((ra_pct h)^2 + ra_floor^2) at the measured
+    height (own) or at ref_agl (shared); the filter's terrain tx, th, rwy and each member's database dbp (M, 4),
+    db_x (k,), db_u (M, k) (kernels.measurements); rho (M, s) pseudoranges m (nan: none), r_sv (s, 3) ECEF m,
+    sig (s,) their 1-sigma, channel_states: the rows carry the gse / gmp states; pl_rho (M, p), r_pl (p, 3),
+    pl_sig (p,), pl_states. Out: codes (R,), nu_out (M, R), S_out (R,); scratch h, b (n,), ws (kalman.workspace).
+    """
+    M = X.shape[0]
+    n = X.shape[1]
+    W, v, val, ptr, col = ws
+    kc = v
+    # predict: x_m <- Phi x_m ; P <- Phi P Phi' + Qd
+    kk.csr(phi, ptr, col, val)
+    for m in range(M):
+        for i in range(n):
+            acc = 0.0
+            for p in range(ptr[i], ptr[i + 1]):
+                acc += val[p] * X[m, col[p]]
+            b[i] = acc
+        for i in range(n):
+            X[m, i] = b[i]
+    kk._predict_cov(P, qd, W, ptr, col, val)
+    x0 = np.zeros(n)
+    nu = np.empty(M)
+    r_ins = np.empty(3)
+    r_ref = np.empty(3)
+    c_ins = np.empty((3, 3))
+    c_ref = np.empty((3, 3))
+    _ecef(ref, r_ref)
+    _c_en(ref[0], ref[1], c_ref)
+    k = 0
+    empty_u = np.zeros(0)
+    # baro
+    if baro_h[0] == baro_h[0]:
+        if own:
+            nu[0], _ = km.baro(lay, X[0], ins[0, 2], baro_h[0], 0.0, h)
+        else:
+            km.baro(lay, x0, ref[2], baro_h[0], 0.0, h)
+            for m in range(M):
+                nu[m] = km.baro_nu(lay, X[m], ins[m, 2], baro_h[m])
+        S_out[k] = _apply(X, P, h, baro_r, nu, b, kc)
+        codes[k] = CODE_BARO
+        for m in range(M):
+            nu_out[m, k] = nu[m]
+        k += 1
+    # radar altimeter
+    if radalt_h[0] == radalt_h[0]:
+        u0 = db_u[0] if db_x.shape[0] > 0 else empty_u
+        if own:
+            hr = radalt_h[0]
+            nu[0], _ = km.radalt(lay, X[0], ins[0, 0], ins[0, 1], ins[0, 2], hr, 0.0, tx, th, rwy, dbp[0], db_x, u0,
+                                 h)
+            s2 = (ra_pct * hr) ** 2 + ra_floor**2
+        else:  # the row at the reference (no database error: it enters only z), sigma at the reference height
+            km.radalt(lay, x0, ref[0], ref[1], ref[2], ref_agl, 0.0, tx, th, rwy, dbp[0], empty_u, empty_u, h)
+            s2 = (ra_pct * ref_agl) ** 2 + ra_floor**2
+            for m in range(M):
+                um = db_u[m] if db_x.shape[0] > 0 else empty_u
+                nu[m] = km._radalt(lay, X[m], ins[m, 0], ins[m, 1], ins[m, 2], radalt_h[m], tx, th, rwy, dbp[m],
+                                   db_x, um, x0, False)
+        r_ra = math.sqrt(s2) ** 2  # sigma^2 as nav/rows.py: sqrt((p h)^2 + floor^2) squared
+        S_out[k] = _apply(X, P, h, r_ra, nu, b, kc)
+        codes[k] = CODE_RADALT
+        for m in range(M):
+            nu_out[m, k] = nu[m]
+        k += 1
+    # GNSS channels
+    for c in range(rho.shape[1]):
+        if rho[0, c] != rho[0, c]:
+            continue
+        sv = c if channel_states else -1
+        if own:
+            _ecef(ins[0], r_ins)
+            _c_en(ins[0, 0], ins[0, 1], c_ins)
+            nu[0] = km._pseudorange(lay, X[0], r_ins, c_ins, r_sv[c], rho[0, c], sv, -1, h, True)
+        else:
+            km._pseudorange(lay, x0, r_ref, c_ref, r_sv[c], rho[0, c], sv, -1, h, True)
+            for m in range(M):
+                _ecef(ins[m], r_ins)
+                _c_en(ins[m, 0], ins[m, 1], c_ins)
+                nu[m] = km._pseudorange(lay, X[m], r_ins, c_ins, r_sv[c], rho[m, c], sv, -1, x0, False)
+        S_out[k] = _apply(X, P, h, sig[c] ** 2, nu, b, kc)
+        codes[k] = CODE_GPS + c
+        for m in range(M):
+            nu_out[m, k] = nu[m]
+        k += 1
+    # pseudolites
+    for c in range(pl_rho.shape[1]):
+        if pl_rho[0, c] != pl_rho[0, c]:
+            continue
+        pl = c if pl_states else -1
+        if own:
+            _ecef(ins[0], r_ins)
+            _c_en(ins[0, 0], ins[0, 1], c_ins)
+            nu[0] = km._pseudorange(lay, X[0], r_ins, c_ins, r_pl[c], pl_rho[0, c], -1, pl, h, True)
+        else:
+            km._pseudorange(lay, x0, r_ref, c_ref, r_pl[c], pl_rho[0, c], -1, pl, h, True)
+            for m in range(M):
+                _ecef(ins[m], r_ins)
+                _c_en(ins[m, 0], ins[m, 1], c_ins)
+                nu[m] = km._pseudorange(lay, X[m], r_ins, c_ins, r_pl[c], pl_rho[m, c], -1, pl, x0, False)
+        S_out[k] = _apply(X, P, h, pl_sig[c] ** 2, nu, b, kc)
+        codes[k] = CODE_PL + c
+        for m in range(M):
+            nu_out[m, k] = nu[m]
+        k += 1
+    return k
