@@ -34,6 +34,21 @@ import numpy as np
 from numba import njit
 
 from approachsim import geo, units
+from approachsim.flight.envelope import (
+    LOC_ANTENNA_PAST_THRESHOLD_M,
+    MON_GLIDEPATH,
+    MON_LOCALIZER,
+    MON_OK,
+    MON_SINK,
+    MON_SPEED,
+    SINK_LIMIT_MPS,
+    SINK_TOLERANCE_MPS,
+    SPEED_HIGH_MPS,
+    SPEED_LOW_MPS,
+    STABILIZATION_HEIGHT_M,
+    WATCH_HEIGHT_M,
+)
+from approachsim.flight.turbulence import COEFF_EVERY, POE_ALT_FT, POE_SIGMA_FPS
 from approachsim.nav.kernels import geodesy as gk
 
 Array = np.ndarray
@@ -64,6 +79,9 @@ _TWO_PI = 2.0 * math.pi
 
 N_CONST = 18
 
+# positions in RAW_FIELDS of the reads the loop uses besides the truth row
+_R_H_FT, _R_VN, _R_PHI, _R_VC, _R_BETA, _R_VT = 2, 3, 6, 24, 25, 26
+
 
 def imu_point_constants(lever_arm_m: Array, lat0_rad: float, runway: Any, dt_s: float) -> Array:
     """The kernel's constants (18,): lever arm l (body axes, m; CG to IMU), the radii R_N, R_E (m) at lat0_rad
@@ -83,7 +101,14 @@ def imu_point_constants(lever_arm_m: Array, lat0_rad: float, runway: Any, dt_s: 
 def imu_point_row(raw: Array, const: Array, along_m: Array, height_m: Array, t_s: float, out: Array) -> float:
     """Truth row of the IMU point at time t_s from one step's JSBSim reads; writes out[0:31] and out[35]
     (flight/run.py's _COLS) and returns the terrain height (m) under the IMU point (np.interp of along_m,
-    height_m at the runway-frame x; height_m[0] when the terrain has one point)."""
+    height_m at the runway-frame x; height_m[0] when the terrain has one point). raw: an array or a tuple."""
+    return _imu_point(raw, const, along_m, height_m, t_s, out)[0]
+
+
+@njit(cache=True)
+def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: float,
+               out: Array) -> tuple[float, float, float]:
+    """imu_point_row, returning (terrain height (m), the CG's Earth-relative body rates p, q (rad/s))."""
     lat, lon, h_ft = raw[0], raw[1], raw[2]
     vn_f, ve_f, vd_f = raw[3], raw[4], raw[5]
     phi, th, psi = raw[6], raw[7], raw[8]
@@ -179,7 +204,7 @@ def imu_point_row(raw: Array, const: Array, along_m: Array, height_m: Array, t_s
     out[26], out[27], out[28] = xr, yr, zr
     out[29], out[30] = zr - (tch - xr * tan_gp), yr
     out[35] = vc_kt * _KT
-    return terr
+    return terr, p, q
 
 
 def _cross(a: Array, b: Array) -> Array:
@@ -256,3 +281,405 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
     out[:, 29], out[:, 30] = zr - (tch - xy[:, 0] * tan_gp), xy[:, 1]
     out[:, 35] = raw[:, 24] * _KT
     return out
+
+
+# --- the flight loop's per-step kernel: turbulence, autopilot, stabilized-approach monitor, termination -----------
+# Parameters and state live in plain float vectors; the names below are their indices. Each component has its own
+# small vectors (filled by its readable oracle: flight/turbulence.DrydenTurbulence, flight/autopilot.Autopilot,
+# flight/envelope.StabilityMonitor, method kernel_arrays()), and `fly_step` gets them concatenated (offsets P_*,
+# S_*), so one compiled call per step does everything that is not a JSBSim read or write.
+
+GEAR_FIELDS = ("gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW", "gear/unit[1]/AGL-ft",
+               "gear/unit[2]/AGL-ft")
+"""The gear state (nose, left main, right main weight on wheels; main-gear heights above the ground, ft), read
+only near the ground; `fly_step`'s raw tuple is RAW_FIELDS + GEAR_FIELDS."""
+GEAR_AIRBORNE = (0.0, 0.0, 0.0, math.inf, math.inf)
+"""GEAR_FIELDS' values standing in for reads far from the ground (no weight on wheels, gear infinitely high)."""
+N_RAW = len(RAW_FIELDS)
+LOW_READ_HEIGHT_M = 100.0
+"""IMU height above the terrain below which the gear state counts (the gear hangs about 4 m below it): above it
+`fly_step` takes the gear as GEAR_AIRBORNE, whatever it was given."""
+GEAR_READ_MARGIN_M = 30.0
+"""`fly_step` asks for the gear reads at the next step from LOW_READ_HEIGHT_M + this margin down, so that they are
+there whenever the IMU is below LOW_READ_HEIGHT_M (at any vertical speed below margin / dt: 3600 m/s at 120 Hz)."""
+
+# autopilot: parameters (the gains in AP_GAINS order, then trim, geometry, step) and state
+AP_GAINS = ("k_theta", "k_q", "k_gs_p", "k_gs_d", "k_gs_i", "k_v_p", "k_v_i", "tau_v_s", "k_phi", "k_p", "k_beta",
+            "k_loc_p", "k_loc_d", "k_loc_i", "bank_limit_rad", "pitch_limit_rad", "tau_wind_s", "flare_height_m",
+            "flare_tau_s", "touchdown_sink_mps", "k_flare", "k_flare_i", "retard_height_m")
+"""flight.design.AutopilotGains fields, in the order of the autopilot parameter vector."""
+(AP_K_THETA, AP_K_Q, AP_K_GS_P, AP_K_GS_D, AP_K_GS_I, AP_K_V_P, AP_K_V_I, AP_TAU_V, AP_K_PHI, AP_K_P, AP_K_BETA,
+ AP_K_LOC_P, AP_K_LOC_D, AP_K_LOC_I, AP_BANK_LIMIT, AP_PITCH_LIMIT, AP_TAU_WIND, AP_FLARE_H, AP_FLARE_TAU, AP_TD_SINK,
+ AP_K_FLARE, AP_K_FLARE_I, AP_RETARD_H, AP_THETA0, AP_THR0, AP_CAS0, AP_CH, AP_SH, AP_TAN_GP, AP_TCH, AP_CONV,
+ AP_DT) = range(32)
+N_AP_PAR = 32
+(APS_INT_D, APS_INT_Y, APS_E_F, APS_WIND, APS_INT_E, APS_FLARING, APS_THETA_FLARE0, APS_INT_FLARE,
+ APS_THETA_C) = range(9)
+N_AP_STATE = 9
+
+# Dryden turbulence: parameters (W20, dt, wind-axes rotation, the intensity table's altitudes and the level's row)
+(TB_W20, TB_DT, TB_COS, TB_SIN) = range(4)
+N_POE = len(POE_ALT_FT)
+TB_ALT = 4
+TB_SIGMA = TB_ALT + N_POE
+N_TB_PAR = TB_SIGMA + N_POE
+(TBS_XI_U, TBS_XI_V, TBS_XI_W, TBS_VALID, TBS_AU, TBS_BU, TBS_AV, TBS_BV, TBS_AW, TBS_BW) = range(10)
+N_TB_STATE = 10
+
+# stabilized-approach monitor: parameters, state; its ring buffer is [speed (n) | sink (m) | sink excess (m)]
+(MN_TAN_GP, MN_GS_DOT_TAN, MN_X_GP, MN_X_FLOOR, MN_LOC_DOT_TAN, MN_TCH, MN_TARGET, MN_N, MN_M) = range(9)
+N_MN_PAR = 9
+(MNS_I, MNS_J, MNS_COUNT, MNS_SUM_CAS, MNS_SUM_SINK, MNS_SUM_EXCESS) = range(6)
+N_MN_STATE = 6
+# the step: its own parameters and state, then the components' at these offsets
+(F_PITCH_TRIM, F_STOP_H, F_LAND, F_TAN_GP, F_TCH, F_MON_FLOOR, F_WIND_N, F_WIND_E, F_TURBULENT) = range(9)
+N_F_PAR = 9
+P_IMU = 0
+P_STEP = P_IMU + N_CONST
+P_AP = P_STEP + N_F_PAR
+P_TB = P_AP + N_AP_PAR
+P_MN = P_TB + N_TB_PAR
+N_PAR = P_MN + N_MN_PAR
+(FS_DE, FS_DA, FS_DR, FS_THR, FS_LOWEST, FS_TD_X, FS_TD_SINK, FS_MON, FS_MON_Z, FS_MON_A, FS_MON_B,
+ FS_PHI, FS_THETA, FS_P, FS_Q, FS_BETA, FS_CAS, FS_H_GEAR, FS_TAS) = range(19)
+N_F_STATE = 19
+S_STEP = 0
+S_AP = S_STEP + N_F_STATE
+S_TB = S_AP + N_AP_STATE
+S_MN = S_TB + N_TB_STATE
+N_STATE = S_MN + N_MN_STATE
+
+TERM_NONE, TERM_STOP, TERM_TOUCHDOWN, TERM_SHORT, TERM_GROUND, TERM_DIVERGED, TERM_UNSTABLE = range(7)
+"""`fly_step`'s termination codes (flight/run.termination_reason words them)."""
+DIVERGED_BANK_RAD = 1.0
+DIVERGED_VERTICAL_M = 300.0
+DIVERGED_LATERAL_M = 1500.0
+"""A run has diverged beyond these: bank, distance from the glidepath, from the centreline."""
+CONTROLS_COL = 31
+"""First of the Truth row's four control columns (elevator incl. pitch trim, aileron, rudder, throttle)."""
+
+
+@njit(cache=True)
+def _clip1(u: float) -> float:
+    return 1.0 if u > 1.0 else (-1.0 if u < -1.0 else u)
+
+
+@njit(cache=True)
+def autopilot_step(par: Array, st: Array, x: float, y: float, z: float, vn: float, ve: float, vd: float,
+                   phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float,
+                   tas: float) -> tuple[float, float, float, float]:
+    """One autopilot step (flight/autopilot.Autopilot.step, the oracle, whose module docstring has the laws):
+    guidance position (runway frame, m), NED velocity (m/s), attitude (rad), body rates (rad/s), sideslip (rad),
+    CAS (m/s), main-gear height (m; nan: no flare), TAS (m/s; nan: no speed complement) -> elevator, aileron,
+    rudder, throttle. par: AP_* parameters, st: APS_* state (updated)."""
+    dt = par[AP_DT]
+    if tas > 1.0:  # inertially smoothed speed
+        gs = math.sqrt(vn * vn + ve * ve + vd * vd)
+        if st[APS_WIND] != st[APS_WIND]:
+            st[APS_WIND] = tas - gs
+        st[APS_WIND] += dt / par[AP_TAU_WIND] * (tas - gs - st[APS_WIND])
+        cas = cas * (gs + st[APS_WIND]) / tas
+    # glidepath and cross-track deviations, the runway axes turned by the meridian convergence
+    ch, sh, tan_gp = par[AP_CH], par[AP_SH], par[AP_TAN_GP]
+    conv = (x * sh + y * ch) * par[AP_CONV]
+    x0 = vn * ch + ve * sh
+    y0 = -vn * sh + ve * ch
+    d = z - (par[AP_TCH] - x * tan_gp)
+    d_dot = -vd + (x0 + conv * y0) * tan_gp
+    y_dot = y0 - conv * x0
+    # glidepath -> pitch command (integral frozen while the command is limited)
+    th_off = -(par[AP_K_GS_P] * d + par[AP_K_GS_D] * d_dot + par[AP_K_GS_I] * st[APS_INT_D])
+    lim = par[AP_PITCH_LIMIT]
+    if -lim < th_off < lim:
+        st[APS_INT_D] += d * dt
+    else:
+        th_off = lim if th_off > 0.0 else -lim
+    theta_c = par[AP_THETA0] + th_off
+    flare = h_gear == h_gear and (st[APS_FLARING] != 0.0 or h_gear <= par[AP_FLARE_H])
+    thr_flare = 1.0
+    if flare:  # sink-rate command -(h_gear / tau + sink_td) from the pitch command at flare entry
+        if st[APS_FLARING] == 0.0:
+            st[APS_FLARING] = 1.0
+            st[APS_THETA_FLARE0] = st[APS_THETA_C]
+        h_dot = -vd
+        e = -(max(h_gear, 0.0) / par[AP_FLARE_TAU] + par[AP_TD_SINK]) - h_dot
+        st[APS_INT_FLARE] += e * dt
+        theta_c = st[APS_THETA_FLARE0] + par[AP_K_FLARE] * e + par[AP_K_FLARE_I] * st[APS_INT_FLARE]
+        thr_flare = 1.0 if h_gear > par[AP_RETARD_H] else 0.0
+    st[APS_THETA_C] = theta_c
+    de = -par[AP_K_THETA] * (theta_c - theta) + par[AP_K_Q] * q
+    # autothrottle on the filtered speed error (integral frozen at saturation)
+    st[APS_E_F] += dt / par[AP_TAU_V] * (par[AP_CAS0] - cas - st[APS_E_F])
+    thr = par[AP_THR0] + par[AP_K_V_P] * st[APS_E_F] + par[AP_K_V_I] * st[APS_INT_E]
+    if 0.0 < thr < 1.0:
+        st[APS_INT_E] += st[APS_E_F] * dt
+    else:
+        thr = 1.0 if thr >= 1.0 else 0.0
+    if flare:
+        thr = min(thr, thr_flare)
+    # localizer -> bank command
+    phi_c = -(par[AP_K_LOC_P] * y + par[AP_K_LOC_D] * y_dot + par[AP_K_LOC_I] * st[APS_INT_Y])
+    blim = par[AP_BANK_LIMIT]
+    if -blim < phi_c < blim:
+        st[APS_INT_Y] += y * dt
+    else:
+        phi_c = blim if phi_c > 0.0 else -blim
+    da = par[AP_K_PHI] * (phi_c - phi) - par[AP_K_P] * p
+    dr = -par[AP_K_BETA] * beta
+    return _clip1(de), _clip1(da), _clip1(dr), thr
+
+
+@njit(cache=True)
+def dryden_scales(h_ft: float, w20_fps: float, alt_ft: Array, sigma_fps: Array) -> tuple[float, float, float, float]:
+    """Scale lengths L_u, L_w (ft) and intensities sigma_u, sigma_w (ft/s) at height h_ft above the ground
+    (flight/turbulence.scales, the oracle): MIL-F-8785C low-altitude model below 1000 ft, the level's
+    probability-of-exceedance row sigma_fps at alt_ft above 2000 ft, linear in between; heights clipped at 10 ft."""
+    h = max(h_ft, 10.0)
+    if h <= 1000.0:
+        den = 0.177 + 0.000823 * h
+        sig_w = 0.1 * w20_fps
+        return h / den**1.2, h, sig_w / den**0.4, sig_w
+    # piecewise-linear interpolation of the table, held at its ends
+    n = alt_ft.shape[0]
+    if h <= alt_ft[0]:
+        sig_hi = sigma_fps[0]
+    else:
+        i = 0
+        while i < n and alt_ft[i] <= h:  # bisect_right
+            i += 1
+        if i >= n:
+            sig_hi = sigma_fps[n - 1]
+        else:
+            x0, x1 = alt_ft[i - 1], alt_ft[i]
+            sig_hi = sigma_fps[i - 1] + (h - x0) / (x1 - x0) * (sigma_fps[i] - sigma_fps[i - 1])
+    if h <= 2000.0:
+        f = (h - 1000.0) / 1000.0
+        L = 1000.0 + f * 750.0
+        s = 0.1 * w20_fps + f * (sig_hi - 0.1 * w20_fps)
+        return L, L, s, s
+    return 1750.0, 1750.0, sig_hi, sig_hi
+
+
+@njit(cache=True)
+def dryden_step(par: Array, st: Array, nu: Array, k: int, h_agl_m: float,
+                v_true_mps: float) -> tuple[float, float, float]:
+    """Turbulence velocity at step k (NED, m/s) at height h_agl_m above the terrain and true airspeed v_true_mps
+    (flight/turbulence.DrydenTurbulence.step, the oracle): Yeager 1998 eqs. 30-32,
+        xi_u <- (1 - T/tau_u) xi_u + sigma_u sqrt(2T/tau_u) nu_u,  xi_v, xi_w with 2T/tau, sqrt(4T/tau), tau = L / V,
+    the coefficients re-evaluated every COEFF_EVERY steps; nu (n, 3) the run's white noise. par: TB_*, st: TBS_*."""
+    if k % COEFF_EVERY == 0 or st[TBS_VALID] == 0.0:
+        L_u, L_w, sig_u, sig_w = dryden_scales(h_agl_m / _FT, par[TB_W20], par[TB_ALT:TB_ALT + N_POE],
+                                               par[TB_SIGMA:TB_SIGMA + N_POE])
+        V = max(v_true_mps / _FPS, 1.0)
+        T = par[TB_DT]
+        tu = L_u / V
+        tw = L_w / V
+        st[TBS_AU], st[TBS_BU] = 1.0 - T / tu, sig_u * math.sqrt(2.0 * T / tu)
+        st[TBS_AV], st[TBS_BV] = 1.0 - 2.0 * T / tu, sig_u * math.sqrt(4.0 * T / tu)
+        st[TBS_AW], st[TBS_BW] = 1.0 - 2.0 * T / tw, sig_w * math.sqrt(4.0 * T / tw)
+        st[TBS_VALID] = 1.0
+    xu = st[TBS_XI_U] = st[TBS_AU] * st[TBS_XI_U] + st[TBS_BU] * nu[k, 0]
+    xv = st[TBS_XI_V] = st[TBS_AV] * st[TBS_XI_V] + st[TBS_BV] * nu[k, 1]
+    xw = st[TBS_XI_W] = st[TBS_AW] * st[TBS_XI_W] + st[TBS_BW] * nu[k, 2]
+    c, s = par[TB_COS], par[TB_SIN]
+    # from wind axes (u along the direction the wind blows to, v to its right) to NED
+    return c * xu - s * xv, s * xu + c * xv, xw * _FPS
+
+
+@njit(cache=True)
+def monitor_step(par: Array, st: Array, ring: Array, x_m: float, y_m: float, z_m: float, cas_mps: float,
+                 v_down_mps: float, ground_speed_mps: float) -> tuple[int, float, float]:
+    """One step of the stabilized-approach monitor (flight/envelope.StabilityMonitor.step, the oracle, whose module
+    docstring has the criterion): true position (runway frame, m), air-mass speed as CAS, down velocity and
+    horizontal ground speed (m/s) -> (MON_* result, its two figures): glidepath / localizer deviation in dots,
+    3 s mean speed minus the target (m/s), or the 10 s mean sink rate and its excess over the glidepath's (m/s).
+    par: MN_*, st: MNS_*, ring: the speed, sink and excess windows (updated)."""
+    n, m = int(par[MN_N]), int(par[MN_M])
+    i, j = int(st[MNS_I]), int(st[MNS_J])
+    excess = v_down_mps - ground_speed_mps * par[MN_TAN_GP]  # sink beyond what the glidepath needs
+    st[MNS_SUM_CAS] += cas_mps - ring[i]
+    st[MNS_SUM_SINK] += v_down_mps - ring[n + j]
+    st[MNS_SUM_EXCESS] += excess - ring[n + m + j]
+    ring[i] = cas_mps
+    ring[n + j], ring[n + m + j] = v_down_mps, excess
+    st[MNS_I] = (i + 1) % n
+    st[MNS_J] = (j + 1) % m
+    st[MNS_COUNT] += 1.0
+    if z_m > STABILIZATION_HEIGHT_M:
+        return MON_OK, 0.0, 0.0
+    # deviations in dots: the glide path's angular dot held at its 200 ft size below, the localizer's angular
+    d = z_m - (par[MN_TCH] - x_m * par[MN_TAN_GP])
+    r_gp = max(par[MN_X_GP] - min(x_m, par[MN_X_FLOOR]), 1.0)
+    gs_dots = d / (r_gp * par[MN_GS_DOT_TAN])
+    loc_dots = y_m / ((LOC_ANTENNA_PAST_THRESHOLD_M - x_m) * par[MN_LOC_DOT_TAN])
+    if abs(gs_dots) > 1.0:
+        return MON_GLIDEPATH, gs_dots, 0.0
+    if abs(loc_dots) > 1.0:
+        return MON_LOCALIZER, loc_dots, 0.0
+    if st[MNS_COUNT] < n:
+        return MON_OK, 0.0, 0.0
+    dv = st[MNS_SUM_CAS] / n - par[MN_TARGET]
+    if dv > SPEED_HIGH_MPS or dv < -SPEED_LOW_MPS:
+        return MON_SPEED, dv, 0.0
+    if st[MNS_COUNT] < m:
+        return MON_OK, 0.0, 0.0
+    sink, excess = st[MNS_SUM_SINK] / m, st[MNS_SUM_EXCESS] / m
+    if sink > SINK_LIMIT_MPS and excess > SINK_TOLERANCE_MPS:
+        return MON_SINK, sink, excess
+    return MON_OK, 0.0, 0.0
+
+
+@njit(cache=True)
+def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, x: float, y: float, z: float,
+                vn: float, ve: float, vd: float, h_agl: float, phi: float, wow_nose: float, wow_left: float,
+                wow_right: float, vn_cg: float, ve_cg: float, vd_cg: float, cas: float, tas: float) -> int:
+    """Why the run ends at this step (TERM_*; TERM_NONE: it goes on), checked in this order on the true state:
+    the IMU at the stop height; (landing runs) a main gear on the ground with the nose gear in the air: touchdown,
+    short of the threshold when x < 0; anything else on the ground or the IMU at the terrain; divergence (bank,
+    distance from the glidepath or the centreline); below WATCH_HEIGHT_M (above the flare on landing runs) the
+    stabilized-approach monitor, fed the speed through the mean air mass (CG ground velocity minus the steady
+    wind) as CAS with JSBSim's CAS/TAS ratio. Position x, y, z (runway frame), velocity (IMU, NED) and height
+    above the terrain in m, m/s; wow_* JSBSim's weight-on-wheels; CG velocity, CAS and TAS in m/s.
+    fpar, fst: the step's F_* parameters and FS_* state (touchdown and monitor figures are stored there)."""
+    if z <= fpar[F_STOP_H]:
+        return TERM_STOP
+    if fpar[F_LAND] != 0.0 and (wow_left > 0.0 or wow_right > 0.0) and wow_nose == 0.0:
+        fst[FS_TD_X], fst[FS_TD_SINK] = x, vd
+        return TERM_TOUCHDOWN if x >= 0.0 else TERM_SHORT
+    if wow_nose > 0.0 or wow_left > 0.0 or wow_right > 0.0 or h_agl <= 0.0:
+        return TERM_GROUND
+    if (abs(phi) > DIVERGED_BANK_RAD or abs(z - (fpar[F_TCH] - x * fpar[F_TAN_GP])) > DIVERGED_VERTICAL_M
+            or abs(y) > DIVERGED_LATERAL_M):
+        return TERM_DIVERGED
+    if fpar[F_MON_FLOOR] < z < WATCH_HEIGHT_M:
+        an, ae = vn_cg - fpar[F_WIND_N], ve_cg - fpar[F_WIND_E]
+        v_air = math.sqrt(an * an + ae * ae + vd_cg ** 2)
+        result, a, b = monitor_step(mpar, mst, ring, x, y, z, v_air * cas / tas, vd, math.sqrt(vn * vn + ve * ve))
+        if result != MON_OK:
+            fst[FS_MON], fst[FS_MON_Z], fst[FS_MON_A], fst[FS_MON_B] = result, z, a, b
+            return TERM_UNSTABLE
+    return TERM_NONE
+
+
+@njit(cache=True)
+def _control(par: Array, st: Array, row: Array, x: float, y: float, z: float, vn: float, ve: float, vd: float,
+             phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float,
+             tas: float) -> tuple[float, float, float, float]:
+    """The autopilot on guidance (x, y, z, vn, ve, vd); the commands go into the row and the step's state."""
+    de, da, dr, thr = autopilot_step(par[P_AP:P_AP + N_AP_PAR], st[S_AP:S_AP + N_AP_STATE], x, y, z, vn, ve, vd,
+                                     phi, theta, p, q, beta, cas, h_gear, tas)
+    row[CONTROLS_COL] = de + par[P_STEP + F_PITCH_TRIM]
+    row[CONTROLS_COL + 1], row[CONTROLS_COL + 2], row[CONTROLS_COL + 3] = da, dr, thr
+    st[S_STEP + FS_DE], st[S_STEP + FS_DA], st[S_STEP + FS_DR], st[S_STEP + FS_THR] = de, da, dr, thr
+    return de, da, dr, thr
+
+
+@njit(cache=True)
+def fly_step(k: int, raw: Any, buf: Array, nu: Array, terrain: Array, par: Array, st: Array, ring: Array,
+             guided: bool) -> tuple[int, float, float, float, float, float, float, float, float, bool]:
+    """Step k of the flight loop after JSBSim's step k: everything that is not a JSBSim read or write.
+
+    raw: the reads, RAW_FIELDS + GEAR_FIELDS (a tuple; the gear as GEAR_AIRBORNE when not read), JSBSim units.
+    Writes Truth row buf[k] (imu_point_row; the controls in force), then steps the turbulence at the CG's height
+    above the terrain (dryden_step, noise nu) and checks `termination` (incl. the monitor); with guided (the
+    autopilot flies on the truth) and no termination it runs the autopilot on row k (else `fly_control` does, on
+    the navigation source's guidance). terrain: (2, m) along-track distances and heights (m). par, st, ring: the
+    parameter and state vectors (P_*, S_* offsets) and the monitor's windows (flight_vectors builds them).
+
+    Returns (TERM_* code, elevator, aileron, rudder, throttle (the commands to set for the next step; the ones in
+    force when not guided), gust north, east, down (ft/s, for JSBSim's atmosphere/gust-*-fps), terrain height
+    under the IMU (ft, for position/terrain-elevation-asl-ft), whether to read the gear at the next step).
+    """
+    row = buf[k]
+    fpar, fst = par[P_STEP:P_STEP + N_F_PAR], st[S_STEP:S_STEP + N_F_STATE]
+    terr, p, q = _imu_point(raw, par[P_IMU:P_IMU + N_CONST], terrain[0], terrain[1], k * par[P_IMU + N_CONST - 1],
+                            row)
+    vn_f, ve_f, vd_f, phi, theta = raw[_R_VN], raw[_R_VN + 1], raw[_R_VN + 2], raw[_R_PHI], raw[_R_PHI + 1]
+    cas, beta, tas = raw[_R_VC] * _KT, raw[_R_BETA], raw[_R_VT] * _FPS
+    vn, ve, vd, xr, yr, zr = row[7], row[8], row[9], row[26], row[27], row[28]
+    h_agl = row[3] - terr
+    if h_agl < LOW_READ_HEIGHT_M:  # the gear counts near the ground only
+        w0, w1, w2, g1_ft, g2_ft = raw[N_RAW], raw[N_RAW + 1], raw[N_RAW + 2], raw[N_RAW + 3], raw[N_RAW + 4]
+    else:
+        w0, w1, w2, g1_ft, g2_ft = GEAR_AIRBORNE
+    near = h_agl < LOW_READ_HEIGHT_M + GEAR_READ_MARGIN_M
+    gn = ge = gd = 0.0
+    if fpar[F_TURBULENT] != 0.0:  # turbulence for the next step, at the CG's height above the terrain
+        tn, te, td = dryden_step(par[P_TB:P_TB + N_TB_PAR], st[S_TB:S_TB + N_TB_STATE], nu, k,
+                                 raw[_R_H_FT] * _FT - terr, tas)
+        gn, ge, gd = tn / _FPS, te / _FPS, td / _FPS
+    # the controls of the previous step act on this row until replaced
+    row[CONTROLS_COL] = fst[FS_DE] + fpar[F_PITCH_TRIM]
+    row[CONTROLS_COL + 1], row[CONTROLS_COL + 2], row[CONTROLS_COL + 3] = fst[FS_DA], fst[FS_DR], fst[FS_THR]
+    if zr < fst[FS_LOWEST]:
+        fst[FS_LOWEST] = zr
+    code = termination(fpar, fst, par[P_MN:P_MN + N_MN_PAR], st[S_MN:S_MN + N_MN_STATE], ring, xr, yr, zr, vn, ve,
+                       vd, h_agl, phi, w0, w1, w2, vn_f * _FPS, ve_f * _FPS, vd_f * _FPS, cas, tas)
+    h_gear = min(g1_ft, g2_ft) * _FT if fpar[F_LAND] != 0.0 else math.nan
+    if guided and code == TERM_NONE:
+        de, da, dr, thr = _control(par, st, row, xr, yr, zr, vn, ve, vd, phi, theta, p, q, beta, cas, h_gear, tas)
+    else:  # the inner loops' inputs, for fly_control
+        fst[FS_PHI], fst[FS_THETA], fst[FS_P], fst[FS_Q], fst[FS_BETA] = phi, theta, p, q, beta
+        fst[FS_CAS], fst[FS_H_GEAR], fst[FS_TAS] = cas, h_gear, tas
+        de, da, dr, thr = fst[FS_DE], fst[FS_DA], fst[FS_DR], fst[FS_THR]
+    return code, de, da, dr, thr, gn, ge, gd, terr / _FT, near
+
+
+@njit(cache=True)
+def fly_control(k: int, guidance: Array, buf: Array, par: Array, st: Array) -> tuple[float, float, float, float]:
+    """The autopilot of step k on a navigation source's guidance (k, 0:6): runway-frame position (m) and NED
+    velocity (m/s), after fly_step(..., guided=False); returns elevator, aileron, rudder, throttle to set."""
+    g = guidance[k]
+    s = st[S_STEP:S_STEP + N_F_STATE]
+    return _control(par, st, buf[k], g[0], g[1], g[2], g[3], g[4], g[5], s[FS_PHI], s[FS_THETA], s[FS_P], s[FS_Q],
+                    s[FS_BETA], s[FS_CAS], s[FS_H_GEAR], s[FS_TAS])
+
+
+def autopilot_arrays(ap: Any) -> tuple[Array, Array]:
+    """(parameters, state) of the compiled autopilot (AP_*, APS_*) from its oracle (flight/autopilot.Autopilot)."""
+    par = [getattr(ap.g, name) for name in AP_GAINS]
+    par += [ap.trim.theta_rad, ap.trim.throttle, ap.trim.cas_mps, ap.ch, ap.sh, ap.tan_gp, ap.tch_m,
+            ap.conv_per_east_m, ap.dt]
+    return np.array(par, dtype=float), np.array(ap.state(), dtype=float)
+
+
+def dryden_arrays(turb: Any) -> tuple[Array, Array]:
+    """(parameters, state) of the compiled turbulence (TB_*, TBS_*) from its oracle
+    (flight/turbulence.DrydenTurbulence); its noise is turb.nu."""
+    par = [turb.w20_fps, turb.dt, turb.cos_fps, turb.sin_fps, *POE_ALT_FT, *POE_SIGMA_FPS[turb.index - 1]]
+    return np.array(par, dtype=float), np.array(turb.state(), dtype=float)
+
+
+def monitor_arrays(mon: Any) -> tuple[Array, Array, Array]:
+    """(parameters, state, windows) of the compiled stabilized-approach monitor (MN_*, MNS_*, the ring buffer)
+    from its oracle (flight/envelope.StabilityMonitor)."""
+    par = [mon.tan_gp, math.tan(mon.gs_dot_rad), mon.x_gp_m, mon.x_floor_m, math.tan(mon.loc_dot_rad), mon.tch_m,
+           mon.target_mps, float(mon.n), float(mon.m)]
+    return np.array(par, dtype=float), np.array(mon.state(), dtype=float), np.array(mon.windows(), dtype=float)
+
+
+def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, *, pitch_trim: float, stop_height_m: float,
+                   land: bool, monitor_floor_m: float, wind_ned_mps: tuple[float, float]) -> tuple[Array, Array, Array]:
+    """fly_step's (par, st, ring) for one flight: the IMU-point constants (imu_point_constants), the autopilot,
+    monitor and turbulence (None: calm air) of the run (their oracles, fresh), the trimmed pitch trim (the
+    elevator column of the Truth controls adds it), the stop height above the threshold (m; -inf: none), landing
+    run (flare, touchdown), the height above the threshold the monitor stops at (m) and the steady wind (north,
+    east, m/s; the air moves with it)."""
+    ap_par, ap_st = autopilot_arrays(ap)
+    mn_par, mn_st, ring = monitor_arrays(mon)
+    if turb is not None:
+        tb_par, tb_st = dryden_arrays(turb)
+    else:
+        tb_par, tb_st = np.zeros(N_TB_PAR), np.zeros(N_TB_STATE)
+    fpar = np.zeros(N_F_PAR)
+    fpar[F_PITCH_TRIM], fpar[F_STOP_H], fpar[F_LAND] = pitch_trim, stop_height_m, float(land)
+    fpar[F_TAN_GP], fpar[F_TCH] = ap.tan_gp, ap.tch_m
+    fpar[F_MON_FLOOR], fpar[F_WIND_N], fpar[F_WIND_E] = monitor_floor_m, wind_ned_mps[0], wind_ned_mps[1]
+    fpar[F_TURBULENT] = float(turb is not None)
+    fst = np.zeros(N_F_STATE)
+    fst[FS_THR] = ap.trim.throttle  # the trimmed controls are in force at row 0
+    fst[FS_LOWEST] = math.inf
+    fst[FS_TD_X] = fst[FS_TD_SINK] = math.nan
+    par = np.concatenate([np.asarray(const, dtype=float), fpar, ap_par, tb_par, mn_par])
+    st = np.concatenate([fst, ap_st, tb_st, mn_st])
+    return par, st, ring

@@ -182,5 +182,5 @@ def test_every_glidepath_formula_is_geo_glidepath_deviation():
         ref = float(geo.glidepath_deviation_m(x, z, RWY.tch_m, tan_gp))
         assert ap.deviations(x, 3.0, z, 70.0, 1.0, 3.0)[0] == ref
         d_dots = mon.dots(x, 3.0, z)[0]
-        r_gp = max(mon._x_gp_m - min(x, mon._x_floor_m), 1.0)
-        assert d_dots == pytest.approx(ref / (r_gp * math.tan(mon._gs_dot_rad)), rel=1e-15)
+        r_gp = max(mon.x_gp_m - min(x, mon.x_floor_m), 1.0)
+        assert d_dots == pytest.approx(ref / (r_gp * math.tan(mon.gs_dot_rad)), rel=1e-15)
