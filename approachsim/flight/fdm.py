@@ -29,6 +29,7 @@ Python arithmetic runs per step.
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import os
 import sys
@@ -245,13 +246,20 @@ class LoopIO:
 
 
 def _tuple_reader(getters: list[Callable[[], float]], constants: tuple[float, ...]) -> Callable[[], tuple]:
-    """A function returning (getters[0](), getters[1](), ..., *constants): one tuple display, generated."""
-    names = [f"g{i}" for i in range(len(getters))]
-    items = [f"{n}()" for n in names] + [repr(c) for c in constants]
+    """A function returning (getters[0](), getters[1](), ..., *constants): one tuple display."""
+    return _reader_factory(len(getters), constants)(*getters)
+
+
+@functools.cache
+def _reader_factory(n: int, constants: tuple[float, ...]) -> Callable[..., Callable[[], tuple]]:
+    """The factory of _tuple_reader's functions for n getters, generated once per process (compiling it costs
+    more than a millisecond)."""
+    names = [f"g{i}" for i in range(n)]
+    items = [f"{name}()" for name in names] + [repr(c) for c in constants]
     src = (f"def make({', '.join(names)}):\n"
            f"    def read():\n"
            f"        return ({', '.join(items)},)\n"
            f"    return read\n")
     namespace: dict = {}
-    exec(src, {"inf": math.inf, "nan": math.nan}, namespace)  # noqa: S102 (text built above from names only)
-    return namespace["make"](*getters)
+    exec(src, {"inf": math.inf, "nan": math.nan}, namespace)  # text built above from names and float literals
+    return namespace["make"]

@@ -1,8 +1,11 @@
-"""The flight loop's per-step truth kinematics as a compiled kernel (numba, cache=True) and its numpy oracle.
+"""The flight loop's per-step work as compiled kernels (numba, cache=True): one call per JSBSim step does all that
+is not a JSBSim read or write. Each piece has a readable oracle it is tested against (tests/unit/flight/).
 
-JSBSim integrates the centre of gravity; the Truth record is of the IMU point (aircraft file [imu]). Per step,
-from the JSBSim-read scalars (in JSBSim's units, the order of RAW_FIELDS), `imu_point_row` writes one Truth row:
+The truth row. JSBSim integrates the centre of gravity; the Truth record is of the IMU point (aircraft file
+[imu]). Per step, from the JSBSim-read scalars (in JSBSim's units, the order of RAW_FIELDS), `imu_point_row`
+writes one Truth row:
 
+    rates     w_eb = w_ib - C_nb' w_ie(L)                         JSBSim's p, q, r (earth_rates_reference)
     position  p_imu = p_cg + C_nb l  (geodetic offset, then ECEF and the runway frame)
     velocity  v_imu = v_cg + C_nb (w_eb x l), resolved on the IMU point's own NED axes (turned by
               t = (dE / (R_E + h), -dN / (R_N + h), -dE tan L / (R_E + h)) from the CG's)
@@ -13,16 +16,18 @@ from the JSBSim-read scalars (in JSBSim's units, the order of RAW_FIELDS), `imu_
     pressure  p_imu = p_cg exp(d_D g0 / (R_air T))               hydrostatic over the CG-to-IMU height
     attitude  roll, pitch, heading of the IMU point's NED axes and its body-to-NED quaternion
 
-(docs/truth.md and flight/run.py's module docstring say why each term is there.) The kernel is a plain function
-of arrays so that it is testable without JSBSim (tests/unit/flight/test_flight_kernels.py: kernel = the vectorized
-numpy `imu_point_rows_reference` to 1e-12 relative). The flight loop calls it as
+(docs/truth.md and flight/run.py's module docstring say why each term is there; oracle: the vectorized numpy
+`imu_point_rows_reference`, to 1e-12 relative.)
 
-    const = imu_point_constants(lever_arm_m, lat0_rad, profile.runway, dt_s)     # once per flight
-    raw[:] = [gv() for gv in getters]                                              # RAW_FIELDS, JSBSim units
-    terr = imu_point_row(raw, const, terrain_along_m, terrain_height_m, k * dt_s, buf[k])
+The rest of the step: `dryden_step` (oracle flight/turbulence.DrydenTurbulence), `autopilot_step`
+(flight/autopilot.Autopilot), `monitor_step` (flight/envelope.StabilityMonitor), `termination`, composed by
+`fly_step` (and `fly_control`, the autopilot on a navigation source's guidance). Parameters and state are plain
+float vectors built from the oracles (flight_vectors); flight/run.py calls
 
-which fills columns 0-30 and 35 of flight/run.py's (n, 36) row buffer (_COLS) and returns the terrain height
-under the IMU (m); the controls (columns 31-34) stay the caller's.
+    par, st = flight_vectors(imu_point_constants(...), autopilot, monitor, turbulence, terrain..., ...)  # per run
+    code, de, da, dr, thr, gust_n, gust_e, gust_d, terrain_ft, read_gear = fly_step(k, reads, buf, nu, par, st, guided)
+
+which fills row k of flight/run.py's (n, 36) row buffer (_COLS; the controls in columns 31-34).
 """
 
 from __future__ import annotations
@@ -58,13 +63,13 @@ RAW_FIELDS = (
     "velocities/v-north-fps", "velocities/v-east-fps", "velocities/v-down-fps",
     "attitude/phi-rad", "attitude/theta-rad", "attitude/psi-rad",
     "velocities/pi-rad_sec", "velocities/qi-rad_sec", "velocities/ri-rad_sec",
-    "velocities/p-rad_sec", "velocities/q-rad_sec", "velocities/r-rad_sec",
     "accelerations/pidot-rad_sec2", "accelerations/qidot-rad_sec2", "accelerations/ridot-rad_sec2",
     "forces/fbx-total-lbs", "forces/fby-total-lbs", "forces/fbz-total-lbs", "inertia/mass-slugs",
     "atmosphere/P-psf", "atmosphere/T-R", "velocities/vc-kts", "aero/beta-rad",
     "velocities/vtrue-fps",
 )
-"""The JSBSim properties `imu_point_row` reads, in the order of its `raw` (27,) input (flight/run.py's _READ)."""
+"""The JSBSim properties `imu_point_row` reads, in the order of its `raw` (24,) input. JSBSim's Earth-relative body
+rates (velocities/p-rad_sec, ...) are not read: `imu_point_row` derives them from the inertial ones (earth_rates)."""
 
 R_AIR = 287.05287
 """Specific gas constant of dry air, J/(kg K) (US Standard Atmosphere 1976, JSBSim's Rdry)."""
@@ -80,7 +85,7 @@ _TWO_PI = 2.0 * math.pi
 N_CONST = 18
 
 # positions in RAW_FIELDS of the reads the loop uses besides the truth row
-_R_H_FT, _R_VN, _R_PHI, _R_VC, _R_BETA, _R_VT = 2, 3, 6, 24, 25, 26
+_R_H_FT, _R_VN, _R_PHI, _R_VC, _R_BETA, _R_VT = 2, 3, 6, 21, 22, 23
 
 
 def imu_point_constants(lever_arm_m: Array, lat0_rad: float, runway: Any, dt_s: float) -> Array:
@@ -113,10 +118,9 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     vn_f, ve_f, vd_f = raw[3], raw[4], raw[5]
     phi, th, psi = raw[6], raw[7], raw[8]
     pi_, qi, ri = raw[9], raw[10], raw[11]
-    p, q, r = raw[12], raw[13], raw[14]
-    pid, qid, rid = raw[15], raw[16], raw[17]
-    fx, fy, fz, m = raw[18], raw[19], raw[20], raw[21]
-    p_psf, t_r, vc_kt = raw[22], raw[23], raw[24]
+    pid, qid, rid = raw[12], raw[13], raw[14]
+    fx, fy, fz, m = raw[15], raw[16], raw[17], raw[18]
+    p_psf, t_r, vc_kt = raw[19], raw[20], raw[21]
     lx, ly, lz, r_n, r_e = const[0], const[1], const[2], const[3], const[4]
     ox, oy, oz = const[5], const[6], const[7]
     c00, c01, c02, c10, c11, c12 = const[8], const[9], const[10], const[11], const[12], const[13]
@@ -128,6 +132,10 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     n00, n01, n02 = ct * cp, sf * st * cp - cf * sp, cf * st * cp + sf * sp
     n10, n11, n12 = ct * sp, sf * st * sp + cf * cp, cf * st * sp - sf * cp
     n20, n21, n22 = -st, sf * ct, cf * ct
+    # Earth-relative body rates w_eb = w_ib - C_nb' w_ie (earth_rates)
+    s_lat, c_lat = math.sin(lat), math.cos(lat)
+    wn_e, wd_e = _OMEGA * c_lat, -_OMEGA * s_lat
+    p, q, r = pi_ - (n00 * wn_e + n20 * wd_e), qi - (n01 * wn_e + n21 * wd_e), ri - (n02 * wn_e + n22 * wd_e)
     # lever-arm terms: w_eb x l (velocity); w x l with the inertial rate (specific force)
     ux, uy, uz = q * lz - r * ly, r * lx - p * lz, p * ly - q * lx
     wx, wy, wz = qi * lz - ri * ly, ri * lx - pi_ * lz, pi_ * ly - qi * lx
@@ -149,11 +157,12 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     de = n10 * lx + n11 * ly + n12 * lz
     dd = n20 * lx + n21 * ly + n22 * lz
     lat_i = lat + dn / (r_n + h)
-    lon_i = lon + de / ((r_e + h) * math.cos(lat))
+    lon_i = lon + de / ((r_e + h) * c_lat)
     h_i = h - dd
     x_e, y_e, z_e = gk.geodetic_to_ecef(lat_i, lon_i, h_i)
     # gravitation gradient over the lever arm, GM/r^3 (l - 3 d_D C_nb' e_D) (J2 part < 1e-8 m/s^2)
-    kg = _GM / (x_e * x_e + y_e * y_e + z_e * z_e) ** 1.5
+    r2 = x_e * x_e + y_e * y_e + z_e * z_e
+    kg = _GM / (r2 * math.sqrt(r2))
     fbx += kg * (lx - 3.0 * dd * n20)
     fby += kg * (ly - 3.0 * dd * n21)
     fbz += kg * (lz - 3.0 * dd * n22)
@@ -171,7 +180,7 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     fbx, fby, fbz = (fbx - c1 * qx + c2 * (py * qz - pz * qy), fby - c1 * qy + c2 * (pz * qx - px * qz),
                      fbz - c1 * qz + c2 * (px * qy - py * qx))
     # the IMU point's own NED axes, x_imu = (I - [t x]) x_cg
-    ta, tb, tc = de / (r_e + h), -dn / (r_n + h), -de * math.tan(lat) / (r_e + h)
+    ta, tb, tc = de / (r_e + h), -dn / (r_n + h), -de * (s_lat / c_lat) / (r_e + h)
     vn, ve, vd = vn - tb * vd + tc * ve, ve - tc * vn + ta * vd, vd - ta * ve + tb * vn
     m00, m10, m20 = n00 - tb * n20 + tc * n10, n10 - tc * n00 + ta * n20, n20 - ta * n10 + tb * n00
     m21, m22 = n21 - ta * n11 + tb * n01, n22 - ta * n12 + tb * n02
@@ -211,8 +220,26 @@ def _cross(a: Array, b: Array) -> Array:
     return np.cross(a, b)
 
 
+def earth_rates_reference(raw: Array) -> Array:
+    """JSBSim's Earth-relative body rates p, q, r (velocities/p-rad_sec, ...) from reads in RAW_FIELDS order, (n, 3)
+    rad/s: w_eb = w_ib - C_nb' w_ie, w_ie = Omega (cos L, 0, -sin L) in JSBSim's local NED, whose latitude is the
+    geodetic one (FGLocation's local frame), Omega = geo.OMEGA_JSBSIM; C_nb from the Euler angles.
+
+    JSBSim computes vPQR = vPQRi - Ti2b (0, 0, Omega) (FGPropagate::Run) with Ti2b from its ECI quaternion, which
+    it renormalizes only when |1 - |q|| reaches 1e-10 (FGQuaternion::Normalize): its Ti2b is scaled by |q|^2, so
+    its p, q, r differ from these by up to 2e-10 Omega = 1.5e-14 rad/s (tests/integration/test_flight_reads.py)."""
+    raw = np.atleast_2d(np.asarray(raw, dtype=float))
+    lat, phi, th, psi = raw[:, 0], raw[:, 6], raw[:, 7], raw[:, 8]
+    w_ie = _OMEGA * np.stack([np.cos(lat), np.zeros_like(lat), -np.sin(lat)], axis=1)
+    cr, sr, cp, sp, cy, sy = np.cos(phi), np.sin(phi), np.cos(th), np.sin(th), np.cos(psi), np.sin(psi)
+    c_nb = np.stack([np.stack([cp * cy, sr * sp * cy - cr * sy, cr * sp * cy + sr * sy], -1),
+                     np.stack([cp * sy, sr * sp * sy + cr * cy, cr * sp * sy - sr * cy], -1),
+                     np.stack([-sp, sr * cp, cr * cp], -1)], -2)
+    return raw[:, 9:12] - np.einsum("nji,nj->ni", c_nb, w_ie)
+
+
 def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m: Array, t_s: Array) -> Array:
-    """`imu_point_row` for many steps at once in vectorized numpy (the kernel's test oracle): raw (n, 27) in
+    """`imu_point_row` for many steps at once in vectorized numpy (the kernel's test oracle): raw (n, 24) in
     RAW_FIELDS order, t_s (n,); returns (n, 36) rows with columns 0-30 and 35 filled (NaN elsewhere).
 
     Written with matrices and np.cross rather than the kernel's scalar expressions, so that it checks them."""
@@ -226,8 +253,8 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
     lat, lon, h = raw[:, 0], raw[:, 1], raw[:, 2] * _FT
     v_cg = raw[:, 3:6] * _FPS
     eul = raw[:, 6:9]
-    w_ib, w_eb, w_dot = raw[:, 9:12], raw[:, 12:15], raw[:, 15:18]
-    f_cg = raw[:, 18:21] * (_LBF_PER_SLUG / raw[:, 21:22])
+    w_ib, w_dot = raw[:, 9:12], raw[:, 12:15]
+    f_cg = raw[:, 15:18] * (_LBF_PER_SLUG / raw[:, 18:19])
     cr, sr = np.cos(eul[:, 0]), np.sin(eul[:, 0])
     cp, sp = np.cos(eul[:, 1]), np.sin(eul[:, 1])
     cy, sy = np.cos(eul[:, 2]), np.sin(eul[:, 2])
@@ -235,6 +262,7 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
                      np.stack([cp * sy, sr * sp * sy + cr * cy, cr * sp * sy - sr * cy], -1),
                      np.stack([-sp, sr * cp, cr * cp], -1)], -2)  # body -> NED, (n, 3, 3)
     l_b = np.broadcast_to(lev, (n, 3))
+    w_eb = earth_rates_reference(raw)
     e = 0.5 * dt * w_ib
     a = _cross(w_ib + dt * w_dot, l_b)  # w1 x l
     b = _cross(e, a)
@@ -262,7 +290,7 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
     roll = np.arctan2(m_nb[:, 2, 1], m_nb[:, 2, 2])
     pitch = -np.arcsin(m_nb[:, 2, 0])
     yaw = eul[:, 2] + np.remainder(np.arctan2(m_nb[:, 1, 0], m_nb[:, 0, 0]) - eul[:, 2] + np.pi, 2.0 * np.pi) - np.pi
-    p_imu = raw[:, 22] * _PSF * np.exp(d[:, 2] * _G0_OVER_R / (raw[:, 23] / _RANKINE))
+    p_imu = raw[:, 19] * _PSF * np.exp(d[:, 2] * _G0_OVER_R / (raw[:, 20] / _RANKINE))
     xy = (r - origin) @ c_rwy2.T
     zr = h_i - h_thr
     terr = np.full(n, height_m[0]) if len(height_m) == 1 else np.interp(xy[:, 0], along_m, height_m)
@@ -276,10 +304,10 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
     out[:, 4:7], out[:, 7:10], out[:, 10:14] = r, v, q
     out[:, 14], out[:, 15], out[:, 16] = roll, pitch, yaw
     out[:, 17:20], out[:, 20:23] = w_ib, f
-    out[:, 23], out[:, 24], out[:, 25] = p_imu, raw[:, 23] / _RANKINE, h_i - terr
+    out[:, 23], out[:, 24], out[:, 25] = p_imu, raw[:, 20] / _RANKINE, h_i - terr
     out[:, 26], out[:, 27], out[:, 28] = xy[:, 0], xy[:, 1], zr
     out[:, 29], out[:, 30] = zr - (tch - xy[:, 0] * tan_gp), xy[:, 1]
-    out[:, 35] = raw[:, 24] * _KT
+    out[:, 35] = raw[:, 21] * _KT
     return out
 
 
@@ -332,14 +360,16 @@ N_MN_PAR = 9
 (MNS_I, MNS_J, MNS_COUNT, MNS_SUM_CAS, MNS_SUM_SINK, MNS_SUM_EXCESS) = range(6)
 N_MN_STATE = 6
 # the step: its own parameters and state, then the components' at these offsets
-(F_PITCH_TRIM, F_STOP_H, F_LAND, F_TAN_GP, F_TCH, F_MON_FLOOR, F_WIND_N, F_WIND_E, F_TURBULENT) = range(9)
-N_F_PAR = 9
+(F_PITCH_TRIM, F_STOP_H, F_LAND, F_TAN_GP, F_TCH, F_MON_FLOOR, F_WIND_N, F_WIND_E, F_TURBULENT,
+ F_N_TERRAIN) = range(10)
+N_F_PAR = 10
 P_IMU = 0
 P_STEP = P_IMU + N_CONST
 P_AP = P_STEP + N_F_PAR
 P_TB = P_AP + N_AP_PAR
 P_MN = P_TB + N_TB_PAR
-N_PAR = P_MN + N_MN_PAR
+P_TERRAIN = P_MN + N_MN_PAR
+"""The terrain profile ends the parameter vector: F_N_TERRAIN along-track distances, then as many heights (m)."""
 (FS_DE, FS_DA, FS_DR, FS_THR, FS_LOWEST, FS_TD_X, FS_TD_SINK, FS_MON, FS_MON_Z, FS_MON_A, FS_MON_B,
  FS_PHI, FS_THETA, FS_P, FS_Q, FS_BETA, FS_CAS, FS_H_GEAR, FS_TAS) = range(19)
 N_F_STATE = 19
@@ -347,7 +377,8 @@ S_STEP = 0
 S_AP = S_STEP + N_F_STATE
 S_TB = S_AP + N_AP_STATE
 S_MN = S_TB + N_TB_STATE
-N_STATE = S_MN + N_MN_STATE
+S_RING = S_MN + N_MN_STATE
+"""The monitor's windows end the state vector."""
 
 TERM_NONE, TERM_STOP, TERM_TOUCHDOWN, TERM_SHORT, TERM_GROUND, TERM_DIVERGED, TERM_UNSTABLE = range(7)
 """`fly_step`'s termination codes (flight/run.termination_reason words them)."""
@@ -575,7 +606,7 @@ def _control(par: Array, st: Array, row: Array, x: float, y: float, z: float, vn
 
 
 @njit(cache=True)
-def fly_step(k: int, raw: Any, buf: Array, nu: Array, terrain: Array, par: Array, st: Array, ring: Array,
+def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
              guided: bool) -> tuple[int, float, float, float, float, float, float, float, float, bool]:
     """Step k of the flight loop after JSBSim's step k: everything that is not a JSBSim read or write.
 
@@ -583,8 +614,8 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, terrain: Array, par: Array
     Writes Truth row buf[k] (imu_point_row; the controls in force), then steps the turbulence at the CG's height
     above the terrain (dryden_step, noise nu) and checks `termination` (incl. the monitor); with guided (the
     autopilot flies on the truth) and no termination it runs the autopilot on row k (else `fly_control` does, on
-    the navigation source's guidance). terrain: (2, m) along-track distances and heights (m). par, st, ring: the
-    parameter and state vectors (P_*, S_* offsets) and the monitor's windows (flight_vectors builds them).
+    the navigation source's guidance). par, st: the parameter and state vectors (P_*, S_* offsets; the terrain
+    profile and the monitor's windows at their ends: flight_vectors builds them).
 
     Returns (TERM_* code, elevator, aileron, rudder, throttle (the commands to set for the next step; the ones in
     force when not guided), gust north, east, down (ft/s, for JSBSim's atmosphere/gust-*-fps), terrain height
@@ -592,8 +623,9 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, terrain: Array, par: Array
     """
     row = buf[k]
     fpar, fst = par[P_STEP:P_STEP + N_F_PAR], st[S_STEP:S_STEP + N_F_STATE]
-    terr, p, q = _imu_point(raw, par[P_IMU:P_IMU + N_CONST], terrain[0], terrain[1], k * par[P_IMU + N_CONST - 1],
-                            row)
+    nt = int(fpar[F_N_TERRAIN])
+    terr, p, q = _imu_point(raw, par[P_IMU:P_IMU + N_CONST], par[P_TERRAIN:P_TERRAIN + nt],
+                            par[P_TERRAIN + nt:P_TERRAIN + 2 * nt], k * par[P_IMU + N_CONST - 1], row)
     vn_f, ve_f, vd_f, phi, theta = raw[_R_VN], raw[_R_VN + 1], raw[_R_VN + 2], raw[_R_PHI], raw[_R_PHI + 1]
     cas, beta, tas = raw[_R_VC] * _KT, raw[_R_BETA], raw[_R_VT] * _FPS
     vn, ve, vd, xr, yr, zr = row[7], row[8], row[9], row[26], row[27], row[28]
@@ -613,14 +645,15 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, terrain: Array, par: Array
     row[CONTROLS_COL + 1], row[CONTROLS_COL + 2], row[CONTROLS_COL + 3] = fst[FS_DA], fst[FS_DR], fst[FS_THR]
     if zr < fst[FS_LOWEST]:
         fst[FS_LOWEST] = zr
-    code = termination(fpar, fst, par[P_MN:P_MN + N_MN_PAR], st[S_MN:S_MN + N_MN_STATE], ring, xr, yr, zr, vn, ve,
-                       vd, h_agl, phi, w0, w1, w2, vn_f * _FPS, ve_f * _FPS, vd_f * _FPS, cas, tas)
+    code = termination(fpar, fst, par[P_MN:P_MN + N_MN_PAR], st[S_MN:S_MN + N_MN_STATE], st[S_RING:], xr, yr, zr,
+                       vn, ve, vd, h_agl, phi, w0, w1, w2, vn_f * _FPS, ve_f * _FPS, vd_f * _FPS, cas, tas)
     h_gear = min(g1_ft, g2_ft) * _FT if fpar[F_LAND] != 0.0 else math.nan
+    # the inner loops' inputs of this step (fly_control's, when a navigation source guides)
+    fst[FS_PHI], fst[FS_THETA], fst[FS_P], fst[FS_Q], fst[FS_BETA] = phi, theta, p, q, beta
+    fst[FS_CAS], fst[FS_H_GEAR], fst[FS_TAS] = cas, h_gear, tas
     if guided and code == TERM_NONE:
         de, da, dr, thr = _control(par, st, row, xr, yr, zr, vn, ve, vd, phi, theta, p, q, beta, cas, h_gear, tas)
-    else:  # the inner loops' inputs, for fly_control
-        fst[FS_PHI], fst[FS_THETA], fst[FS_P], fst[FS_Q], fst[FS_BETA] = phi, theta, p, q, beta
-        fst[FS_CAS], fst[FS_H_GEAR], fst[FS_TAS] = cas, h_gear, tas
+    else:
         de, da, dr, thr = fst[FS_DE], fst[FS_DA], fst[FS_DR], fst[FS_THR]
     return code, de, da, dr, thr, gn, ge, gd, terr / _FT, near
 
@@ -658,13 +691,14 @@ def monitor_arrays(mon: Any) -> tuple[Array, Array, Array]:
     return np.array(par, dtype=float), np.array(mon.state(), dtype=float), np.array(mon.windows(), dtype=float)
 
 
-def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, *, pitch_trim: float, stop_height_m: float,
-                   land: bool, monitor_floor_m: float, wind_ned_mps: tuple[float, float]) -> tuple[Array, Array, Array]:
-    """fly_step's (par, st, ring) for one flight: the IMU-point constants (imu_point_constants), the autopilot,
-    monitor and turbulence (None: calm air) of the run (their oracles, fresh), the trimmed pitch trim (the
-    elevator column of the Truth controls adds it), the stop height above the threshold (m; -inf: none), landing
-    run (flare, touchdown), the height above the threshold the monitor stops at (m) and the steady wind (north,
-    east, m/s; the air moves with it)."""
+def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, terrain_along_m: Array,
+                   terrain_height_m: Array, *, pitch_trim: float, stop_height_m: float, land: bool,
+                   monitor_floor_m: float, wind_ned_mps: tuple[float, float]) -> tuple[Array, Array]:
+    """fly_step's (par, st) for one flight: the IMU-point constants (imu_point_constants), the autopilot, monitor
+    and turbulence (None: calm air) of the run (their oracles, fresh), the terrain profile (along-track distances
+    and heights, m), the trimmed pitch trim (the elevator column of the Truth controls adds it), the stop height
+    above the threshold (m; -inf: none), landing run (flare, touchdown), the height above the threshold the
+    monitor stops at (m) and the steady wind (north, east, m/s; the air moves with it)."""
     ap_par, ap_st = autopilot_arrays(ap)
     mn_par, mn_st, ring = monitor_arrays(mon)
     if turb is not None:
@@ -676,10 +710,25 @@ def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, *, pitch_t
     fpar[F_TAN_GP], fpar[F_TCH] = ap.tan_gp, ap.tch_m
     fpar[F_MON_FLOOR], fpar[F_WIND_N], fpar[F_WIND_E] = monitor_floor_m, wind_ned_mps[0], wind_ned_mps[1]
     fpar[F_TURBULENT] = float(turb is not None)
+    fpar[F_N_TERRAIN] = len(terrain_along_m)
     fst = np.zeros(N_F_STATE)
     fst[FS_THR] = ap.trim.throttle  # the trimmed controls are in force at row 0
     fst[FS_LOWEST] = math.inf
     fst[FS_TD_X] = fst[FS_TD_SINK] = math.nan
-    par = np.concatenate([np.asarray(const, dtype=float), fpar, ap_par, tb_par, mn_par])
-    st = np.concatenate([fst, ap_st, tb_st, mn_st])
-    return par, st, ring
+    par = np.concatenate([np.asarray(const, dtype=float), fpar, ap_par, tb_par, mn_par,
+                          np.asarray(terrain_along_m, dtype=float), np.asarray(terrain_height_m, dtype=float)])
+    st = np.concatenate([fst, ap_st, tb_st, mn_st, ring])
+    return par, st
+
+
+@njit(cache=True)
+def split_rows(buf: Array, n: int, cols: Array, outs: Any) -> None:
+    """outs[f][k, j] = buf[k, cols[f] + j] for rows k < n: the row buffer's fields as contiguous arrays, in one pass
+    over its rows (a column-by-column copy reads the whole buffer once per field). outs: a tuple of (n, w) arrays."""
+    for k in range(n):
+        row = buf[k]
+        for f in range(len(outs)):
+            o = outs[f]
+            c = cols[f]
+            for j in range(o.shape[1]):
+                o[k, j] = row[c + j]

@@ -21,6 +21,15 @@ below 1000 ft (flight.envelope's monitor), ground contact, a touchdown short of 
 timeout (`FlightResult.ok` / `failure`). The Truth arrays are preallocated for the longest permitted run (NaN
 until written) and trimmed at the end; a navigation source sees that record and may read rows <= k only.
 
+One loop serves both: per step JSBSim's reads (one LoopIO of flight/fdm.py, bound per run), one compiled call
+(flight/kernels.fly_step: the Truth row, the Dryden turbulence, the termination checks with the stabilized-approach
+monitor and, when the truth guides, the autopilot), the writes (controls, gusts, terrain) and JSBSim's next step.
+With a navigation source, fly_step stops after the termination checks, the source steps on row k, and
+kernels.fly_control runs the autopilot on its guidance. The autopilot, turbulence and monitor are compiled twins of
+flight/autopilot.py, flight/turbulence.py and flight/envelope.py, which stay the readable oracles (equal bit for
+bit, tests/unit/flight/test_flight_loop_kernels.py) and fill the kernels' parameter and state vectors. Why a run
+ended is a code during the loop, worded after it (termination_reason).
+
 Truth is of the IMU point (aircraft file [imu]), one row per step from the compiled kernel of flight/kernels.py:
 position, velocity and specific force are moved from the CG with the rigid-body lever-arm terms (f_imu = f_cg +
 w_ib' x l + w_ib x (w_ib x l), in the exact form of JSBSim's Euler step, plus the gravitation gradient; v_imu =
@@ -32,8 +41,11 @@ docs/truth.md says why each term is there.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
+import numba
 import numpy as np
 
 from approachsim import units
@@ -80,6 +92,15 @@ _COLS = {
     "controls": (fk.CONTROLS_COL, 4), "airspeed_mps": (35, 1),
 }
 _NCOL = 36
+_COL_STARTS = np.array([c for c, _ in _COLS.values()], dtype=np.int64)
+
+
+def _final_truth(buf: Array, n: int, runway) -> Truth:
+    """The Truth of a flown run: the first n rows of the row buffer as one contiguous array per field."""
+    outs = tuple(np.empty((n, w)) for (c, w) in _COLS.values())
+    fk.split_rows(buf, n, _COL_STARTS, outs)
+    return Truth(**{name: (o[:, 0] if w == 1 else o) for (name, (c, w)), o in zip(_COLS.items(), outs, strict=True)},
+                 runway=runway)
 
 
 def _truth_views(buf: Array, runway) -> Truth:
@@ -217,21 +238,22 @@ class Approach:
             max_time_s = max(60.0, 2.0 * rw.start_distance_m / ac.approach_speed_mps)
         n_max = int(math.ceil(max_time_s / dt)) + 1
         io = fdm.loop_io(fk.RAW_FIELDS, fk.GEAR_FIELDS, fk.GEAR_AIRBORNE)
-        par, st, ring, nu = self._kernel_vectors(fdm, ic, seed, run, n_max)
+        par, st, nu = self._kernel_vectors(fdm, ic, seed, run, n_max)
         turbulent = par[fk.P_STEP + fk.F_TURBULENT] != 0.0
         if turbulent:
             io.gust_on()
-        terrain = np.array([self.profile.terrain.along_m, self.profile.terrain.height_m], dtype=float)
-        hilly = terrain.shape[1] > 1
+        hilly = par[fk.P_STEP + fk.F_N_TERRAIN] > 1
         buf = np.full((n_max, _NCOL), np.nan)
         truth = _truth_views(buf, rw.frame)
         guidance = None if src is None else np.full((n_max, 6), np.nan)
 
-        # the loop: JSBSim's step, its reads, one compiled call (fly_step: truth row, turbulence, termination and,
-        # guided by the truth, the autopilot), the writes; a navigation source sees row k between fly_step and
-        # the autopilot (fly_control)
-        step, control, guided = fk.fly_step, fk.fly_control, src is None
+        # the loop: JSBSim's reads, one compiled call (fly_step: truth row, turbulence, termination and, guided by
+        # the truth, the autopilot), the writes, JSBSim's step; a navigation source sees row k between fly_step
+        # and the autopilot (fly_control)
+        guided = src is None
         read, read_near, run_step = io.read, io.read_near, io.run
+        step = _entry(fk.fly_step, 0, (0.0,) * (fk.N_RAW + len(fk.GEAR_FIELDS)), buf, nu, par, st, guided)
+        control = None if guided else _entry(fk.fly_control, 0, guidance, buf, par, st)
         set_de, set_da, set_dr, (set_thr0, set_thr1) = io.set_elevator, io.set_aileron, io.set_rudder, io.set_throttle
         set_gn, set_ge, set_gd = io.set_gust_fps
         set_terrain_ft = io.set_terrain_ft
@@ -239,10 +261,8 @@ class Approach:
         near = True
         k = 0
         for k in range(n_max):
-            if k:
-                run_step()
             code, de, da, dr, thr, gn, ge, gd, terr_ft, near = step(
-                k, read_near() if near else read(), buf, nu, terrain, par, st, ring, guided)
+                k, read_near() if near else read(), buf, nu, par, st, guided)
             if src is not None:
                 g_r, g_v = src.step(k, truth)
                 guidance[k, 0:3] = g_r
@@ -263,10 +283,11 @@ class Approach:
                 set_gd(gd)
             if hilly:
                 set_terrain_ft(terr_ft)
+            run_step()  # JSBSim's step k + 1 (after the last permitted row: one step never read)
         n = k + 1
+        final = _final_truth(buf, n, rw.frame)
         if guidance is None:
-            guidance = np.concatenate([truth.r_rwy[:n], truth.v_ned[:n]], axis=1)
-        final = Truth(**{name: np.ascontiguousarray(v[:n]) for name, v in truth.arrays().items()}, runway=rw.frame)
+            guidance = np.concatenate([final.r_rwy, final.v_ned], axis=1)
         fs = st[fk.S_STEP:fk.S_STEP + fk.N_F_STATE]
         return FlightResult(
             truth=final,
@@ -282,8 +303,8 @@ class Approach:
         )
 
     def _kernel_vectors(self, fdm: FDM, ic: InitialCondition, seed: int, run: int,
-                        n_max: int) -> tuple[Array, Array, Array, Array]:
-        """fly_step's parameter and state vectors, monitor windows and turbulence noise for one run, from the
+                        n_max: int) -> tuple[Array, Array, Array]:
+        """fly_step's parameter and state vectors and the turbulence noise for one run, from the
         trimmed JSBSim instance and fresh oracles (autopilot, monitor, turbulence: their compiled twins start
         from the oracles' state)."""
         prof, ac, rw, dt = self.profile, self.aircraft, self.profile.runway, self.dt_s
@@ -304,8 +325,9 @@ class Approach:
             turb = DrydenTurbulence(env.turbulence, stream(seed, run, "turbulence"), n_max, dt,
                                     env.wind_from_rad + math.pi)
             nu = turb.nu
-        par, st, ring = fk.flight_vectors(
-            const, ap, monitor, turb,
+        par, st = fk.flight_vectors(
+            const, ap, monitor, turb, np.asarray(prof.terrain.along_m, dtype=float),
+            np.asarray(prof.terrain.height_m, dtype=float),
             pitch_trim=fdm["fcs/pitch-trim-cmd-norm"],
             stop_height_m=self.stop_height_m,
             land=self.land,
@@ -314,7 +336,18 @@ class Approach:
             wind_ned_mps=(-env.wind_speed_mps * math.cos(env.wind_from_rad),
                           -env.wind_speed_mps * math.sin(env.wind_from_rad)),
         )
-        return par, st, ring, nu
+        return par, st, nu
+
+
+def _entry(dispatcher: Any, *args: Any) -> Callable:
+    """The compiled code's Python entry point of numba `dispatcher` for these arguments' types, called without
+    numba's per-call type dispatch (which costs ~0.35 us of a ~1.4 us fly_step call; the loop makes 31,000 a
+    flight). Calls through it must pass exactly these types (it does not check them). Numba internals
+    (Dispatcher.overloads[signature].entry_point): when they are not there, the dispatcher itself."""
+    sig = tuple(numba.typeof(a) for a in args)
+    dispatcher.compile(sig)  # loads it from numba's cache when compiled before
+    entry = getattr(dispatcher.overloads.get(sig), "entry_point", None)
+    return dispatcher if entry is None else entry
 
 
 def termination_reason(code: int, fs: Array) -> str:
