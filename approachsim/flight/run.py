@@ -264,9 +264,9 @@ class Approach:
             code, de, da, dr, thr, gn, ge, gd, terr_ft, near = step(
                 k, read_near() if near else read(), buf, nu, par, st, guided)
             if src is not None:
-                g_r, g_v = src.step(k, truth)
-                guidance[k, 0:3] = g_r
-                guidance[k, 3:6] = g_v
+                pos, vel = src.step(k, truth)
+                guidance[k, 0:3] = pos
+                guidance[k, 3:6] = vel
                 if code:
                     break
                 de, da, dr, thr = control(k, guidance, buf, par, st)
@@ -286,13 +286,15 @@ class Approach:
             run_step()  # JSBSim's step k + 1 (after the last permitted row: one step never read)
         n = k + 1
         final = _final_truth(buf, n, rw.frame)
-        if guidance is None:
-            guidance = np.concatenate([final.r_rwy, final.v_ned], axis=1)
+        if guidance is None:  # guided by the truth
+            g_r, g_v = final.r_rwy.copy(), final.v_ned.copy()
+        else:
+            g_r, g_v = np.ascontiguousarray(guidance[:n, 0:3]), np.ascontiguousarray(guidance[:n, 3:6])
         fs = st[fk.S_STEP:fk.S_STEP + fk.N_F_STATE]
         return FlightResult(
             truth=final,
-            guidance_r_rwy=np.ascontiguousarray(guidance[:n, :3]),
-            guidance_v_ned=np.ascontiguousarray(guidance[:n, 3:]),
+            guidance_r_rwy=g_r,
+            guidance_v_ned=g_v,
             termination=termination_reason(code, fs),
             lowest_height_ft=float(fs[fk.FS_LOWEST]) / units.FT,
             touchdown_x_m=float(fs[fk.FS_TD_X]),
