@@ -20,7 +20,8 @@ Landing runs add a flare below flare_height (main-gear height h_g): theta_c = th
 k_flare_i int e, e = -(h_g / tau_flare + sink_td) - h', and the throttle to idle below retard_height.
 
 Sign conventions of the 737 FCS: + elevator = nose down, + aileron = roll right, + rudder = nose left.
-Everything is plain float arithmetic: it runs once per JSBSim step.
+This class is the readable oracle; the flight loop runs its compiled twin (flight/kernels.py autopilot_step, equal
+to it bit for bit: tests/unit/flight/test_flight_loop_kernels.py).
 """
 
 from __future__ import annotations
@@ -62,13 +63,14 @@ class Autopilot:
         self.g = gains
         self.trim = trim
         self.dt = dt_s
-        self._ch = math.cos(geometry.heading_rad)
-        self._sh = math.sin(geometry.heading_rad)
-        self._tan_gp = math.tan(geometry.glidepath_rad)
-        self._tch = geometry.tch_m
+        self.ch = math.cos(geometry.heading_rad)
+        self.sh = math.sin(geometry.heading_rad)
+        self.tan_gp = math.tan(geometry.glidepath_rad)
+        self.tch_m = geometry.tch_m
         lat0 = geometry.threshold_lat_rad
         r_e = A_WGS84 / math.sqrt(1.0 - E2_WGS84 * math.sin(lat0) ** 2)
-        self._conv_per_east_m = math.sin(lat0) / (r_e * math.cos(lat0))
+        self.conv_per_east_m = math.sin(lat0) / (r_e * math.cos(lat0))
+        """Meridian convergence per metre east of the threshold, rad/m."""
         self.int_d = 0.0
         self.int_y = 0.0
         self.e_f = 0.0
@@ -81,14 +83,14 @@ class Autopilot:
 
     def deviations(self, x: float, y: float, z: float, vn: float, ve: float, vd: float) -> tuple[float, ...]:
         """Glidepath deviation d (m, + above), its rate (m/s), cross-track y (m, + right) and its rate (m/s)."""
-        ch, sh = self._ch, self._sh
-        conv = (x * sh + y * ch) * self._conv_per_east_m  # runway heading in the local NED minus at the threshold
+        ch, sh = self.ch, self.sh
+        conv = (x * sh + y * ch) * self.conv_per_east_m  # runway heading in the local NED minus at the threshold
         x0 = vn * ch + ve * sh
         y0 = -vn * sh + ve * ch
         x_dot = x0 + conv * y0  # small-angle rotation by the convergence (|conv| < 0.01 rad)
         y_dot = y0 - conv * x0
-        d = z - (self._tch - x * self._tan_gp)
-        d_dot = -vd + x_dot * self._tan_gp
+        d = z - (self.tch_m - x * self.tan_gp)
+        d_dot = -vd + x_dot * self.tan_gp
         return d, d_dot, y, y_dot
 
     def step(
@@ -110,12 +112,12 @@ class Autopilot:
             self._w += dt / g.tau_wind_s * (tas - gs - self._w)
             cas = cas * (gs + self._w) / tas
         # deviations (as deviations(), inlined: this runs every step)
-        ch, sh = self._ch, self._sh
-        conv = (x * sh + y * ch) * self._conv_per_east_m
+        ch, sh = self.ch, self.sh
+        conv = (x * sh + y * ch) * self.conv_per_east_m
         x0 = vn * ch + ve * sh
         y0 = -vn * sh + ve * ch
-        d = z - (self._tch - x * self._tan_gp)
-        d_dot = -vd + (x0 + conv * y0) * self._tan_gp
+        d = z - (self.tch_m - x * self.tan_gp)
+        d_dot = -vd + (x0 + conv * y0) * self.tan_gp
         y_dot = y0 - conv * x0
         # glidepath -> pitch command (integral frozen while the command is limited)
         th_off = -(g.k_gs_p * d + g.k_gs_d * d_dot + g.k_gs_i * self.int_d)
@@ -151,6 +153,11 @@ class Autopilot:
         dr = -g.k_beta * beta
         return _clip1(de), _clip1(da), _clip1(dr), thr
 
+    def state(self) -> tuple[float, ...]:
+        """The integrators and filters (int d, int y, e_f, wind along the path, int e_f, flaring, flare-entry pitch
+        command, flare integral, last pitch command): the compiled autopilot's APS_* state vector."""
+        return (self.int_d, self.int_y, self.e_f, self._w, self.int_e, float(self.flaring), self._theta_flare0,
+                self._int_flare, self._theta_c)
 
     def _flare(self, h_gear: float, h_dot: float, theta_c_path: float) -> tuple[float, float]:
         """Flare: pitch command from the sink-rate error to h'_c = -(h_gear / tau + sink_td), starting from

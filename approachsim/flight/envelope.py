@@ -134,26 +134,51 @@ def check_envelope(profile, limits: ApproachLimits, aircraft_name: str, approach
         )
 
 
+MON_OK, MON_GLIDEPATH, MON_LOCALIZER, MON_SPEED, MON_SINK = range(5)
+"""Results of one monitor step: stabilized, or which criterion failed (the compiled monitor in flight/kernels.py
+returns these with two figures, `unstabilized_reason` words them)."""
+
+
+def unstabilized_reason(result: int, z_m: float, a: float, b: float) -> str:
+    """The failed criterion in words, e.g. "unstabilized at 420 ft: glidepath deviation +1.30 dots": result one of
+    MON_GLIDEPATH, MON_LOCALIZER (a: the deviation in dots), MON_SPEED (a: 3 s mean speed minus the target, m/s),
+    MON_SINK (a, b: 10 s mean sink rate and its excess over the glidepath's, m/s), at height z_m (m)."""
+    where = f"unstabilized at {z_m / units.FT:.0f} ft"
+    if result == MON_GLIDEPATH:
+        return f"{where}: glidepath deviation {a:+.2f} dots"
+    if result == MON_LOCALIZER:
+        return f"{where}: localizer deviation {a:+.2f} dots"
+    if result == MON_SPEED:
+        return f"{where}: air-mass speed {a / units.KT:+.1f} kt from the target (3 s mean)"
+    if result == MON_SINK:
+        return (f"{where}: sink rate {a / units.FT * 60:.0f} ft/min, "
+                f"{b / units.FT * 60:.0f} ft/min above the glidepath's (10 s mean)")
+    raise ValueError(f"not a failed stabilized-approach criterion: {result}")
+
+
 class StabilityMonitor:
     """The stabilized-approach criterion of one run (module docstring), fed every step with the true IMU state.
 
     step() returns None while stabilized, else the named reason, e.g. "unstabilized at 420 ft: glidepath
-    deviation 1.3 dots". Re-create per run."""
+    deviation 1.3 dots". Re-create per run. The readable oracle of the compiled monitor (flight/kernels.py
+    monitor_step); check() is its step with the result as (MON_* code, figures)."""
 
     def __init__(self, glidepath_rad: float, tch_m: float, target_cas_mps: float, dt_s: float) -> None:
-        self._tan_gp = math.tan(glidepath_rad)
-        self._gs_dot_rad = GS_DOT_PER_GLIDEPATH * glidepath_rad
-        self._x_gp_m = tch_m / self._tan_gp  # glide-path origin past the threshold (runway frame x)
-        self._x_floor_m = self._x_gp_m - GS_DOT_FLOOR_HEIGHT_M / self._tan_gp
-        self._loc_dot_rad = math.atan(LOC_DOT_AT_THRESHOLD_M / LOC_ANTENNA_PAST_THRESHOLD_M)
-        self._tch = tch_m
-        self._target = target_cas_mps
-        self._n = max(1, int(round(MEAN_WINDOW_S / dt_s)))
-        self._cas = [0.0] * self._n
-        self._m = max(1, int(round(SINK_WINDOW_S / dt_s)))
+        self.tan_gp = math.tan(glidepath_rad)
+        self.gs_dot_rad = GS_DOT_PER_GLIDEPATH * glidepath_rad
+        self.x_gp_m = tch_m / self.tan_gp  # glide-path origin past the threshold (runway frame x)
+        self.x_floor_m = self.x_gp_m - GS_DOT_FLOOR_HEIGHT_M / self.tan_gp
+        self.loc_dot_rad = math.atan(LOC_DOT_AT_THRESHOLD_M / LOC_ANTENNA_PAST_THRESHOLD_M)
+        self.tch_m = tch_m
+        self.target_mps = target_cas_mps
+        self.n = max(1, int(round(MEAN_WINDOW_S / dt_s)))
+        """Samples in the speed window."""
+        self.m = max(1, int(round(SINK_WINDOW_S / dt_s)))
+        """Samples in the sink-rate window."""
+        self._cas = [0.0] * self.n
         self._j = 0
-        self._sink = [0.0] * self._m
-        self._excess = [0.0] * self._m
+        self._sink = [0.0] * self.m
+        self._excess = [0.0] * self.m
         self._sum_excess = 0.0
         self._i = 0
         self._count = 0
@@ -162,45 +187,58 @@ class StabilityMonitor:
 
     def dots(self, x_m: float, y_m: float, z_m: float) -> tuple[float, float]:
         """Glidepath and localizer deviation in dots (+ above / + right) at runway-frame position (m)."""
-        d = z_m - (self._tch - x_m * self._tan_gp)
-        r_gp = max(self._x_gp_m - min(x_m, self._x_floor_m), 1.0)
-        gs_dots = d / (r_gp * math.tan(self._gs_dot_rad))
+        d = z_m - (self.tch_m - x_m * self.tan_gp)
+        r_gp = max(self.x_gp_m - min(x_m, self.x_floor_m), 1.0)
+        gs_dots = d / (r_gp * math.tan(self.gs_dot_rad))
         r_loc = LOC_ANTENNA_PAST_THRESHOLD_M - x_m
-        loc_dots = y_m / (r_loc * math.tan(self._loc_dot_rad))
+        loc_dots = y_m / (r_loc * math.tan(self.loc_dot_rad))
         return gs_dots, loc_dots
 
     def step(self, x_m: float, y_m: float, z_m: float, cas_mps: float, v_down_mps: float,
              ground_speed_mps: float) -> str | None:
         """Update with one step's true position (runway frame, m), air-mass speed as CAS (m/s), down velocity and
         horizontal ground speed (m/s)."""
+        result, a, b = self.check(x_m, y_m, z_m, cas_mps, v_down_mps, ground_speed_mps)
+        return None if result == MON_OK else unstabilized_reason(result, z_m, a, b)
+
+    def check(self, x_m: float, y_m: float, z_m: float, cas_mps: float, v_down_mps: float,
+              ground_speed_mps: float) -> tuple[int, float, float]:
+        """step() as (MON_* result, figure a, figure b): the figures of unstabilized_reason."""
         i = self._i
-        excess = v_down_mps - ground_speed_mps * self._tan_gp  # sink beyond what the glidepath needs
+        excess = v_down_mps - ground_speed_mps * self.tan_gp  # sink beyond what the glidepath needs
         self._sum_cas += cas_mps - self._cas[i]
         self._sum_sink += v_down_mps - self._sink[self._j]
         self._sum_excess += excess - self._excess[self._j]
         j = self._j
         self._cas[i] = cas_mps
         self._sink[j], self._excess[j] = v_down_mps, excess
-        self._i = (i + 1) % self._n
-        self._j = (j + 1) % self._m
+        self._i = (i + 1) % self.n
+        self._j = (j + 1) % self.m
         self._count += 1
         if z_m > STABILIZATION_HEIGHT_M:
-            return None
-        where = f"unstabilized at {z_m / units.FT:.0f} ft"
+            return MON_OK, 0.0, 0.0
         gs, loc = self.dots(x_m, y_m, z_m)
         if abs(gs) > 1.0:
-            return f"{where}: glidepath deviation {gs:+.2f} dots"
+            return MON_GLIDEPATH, gs, 0.0
         if abs(loc) > 1.0:
-            return f"{where}: localizer deviation {loc:+.2f} dots"
-        if self._count < self._n:
-            return None
-        dv = self._sum_cas / self._n - self._target
+            return MON_LOCALIZER, loc, 0.0
+        if self._count < self.n:
+            return MON_OK, 0.0, 0.0
+        dv = self._sum_cas / self.n - self.target_mps
         if dv > SPEED_HIGH_MPS or dv < -SPEED_LOW_MPS:
-            return f"{where}: air-mass speed {dv / units.KT:+.1f} kt from the target (3 s mean)"
-        if self._count < self._m:
-            return None
-        sink, excess = self._sum_sink / self._m, self._sum_excess / self._m
+            return MON_SPEED, dv, 0.0
+        if self._count < self.m:
+            return MON_OK, 0.0, 0.0
+        sink, excess = self._sum_sink / self.m, self._sum_excess / self.m
         if sink > SINK_LIMIT_MPS and excess > SINK_TOLERANCE_MPS:
-            return (f"{where}: sink rate {sink / units.FT * 60:.0f} ft/min, "
-                    f"{excess / units.FT * 60:.0f} ft/min above the glidepath's (10 s mean)")
-        return None
+            return MON_SINK, sink, excess
+        return MON_OK, 0.0, 0.0
+
+    def state(self) -> tuple[float, ...]:
+        """(i, j, count, speed sum, sink sum, excess sum): the compiled monitor's MNS_* state vector."""
+        return (float(self._i), float(self._j), float(self._count), self._sum_cas, self._sum_sink,
+                self._sum_excess)
+
+    def windows(self) -> list[float]:
+        """The speed, sink and excess windows concatenated: the compiled monitor's ring buffer."""
+        return self._cas + self._sink + self._excess

@@ -1,8 +1,11 @@
-"""The flight loop's per-step truth kinematics as a compiled kernel (numba, cache=True) and its numpy oracle.
+"""The flight loop's per-step work as compiled kernels (numba, cache=True): one call per JSBSim step does all that
+is not a JSBSim read or write. Each piece has a readable oracle it is tested against (tests/unit/flight/).
 
-JSBSim integrates the centre of gravity; the Truth record is of the IMU point (aircraft file [imu]). Per step,
-from the JSBSim-read scalars (in JSBSim's units, the order of RAW_FIELDS), `imu_point_row` writes one Truth row:
+The truth row. JSBSim integrates the centre of gravity; the Truth record is of the IMU point (aircraft file
+[imu]). Per step, from the JSBSim-read scalars (in JSBSim's units, the order of RAW_FIELDS), `imu_point_row`
+writes one Truth row:
 
+    rates     w_eb = w_ib - C_nb' w_ie(L)                         JSBSim's p, q, r (earth_rates_reference)
     position  p_imu = p_cg + C_nb l  (geodetic offset, then ECEF and the runway frame)
     velocity  v_imu = v_cg + C_nb (w_eb x l), resolved on the IMU point's own NED axes (turned by
               t = (dE / (R_E + h), -dN / (R_N + h), -dE tan L / (R_E + h)) from the CG's)
@@ -13,16 +16,18 @@ from the JSBSim-read scalars (in JSBSim's units, the order of RAW_FIELDS), `imu_
     pressure  p_imu = p_cg exp(d_D g0 / (R_air T))               hydrostatic over the CG-to-IMU height
     attitude  roll, pitch, heading of the IMU point's NED axes and its body-to-NED quaternion
 
-(docs/truth.md and flight/run.py's module docstring say why each term is there.) The kernel is a plain function
-of arrays so that it is testable without JSBSim (tests/unit/flight/test_flight_kernels.py: kernel = the vectorized
-numpy `imu_point_rows_reference` to 1e-12 relative). The flight loop calls it as
+(docs/truth.md and flight/run.py's module docstring say why each term is there; oracle: the vectorized numpy
+`imu_point_rows_reference`, to 1e-12 relative.)
 
-    const = imu_point_constants(lever_arm_m, lat0_rad, profile.runway, dt_s)     # once per flight
-    raw[:] = [gv() for gv in getters]                                              # RAW_FIELDS, JSBSim units
-    terr = imu_point_row(raw, const, terrain_along_m, terrain_height_m, k * dt_s, buf[k])
+The rest of the step: `dryden_step` (oracle flight/turbulence.DrydenTurbulence), `autopilot_step`
+(flight/autopilot.Autopilot), `monitor_step` (flight/envelope.StabilityMonitor), `termination`, composed by
+`fly_step` (and `fly_control`, the autopilot on a navigation source's guidance). Parameters and state are plain
+float vectors built from the oracles (flight_vectors); flight/run.py calls
 
-which fills columns 0-30 and 35 of flight/run.py's (n, 36) row buffer (_COLS) and returns the terrain height
-under the IMU (m); the controls (columns 31-34) stay the caller's.
+    par, st = flight_vectors(imu_point_constants(...), autopilot, monitor, turbulence, terrain..., ...)  # per run
+    code, de, da, dr, thr, gust_n, gust_e, gust_d, terrain_ft, read_gear = fly_step(k, reads, buf, nu, par, st, guided)
+
+which fills row k of flight/run.py's (n, 36) row buffer (_COLS; the controls in columns 31-34).
 """
 
 from __future__ import annotations
@@ -34,6 +39,21 @@ import numpy as np
 from numba import njit
 
 from approachsim import geo, units
+from approachsim.flight.envelope import (
+    LOC_ANTENNA_PAST_THRESHOLD_M,
+    MON_GLIDEPATH,
+    MON_LOCALIZER,
+    MON_OK,
+    MON_SINK,
+    MON_SPEED,
+    SINK_LIMIT_MPS,
+    SINK_TOLERANCE_MPS,
+    SPEED_HIGH_MPS,
+    SPEED_LOW_MPS,
+    STABILIZATION_HEIGHT_M,
+    WATCH_HEIGHT_M,
+)
+from approachsim.flight.turbulence import COEFF_EVERY, POE_ALT_FT, POE_SIGMA_FPS
 from approachsim.nav.kernels import geodesy as gk
 
 Array = np.ndarray
@@ -43,13 +63,13 @@ RAW_FIELDS = (
     "velocities/v-north-fps", "velocities/v-east-fps", "velocities/v-down-fps",
     "attitude/phi-rad", "attitude/theta-rad", "attitude/psi-rad",
     "velocities/pi-rad_sec", "velocities/qi-rad_sec", "velocities/ri-rad_sec",
-    "velocities/p-rad_sec", "velocities/q-rad_sec", "velocities/r-rad_sec",
     "accelerations/pidot-rad_sec2", "accelerations/qidot-rad_sec2", "accelerations/ridot-rad_sec2",
     "forces/fbx-total-lbs", "forces/fby-total-lbs", "forces/fbz-total-lbs", "inertia/mass-slugs",
     "atmosphere/P-psf", "atmosphere/T-R", "velocities/vc-kts", "aero/beta-rad",
     "velocities/vtrue-fps",
 )
-"""The JSBSim properties `imu_point_row` reads, in the order of its `raw` (27,) input (flight/run.py's _READ)."""
+"""The JSBSim properties `imu_point_row` reads, in the order of its `raw` (24,) input. JSBSim's Earth-relative body
+rates (velocities/p-rad_sec, ...) are not read: `imu_point_row` derives them from the inertial ones (earth_rates)."""
 
 R_AIR = 287.05287
 """Specific gas constant of dry air, J/(kg K) (US Standard Atmosphere 1976, JSBSim's Rdry)."""
@@ -63,6 +83,9 @@ _RANKINE = 1.8
 _TWO_PI = 2.0 * math.pi
 
 N_CONST = 18
+
+# positions in RAW_FIELDS of the reads the loop uses besides the truth row
+_R_H_FT, _R_VN, _R_PHI, _R_VC, _R_BETA, _R_VT = 2, 3, 6, 21, 22, 23
 
 
 def imu_point_constants(lever_arm_m: Array, lat0_rad: float, runway: Any, dt_s: float) -> Array:
@@ -83,15 +106,21 @@ def imu_point_constants(lever_arm_m: Array, lat0_rad: float, runway: Any, dt_s: 
 def imu_point_row(raw: Array, const: Array, along_m: Array, height_m: Array, t_s: float, out: Array) -> float:
     """Truth row of the IMU point at time t_s from one step's JSBSim reads; writes out[0:31] and out[35]
     (flight/run.py's _COLS) and returns the terrain height (m) under the IMU point (np.interp of along_m,
-    height_m at the runway-frame x; height_m[0] when the terrain has one point)."""
+    height_m at the runway-frame x; height_m[0] when the terrain has one point). raw: an array or a tuple."""
+    return _imu_point(raw, const, along_m, height_m, t_s, out)[0]
+
+
+@njit(cache=True)
+def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: float,
+               out: Array) -> tuple[float, float, float]:
+    """imu_point_row, returning (terrain height (m), the CG's Earth-relative body rates p, q (rad/s))."""
     lat, lon, h_ft = raw[0], raw[1], raw[2]
     vn_f, ve_f, vd_f = raw[3], raw[4], raw[5]
     phi, th, psi = raw[6], raw[7], raw[8]
     pi_, qi, ri = raw[9], raw[10], raw[11]
-    p, q, r = raw[12], raw[13], raw[14]
-    pid, qid, rid = raw[15], raw[16], raw[17]
-    fx, fy, fz, m = raw[18], raw[19], raw[20], raw[21]
-    p_psf, t_r, vc_kt = raw[22], raw[23], raw[24]
+    pid, qid, rid = raw[12], raw[13], raw[14]
+    fx, fy, fz, m = raw[15], raw[16], raw[17], raw[18]
+    p_psf, t_r, vc_kt = raw[19], raw[20], raw[21]
     lx, ly, lz, r_n, r_e = const[0], const[1], const[2], const[3], const[4]
     ox, oy, oz = const[5], const[6], const[7]
     c00, c01, c02, c10, c11, c12 = const[8], const[9], const[10], const[11], const[12], const[13]
@@ -103,6 +132,10 @@ def imu_point_row(raw: Array, const: Array, along_m: Array, height_m: Array, t_s
     n00, n01, n02 = ct * cp, sf * st * cp - cf * sp, cf * st * cp + sf * sp
     n10, n11, n12 = ct * sp, sf * st * sp + cf * cp, cf * st * sp - sf * cp
     n20, n21, n22 = -st, sf * ct, cf * ct
+    # Earth-relative body rates w_eb = w_ib - C_nb' w_ie (earth_rates)
+    s_lat, c_lat = math.sin(lat), math.cos(lat)
+    wn_e, wd_e = _OMEGA * c_lat, -_OMEGA * s_lat
+    p, q, r = pi_ - (n00 * wn_e + n20 * wd_e), qi - (n01 * wn_e + n21 * wd_e), ri - (n02 * wn_e + n22 * wd_e)
     # lever-arm terms: w_eb x l (velocity); w x l with the inertial rate (specific force)
     ux, uy, uz = q * lz - r * ly, r * lx - p * lz, p * ly - q * lx
     wx, wy, wz = qi * lz - ri * ly, ri * lx - pi_ * lz, pi_ * ly - qi * lx
@@ -124,11 +157,12 @@ def imu_point_row(raw: Array, const: Array, along_m: Array, height_m: Array, t_s
     de = n10 * lx + n11 * ly + n12 * lz
     dd = n20 * lx + n21 * ly + n22 * lz
     lat_i = lat + dn / (r_n + h)
-    lon_i = lon + de / ((r_e + h) * math.cos(lat))
+    lon_i = lon + de / ((r_e + h) * c_lat)
     h_i = h - dd
     x_e, y_e, z_e = gk.geodetic_to_ecef(lat_i, lon_i, h_i)
     # gravitation gradient over the lever arm, GM/r^3 (l - 3 d_D C_nb' e_D) (J2 part < 1e-8 m/s^2)
-    kg = _GM / (x_e * x_e + y_e * y_e + z_e * z_e) ** 1.5
+    r2 = x_e * x_e + y_e * y_e + z_e * z_e
+    kg = _GM / (r2 * math.sqrt(r2))
     fbx += kg * (lx - 3.0 * dd * n20)
     fby += kg * (ly - 3.0 * dd * n21)
     fbz += kg * (lz - 3.0 * dd * n22)
@@ -146,7 +180,7 @@ def imu_point_row(raw: Array, const: Array, along_m: Array, height_m: Array, t_s
     fbx, fby, fbz = (fbx - c1 * qx + c2 * (py * qz - pz * qy), fby - c1 * qy + c2 * (pz * qx - px * qz),
                      fbz - c1 * qz + c2 * (px * qy - py * qx))
     # the IMU point's own NED axes, x_imu = (I - [t x]) x_cg
-    ta, tb, tc = de / (r_e + h), -dn / (r_n + h), -de * math.tan(lat) / (r_e + h)
+    ta, tb, tc = de / (r_e + h), -dn / (r_n + h), -de * (s_lat / c_lat) / (r_e + h)
     vn, ve, vd = vn - tb * vd + tc * ve, ve - tc * vn + ta * vd, vd - ta * ve + tb * vn
     m00, m10, m20 = n00 - tb * n20 + tc * n10, n10 - tc * n00 + ta * n20, n20 - ta * n10 + tb * n00
     m21, m22 = n21 - ta * n11 + tb * n01, n22 - ta * n12 + tb * n02
@@ -179,15 +213,33 @@ def imu_point_row(raw: Array, const: Array, along_m: Array, height_m: Array, t_s
     out[26], out[27], out[28] = xr, yr, zr
     out[29], out[30] = zr - (tch - xr * tan_gp), yr
     out[35] = vc_kt * _KT
-    return terr
+    return terr, p, q
 
 
 def _cross(a: Array, b: Array) -> Array:
     return np.cross(a, b)
 
 
+def earth_rates_reference(raw: Array) -> Array:
+    """JSBSim's Earth-relative body rates p, q, r (velocities/p-rad_sec, ...) from reads in RAW_FIELDS order, (n, 3)
+    rad/s: w_eb = w_ib - C_nb' w_ie, w_ie = Omega (cos L, 0, -sin L) in JSBSim's local NED, whose latitude is the
+    geodetic one (FGLocation's local frame), Omega = geo.OMEGA_JSBSIM; C_nb from the Euler angles.
+
+    JSBSim computes vPQR = vPQRi - Ti2b (0, 0, Omega) (FGPropagate::Run) with Ti2b from its ECI quaternion, which
+    it renormalizes only when |1 - |q|| reaches 1e-10 (FGQuaternion::Normalize): its Ti2b is scaled by |q|^2, so
+    its p, q, r differ from these by up to 2e-10 Omega = 1.5e-14 rad/s (tests/integration/test_flight_reads.py)."""
+    raw = np.atleast_2d(np.asarray(raw, dtype=float))
+    lat, phi, th, psi = raw[:, 0], raw[:, 6], raw[:, 7], raw[:, 8]
+    w_ie = _OMEGA * np.stack([np.cos(lat), np.zeros_like(lat), -np.sin(lat)], axis=1)
+    cr, sr, cp, sp, cy, sy = np.cos(phi), np.sin(phi), np.cos(th), np.sin(th), np.cos(psi), np.sin(psi)
+    c_nb = np.stack([np.stack([cp * cy, sr * sp * cy - cr * sy, cr * sp * cy + sr * sy], -1),
+                     np.stack([cp * sy, sr * sp * sy + cr * cy, cr * sp * sy - sr * cy], -1),
+                     np.stack([-sp, sr * cp, cr * cp], -1)], -2)
+    return raw[:, 9:12] - np.einsum("nji,nj->ni", c_nb, w_ie)
+
+
 def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m: Array, t_s: Array) -> Array:
-    """`imu_point_row` for many steps at once in vectorized numpy (the kernel's test oracle): raw (n, 27) in
+    """`imu_point_row` for many steps at once in vectorized numpy (the kernel's test oracle): raw (n, 24) in
     RAW_FIELDS order, t_s (n,); returns (n, 36) rows with columns 0-30 and 35 filled (NaN elsewhere).
 
     Written with matrices and np.cross rather than the kernel's scalar expressions, so that it checks them."""
@@ -201,8 +253,8 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
     lat, lon, h = raw[:, 0], raw[:, 1], raw[:, 2] * _FT
     v_cg = raw[:, 3:6] * _FPS
     eul = raw[:, 6:9]
-    w_ib, w_eb, w_dot = raw[:, 9:12], raw[:, 12:15], raw[:, 15:18]
-    f_cg = raw[:, 18:21] * (_LBF_PER_SLUG / raw[:, 21:22])
+    w_ib, w_dot = raw[:, 9:12], raw[:, 12:15]
+    f_cg = raw[:, 15:18] * (_LBF_PER_SLUG / raw[:, 18:19])
     cr, sr = np.cos(eul[:, 0]), np.sin(eul[:, 0])
     cp, sp = np.cos(eul[:, 1]), np.sin(eul[:, 1])
     cy, sy = np.cos(eul[:, 2]), np.sin(eul[:, 2])
@@ -210,6 +262,7 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
                      np.stack([cp * sy, sr * sp * sy + cr * cy, cr * sp * sy - sr * cy], -1),
                      np.stack([-sp, sr * cp, cr * cp], -1)], -2)  # body -> NED, (n, 3, 3)
     l_b = np.broadcast_to(lev, (n, 3))
+    w_eb = earth_rates_reference(raw)
     e = 0.5 * dt * w_ib
     a = _cross(w_ib + dt * w_dot, l_b)  # w1 x l
     b = _cross(e, a)
@@ -237,7 +290,7 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
     roll = np.arctan2(m_nb[:, 2, 1], m_nb[:, 2, 2])
     pitch = -np.arcsin(m_nb[:, 2, 0])
     yaw = eul[:, 2] + np.remainder(np.arctan2(m_nb[:, 1, 0], m_nb[:, 0, 0]) - eul[:, 2] + np.pi, 2.0 * np.pi) - np.pi
-    p_imu = raw[:, 22] * _PSF * np.exp(d[:, 2] * _G0_OVER_R / (raw[:, 23] / _RANKINE))
+    p_imu = raw[:, 19] * _PSF * np.exp(d[:, 2] * _G0_OVER_R / (raw[:, 20] / _RANKINE))
     xy = (r - origin) @ c_rwy2.T
     zr = h_i - h_thr
     terr = np.full(n, height_m[0]) if len(height_m) == 1 else np.interp(xy[:, 0], along_m, height_m)
@@ -251,8 +304,431 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
     out[:, 4:7], out[:, 7:10], out[:, 10:14] = r, v, q
     out[:, 14], out[:, 15], out[:, 16] = roll, pitch, yaw
     out[:, 17:20], out[:, 20:23] = w_ib, f
-    out[:, 23], out[:, 24], out[:, 25] = p_imu, raw[:, 23] / _RANKINE, h_i - terr
+    out[:, 23], out[:, 24], out[:, 25] = p_imu, raw[:, 20] / _RANKINE, h_i - terr
     out[:, 26], out[:, 27], out[:, 28] = xy[:, 0], xy[:, 1], zr
     out[:, 29], out[:, 30] = zr - (tch - xy[:, 0] * tan_gp), xy[:, 1]
-    out[:, 35] = raw[:, 24] * _KT
+    out[:, 35] = raw[:, 21] * _KT
     return out
+
+
+# --- the flight loop's per-step kernel: turbulence, autopilot, stabilized-approach monitor, termination -----------
+# Parameters and state live in plain float vectors; the names below are their indices. Each component has its own
+# small vectors (filled by its readable oracle: flight/turbulence.DrydenTurbulence, flight/autopilot.Autopilot,
+# flight/envelope.StabilityMonitor, method kernel_arrays()), and `fly_step` gets them concatenated (offsets P_*,
+# S_*), so one compiled call per step does everything that is not a JSBSim read or write.
+
+GEAR_FIELDS = ("gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW", "gear/unit[1]/AGL-ft",
+               "gear/unit[2]/AGL-ft")
+"""The gear state (nose, left main, right main weight on wheels; main-gear heights above the ground, ft), read
+only near the ground; `fly_step`'s raw tuple is RAW_FIELDS + GEAR_FIELDS."""
+GEAR_AIRBORNE = (0.0, 0.0, 0.0, math.inf, math.inf)
+"""GEAR_FIELDS' values standing in for reads far from the ground (no weight on wheels, gear infinitely high)."""
+N_RAW = len(RAW_FIELDS)
+LOW_READ_HEIGHT_M = 100.0
+"""IMU height above the terrain below which the gear state counts (the gear hangs about 4 m below it): above it
+`fly_step` takes the gear as GEAR_AIRBORNE, whatever it was given."""
+GEAR_READ_MARGIN_M = 30.0
+"""`fly_step` asks for the gear reads at the next step from LOW_READ_HEIGHT_M + this margin down, so that they are
+there whenever the IMU is below LOW_READ_HEIGHT_M (at any vertical speed below margin / dt: 3600 m/s at 120 Hz)."""
+
+# autopilot: parameters (the gains in AP_GAINS order, then trim, geometry, step) and state
+AP_GAINS = ("k_theta", "k_q", "k_gs_p", "k_gs_d", "k_gs_i", "k_v_p", "k_v_i", "tau_v_s", "k_phi", "k_p", "k_beta",
+            "k_loc_p", "k_loc_d", "k_loc_i", "bank_limit_rad", "pitch_limit_rad", "tau_wind_s", "flare_height_m",
+            "flare_tau_s", "touchdown_sink_mps", "k_flare", "k_flare_i", "retard_height_m")
+"""flight.design.AutopilotGains fields, in the order of the autopilot parameter vector."""
+(AP_K_THETA, AP_K_Q, AP_K_GS_P, AP_K_GS_D, AP_K_GS_I, AP_K_V_P, AP_K_V_I, AP_TAU_V, AP_K_PHI, AP_K_P, AP_K_BETA,
+ AP_K_LOC_P, AP_K_LOC_D, AP_K_LOC_I, AP_BANK_LIMIT, AP_PITCH_LIMIT, AP_TAU_WIND, AP_FLARE_H, AP_FLARE_TAU, AP_TD_SINK,
+ AP_K_FLARE, AP_K_FLARE_I, AP_RETARD_H, AP_THETA0, AP_THR0, AP_CAS0, AP_CH, AP_SH, AP_TAN_GP, AP_TCH, AP_CONV,
+ AP_DT) = range(32)
+N_AP_PAR = 32
+(APS_INT_D, APS_INT_Y, APS_E_F, APS_WIND, APS_INT_E, APS_FLARING, APS_THETA_FLARE0, APS_INT_FLARE,
+ APS_THETA_C) = range(9)
+N_AP_STATE = 9
+
+# Dryden turbulence: parameters (W20, dt, wind-axes rotation, the intensity table's altitudes and the level's row)
+(TB_W20, TB_DT, TB_COS, TB_SIN) = range(4)
+N_POE = len(POE_ALT_FT)
+TB_ALT = 4
+TB_SIGMA = TB_ALT + N_POE
+N_TB_PAR = TB_SIGMA + N_POE
+(TBS_XI_U, TBS_XI_V, TBS_XI_W, TBS_VALID, TBS_AU, TBS_BU, TBS_AV, TBS_BV, TBS_AW, TBS_BW) = range(10)
+N_TB_STATE = 10
+
+# stabilized-approach monitor: parameters, state; its ring buffer is [speed (n) | sink (m) | sink excess (m)]
+(MN_TAN_GP, MN_GS_DOT_TAN, MN_X_GP, MN_X_FLOOR, MN_LOC_DOT_TAN, MN_TCH, MN_TARGET, MN_N, MN_M) = range(9)
+N_MN_PAR = 9
+(MNS_I, MNS_J, MNS_COUNT, MNS_SUM_CAS, MNS_SUM_SINK, MNS_SUM_EXCESS) = range(6)
+N_MN_STATE = 6
+# the step: its own parameters and state, then the components' at these offsets
+(F_PITCH_TRIM, F_STOP_H, F_LAND, F_TAN_GP, F_TCH, F_MON_FLOOR, F_WIND_N, F_WIND_E, F_TURBULENT,
+ F_N_TERRAIN) = range(10)
+N_F_PAR = 10
+P_IMU = 0
+P_STEP = P_IMU + N_CONST
+P_AP = P_STEP + N_F_PAR
+P_TB = P_AP + N_AP_PAR
+P_MN = P_TB + N_TB_PAR
+P_TERRAIN = P_MN + N_MN_PAR
+"""The terrain profile ends the parameter vector: F_N_TERRAIN along-track distances, then as many heights (m)."""
+(FS_DE, FS_DA, FS_DR, FS_THR, FS_LOWEST, FS_TD_X, FS_TD_SINK, FS_MON, FS_MON_Z, FS_MON_A, FS_MON_B,
+ FS_PHI, FS_THETA, FS_P, FS_Q, FS_BETA, FS_CAS, FS_H_GEAR, FS_TAS) = range(19)
+N_F_STATE = 19
+S_STEP = 0
+S_AP = S_STEP + N_F_STATE
+S_TB = S_AP + N_AP_STATE
+S_MN = S_TB + N_TB_STATE
+S_RING = S_MN + N_MN_STATE
+"""The monitor's windows end the state vector."""
+
+TERM_NONE, TERM_STOP, TERM_TOUCHDOWN, TERM_SHORT, TERM_GROUND, TERM_DIVERGED, TERM_UNSTABLE = range(7)
+"""`fly_step`'s termination codes (flight/run.termination_reason words them)."""
+DIVERGED_BANK_RAD = 1.0
+DIVERGED_VERTICAL_M = 300.0
+DIVERGED_LATERAL_M = 1500.0
+"""A run has diverged beyond these: bank, distance from the glidepath, from the centreline."""
+CONTROLS_COL = 31
+"""First of the Truth row's four control columns (elevator incl. pitch trim, aileron, rudder, throttle)."""
+
+
+@njit(cache=True)
+def _clip1(u: float) -> float:
+    return 1.0 if u > 1.0 else (-1.0 if u < -1.0 else u)
+
+
+@njit(cache=True)
+def autopilot_step(par: Array, st: Array, x: float, y: float, z: float, vn: float, ve: float, vd: float,
+                   phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float,
+                   tas: float) -> tuple[float, float, float, float]:
+    """One autopilot step (flight/autopilot.Autopilot.step, the oracle, whose module docstring has the laws):
+    guidance position (runway frame, m), NED velocity (m/s), attitude (rad), body rates (rad/s), sideslip (rad),
+    CAS (m/s), main-gear height (m; nan: no flare), TAS (m/s; nan: no speed complement) -> elevator, aileron,
+    rudder, throttle. par: AP_* parameters, st: APS_* state (updated)."""
+    dt = par[AP_DT]
+    if tas > 1.0:  # inertially smoothed speed
+        gs = math.sqrt(vn * vn + ve * ve + vd * vd)
+        if st[APS_WIND] != st[APS_WIND]:
+            st[APS_WIND] = tas - gs
+        st[APS_WIND] += dt / par[AP_TAU_WIND] * (tas - gs - st[APS_WIND])
+        cas = cas * (gs + st[APS_WIND]) / tas
+    # glidepath and cross-track deviations, the runway axes turned by the meridian convergence
+    ch, sh, tan_gp = par[AP_CH], par[AP_SH], par[AP_TAN_GP]
+    conv = (x * sh + y * ch) * par[AP_CONV]
+    x0 = vn * ch + ve * sh
+    y0 = -vn * sh + ve * ch
+    d = z - (par[AP_TCH] - x * tan_gp)
+    d_dot = -vd + (x0 + conv * y0) * tan_gp
+    y_dot = y0 - conv * x0
+    # glidepath -> pitch command (integral frozen while the command is limited)
+    th_off = -(par[AP_K_GS_P] * d + par[AP_K_GS_D] * d_dot + par[AP_K_GS_I] * st[APS_INT_D])
+    lim = par[AP_PITCH_LIMIT]
+    if -lim < th_off < lim:
+        st[APS_INT_D] += d * dt
+    else:
+        th_off = lim if th_off > 0.0 else -lim
+    theta_c = par[AP_THETA0] + th_off
+    flare = h_gear == h_gear and (st[APS_FLARING] != 0.0 or h_gear <= par[AP_FLARE_H])
+    thr_flare = 1.0
+    if flare:  # sink-rate command -(h_gear / tau + sink_td) from the pitch command at flare entry
+        if st[APS_FLARING] == 0.0:
+            st[APS_FLARING] = 1.0
+            st[APS_THETA_FLARE0] = st[APS_THETA_C]
+        h_dot = -vd
+        e = -(max(h_gear, 0.0) / par[AP_FLARE_TAU] + par[AP_TD_SINK]) - h_dot
+        st[APS_INT_FLARE] += e * dt
+        theta_c = st[APS_THETA_FLARE0] + par[AP_K_FLARE] * e + par[AP_K_FLARE_I] * st[APS_INT_FLARE]
+        thr_flare = 1.0 if h_gear > par[AP_RETARD_H] else 0.0
+    st[APS_THETA_C] = theta_c
+    de = -par[AP_K_THETA] * (theta_c - theta) + par[AP_K_Q] * q
+    # autothrottle on the filtered speed error (integral frozen at saturation)
+    st[APS_E_F] += dt / par[AP_TAU_V] * (par[AP_CAS0] - cas - st[APS_E_F])
+    thr = par[AP_THR0] + par[AP_K_V_P] * st[APS_E_F] + par[AP_K_V_I] * st[APS_INT_E]
+    if 0.0 < thr < 1.0:
+        st[APS_INT_E] += st[APS_E_F] * dt
+    else:
+        thr = 1.0 if thr >= 1.0 else 0.0
+    if flare:
+        thr = min(thr, thr_flare)
+    # localizer -> bank command
+    phi_c = -(par[AP_K_LOC_P] * y + par[AP_K_LOC_D] * y_dot + par[AP_K_LOC_I] * st[APS_INT_Y])
+    blim = par[AP_BANK_LIMIT]
+    if -blim < phi_c < blim:
+        st[APS_INT_Y] += y * dt
+    else:
+        phi_c = blim if phi_c > 0.0 else -blim
+    da = par[AP_K_PHI] * (phi_c - phi) - par[AP_K_P] * p
+    dr = -par[AP_K_BETA] * beta
+    return _clip1(de), _clip1(da), _clip1(dr), thr
+
+
+@njit(cache=True)
+def dryden_scales(h_ft: float, w20_fps: float, alt_ft: Array, sigma_fps: Array) -> tuple[float, float, float, float]:
+    """Scale lengths L_u, L_w (ft) and intensities sigma_u, sigma_w (ft/s) at height h_ft above the ground
+    (flight/turbulence.scales, the oracle): MIL-F-8785C low-altitude model below 1000 ft, the level's
+    probability-of-exceedance row sigma_fps at alt_ft above 2000 ft, linear in between; heights clipped at 10 ft."""
+    h = max(h_ft, 10.0)
+    if h <= 1000.0:
+        den = 0.177 + 0.000823 * h
+        sig_w = 0.1 * w20_fps
+        return h / den**1.2, h, sig_w / den**0.4, sig_w
+    # piecewise-linear interpolation of the table, held at its ends
+    n = alt_ft.shape[0]
+    if h <= alt_ft[0]:
+        sig_hi = sigma_fps[0]
+    else:
+        i = 0
+        while i < n and alt_ft[i] <= h:  # bisect_right
+            i += 1
+        if i >= n:
+            sig_hi = sigma_fps[n - 1]
+        else:
+            x0, x1 = alt_ft[i - 1], alt_ft[i]
+            sig_hi = sigma_fps[i - 1] + (h - x0) / (x1 - x0) * (sigma_fps[i] - sigma_fps[i - 1])
+    if h <= 2000.0:
+        f = (h - 1000.0) / 1000.0
+        L = 1000.0 + f * 750.0
+        s = 0.1 * w20_fps + f * (sig_hi - 0.1 * w20_fps)
+        return L, L, s, s
+    return 1750.0, 1750.0, sig_hi, sig_hi
+
+
+@njit(cache=True)
+def dryden_step(par: Array, st: Array, nu: Array, k: int, h_agl_m: float,
+                v_true_mps: float) -> tuple[float, float, float]:
+    """Turbulence velocity at step k (NED, m/s) at height h_agl_m above the terrain and true airspeed v_true_mps
+    (flight/turbulence.DrydenTurbulence.step, the oracle): Yeager 1998 eqs. 30-32,
+        xi_u <- (1 - T/tau_u) xi_u + sigma_u sqrt(2T/tau_u) nu_u,  xi_v, xi_w with 2T/tau, sqrt(4T/tau), tau = L / V,
+    the coefficients re-evaluated every COEFF_EVERY steps; nu (n, 3) the run's white noise. par: TB_*, st: TBS_*."""
+    if k % COEFF_EVERY == 0 or st[TBS_VALID] == 0.0:
+        L_u, L_w, sig_u, sig_w = dryden_scales(h_agl_m / _FT, par[TB_W20], par[TB_ALT:TB_ALT + N_POE],
+                                               par[TB_SIGMA:TB_SIGMA + N_POE])
+        V = max(v_true_mps / _FPS, 1.0)
+        T = par[TB_DT]
+        tu = L_u / V
+        tw = L_w / V
+        st[TBS_AU], st[TBS_BU] = 1.0 - T / tu, sig_u * math.sqrt(2.0 * T / tu)
+        st[TBS_AV], st[TBS_BV] = 1.0 - 2.0 * T / tu, sig_u * math.sqrt(4.0 * T / tu)
+        st[TBS_AW], st[TBS_BW] = 1.0 - 2.0 * T / tw, sig_w * math.sqrt(4.0 * T / tw)
+        st[TBS_VALID] = 1.0
+    xu = st[TBS_XI_U] = st[TBS_AU] * st[TBS_XI_U] + st[TBS_BU] * nu[k, 0]
+    xv = st[TBS_XI_V] = st[TBS_AV] * st[TBS_XI_V] + st[TBS_BV] * nu[k, 1]
+    xw = st[TBS_XI_W] = st[TBS_AW] * st[TBS_XI_W] + st[TBS_BW] * nu[k, 2]
+    c, s = par[TB_COS], par[TB_SIN]
+    # from wind axes (u along the direction the wind blows to, v to its right) to NED
+    return c * xu - s * xv, s * xu + c * xv, xw * _FPS
+
+
+@njit(cache=True)
+def monitor_step(par: Array, st: Array, ring: Array, x_m: float, y_m: float, z_m: float, cas_mps: float,
+                 v_down_mps: float, ground_speed_mps: float) -> tuple[int, float, float]:
+    """One step of the stabilized-approach monitor (flight/envelope.StabilityMonitor.step, the oracle, whose module
+    docstring has the criterion): true position (runway frame, m), air-mass speed as CAS, down velocity and
+    horizontal ground speed (m/s) -> (MON_* result, its two figures): glidepath / localizer deviation in dots,
+    3 s mean speed minus the target (m/s), or the 10 s mean sink rate and its excess over the glidepath's (m/s).
+    par: MN_*, st: MNS_*, ring: the speed, sink and excess windows (updated)."""
+    n, m = int(par[MN_N]), int(par[MN_M])
+    i, j = int(st[MNS_I]), int(st[MNS_J])
+    excess = v_down_mps - ground_speed_mps * par[MN_TAN_GP]  # sink beyond what the glidepath needs
+    st[MNS_SUM_CAS] += cas_mps - ring[i]
+    st[MNS_SUM_SINK] += v_down_mps - ring[n + j]
+    st[MNS_SUM_EXCESS] += excess - ring[n + m + j]
+    ring[i] = cas_mps
+    ring[n + j], ring[n + m + j] = v_down_mps, excess
+    st[MNS_I] = (i + 1) % n
+    st[MNS_J] = (j + 1) % m
+    st[MNS_COUNT] += 1.0
+    if z_m > STABILIZATION_HEIGHT_M:
+        return MON_OK, 0.0, 0.0
+    # deviations in dots: the glide path's angular dot held at its 200 ft size below, the localizer's angular
+    d = z_m - (par[MN_TCH] - x_m * par[MN_TAN_GP])
+    r_gp = max(par[MN_X_GP] - min(x_m, par[MN_X_FLOOR]), 1.0)
+    gs_dots = d / (r_gp * par[MN_GS_DOT_TAN])
+    loc_dots = y_m / ((LOC_ANTENNA_PAST_THRESHOLD_M - x_m) * par[MN_LOC_DOT_TAN])
+    if abs(gs_dots) > 1.0:
+        return MON_GLIDEPATH, gs_dots, 0.0
+    if abs(loc_dots) > 1.0:
+        return MON_LOCALIZER, loc_dots, 0.0
+    if st[MNS_COUNT] < n:
+        return MON_OK, 0.0, 0.0
+    dv = st[MNS_SUM_CAS] / n - par[MN_TARGET]
+    if dv > SPEED_HIGH_MPS or dv < -SPEED_LOW_MPS:
+        return MON_SPEED, dv, 0.0
+    if st[MNS_COUNT] < m:
+        return MON_OK, 0.0, 0.0
+    sink, excess = st[MNS_SUM_SINK] / m, st[MNS_SUM_EXCESS] / m
+    if sink > SINK_LIMIT_MPS and excess > SINK_TOLERANCE_MPS:
+        return MON_SINK, sink, excess
+    return MON_OK, 0.0, 0.0
+
+
+@njit(cache=True)
+def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, x: float, y: float, z: float,
+                vn: float, ve: float, vd: float, h_agl: float, phi: float, wow_nose: float, wow_left: float,
+                wow_right: float, vn_cg: float, ve_cg: float, vd_cg: float, cas: float, tas: float) -> int:
+    """Why the run ends at this step (TERM_*; TERM_NONE: it goes on), checked in this order on the true state:
+    the IMU at the stop height; (landing runs) a main gear on the ground with the nose gear in the air: touchdown,
+    short of the threshold when x < 0; anything else on the ground or the IMU at the terrain; divergence (bank,
+    distance from the glidepath or the centreline); below WATCH_HEIGHT_M (above the flare on landing runs) the
+    stabilized-approach monitor, fed the speed through the mean air mass (CG ground velocity minus the steady
+    wind) as CAS with JSBSim's CAS/TAS ratio. Position x, y, z (runway frame), velocity (IMU, NED) and height
+    above the terrain in m, m/s; wow_* JSBSim's weight-on-wheels; CG velocity, CAS and TAS in m/s.
+    fpar, fst: the step's F_* parameters and FS_* state (touchdown and monitor figures are stored there)."""
+    if z <= fpar[F_STOP_H]:
+        return TERM_STOP
+    if fpar[F_LAND] != 0.0 and (wow_left > 0.0 or wow_right > 0.0) and wow_nose == 0.0:
+        fst[FS_TD_X], fst[FS_TD_SINK] = x, vd
+        return TERM_TOUCHDOWN if x >= 0.0 else TERM_SHORT
+    if wow_nose > 0.0 or wow_left > 0.0 or wow_right > 0.0 or h_agl <= 0.0:
+        return TERM_GROUND
+    if (abs(phi) > DIVERGED_BANK_RAD or abs(z - (fpar[F_TCH] - x * fpar[F_TAN_GP])) > DIVERGED_VERTICAL_M
+            or abs(y) > DIVERGED_LATERAL_M):
+        return TERM_DIVERGED
+    if fpar[F_MON_FLOOR] < z < WATCH_HEIGHT_M:
+        an, ae = vn_cg - fpar[F_WIND_N], ve_cg - fpar[F_WIND_E]
+        v_air = math.sqrt(an * an + ae * ae + vd_cg ** 2)
+        result, a, b = monitor_step(mpar, mst, ring, x, y, z, v_air * cas / tas, vd, math.sqrt(vn * vn + ve * ve))
+        if result != MON_OK:
+            fst[FS_MON], fst[FS_MON_Z], fst[FS_MON_A], fst[FS_MON_B] = result, z, a, b
+            return TERM_UNSTABLE
+    return TERM_NONE
+
+
+@njit(cache=True)
+def _control(par: Array, st: Array, row: Array, x: float, y: float, z: float, vn: float, ve: float, vd: float,
+             phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float,
+             tas: float) -> tuple[float, float, float, float]:
+    """The autopilot on guidance (x, y, z, vn, ve, vd); the commands go into the row and the step's state."""
+    de, da, dr, thr = autopilot_step(par[P_AP:P_AP + N_AP_PAR], st[S_AP:S_AP + N_AP_STATE], x, y, z, vn, ve, vd,
+                                     phi, theta, p, q, beta, cas, h_gear, tas)
+    row[CONTROLS_COL] = de + par[P_STEP + F_PITCH_TRIM]
+    row[CONTROLS_COL + 1], row[CONTROLS_COL + 2], row[CONTROLS_COL + 3] = da, dr, thr
+    st[S_STEP + FS_DE], st[S_STEP + FS_DA], st[S_STEP + FS_DR], st[S_STEP + FS_THR] = de, da, dr, thr
+    return de, da, dr, thr
+
+
+@njit(cache=True)
+def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
+             guided: bool) -> tuple[int, float, float, float, float, float, float, float, float, bool]:
+    """Step k of the flight loop after JSBSim's step k: everything that is not a JSBSim read or write.
+
+    raw: the reads, RAW_FIELDS + GEAR_FIELDS (a tuple; the gear as GEAR_AIRBORNE when not read), JSBSim units.
+    Writes Truth row buf[k] (imu_point_row; the controls in force), then steps the turbulence at the CG's height
+    above the terrain (dryden_step, noise nu) and checks `termination` (incl. the monitor); with guided (the
+    autopilot flies on the truth) and no termination it runs the autopilot on row k (else `fly_control` does, on
+    the navigation source's guidance). par, st: the parameter and state vectors (P_*, S_* offsets; the terrain
+    profile and the monitor's windows at their ends: flight_vectors builds them).
+
+    Returns (TERM_* code, elevator, aileron, rudder, throttle (the commands to set for the next step; the ones in
+    force when not guided), gust north, east, down (ft/s, for JSBSim's atmosphere/gust-*-fps), terrain height
+    under the IMU (ft, for position/terrain-elevation-asl-ft), whether to read the gear at the next step).
+    """
+    row = buf[k]
+    fpar, fst = par[P_STEP:P_STEP + N_F_PAR], st[S_STEP:S_STEP + N_F_STATE]
+    nt = int(fpar[F_N_TERRAIN])
+    terr, p, q = _imu_point(raw, par[P_IMU:P_IMU + N_CONST], par[P_TERRAIN:P_TERRAIN + nt],
+                            par[P_TERRAIN + nt:P_TERRAIN + 2 * nt], k * par[P_IMU + N_CONST - 1], row)
+    vn_f, ve_f, vd_f, phi, theta = raw[_R_VN], raw[_R_VN + 1], raw[_R_VN + 2], raw[_R_PHI], raw[_R_PHI + 1]
+    cas, beta, tas = raw[_R_VC] * _KT, raw[_R_BETA], raw[_R_VT] * _FPS
+    vn, ve, vd, xr, yr, zr = row[7], row[8], row[9], row[26], row[27], row[28]
+    h_agl = row[3] - terr
+    if h_agl < LOW_READ_HEIGHT_M:  # the gear counts near the ground only
+        w0, w1, w2, g1_ft, g2_ft = raw[N_RAW], raw[N_RAW + 1], raw[N_RAW + 2], raw[N_RAW + 3], raw[N_RAW + 4]
+    else:
+        w0, w1, w2, g1_ft, g2_ft = GEAR_AIRBORNE
+    near = h_agl < LOW_READ_HEIGHT_M + GEAR_READ_MARGIN_M
+    gn = ge = gd = 0.0
+    if fpar[F_TURBULENT] != 0.0:  # turbulence for the next step, at the CG's height above the terrain
+        tn, te, td = dryden_step(par[P_TB:P_TB + N_TB_PAR], st[S_TB:S_TB + N_TB_STATE], nu, k,
+                                 raw[_R_H_FT] * _FT - terr, tas)
+        gn, ge, gd = tn / _FPS, te / _FPS, td / _FPS
+    # the controls of the previous step act on this row until replaced
+    row[CONTROLS_COL] = fst[FS_DE] + fpar[F_PITCH_TRIM]
+    row[CONTROLS_COL + 1], row[CONTROLS_COL + 2], row[CONTROLS_COL + 3] = fst[FS_DA], fst[FS_DR], fst[FS_THR]
+    if zr < fst[FS_LOWEST]:
+        fst[FS_LOWEST] = zr
+    code = termination(fpar, fst, par[P_MN:P_MN + N_MN_PAR], st[S_MN:S_MN + N_MN_STATE], st[S_RING:], xr, yr, zr,
+                       vn, ve, vd, h_agl, phi, w0, w1, w2, vn_f * _FPS, ve_f * _FPS, vd_f * _FPS, cas, tas)
+    h_gear = min(g1_ft, g2_ft) * _FT if fpar[F_LAND] != 0.0 else math.nan
+    # the inner loops' inputs of this step (fly_control's, when a navigation source guides)
+    fst[FS_PHI], fst[FS_THETA], fst[FS_P], fst[FS_Q], fst[FS_BETA] = phi, theta, p, q, beta
+    fst[FS_CAS], fst[FS_H_GEAR], fst[FS_TAS] = cas, h_gear, tas
+    if guided and code == TERM_NONE:
+        de, da, dr, thr = _control(par, st, row, xr, yr, zr, vn, ve, vd, phi, theta, p, q, beta, cas, h_gear, tas)
+    else:
+        de, da, dr, thr = fst[FS_DE], fst[FS_DA], fst[FS_DR], fst[FS_THR]
+    return code, de, da, dr, thr, gn, ge, gd, terr / _FT, near
+
+
+@njit(cache=True)
+def fly_control(k: int, guidance: Array, buf: Array, par: Array, st: Array) -> tuple[float, float, float, float]:
+    """The autopilot of step k on a navigation source's guidance (k, 0:6): runway-frame position (m) and NED
+    velocity (m/s), after fly_step(..., guided=False); returns elevator, aileron, rudder, throttle to set."""
+    g = guidance[k]
+    s = st[S_STEP:S_STEP + N_F_STATE]
+    return _control(par, st, buf[k], g[0], g[1], g[2], g[3], g[4], g[5], s[FS_PHI], s[FS_THETA], s[FS_P], s[FS_Q],
+                    s[FS_BETA], s[FS_CAS], s[FS_H_GEAR], s[FS_TAS])
+
+
+def autopilot_arrays(ap: Any) -> tuple[Array, Array]:
+    """(parameters, state) of the compiled autopilot (AP_*, APS_*) from its oracle (flight/autopilot.Autopilot)."""
+    par = [getattr(ap.g, name) for name in AP_GAINS]
+    par += [ap.trim.theta_rad, ap.trim.throttle, ap.trim.cas_mps, ap.ch, ap.sh, ap.tan_gp, ap.tch_m,
+            ap.conv_per_east_m, ap.dt]
+    return np.array(par, dtype=float), np.array(ap.state(), dtype=float)
+
+
+def dryden_arrays(turb: Any) -> tuple[Array, Array]:
+    """(parameters, state) of the compiled turbulence (TB_*, TBS_*) from its oracle
+    (flight/turbulence.DrydenTurbulence); its noise is turb.nu."""
+    par = [turb.w20_fps, turb.dt, turb.cos_fps, turb.sin_fps, *POE_ALT_FT, *POE_SIGMA_FPS[turb.index - 1]]
+    return np.array(par, dtype=float), np.array(turb.state(), dtype=float)
+
+
+def monitor_arrays(mon: Any) -> tuple[Array, Array, Array]:
+    """(parameters, state, windows) of the compiled stabilized-approach monitor (MN_*, MNS_*, the ring buffer)
+    from its oracle (flight/envelope.StabilityMonitor)."""
+    par = [mon.tan_gp, math.tan(mon.gs_dot_rad), mon.x_gp_m, mon.x_floor_m, math.tan(mon.loc_dot_rad), mon.tch_m,
+           mon.target_mps, float(mon.n), float(mon.m)]
+    return np.array(par, dtype=float), np.array(mon.state(), dtype=float), np.array(mon.windows(), dtype=float)
+
+
+def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, terrain_along_m: Array,
+                   terrain_height_m: Array, *, pitch_trim: float, stop_height_m: float, land: bool,
+                   monitor_floor_m: float, wind_ned_mps: tuple[float, float]) -> tuple[Array, Array]:
+    """fly_step's (par, st) for one flight: the IMU-point constants (imu_point_constants), the autopilot, monitor
+    and turbulence (None: calm air) of the run (their oracles, fresh), the terrain profile (along-track distances
+    and heights, m), the trimmed pitch trim (the elevator column of the Truth controls adds it), the stop height
+    above the threshold (m; -inf: none), landing run (flare, touchdown), the height above the threshold the
+    monitor stops at (m) and the steady wind (north, east, m/s; the air moves with it)."""
+    ap_par, ap_st = autopilot_arrays(ap)
+    mn_par, mn_st, ring = monitor_arrays(mon)
+    if turb is not None:
+        tb_par, tb_st = dryden_arrays(turb)
+    else:
+        tb_par, tb_st = np.zeros(N_TB_PAR), np.zeros(N_TB_STATE)
+    fpar = np.zeros(N_F_PAR)
+    fpar[F_PITCH_TRIM], fpar[F_STOP_H], fpar[F_LAND] = pitch_trim, stop_height_m, float(land)
+    fpar[F_TAN_GP], fpar[F_TCH] = ap.tan_gp, ap.tch_m
+    fpar[F_MON_FLOOR], fpar[F_WIND_N], fpar[F_WIND_E] = monitor_floor_m, wind_ned_mps[0], wind_ned_mps[1]
+    fpar[F_TURBULENT] = float(turb is not None)
+    fpar[F_N_TERRAIN] = len(terrain_along_m)
+    fst = np.zeros(N_F_STATE)
+    fst[FS_THR] = ap.trim.throttle  # the trimmed controls are in force at row 0
+    fst[FS_LOWEST] = math.inf
+    fst[FS_TD_X] = fst[FS_TD_SINK] = math.nan
+    par = np.concatenate([np.asarray(const, dtype=float), fpar, ap_par, tb_par, mn_par,
+                          np.asarray(terrain_along_m, dtype=float), np.asarray(terrain_height_m, dtype=float)])
+    st = np.concatenate([fst, ap_st, tb_st, mn_st, ring])
+    return par, st
+
+
+@njit(cache=True)
+def split_rows(buf: Array, n: int, cols: Array, outs: Any) -> None:
+    """outs[f][k, j] = buf[k, cols[f] + j] for rows k < n: the row buffer's fields as contiguous arrays, in one pass
+    over its rows (a column-by-column copy reads the whole buffer once per field). outs: a tuple of (n, w) arrays."""
+    for k in range(n):
+        row = buf[k]
+        for f in range(len(outs)):
+            o = outs[f]
+            c = cols[f]
+            for j in range(o.shape[1]):
+                o[k, j] = row[c + j]

@@ -21,6 +21,15 @@ below 1000 ft (flight.envelope's monitor), ground contact, a touchdown short of 
 timeout (`FlightResult.ok` / `failure`). The Truth arrays are preallocated for the longest permitted run (NaN
 until written) and trimmed at the end; a navigation source sees that record and may read rows <= k only.
 
+One loop serves both: per step JSBSim's reads (one LoopIO of flight/fdm.py, bound per run), one compiled call
+(flight/kernels.fly_step: the Truth row, the Dryden turbulence, the termination checks with the stabilized-approach
+monitor and, when the truth guides, the autopilot), the writes (controls, gusts, terrain) and JSBSim's next step.
+With a navigation source, fly_step stops after the termination checks, the source steps on row k, and
+kernels.fly_control runs the autopilot on its guidance. The autopilot, turbulence and monitor are compiled twins of
+flight/autopilot.py, flight/turbulence.py and flight/envelope.py, which stay the readable oracles (equal bit for
+bit, tests/unit/flight/test_flight_loop_kernels.py) and fill the kernels' parameter and state vectors. Why a run
+ended is a code during the loop, worded after it (termination_reason).
+
 Truth is of the IMU point (aircraft file [imu]), one row per step from the compiled kernel of flight/kernels.py:
 position, velocity and specific force are moved from the CG with the rigid-body lever-arm terms (f_imu = f_cg +
 w_ib' x l + w_ib x (w_ib x l), in the exact form of JSBSim's Euler step, plus the gravitation gradient; v_imu =
@@ -32,18 +41,22 @@ docs/truth.md says why each term is there.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
+import numba
 import numpy as np
 
 from approachsim import units
 from approachsim.config import ProfileError
+from approachsim.flight import kernels as fk
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import Linearization
-from approachsim.flight.envelope import WATCH_HEIGHT_M, StabilityMonitor, check_envelope
+from approachsim.flight.envelope import StabilityMonitor, check_envelope, unstabilized_reason
 from approachsim.flight.fdm import FDM, InitialCondition, TrimError
-from approachsim.flight.kernels import RAW_FIELDS, imu_point_constants, imu_point_row
+from approachsim.flight.kernels import imu_point_constants
 from approachsim.flight.trim import (
     CAS_TOLERANCE_MPS,
     PATH_TOLERANCE_RAD,
@@ -76,17 +89,18 @@ _COLS = {
     "t_s": (0, 1), "lat_rad": (1, 1), "lon_rad": (2, 1), "h_m": (3, 1), "r_ecef": (4, 3), "v_ned": (7, 3),
     "q_nb": (10, 4), "euler_rad": (14, 3), "w_ib_body": (17, 3), "f_body": (20, 3), "p_static_pa": (23, 1),
     "t_air_k": (24, 1), "h_agl_m": (25, 1), "r_rwy": (26, 3), "gs_dev_m": (29, 1), "loc_dev_m": (30, 1),
-    "controls": (31, 4), "airspeed_mps": (35, 1),
+    "controls": (fk.CONTROLS_COL, 4), "airspeed_mps": (35, 1),
 }
 _NCOL = 36
-_CTRL = 31
+_COL_STARTS = np.array([c for c, _ in _COLS.values()], dtype=np.int64)
 
-_READ = RAW_FIELDS
-"""The JSBSim properties read every step, in the kernel's order (flight/kernels.py)."""
-_READ_LOW = ("gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW", "gear/unit[1]/AGL-ft", "gear/unit[2]/AGL-ft")
-"""Read only below LOW_READ_HEIGHT_M: the gear (nose, left main, right main)."""
-LOW_READ_HEIGHT_M = 100.0
-"""IMU height above the terrain below which the gear state is read (the gear hangs about 4 m below it)."""
+
+def _final_truth(buf: Array, n: int, runway) -> Truth:
+    """The Truth of a flown run: the first n rows of the row buffer as one contiguous array per field."""
+    outs = tuple(np.empty((n, w)) for (c, w) in _COLS.values())
+    fk.split_rows(buf, n, _COL_STARTS, outs)
+    return Truth(**{name: (o[:, 0] if w == 1 else o) for (name, (c, w)), o in zip(_COLS.items(), outs, strict=True)},
+                 runway=runway)
 
 
 def _truth_views(buf: Array, runway) -> Truth:
@@ -205,8 +219,7 @@ class Approach:
         ac = self.aircraft
         rw = prof.runway
         dt = self.dt_s
-        src = TruthSource() if nav_source is None else nav_source
-        on_truth = type(src) is TruthSource
+        src = None if nav_source is None or type(nav_source) is TruthSource else nav_source
         ic = self.start()
         fdm = FDM(ac.jsbsim_model, dt)
         self._trim(fdm, ic)
@@ -220,145 +233,141 @@ class Approach:
             )
         turb_seed = stream_int(seed, run, "turbulence")
         fdm.set_seed(turb_seed)
-
         # time budget: twice the still-air time to the threshold, at least 60 s
         if max_time_s is None:
             max_time_s = max(60.0, 2.0 * rw.start_distance_m / ac.approach_speed_mps)
         n_max = int(math.ceil(max_time_s / dt)) + 1
-        env = prof.environment
-        turb = None
-        if env.turbulence != "none":
-            turb = DrydenTurbulence(env.turbulence, stream(seed, run, "turbulence"), n_max, dt,
-                                    env.wind_from_rad + math.pi)
-            set_tn, set_te, set_td = fdm.turbulence_setters()
-            turb_step = turb.step
+        io = fdm.loop_io(fk.RAW_FIELDS, fk.GEAR_FIELDS, fk.GEAR_AIRBORNE)
+        par, st, nu = self._kernel_vectors(fdm, ic, seed, run, n_max)
+        turbulent = par[fk.P_STEP + fk.F_TURBULENT] != 0.0
+        if turbulent:
+            io.gust_on()
+        hilly = par[fk.P_STEP + fk.F_N_TERRAIN] > 1
         buf = np.full((n_max, _NCOL), np.nan)
-        gbuf = None if on_truth else np.full((n_max, 6), np.nan)
         truth = _truth_views(buf, rw.frame)
+        guidance = None if src is None else np.full((n_max, 6), np.nan)
 
-        getters = [fdm.node(n).get_double_value for n in _READ]
-        getters_low = [fdm.node(n).get_double_value for n in _READ_LOW]
-        w0 = w1 = w2 = 0.0
-        g1_ft = g2_ft = math.inf
-        set_de = fdm.node("fcs/elevator-cmd-norm").set_double_value
-        set_da = fdm.node("fcs/aileron-cmd-norm").set_double_value
-        set_dr = fdm.node("fcs/rudder-cmd-norm").set_double_value
-        set_thr = [fdm.node(f"fcs/throttle-cmd-norm[{i}]").set_double_value for i in range(2)]
-        pitch_trim = fdm["fcs/pitch-trim-cmd-norm"]
-        terrain = prof.terrain
-        flat_terrain = len(terrain.along_m) == 1
-        terr_along = np.asarray(terrain.along_m, dtype=float)
-        terr_height = np.asarray(terrain.height_m, dtype=float)
-        set_terrain = fdm.node("position/terrain-elevation-asl-ft").set_double_value
+        # the loop: JSBSim's reads, one compiled call (fly_step: truth row, turbulence, termination and, guided by
+        # the truth, the autopilot), the writes, JSBSim's step; a navigation source sees row k between fly_step
+        # and the autopilot (fly_control)
+        guided = src is None
+        read, read_near, run_step = io.read, io.read_near, io.run
+        step = _entry(fk.fly_step, 0, (0.0,) * (fk.N_RAW + len(fk.GEAR_FIELDS)), buf, nu, par, st, guided)
+        control = None if guided else _entry(fk.fly_control, 0, guidance, buf, par, st)
+        set_de, set_da, set_dr, (set_thr0, set_thr1) = io.set_elevator, io.set_aileron, io.set_rudder, io.set_throttle
+        set_gn, set_ge, set_gd = io.set_gust_fps
+        set_terrain_ft = io.set_terrain_ft
+        code = fk.TERM_NONE
+        near = True
+        k = 0
+        for k in range(n_max):
+            code, de, da, dr, thr, gn, ge, gd, terr_ft, near = step(
+                k, read_near() if near else read(), buf, nu, par, st, guided)
+            if src is not None:
+                pos, vel = src.step(k, truth)
+                guidance[k, 0:3] = pos
+                guidance[k, 3:6] = vel
+                if code:
+                    break
+                de, da, dr, thr = control(k, guidance, buf, par, st)
+            elif code:
+                break
+            set_de(de)
+            set_da(da)
+            set_dr(dr)
+            set_thr0(thr)
+            set_thr1(thr)
+            if turbulent:
+                set_gn(gn)
+                set_ge(ge)
+                set_gd(gd)
+            if hilly:
+                set_terrain_ft(terr_ft)
+            run_step()  # JSBSim's step k + 1 (after the last permitted row: one step never read)
+        n = k + 1
+        final = _final_truth(buf, n, rw.frame)
+        if guidance is None:  # guided by the truth
+            g_r, g_v = final.r_rwy.copy(), final.v_ned.copy()
+        else:
+            g_r, g_v = np.ascontiguousarray(guidance[:n, 0:3]), np.ascontiguousarray(guidance[:n, 3:6])
+        fs = st[fk.S_STEP:fk.S_STEP + fk.N_F_STATE]
+        return FlightResult(
+            truth=final,
+            guidance_r_rwy=g_r,
+            guidance_v_ned=g_v,
+            termination=termination_reason(code, fs),
+            lowest_height_ft=float(fs[fk.FS_LOWEST]) / units.FT,
+            touchdown_x_m=float(fs[fk.FS_TD_X]),
+            touchdown_sink_mps=float(fs[fk.FS_TD_SINK]),
+            seed=seed,
+            run=run,
+            turbulence_seed=turb_seed,
+        )
 
-        # constants of the IMU-point kernel: lever arm (body axes, m; CG to IMU), geodesy, runway frame
+    def _kernel_vectors(self, fdm: FDM, ic: InitialCondition, seed: int, run: int,
+                        n_max: int) -> tuple[Array, Array, Array]:
+        """fly_step's parameter and state vectors and the turbulence noise for one run, from the
+        trimmed JSBSim instance and fresh oracles (autopilot, monitor, turbulence: their compiled twins start
+        from the oracles' state)."""
+        prof, ac, rw, dt = self.profile, self.aircraft, self.profile.runway, self.dt_s
+        env = prof.environment
+        # the IMU-point kernel's constants: lever arm (body axes, m; CG to IMU), geodesy, runway frame
         cg = (fdm["inertia/cg-x-in"], fdm["inertia/cg-y-in"], fdm["inertia/cg-z-in"])
         imu = ac.imu_location_struct_m
         IN = 0.0254
         lever = (cg[0] * IN - imu[0], imu[1] - cg[1] * IN, cg[2] * IN - imu[2])  # structural x aft / z up
         const = imu_point_constants(np.array(lever), ic.lat_rad, rw, dt)
-        raw = np.empty(len(_READ))
-        FT, FPS, KT = units.FT, units.FPS, units.KT
-        tan_gp = math.tan(rw.glidepath_rad)
-        tch = rw.tch_m
-        sqrt = math.sqrt
-
         trim = Trim(theta_rad=fdm["attitude/theta-rad"], throttle=fdm["fcs/throttle-cmd-norm[0]"],
                     cas_mps=ac.approach_speed_mps)
         ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m, rw.threshold_lat_rad), dt)
-        ap_step = ap.step
         monitor = StabilityMonitor(rw.glidepath_rad, rw.tch_m, ac.approach_speed_mps, dt)
-        mon_step = monitor.step
-        monitor_floor = ac.gains.flare_height_m if self.land else -math.inf  # the flare leaves the glidepath
-        w_n = -env.wind_speed_mps * math.cos(env.wind_from_rad)  # the steady wind (blowing towards from + pi), m/s
-        w_e = -env.wind_speed_mps * math.sin(env.wind_from_rad)
-        stop_h = self.stop_height_m
-        land = self.land
-        touchdown = (math.nan, math.nan)
-        run_step = fdm.run
-        termination = "timeout"
-        lowest = math.inf
-        k = 0
-        de = da = dr = 0.0
-        thr = trim.throttle
-        for k in range(n_max):
-            if k > 0:
-                run_step()
-            vals = [gv() for gv in getters]
-            raw[:] = vals
-            row = buf[k]
-            # the IMU point's truth row (flight/kernels.py: lever arm, gravitation terms, step-mean specific
-            # force, IMU-point NED axes, hydrostatic pressure, runway frame); returns the terrain under it
-            terr = imu_point_row(raw, const, terr_along, terr_height, k * dt, row)
-            (_lat, _lon, h_ft, vn_f, ve_f, vd_f, phi, th, _psi, _pi, _qi, _ri, p, q, _r, _pid, _qid, _rid,
-             _fx, _fy, _fz, _m, _p_psf, _t_r, vc_kt, beta, vt_fps) = vals
-            rv = row.tolist()
-            vn, ve, vd = rv[7], rv[8], rv[9]
-            h_i, xr, yr, zr = rv[3], rv[26], rv[27], rv[28]
-            cas = vc_kt * KT
-            if not flat_terrain:
-                set_terrain(terr / FT)
-            if h_i - terr < LOW_READ_HEIGHT_M:
-                w0, w1, w2, g1_ft, g2_ft = [gv() for gv in getters_low]
-            if turb is not None:  # turbulence for the next step, at the CG's height above the terrain
-                tn, te, td = turb_step(k, h_ft * FT - terr, vt_fps * FPS)
-                set_tn(tn)
-                set_te(te)
-                set_td(td)
-            # the controls of the previous step act on this row until replaced below
-            row[_CTRL], row[_CTRL + 1], row[_CTRL + 2], row[_CTRL + 3] = de + pitch_trim, da, dr, thr
-            # termination checks on the true state
-            if zr < lowest:
-                lowest = zr
-            term = None
-            if zr <= stop_h:
-                term = "reached stop height"
-            elif land and (w1 > 0.0 or w2 > 0.0) and w0 == 0.0:
-                term = "touchdown" if xr >= 0.0 else f"touchdown short of the threshold ({-xr / FT:.0f} ft)"
-                touchdown = (xr, vd)
-            elif w0 > 0.0 or w1 > 0.0 or w2 > 0.0 or h_i - terr <= 0.0:
-                term = "ground contact"
-            elif abs(phi) > 1.0 or abs(zr - (tch - xr * tan_gp)) > 300.0 or abs(yr) > 1500.0:
-                term = "diverged"
-            elif monitor_floor < zr < WATCH_HEIGHT_M:  # speed through the mean air mass (gusts removed), as CAS
-                an, ae = vn_f * FPS - w_n, ve_f * FPS - w_e
-                v_air = sqrt(an * an + ae * ae + (vd_f * FPS) ** 2)
-                term = mon_step(xr, yr, zr, v_air * cas / (vt_fps * FPS), vd, sqrt(vn * vn + ve * ve))
-            if on_truth:
-                gx, gy, gz, gvn, gve, gvd = xr, yr, zr, vn, ve, vd
-            else:  # the navigation source sees row k (and rows before it)
-                gr, gv = src.step(k, truth)
-                gx, gy, gz = float(gr[0]), float(gr[1]), float(gr[2])
-                gvn, gve, gvd = float(gv[0]), float(gv[1]), float(gv[2])
-                gbuf[k] = (gx, gy, gz, gvn, gve, gvd)
-            if term is not None:
-                termination = term
-                break
-            h_gear = min(g1_ft, g2_ft) * FT if land else None
-            de, da, dr, thr = ap_step(gx, gy, gz, gvn, gve, gvd, phi, th, p, q, beta, cas, h_gear, vt_fps * FPS)
-            row[_CTRL], row[_CTRL + 1], row[_CTRL + 2], row[_CTRL + 3] = de + pitch_trim, da, dr, thr
-            # the controls for the next step
-            set_de(de)
-            set_da(da)
-            set_dr(dr)
-            set_thr[0](thr)
-            set_thr[1](thr)
-        n = k + 1
-        if on_truth:
-            gbuf = np.concatenate([truth.r_rwy[:n], truth.v_ned[:n]], axis=1)
-        final = Truth(**{name: np.ascontiguousarray(v[:n]) for name, v in truth.arrays().items()}, runway=rw.frame)
-        return FlightResult(
-            truth=final,
-            guidance_r_rwy=np.ascontiguousarray(gbuf[:n, :3]),
-            guidance_v_ned=np.ascontiguousarray(gbuf[:n, 3:]),
-            termination=termination,
-            lowest_height_ft=lowest / FT,
-            touchdown_x_m=touchdown[0],
-            touchdown_sink_mps=touchdown[1],
-            seed=seed,
-            run=run,
-            turbulence_seed=turb_seed,
+        turb = None
+        nu = np.zeros((1, 3))
+        if env.turbulence != "none":
+            turb = DrydenTurbulence(env.turbulence, stream(seed, run, "turbulence"), n_max, dt,
+                                    env.wind_from_rad + math.pi)
+            nu = turb.nu
+        par, st = fk.flight_vectors(
+            const, ap, monitor, turb, np.asarray(prof.terrain.along_m, dtype=float),
+            np.asarray(prof.terrain.height_m, dtype=float),
+            pitch_trim=fdm["fcs/pitch-trim-cmd-norm"],
+            stop_height_m=self.stop_height_m,
+            land=self.land,
+            monitor_floor_m=ac.gains.flare_height_m if self.land else -math.inf,  # the flare leaves the glidepath
+            # the steady wind (blowing towards from + pi), m/s
+            wind_ned_mps=(-env.wind_speed_mps * math.cos(env.wind_from_rad),
+                          -env.wind_speed_mps * math.sin(env.wind_from_rad)),
         )
+        return par, st, nu
+
+
+def _entry(dispatcher: Any, *args: Any) -> Callable:
+    """The compiled code's Python entry point of numba `dispatcher` for these arguments' types, called without
+    numba's per-call type dispatch (which costs ~0.35 us of a ~1.4 us fly_step call; the loop makes 31,000 a
+    flight). Calls through it must pass exactly these types (it does not check them). Numba internals
+    (Dispatcher.overloads[signature].entry_point): when they are not there, the dispatcher itself."""
+    sig = tuple(numba.typeof(a) for a in args)
+    dispatcher.compile(sig)  # loads it from numba's cache when compiled before
+    entry = getattr(dispatcher.overloads.get(sig), "entry_point", None)
+    return dispatcher if entry is None else entry
+
+
+def termination_reason(code: int, fs: Array) -> str:
+    """FlightResult.termination in words from fly_step's termination code (flight/kernels.py TERM_*) and the
+    figures its state fs (FS_*) keeps; TERM_NONE after the last permitted step is a timeout."""
+    if code == fk.TERM_STOP:
+        return "reached stop height"
+    if code == fk.TERM_TOUCHDOWN:
+        return "touchdown"
+    if code == fk.TERM_SHORT:
+        return f"touchdown short of the threshold ({-fs[fk.FS_TD_X] / units.FT:.0f} ft)"
+    if code == fk.TERM_GROUND:
+        return "ground contact"
+    if code == fk.TERM_DIVERGED:
+        return "diverged"
+    if code == fk.TERM_UNSTABLE:
+        return unstabilized_reason(int(fs[fk.FS_MON]), fs[fk.FS_MON_Z], fs[fk.FS_MON_A], fs[fk.FS_MON_B])
+    return "timeout"
 
 
 def tracking_stats(result: FlightResult, profile: Profile, upper_ft: float = 1000.0,

@@ -91,7 +91,8 @@ class DrydenTurbulence:
     """Turbulence velocity of one run, one step at a time (NED, m/s): u along the mean wind, v across it, w down.
 
     The white-noise sequence is drawn up front from `rng` (the run's "turbulence" stream), so a run's
-    turbulence depends on nothing but its seed.
+    turbulence depends on nothing but its seed. The readable oracle of the compiled step the flight loop runs
+    (flight/kernels.py dryden_step, equal to it bit for bit).
     """
 
     def __init__(self, level: str, rng: np.random.Generator, n_steps: int, dt_s: float, wind_to_rad: float) -> None:
@@ -100,9 +101,11 @@ class DrydenTurbulence:
             raise ValueError("DrydenTurbulence needs a turbulence level other than 'none'")
         self.w20_fps, self.index = spec
         self.dt = dt_s
-        self._nu = rng.standard_normal((n_steps, 3)).tolist()
-        self._cf = math.cos(wind_to_rad) * units.FPS
-        self._sf = math.sin(wind_to_rad) * units.FPS
+        self.nu = rng.standard_normal((n_steps, 3))
+        """(n_steps, 3) the white noise nu_u, nu_v, nu_w of every step."""
+        self.cos_fps = math.cos(wind_to_rad) * units.FPS
+        self.sin_fps = math.sin(wind_to_rad) * units.FPS
+        """cos and sin of the direction the wind blows to, times m per ft (wind axes, ft/s -> NED, m/s)."""
         self._coef: tuple[float, ...] | None = None
         self.xi_u = self.xi_v = self.xi_w = 0.0
         """Turbulence state in wind axes, ft/s."""
@@ -123,10 +126,16 @@ class DrydenTurbulence:
             self._coef = (1.0 - T / tu, sig_u * math.sqrt(2.0 * T / tu), 1.0 - 2.0 * T / tu,
                           sig_u * math.sqrt(4.0 * T / tu), 1.0 - 2.0 * T / tw, sig_w * math.sqrt(4.0 * T / tw))
         au, bu, av, bv, aw, bw = self._coef
-        nu_u, nu_v, nu_w = self._nu[k]
+        nu_u, nu_v, nu_w = self.nu[k].tolist()
         xu = self.xi_u = au * self.xi_u + bu * nu_u
         xv = self.xi_v = av * self.xi_v + bv * nu_v
         xw = self.xi_w = aw * self.xi_w + bw * nu_w
-        c, s = self._cf, self._sf
+        c, s = self.cos_fps, self.sin_fps
         # rotate from wind axes (u along the direction the wind blows to, v to its right) to NED
         return c * xu - s * xv, s * xu + c * xv, xw * units.FPS
+
+    def state(self) -> tuple[float, ...]:
+        """(xi_u, xi_v, xi_w, coefficients valid, a_u, b_u, a_v, b_v, a_w, b_w): the compiled turbulence's TBS_*
+        state vector (flight/kernels.py dryden_step)."""
+        coef = self._coef if self._coef is not None else (0.0,) * 6
+        return (self.xi_u, self.xi_v, self.xi_w, float(self._coef is not None), *coef)
