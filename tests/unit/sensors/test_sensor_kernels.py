@@ -1,5 +1,6 @@
-"""The compiled IMU error application (sensors/kernels.py) against the numpy `Imu.apply_reference`: equal to
-1e-12 relative for one run and a batch, with and without quantization; a run's bits independent of its batch."""
+"""The compiled IMU error application (sensors/kernels/imu.py) against the numpy `Imu.apply_reference`: equal to
+1e-12 relative for one run and a batch, with and without quantization; a run's bits independent of its batch. The
+compiled Gauss-Markov recursion (sensors/kernels/noise.py) against scipy's lfilter: bit for bit."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from approachsim.sensors import base
 from approachsim.sensors.imu import Imu
 from approachsim.sensors.presets import PRESETS
 
@@ -38,3 +40,20 @@ def test_imu_apply_kernel_equals_numpy_reference(descent, grade, quantized):
             assert np.mean(a.dv_body == b.dv_body) > 0.999
     # run 0 of the batch has run `one`'s generator: the same bits alone and in the batch
     np.testing.assert_array_equal(imu.apply(descent, batch).dv_body[0], imu.apply(descent, one).dv_body)
+
+
+@pytest.mark.parametrize(("shape", "sigma", "tau_s"), [
+    ((31300,), 1.0, 100.0),
+    ((31300, 3), np.array([1e-6, 2e-6, 3e-6]), np.array([3600.0, 100.0, np.inf])),
+    ((266, 24), 1.0, 1e-3),
+    ((1, 24), 0.5, 10.0),
+    ((266, 2, 3), np.array([1.0, 0.0, 2.0]), 60.0),
+])
+def test_gauss_markov_kernel_equals_lfilter_bit_for_bit(shape, sigma, tau_s):
+    """The draws keep their bits: the kernel's recursion x_k = d_k + a x_{k-1} rounds as lfilter's does."""
+    z = np.random.default_rng(len(shape) * 1000 + shape[0]).standard_normal(shape)
+    a = base.gauss_markov(z, sigma, tau_s, 1.0 / 120.0)
+    b = base.gauss_markov_reference(z, sigma, tau_s, 1.0 / 120.0)
+    assert a.shape == b.shape == z.shape
+    np.testing.assert_array_equal(a, b)
+    assert np.any(a != 0.0)
