@@ -72,15 +72,20 @@ def gauss_markov(z: Array, sigma: float | Array, tau_s: float | Array, dt_s: flo
     constant, sigma = 0 gives zeros. The recursion is compiled (sensors/kernels/noise.py first_order), bit-identical
     to gauss_markov_reference.
     """
-    a, drive = _gm_drive(z, sigma, tau_s, dt_s)
-    d2 = np.ascontiguousarray(drive.reshape(drive.shape[0], -1))
-    out = np.empty(d2.shape)
-    noise_kernels.first_order(d2, np.ascontiguousarray(a.reshape(-1)), out)
-    return out.reshape(drive.shape)
+    z = np.asarray(z, dtype=float)
+    sigma = np.broadcast_to(np.asarray(sigma, dtype=float), z.shape[1:])
+    a = np.exp(-dt_s / np.broadcast_to(np.asarray(tau_s, dtype=float), z.shape[1:]))
+    z2 = z.reshape(z.shape[0], -1)
+    out = np.empty(z2.shape)
+    noise_kernels.first_order(z2, np.ascontiguousarray(sigma.reshape(-1)),
+                              np.ascontiguousarray((sigma * np.sqrt(1.0 - a * a)).reshape(-1)),
+                              np.ascontiguousarray(np.asarray(a).reshape(-1)), out)
+    return out.reshape(z.shape)
 
 
-def _gm_drive(z: Array, sigma: float | Array, tau_s: float | Array, dt_s: float) -> tuple[Array, Array]:
-    """The factors a = exp(-dt / tau) (trailing shape of z) and the driving terms sigma z_0, sigma sqrt(1 - a^2) z_k."""
+def gauss_markov_reference(z: Array, sigma: float | Array, tau_s: float | Array, dt_s: float) -> Array:
+    """gauss_markov in numpy and scipy (the oracle): the driving terms d_0 = sigma z_0, d_k = sigma sqrt(1 - a^2) z_k
+    filtered by scipy.signal.lfilter([1], [1, -a]) per column."""
     z = np.asarray(z, dtype=float)
     sigma = np.broadcast_to(np.asarray(sigma, dtype=float), z.shape[1:])
     tau = np.broadcast_to(np.asarray(tau_s, dtype=float), z.shape[1:])
@@ -88,18 +93,12 @@ def _gm_drive(z: Array, sigma: float | Array, tau_s: float | Array, dt_s: float)
     drive = np.empty_like(z)
     drive[0] = sigma * z[0]
     drive[1:] = (sigma * np.sqrt(1.0 - a * a)) * z[1:]
-    return np.asarray(a), drive
-
-
-def gauss_markov_reference(z: Array, sigma: float | Array, tau_s: float | Array, dt_s: float) -> Array:
-    """gauss_markov with the recursion run by scipy.signal.lfilter([1], [1, -a]) per column (the oracle)."""
-    a, drive = _gm_drive(z, sigma, tau_s, dt_s)
-    if drive.ndim == 1:
+    if z.ndim == 1:
         return lfilter([1.0], [1.0, -float(a)], drive)
     out = np.empty_like(drive)
     flat_a = a.reshape(-1)
-    d2 = drive.reshape(drive.shape[0], -1)
-    o2 = out.reshape(drive.shape[0], -1)
+    d2 = drive.reshape(z.shape[0], -1)
+    o2 = out.reshape(z.shape[0], -1)
     for i, ai in enumerate(flat_a):
         o2[:, i] = lfilter([1.0], [1.0, -ai], d2[:, i])
     return out

@@ -57,3 +57,7 @@ def test_gauss_markov_kernel_equals_lfilter_bit_for_bit(shape, sigma, tau_s):
     assert a.shape == b.shape == z.shape
     np.testing.assert_array_equal(a, b)
     assert np.any(a != 0.0)
+    # columns of a wider draw (the IMU's z[:, 3:6]): a strided view gives the same bits as a contiguous copy
+    wide = np.random.default_rng(9).standard_normal((shape[0], 12))
+    np.testing.assert_array_equal(base.gauss_markov(wide[:, 3:6], 2.0, 50.0, 0.1),
+                                  base.gauss_markov_reference(np.ascontiguousarray(wide[:, 3:6]), 2.0, 50.0, 0.1))
