@@ -61,3 +61,4 @@ def test_gauss_markov_kernel_equals_lfilter_bit_for_bit(shape, sigma, tau_s):
     wide = np.random.default_rng(9).standard_normal((shape[0], 12))
     np.testing.assert_array_equal(base.gauss_markov(wide[:, 3:6], 2.0, 50.0, 0.1),
                                   base.gauss_markov_reference(np.ascontiguousarray(wide[:, 3:6]), 2.0, 50.0, 0.1))
+
