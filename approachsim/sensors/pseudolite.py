@@ -84,12 +84,26 @@ class Pseudolite:
 
         return base.make_errors(t_s, self.rate_hz, rng, one)
 
+    def c_ecef_to_ned(self, r_published_ecef: Array) -> Array:
+        """Rotations ECEF -> local NED (p, 3, 3) at the published transmitter positions (p, 3)."""
+        lat, lon, _ = geo.ecef_to_geodetic(r_published_ecef)
+        return geo.c_ecef_to_ned(lat, lon)
+
     def apply(
         self, truth: Truth, errors: base.SensorErrors, clock: base.SensorErrors | None = None
     ) -> PseudoliteSamples:
         """Pseudoranges at the truth rows of `errors`; `clock` the receiver clock (None: zero)."""
+        pub = self.r_published_ecef
+        return self.record(truth, errors, clock, pub, self.c_ecef_to_ned(pub))
+
+    def prepare(self, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> PreparedPseudolite:
+        """`errors` (and the receiver clock on the same samples) laid out for one sample at a time (base.prepare)."""
+        return PreparedPseudolite(self, errors, clock)
+
+    def record(self, truth: Truth, errors: base.SensorErrors, clock: base.SensorErrors | None, pub: Array,
+               c_ned: Array) -> PseudoliteSamples:
+        """apply with the published positions pub (p, 3) and their ECEF -> NED rotations c_ned (p, 3, 3) given."""
         r = truth.r_ecef[errors.rows]  # (m, 3)
-        pub = self.r_published_ecef  # (p, 3)
         surv = errors.constants["survey"]
         true_pl = pub + surv  # (p, 3) or (runs, p, 3)
         if errors.batched:
@@ -106,8 +120,6 @@ class Pseudolite:
         # visibility from the published geometry (what the transmitter / receiver geometry is)
         dp = pub[None, :, :] - r[:, None, :]
         rng_pub = np.linalg.norm(dp, axis=-1)
-        lat, lon, _ = geo.ecef_to_geodetic(pub)
-        c_ned = geo.c_ecef_to_ned(lat, lon)  # (p, 3, 3)
         up = -np.einsum("pij,mpj->mpi", c_ned, -dp)[..., 2]  # aircraft height above the transmitter plane
         el = np.arcsin(np.clip(up / rng_pub, -1.0, 1.0))
         ok = (rng_pub <= self.max_range_m) & (el >= self.mask_rad)
@@ -125,3 +137,20 @@ class Pseudolite:
         """apply(truth, draw(truth.t_s, rng), clock); noise=False gives the geometric range (plus the clock)."""
         e = self.draw(truth.t_s, rng)
         return self.apply(truth, e if noise else e.zeroed(), clock)
+
+
+class PreparedPseudolite:
+    """A pseudolite's drawn errors for one sample at a time: the published positions and their NED rotations made
+    once; at(truth, j) is Pseudolite.apply(truth, errors.sample(j), clock.sample(j)) bit for bit."""
+
+    def __init__(self, pl: Pseudolite, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> None:
+        self.pl = pl
+        self.errors = errors
+        self.clock = clock
+        self.pub = pl.r_published_ecef
+        self.c_ned = pl.c_ecef_to_ned(self.pub)
+
+    def at(self, truth: Truth, j: int) -> PseudoliteSamples:
+        """The record of sample j alone (one-sample axes; its own copy of the published positions)."""
+        clk = None if self.clock is None else self.clock.sample(j)
+        return self.pl.record(truth, self.errors.sample(j), clk, self.pub.copy(), self.c_ned)
