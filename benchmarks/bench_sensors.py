@@ -16,8 +16,9 @@ same length). --pseudolite adds one pseudolite unit near the threshold to the pr
 4. --runs N runs in chunks, compiled (throughput; 0 skips it).
 
 Times are the minimum over --repeat repetitions (one warm-up call first: numba's cache load and compilation are not
-counted). The load average is printed before and after: figures taken under load are slower and noisier, the
-ratios within one run are the figures to read. Not a test: results go to benchmarks/RESULTS.md.
+counted; in part 1 the reference and compiled rounds alternate). The load average is printed before and after:
+figures taken under load are slower and noisier, the ratios within one run are the figures to read. Not a test:
+results go to benchmarks/RESULTS.md.
 """
 
 from __future__ import annotations
@@ -71,28 +72,35 @@ def load() -> str:
 
 
 def per_run_part(suite, truth, seed: int, runs: list[int], repeat: int) -> dict:
-    """ms per run of draw and of each sensor's apply, reference and compiled."""
-    out = {}
-    for mode in ("reference", "compiled"):
-        with numpy_reference() if mode == "reference" else nullcontext():
-            draw_s = best_of(lambda: suite.draw(truth.t_s, seed, runs), repeat)
-            errors = suite.draw(truth.t_s, seed, runs)
-            apply_s = {name: best_of(lambda n=name, e=errors: suite.apply(truth, e, names=[n]), repeat)
-                       for name in suite.sensors}
-        out[mode] = {"draw": 1e3 * draw_s / len(runs)} | {n: 1e3 * s / len(runs) for n, s in apply_s.items()}
-    return out
+    """ms per run of draw and of each sensor's apply, reference and compiled: the minimum over `repeat` rounds that
+    alternate the two (a first round is discarded as warm-up), so a change of load hits both alike."""
+    modes = {"reference": numpy_reference, "compiled": nullcontext}
+    best = {m: dict.fromkeys(["draw", *suite.sensors], np.inf) for m in modes}
+    for rnd in range(repeat + 1):
+        for mode, ctx in modes.items():
+            with ctx():
+                t0 = time.perf_counter()
+                errors = suite.draw(truth.t_s, seed, runs)
+                times = {"draw": time.perf_counter() - t0}
+                for name in suite.sensors:
+                    t0 = time.perf_counter()
+                    suite.apply(truth, errors, names=[name])
+                    times[name] = time.perf_counter() - t0
+            if rnd > 0:
+                best[mode] = {k: min(v, 1e3 * times[k] / len(runs)) for k, v in best[mode].items()}
+    return best
 
 
 def print_per_run(title: str, res: dict, names) -> None:
     print(f"\n{title} (ms per run; min of repeats)")
     cols = ["draw", *names]
-    print(f"  {'':10s}" + "".join(f"{c:>10s}" for c in cols) + f"{'total':>10s}")
+    print(f"  {'':10s}" + "".join(f"{c:>11s}" for c in cols) + f"{'total':>11s}")
     for mode in ("reference", "compiled"):
         r = res[mode]
-        print(f"  {mode:10s}" + "".join(f"{r[c]:10.2f}" for c in cols) + f"{sum(r[c] for c in cols):10.2f}")
+        print(f"  {mode:10s}" + "".join(f"{r[c]:11.2f}" for c in cols) + f"{sum(r[c] for c in cols):11.2f}")
     ratio = {c: res["reference"][c] / max(res["compiled"][c], 1e-12) for c in cols}
     tot = sum(res["reference"][c] for c in cols) / sum(res["compiled"][c] for c in cols)
-    print(f"  {'ratio':10s}" + "".join(f"{ratio[c]:9.1f}x" for c in cols) + f"{tot:9.1f}x")
+    print(f"  {'ratio':10s}" + "".join(f"{ratio[c]:10.1f}x" for c in cols) + f"{tot:10.1f}x")
 
 
 def selection_part(suite, truth, seed: int, runs: list[int], repeat: int) -> None:

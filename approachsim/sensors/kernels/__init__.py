@@ -8,6 +8,8 @@ constants (import-linter contract in pyproject.toml).
     imu    imu_apply: the IMU error application (sensors/imu.py `Imu.apply`; oracle `Imu.apply_reference`)
     noise  first_order: the Gauss-Markov recursion of every error draw (sensors/base.py `gauss_markov`; oracle
            `gauss_markov_reference`, bit-identical)
+    radalt radalt_apply: the radar altimeter's errors and validity (sensors/radalt.py `RadarAltimeter.apply`;
+           oracle `RadarAltimeter.apply_reference`, bit-identical)
     gnss   satellite orbits, look angles, best-PDOP selection, PDOP, pseudoranges and rates (sensors/gnss/
            receiver.py `GnssReceiver.apply`; oracle `GnssReceiver.apply_reference`)
 """

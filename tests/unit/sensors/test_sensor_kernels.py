@@ -1,6 +1,7 @@
 """The compiled IMU error application (sensors/kernels/imu.py) against the numpy `Imu.apply_reference`: equal to
 1e-12 relative for one run and a batch, with and without quantization; a run's bits independent of its batch. The
-compiled Gauss-Markov recursion (sensors/kernels/noise.py) against scipy's lfilter: bit for bit."""
+compiled Gauss-Markov recursion (sensors/kernels/noise.py) against scipy's lfilter, and the compiled radar altimeter
+(sensors/kernels/radalt.py) against `RadarAltimeter.apply_reference`: bit for bit."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import pytest
 from approachsim.sensors import base
 from approachsim.sensors.imu import Imu
 from approachsim.sensors.presets import PRESETS
+from approachsim.sensors.radalt import RadarAltimeter
 
 
 def _close(a, b, what):
@@ -62,3 +64,16 @@ def test_gauss_markov_kernel_equals_lfilter_bit_for_bit(shape, sigma, tau_s):
     np.testing.assert_array_equal(base.gauss_markov(wide[:, 3:6], 2.0, 50.0, 0.1),
                                   base.gauss_markov_reference(np.ascontiguousarray(wide[:, 3:6]), 2.0, 50.0, 0.1))
 
+
+
+def test_radalt_kernel_equals_numpy_reference_bit_for_bit(descent):
+    """One run and a batch over the whole descent (above and below the maximum range: nan and invalid above)."""
+    ra = RadarAltimeter(max_range_m=200.0)
+    for rng in (np.random.default_rng(3), [np.random.default_rng(s) for s in (3, 4, 5)]):
+        e = ra.draw(descent.t_s, rng)
+        a, b = ra.apply(descent, e), ra.apply_reference(descent, e)
+        for f in ("h_agl_m", "sigma_m", "valid", "fault"):
+            x, y = getattr(a, f), getattr(b, f)
+            assert x.shape == y.shape and x.dtype == y.dtype, f
+            np.testing.assert_array_equal(x, y, err_msg=f)
+        assert a.valid.any() and not a.valid.all()
