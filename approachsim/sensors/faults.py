@@ -205,7 +205,10 @@ class PreparedFaulted:
         self.masks = masks
 
     def at(self, truth: Any, j: int) -> Any:
-        """The faulted record of sample j alone."""
+        """The faulted record of sample j alone. A sample no fault touches is the wrapped sensor's record as it is:
+        labelling it would change no value (its invalid values are already nan)."""
         sl = slice(j, j + 1)
-        return self.faulted._label(self.inner.at(truth, j), self.errors.t_s[sl], self.errors.batched,
-                                   [m[sl] for m in self.masks])
+        rec = self.inner.at(truth, j)
+        if not any(m[j] for m in self.masks):
+            return rec
+        return self.faulted._label(rec, self.errors.t_s[sl], self.errors.batched, [m[sl] for m in self.masks])
