@@ -11,8 +11,9 @@ same length). --pseudolite adds one pseudolite unit near the threshold to the pr
    profile's epoch is per-run), "reference" (numpy: scipy lfilter Gauss-Markov recursions, GnssReceiver.
    apply_reference with best_pdop_four_reference) vs "compiled" (the kernels of sensors/kernels/), per sensor;
 2. the best-PDOP selection alone on those skies: best_pdop_four_reference vs the kernel (and that they agree);
-3. one truth row at a time (the closed loop's 1 Hz aiding epochs: baro + radalt + gnss [+ pseudolite]): the
-   generic path with the numpy GNSS (before), the generic path compiled, and SensorSuite.prepare(...).at;
+3. one truth row at a time: the closed loop's aiding epochs (baro + radalt + gnss [+ pseudolite]) and all its sensor
+   calls over an approach (the epochs and every baro sample): the generic path with the numpy GNSS (before), the
+   generic path compiled, and SensorSuite.prepare(...).at;
 4. --runs N runs in chunks, compiled (throughput; 0 skips it).
 
 Times are the minimum over --repeat repetitions (one warm-up call first: numba's cache load and compilation are not
@@ -122,39 +123,53 @@ def selection_part(suite, truth, seed: int, runs: list[int], repeat: int) -> Non
           f"{t_ref / t_k:.0f}x")
 
 
-def one_row_part(suite, truth, seed: int, run: int, repeat: int) -> None:
-    """us per aiding epoch of baro + radalt + gnss (+ pseudolite) one truth row at a time."""
+def one_row_part(prof, suite, truth, seed: int, run: int, repeat: int) -> None:
+    """One truth row at a time: us per aiding epoch (baro + radalt + gnss [+ pseudolite] at each GNSS epoch) and
+    ms per approach of the closed loop's calls (nav/closed_loop.py: those at every aiding epoch and the baro at
+    every baro sample for the damping loop), before (generic path, numpy GNSS), generic compiled, prepared."""
     errors = suite.draw(truth.t_s, seed, run)
     names = tuple(n for n in EPOCH_SENSORS if n in suite.sensors)
     ks = [int(k) for k in errors.sensors["gnss"].rows if k < len(truth)]
     at = {n: {int(r): j for j, r in enumerate(errors.sensors[n].rows)} for n in names}
+    epoch_rows = max(1, int(round(prof.rates.imu_hz / prof.nav.aiding_rate_hz)))
+    calls = []  # (sensor, row) in the closed loop's order; rows without a sample are skipped by its lookup
+    for k in range(len(truth)):
+        if k % epoch_rows == 0:
+            calls += [(n, k) for n in names if k in at[n]]
+        if k in at.get("baro", {}):
+            calls.append(("baro", k))
 
-    def generic():  # nav/closed_loop.py NavInTheLoop._apply: a one-sample view through SensorSuite.apply
-        for k in ks:
-            for n in names:
-                j = at[n].get(k)
-                if j is None:
-                    continue
-                e = errors.sensors[n]
-                one = replace(e, index=e.index[j:j + 1], rows=e.rows[j:j + 1], t_s=e.t_s[j:j + 1],
-                              series={s: v[j:j + 1] for s, v in e.series.items()})
-                suite.apply(truth, SuiteErrors(MappingProxyType({n: one}), errors.clock), names=[n])
+    def generic(k: int, n: str) -> None:  # NavInTheLoop._apply: a one-sample view through SensorSuite.apply
+        j = at[n][k]
+        e = errors.sensors[n]
+        one = replace(e, index=e.index[j:j + 1], rows=e.rows[j:j + 1], t_s=e.t_s[j:j + 1],
+                      series={s: v[j:j + 1] for s, v in e.series.items()})
+        suite.apply(truth, SuiteErrors(MappingProxyType({n: one}), errors.clock), names=[n])
 
-    with numpy_reference():
-        t_before = best_of(generic, repeat)
-    t_generic = best_of(generic, repeat)
     t_prep0 = time.perf_counter()
     prepared = suite.prepare(errors)
     t_prep = time.perf_counter() - t_prep0
-    t_at = best_of(lambda: [prepared.at(truth, k, names) for k in ks], repeat)
-    per = {n: best_of(lambda n=n: [prepared.at(truth, k, (n,)) for k in ks], repeat) for n in names}
+
+    def prep(k: int, n: str) -> None:
+        prepared.at(truth, k, (n,))
+
+    res = {}
+    for label, fn, ctx in (("generic path, numpy GNSS (before)", generic, numpy_reference),
+                           ("generic path, compiled", generic, nullcontext), ("prepared .at", prep, nullcontext)):
+        with ctx():
+            epoch = best_of(lambda f=fn: [f(k, n) for k in ks for n in names if k in at[n]], repeat)
+            approach = best_of(lambda f=fn: [f(k, n) for n, k in calls], repeat)
+        res[label] = (epoch, approach)
+    per = {n: best_of(lambda n=n: [prepared.at(truth, k, (n,)) for k in ks if k in at[n]], repeat) for n in names}
     us = 1e6 / len(ks)
-    print(f"\none truth row at a time: {' + '.join(names)} at each of {len(ks)} GNSS epochs (one run, "
-          f"{'per-run sky' if suite.epoch_window_s > 0 else 'fixed sky'})")
-    print(f"  generic path, numpy GNSS (before) {t_before * us:7.1f} us per epoch")
-    print(f"  generic path, compiled            {t_generic * us:7.1f} us per epoch ({t_before / t_generic:.1f}x)")
-    print(f"  prepared .at                      {t_at * us:7.1f} us per epoch ({t_before / t_at:.1f}x; "
-          + ", ".join(f"{n} {per[n] * us:.1f}" for n in names) + f"); prepare once per run {1e3 * t_prep:.1f} ms")
+    base_e, base_a = res["generic path, numpy GNSS (before)"]
+    print(f"\none truth row at a time (one run, {'per-run sky' if suite.epoch_window_s > 0 else 'fixed sky'}): "
+          f"{' + '.join(names)} at each of {len(ks)} GNSS epochs; per approach the closed loop's {len(calls)} calls")
+    for label, (e, a) in res.items():
+        print(f"  {label:34s} {e * us:7.1f} us per epoch ({base_e / e:4.1f}x)   {1e3 * a:7.1f} ms per approach "
+              f"({base_a / a:4.1f}x)")
+    print("  prepared, per sensor: " + ", ".join(f"{n} {per[n] * us:.1f} us" for n in names)
+          + f"; prepare once per run {1e3 * t_prep:.1f} ms")
 
 
 def throughput_part(suite, truth, seed: int, n_runs: int, chunk: int) -> None:
@@ -215,7 +230,7 @@ def main() -> None:
                   per_run_part(suite, truth, args.seed, chunk, args.repeat), names)
     if "gnss" in suite.sensors:
         selection_part(suite, truth, args.seed, chunk, args.repeat)
-        one_row_part(suite, truth, args.seed, 0, args.repeat)
+        one_row_part(prof, suite, truth, args.seed, 0, args.repeat)
     if args.runs > 0:
         throughput_part(suite, truth, args.seed, args.runs, args.chunk)
     print(f"\nend: {load()}")

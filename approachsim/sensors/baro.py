@@ -30,8 +30,14 @@ import numpy as np
 
 from approachsim.records import BaroSamples, Truth
 from approachsim.sensors import atmosphere, base
+from approachsim.sensors.kernels import baro as bk
 
 Array = np.ndarray
+_T0_OVER_LAPSE_M = atmosphere.T0_K / atmosphere.LAPSE_K_PER_M
+"""T0 / L of atmosphere.indicated_altitude_m, m (the same expression)."""
+_EXPONENT_INV = 1.0 / atmosphere.EXPONENT
+"""R L / g0 of atmosphere.indicated_altitude_m (the same expression)."""
+_NO_LAG = np.zeros(0)
 
 
 @dataclass(frozen=True)
@@ -77,7 +83,8 @@ class Baro:
         return w / w.sum()
 
     def apply(self, truth: Truth, errors: base.SensorErrors) -> BaroSamples:
-        """Measurements at the truth rows of `errors`."""
+        """Measurements at the truth rows of `errors`; compiled (sensors/kernels/baro.py), equal to apply_reference to
+        1e-12 of the ISA scale T0 / L (4.4e-8 m; the kernel module says why not 1e-12 of the height)."""
         sf = np.asarray(errors.constants["scale_factor"], dtype=float)
         run = (lambda a: a) if errors.batched else (lambda a: a[None])
         return self.record(truth, errors.rows, errors.t_s, run(sf), run(errors.series["bias"]),
@@ -87,15 +94,18 @@ class Baro:
                batched: bool) -> BaroSamples:
         """The record of the samples at truth `rows` (times t_s) of R runs: scale factors sf (R,), bias and noise
         (R, m) m; batched: the run axis is kept."""
+        rows = np.asarray(rows)
         if self.lag_s > 0.0:
             w = self.lag_weights(float(truth.t_s[1] - truth.t_s[0]))
-            idx = np.maximum(np.asarray(rows)[:, None] - np.arange(w.shape[0])[None, :], 0)
-            # row-wise sum (not a matrix product: BLAS blocking would make one row differ from the batch)
-            h_ind = np.sum(atmosphere.indicated_altitude_m(truth.p_static_pa[idx], self.setting_pa) * w, axis=-1)
+            p = truth.p_static_pa[np.maximum(rows[:, None] - np.arange(w.shape[0])[None, :], 0)]
         else:
-            h_ind = atmosphere.indicated_altitude_m(truth.p_static_pa[rows], self.setting_pa)
-        h = h_ind * (1.0 + sf[:, None]) + bias + noise
-        h = h if batched else h[0]
+            w = _NO_LAG
+            p = truth.p_static_pa[rows[:, None]]
+        c = np.ascontiguousarray
+        out = np.empty(np.shape(bias))
+        bk.baro_apply(c(p, dtype=float), float(self.setting_pa), _T0_OVER_LAPSE_M, _EXPONENT_INV, w,
+                      c(sf, dtype=float), c(bias, dtype=float), c(noise, dtype=float), out)
+        h = out if batched else out[0]
         return BaroSamples(
             t_s=t_s, h_baro_m=h, sigma_m=np.full(np.shape(t_s), self.noise_sigma_m),
             valid=np.ones(h.shape, dtype=bool), fault=np.zeros(h.shape, dtype=np.int8),
@@ -105,6 +115,24 @@ class Baro:
         """`errors` laid out for one sample at a time (base.prepare; the baro has no clock)."""
         return PreparedBaro(self, errors)
 
+    def apply_reference(self, truth: Truth, errors: base.SensorErrors) -> BaroSamples:
+        """`apply` in numpy: the readable model (module docstring) and the kernel's test oracle."""
+        if self.lag_s > 0.0:
+            w = self.lag_weights(float(truth.t_s[1] - truth.t_s[0]))
+            idx = np.maximum(errors.rows[:, None] - np.arange(w.shape[0])[None, :], 0)
+            # row-wise sum (not a matrix product: BLAS blocking would make one row differ from the batch)
+            h_ind = np.sum(atmosphere.indicated_altitude_m(truth.p_static_pa[idx], self.setting_pa) * w, axis=-1)
+        else:
+            h_ind = atmosphere.indicated_altitude_m(truth.p_static_pa[errors.rows], self.setting_pa)
+        sf = errors.constants["scale_factor"]
+        sf = sf[:, None] if errors.batched else sf
+        h = h_ind * (1.0 + sf) + errors.series["bias"] + errors.series["noise"]
+        shape = h.shape
+        return BaroSamples(
+            t_s=errors.t_s, h_baro_m=h, sigma_m=np.full(errors.t_s.shape, self.noise_sigma_m),
+            valid=np.ones(shape, dtype=bool), fault=np.zeros(shape, dtype=np.int8),
+        )
+
     def measure(self, truth: Truth, rng: base.RngLike, *, noise: bool = True) -> BaroSamples:
         """apply(truth, draw(truth.t_s, rng)); noise=False gives the exact indicated altitude."""
         e = self.draw(truth.t_s, rng)
@@ -113,7 +141,7 @@ class Baro:
 
 class PreparedBaro:
     """A baro's drawn errors for one sample at a time (the closed loop's damping loop reads every baro sample):
-    at(truth, j) is Baro.apply(truth, errors.sample(j)) bit for bit (the same code on the same values), without
+    at(truth, j) is Baro.apply(truth, errors.sample(j)) bit for bit (the same kernel on the same values), without
     rebuilding the errors of sample j."""
 
     def __init__(self, baro: Baro, errors: base.SensorErrors) -> None:

@@ -8,6 +8,8 @@ constants (import-linter contract in pyproject.toml).
     imu    imu_apply: the IMU error application (sensors/imu.py `Imu.apply`; oracle `Imu.apply_reference`)
     noise  first_order: the Gauss-Markov recursion of every error draw (sensors/base.py `gauss_markov`; oracle
            `gauss_markov_reference`, bit-identical)
+    baro   baro_apply: the baro's indicated altitude (with its lag) and errors (sensors/baro.py `Baro.apply`; oracle
+           `Baro.apply_reference`, to 1e-12 of the ISA scale T0 / L)
     radalt radalt_apply: the radar altimeter's errors and validity (sensors/radalt.py `RadarAltimeter.apply`;
            oracle `RadarAltimeter.apply_reference`, bit-identical)
     gnss   satellite orbits, look angles, best-PDOP selection, PDOP, pseudoranges and rates (sensors/gnss/

@@ -1,7 +1,9 @@
 """The compiled IMU error application (sensors/kernels/imu.py) against the numpy `Imu.apply_reference`: equal to
 1e-12 relative for one run and a batch, with and without quantization; a run's bits independent of its batch. The
 compiled Gauss-Markov recursion (sensors/kernels/noise.py) against scipy's lfilter, and the compiled radar altimeter
-(sensors/kernels/radalt.py) against `RadarAltimeter.apply_reference`: bit for bit."""
+(sensors/kernels/radalt.py) against `RadarAltimeter.apply_reference`: bit for bit. The compiled baro
+(sensors/kernels/baro.py) against `Baro.apply_reference`: to 1e-12 of the ISA scale T0 / L (4.4e-8 m), with and
+without the static-system lag."""
 
 from __future__ import annotations
 
@@ -10,7 +12,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from approachsim.sensors import base
+from approachsim.sensors import atmosphere, base
+from approachsim.sensors.baro import Baro
 from approachsim.sensors.imu import Imu
 from approachsim.sensors.presets import PRESETS
 from approachsim.sensors.radalt import RadarAltimeter
@@ -77,3 +80,24 @@ def test_radalt_kernel_equals_numpy_reference_bit_for_bit(descent):
             assert x.shape == y.shape and x.dtype == y.dtype, f
             np.testing.assert_array_equal(x, y, err_msg=f)
         assert a.valid.any() and not a.valid.all()
+
+
+@pytest.mark.parametrize("lag_s", [0.0, 0.4])
+def test_baro_kernel_equals_numpy_reference(descent, lag_s):
+    """|h - h_ref| <= 1e-12 T0 / L (the indication's own scale; near sea level it cancels to a few metres, so one
+    rounding of the power differs by ~1e-11 m between libm and numpy); a run's bits independent of its batch."""
+    baro = Baro(setting_pa=101000.0, scale_factor_sigma=1e-3, lag_s=lag_s)
+    one = baro.draw(descent.t_s, np.random.default_rng(3))
+    batch = baro.draw(descent.t_s, [np.random.default_rng(s) for s in (3, 4, 5)])
+    tol_m = 1e-12 * atmosphere.T0_K / atmosphere.LAPSE_K_PER_M
+    for e in (one, batch):
+        a, b = baro.apply(descent, e), baro.apply_reference(descent, e)
+        assert a.h_baro_m.shape == b.h_baro_m.shape
+        assert np.max(np.abs(a.h_baro_m - b.h_baro_m)) <= tol_m
+        for f in ("sigma_m", "valid", "fault", "t_s"):
+            np.testing.assert_array_equal(getattr(a, f), getattr(b, f), err_msg=f)
+    np.testing.assert_array_equal(baro.apply(descent, batch).h_baro_m[0], baro.apply(descent, one).h_baro_m)
+    if lag_s > 0.0:  # the lag is in: a descent reads high
+        lagged = baro.apply(descent, one.zeroed()).h_baro_m
+        plain = Baro(setting_pa=101000.0).apply(descent, one.zeroed()).h_baro_m
+        assert np.all(lagged[5:] > plain[5:])
