@@ -14,6 +14,7 @@ bit-identical (tests/unit/sensors/test_suite.py).
     recs_k = suite.apply(truth, suite.take(errors, "baro", sl))     # ... apply sample by sample
     prepared = suite.prepare(errors)                                # or: lay the draw out once per run ...
     recs_k = prepared.at(truth, k, ("baro", "gnss"))                # ... the records of the sensors sampled at row k
+    baro_k = prepared.one("baro", truth, k)                         # ... one sensor's record at row k, or None
 
 `prepared.at(truth, k, names)` gives, for each named sensor with a sample at truth row k, exactly (bit for bit) the
 record `apply` gives for that one sample (tests/unit/sensors/test_prepared.py), with the work that does not depend on
@@ -249,6 +250,11 @@ class PreparedSuite:
             if j is not None:
                 out[name] = self.sensors[name].at(truth, j)
         return out
+
+    def one(self, name: str, truth: Any, k: int) -> Any:
+        """Sensor `name`'s record at truth row k (as `at`), or None when it has no sample there or is not fitted."""
+        j = self.sample(name, k)
+        return None if j is None else self.sensors[name].at(truth, j)
 
 
 def _clock_rows(clock: base.SensorErrors, e: base.SensorErrors) -> Array:

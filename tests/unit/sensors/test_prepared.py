@@ -96,5 +96,7 @@ def test_prepared_suite_skips_absent_sensors_and_rows_without_samples(truth):
     assert set(recs) == {"baro", "gnss"}
     assert set(prepared.at(truth, 21, ("baro", "gnss"))) == set()  # 20 Hz truth: baro every 2nd row, GNSS 20th
     assert set(prepared.at(truth, 22, ("baro", "gnss"))) == {"baro"}
+    assert prepared.one("gnss", truth, 22) is None and prepared.one("radalt", truth, 20) is None
+    _identical(prepared.one("baro", truth, 22), prepared.at(truth, 22, ("baro",))["baro"], "baro")
     assert prepared.sample("gnss", 40) == 2 and prepared.sample("gnss", 41) is None
     assert prepared.sample("gnss", 20 * 10_000) is None  # beyond the drawn samples
