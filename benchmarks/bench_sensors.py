@@ -13,7 +13,7 @@ same length). --pseudolite adds one pseudolite unit near the threshold to the pr
 2. the best-PDOP selection alone on those skies: best_pdop_four_reference vs the kernel (and that they agree);
 3. one truth row at a time: the closed loop's aiding epochs (baro + radalt + gnss [+ pseudolite]) and all its sensor
    calls over an approach (the epochs and every baro sample): the generic path with the numpy GNSS (before), the
-   generic path compiled, and SensorSuite.prepare(...).at;
+   generic path compiled, and SensorSuite.prepare(...).one;
 4. --runs N runs in chunks, compiled (throughput; 0 skips it).
 
 Times are the minimum over --repeat repetitions (one warm-up call first: numba's cache load and compilation are not
@@ -150,17 +150,17 @@ def one_row_part(prof, suite, truth, seed: int, run: int, repeat: int) -> None:
     prepared = suite.prepare(errors)
     t_prep = time.perf_counter() - t_prep0
 
-    def prep(k: int, n: str) -> None:
-        prepared.at(truth, k, (n,))
+    def prep(k: int, n: str) -> None:  # what NavInTheLoop._apply would call
+        prepared.one(n, truth, k)
 
     res = {}
     for label, fn, ctx in (("generic path, numpy GNSS (before)", generic, numpy_reference),
-                           ("generic path, compiled", generic, nullcontext), ("prepared .at", prep, nullcontext)):
+                           ("generic path, compiled", generic, nullcontext), ("prepared (.one)", prep, nullcontext)):
         with ctx():
             epoch = best_of(lambda f=fn: [f(k, n) for k in ks for n in names if k in at[n]], repeat)
             approach = best_of(lambda f=fn: [f(k, n) for n, k in calls], repeat)
         res[label] = (epoch, approach)
-    per = {n: best_of(lambda n=n: [prepared.at(truth, k, (n,)) for k in ks if k in at[n]], repeat) for n in names}
+    per = {n: best_of(lambda n=n: [prepared.one(n, truth, k) for k in ks if k in at[n]], repeat) for n in names}
     us = 1e6 / len(ks)
     base_e, base_a = res["generic path, numpy GNSS (before)"]
     print(f"\none truth row at a time (one run, {'per-run sky' if suite.epoch_window_s > 0 else 'fixed sky'}): "
