@@ -8,8 +8,8 @@ constant-velocity test truth of the same profile (approachsim.synthetic.profile_
 same length). --pseudolite adds one pseudolite unit near the threshold to the profile's suite. Prints, in one run:
 
 1. draw + apply per run, for 1 run and for a chunk of runs sharing the truth (each its own GPS sky when the
-   profile's epoch is per-run), "reference" (numpy: scipy lfilter Gauss-Markov recursions, GnssReceiver.
-   apply_reference with best_pdop_four_reference) vs "compiled" (the kernels of sensors/kernels/), per sensor;
+   profile's epoch is per-run), "reference" (numpy: scipy lfilter Gauss-Markov recursions, the apply_reference of
+   the GNSS receiver (best_pdop_four_reference), baro and radar altimeter) vs "compiled" (sensors/kernels/);
 2. the best-PDOP selection alone on those skies: best_pdop_four_reference vs the kernel (and that they agree);
 3. one truth row at a time: the closed loop's aiding epochs (baro + radalt + gnss [+ pseudolite]) and all its sensor
    calls over an approach (the epochs and every baro sample): the generic path with the numpy GNSS (before), the
@@ -37,9 +37,11 @@ import numpy as np
 
 from approachsim.profile import load_profile
 from approachsim.sensors import base
+from approachsim.sensors.baro import Baro
 from approachsim.sensors.config import PseudoliteConfig
 from approachsim.sensors.gnss.constellation import look_angles
 from approachsim.sensors.gnss.receiver import GnssReceiver, best_pdop_four, best_pdop_four_reference
+from approachsim.sensors.radalt import RadarAltimeter
 from approachsim.sensors.suite import SensorSuite, SuiteErrors
 
 EPOCH_SENSORS = ("baro", "radalt", "gnss", "pseudolite")
@@ -47,14 +49,19 @@ EPOCH_SENSORS = ("baro", "radalt", "gnss", "pseudolite")
 
 @contextmanager
 def numpy_reference():
-    """The numpy versions in place of the kernels: lfilter Gauss-Markov recursions and the numpy GNSS apply."""
-    gm, apply = base.gauss_markov, GnssReceiver.apply
+    """The numpy versions in place of this work's kernels (the code before them): lfilter Gauss-Markov recursions,
+    and the numpy apply of the GNSS receiver, the baro and the radar altimeter (the IMU kernel is older: kept)."""
+    gm = base.gauss_markov
+    applies = {cls: cls.apply for cls in (GnssReceiver, Baro, RadarAltimeter)}
     base.gauss_markov = base.gauss_markov_reference
-    GnssReceiver.apply = GnssReceiver.apply_reference
+    for cls in applies:
+        cls.apply = cls.apply_reference
     try:
         yield
     finally:
-        base.gauss_markov, GnssReceiver.apply = gm, apply
+        base.gauss_markov = gm
+        for cls, fn in applies.items():
+            cls.apply = fn
 
 
 def best_of(fn, repeat: int) -> float:

@@ -12,6 +12,8 @@ constants (import-linter contract in pyproject.toml).
            `Baro.apply_reference`, to 1e-12 of the ISA scale T0 / L)
     radalt radalt_apply: the radar altimeter's errors and validity (sensors/radalt.py `RadarAltimeter.apply`;
            oracle `RadarAltimeter.apply_reference`, bit-identical)
+    pseudolite  pseudolite_apply: ranges, elevation and validity of the pseudolites (sensors/pseudolite.py
+           `Pseudolite.apply`; oracle `Pseudolite.apply_reference`)
     gnss   satellite orbits, look angles, best-PDOP selection, PDOP, pseudoranges and rates (sensors/gnss/
            receiver.py `GnssReceiver.apply`; oracle `GnssReceiver.apply_reference`)
 """
