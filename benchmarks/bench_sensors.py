@@ -9,7 +9,7 @@ same length). --pseudolite adds one pseudolite unit near the threshold to the pr
 
 1. draw + apply per run, for 1 run and for a chunk of runs sharing the truth (each its own GPS sky when the
    profile's epoch is per-run), "reference" (numpy: scipy lfilter Gauss-Markov recursions, the apply_reference of
-   the GNSS receiver (best_pdop_four_reference), baro and radar altimeter) vs "compiled" (sensors/kernels/);
+   the GNSS receiver (best_pdop_four_reference), baro, radar altimeter, pseudolite) vs "compiled" (sensors/kernels/);
 2. the best-PDOP selection alone on those skies: best_pdop_four_reference vs the kernel (and that they agree);
 3. one truth row at a time: the closed loop's aiding epochs (baro + radalt + gnss [+ pseudolite]) and all its sensor
    calls over an approach (the epochs and every baro sample): the generic path with the numpy GNSS (before), the
@@ -41,6 +41,7 @@ from approachsim.sensors.baro import Baro
 from approachsim.sensors.config import PseudoliteConfig
 from approachsim.sensors.gnss.constellation import look_angles
 from approachsim.sensors.gnss.receiver import GnssReceiver, best_pdop_four, best_pdop_four_reference
+from approachsim.sensors.pseudolite import Pseudolite
 from approachsim.sensors.radalt import RadarAltimeter
 from approachsim.sensors.suite import SensorSuite, SuiteErrors
 
@@ -50,9 +51,9 @@ EPOCH_SENSORS = ("baro", "radalt", "gnss", "pseudolite")
 @contextmanager
 def numpy_reference():
     """The numpy versions in place of this work's kernels (the code before them): lfilter Gauss-Markov recursions,
-    and the numpy apply of the GNSS receiver, the baro and the radar altimeter (the IMU kernel is older: kept)."""
+    and the numpy apply of the GNSS receiver, baro, radar altimeter and pseudolite (the IMU kernel is older: kept)."""
     gm = base.gauss_markov
-    applies = {cls: cls.apply for cls in (GnssReceiver, Baro, RadarAltimeter)}
+    applies = {cls: cls.apply for cls in (GnssReceiver, Baro, RadarAltimeter, Pseudolite)}
     base.gauss_markov = base.gauss_markov_reference
     for cls in applies:
         cls.apply = cls.apply_reference
