@@ -247,7 +247,8 @@ def pdop(u: np.ndarray, use: np.ndarray) -> float:
 
 @njit(cache=True)
 def sky(r_rx: np.ndarray, r_sv: np.ndarray, mask_rad: float, mode: int, plan: np.ndarray, shell_m: float,
-        do253: bool, mp_sigma_m: float, ce2: float, iono_zenith_m: float, tropo_zenith_m: float, cn2: float):
+        do253: bool, mp_sigma_m: float, ce2: float, iono_zenith_m: float, tropo_zenith_m: float,
+        cn2: float) -> tuple[np.ndarray, ...]:
     """The geometry of every sky s and sample i (receiver.py): receivers r_rx (m, 3) m, satellites r_sv (S, m, k, 3).
 
     Returns range (S, m, k) m, line of sight (S, m, k, 3), elevation, azimuth (S, m, k) rad, visible
