@@ -18,6 +18,11 @@ The interface (every sensor; the navigation stage builds against it)
     draws once for the longest possible flight and applies one sample at a time as truth rows appear.
     GNSS and pseudolite apply take the receiver clock: ``apply(truth, errors, clock=clock_errors)``.
 
+``base.prepare(sensor, errors, clock) -> prepared`` and ``prepared.at(truth, j) -> record``
+    The closed loop's path: the errors laid out once per run (the GNSS satellite orbits of every sample, the
+    pseudolites' published positions, fault masks), then one sample at a time, giving exactly (bit for bit)
+    ``apply(truth, errors.sample(j))``'s record. SensorSuite.prepare does it for a suite (suite.py).
+
 Sample grids: a sensor at rate f takes truth rows 0, d, 2d, ... with d = round(truth rate / f); the IMU
 takes every row from 1 on: IMU sample j is increment k = j + 1 over (t_{k-1}, t_k], the truth's body rate
 and specific force of row k-1 held over the step, the Truth's sampling convention (imu.py:
@@ -30,5 +35,7 @@ GNSS and pseudolite channels share (suite.py). Adding or removing a sensor leave
 Faults: faults.Faulted wraps any sensor with the same interface; the profile's [[faults]] declare them.
 
 Modules: imu (+ presets), baro (+ atmosphere), radalt, gnss (constellation, clock, receiver), pseudolite,
-faults, suite (builds everything from a Profile), config (parses [sensors] and [[faults]]).
+faults, suite (builds everything from a Profile), config (parses [sensors] and [[faults]]), states (a run's error
+states for the filter), kernels (the compiled IMU, Gauss-Markov and GNSS loops; their numpy oracles stay in the
+modules above).
 """

@@ -30,8 +30,14 @@ import numpy as np
 
 from approachsim.records import BaroSamples, Truth
 from approachsim.sensors import atmosphere, base
+from approachsim.sensors.kernels import baro as bk
 
 Array = np.ndarray
+_T0_OVER_LAPSE_M = atmosphere.T0_K / atmosphere.LAPSE_K_PER_M
+"""T0 / L of atmosphere.indicated_altitude_m, m (the same expression)."""
+_EXPONENT_INV = 1.0 / atmosphere.EXPONENT
+"""R L / g0 of atmosphere.indicated_altitude_m (the same expression)."""
+_NO_LAG = np.zeros(0)
 
 
 @dataclass(frozen=True)
@@ -64,17 +70,56 @@ class Baro:
 
         return base.make_errors(t_s, self.rate_hz, rng, one)
 
+    def lag_weights(self, dt_s: float) -> Array:
+        """The lag's impulse-response weights (M + 1,) on a truth step dt_s (s), renormalized to sum 1 (module
+        docstring); empty without a lag."""
+        if self.lag_s <= 0.0:
+            return np.zeros(0)
+        a = math.exp(-dt_s / self.lag_s)
+        m = int(math.ceil(10.0 * self.lag_s / dt_s))
+        b0 = 1.0 - self.lag_s * (1.0 - a) / dt_s
+        b1 = self.lag_s * (1.0 - a) / dt_s - a
+        w = np.concatenate([[b0], (a * b0 + b1) * a ** np.arange(m)])
+        return w / w.sum()
+
     def apply(self, truth: Truth, errors: base.SensorErrors) -> BaroSamples:
-        """Measurements at the truth rows of `errors`."""
+        """Measurements at the truth rows of `errors`; compiled (sensors/kernels/baro.py), equal to apply_reference to
+        1e-12 of the ISA scale T0 / L (4.4e-8 m; the kernel module says why not 1e-12 of the height)."""
+        sf = np.asarray(errors.constants["scale_factor"], dtype=float)
+        run = (lambda a: a) if errors.batched else (lambda a: a[None])
+        return self.record(truth, errors.rows, errors.t_s, run(sf), run(errors.series["bias"]),
+                           run(errors.series["noise"]), errors.batched)
+
+    def record(self, truth: Truth, rows: Array, t_s: Array, sf: Array, bias: Array, noise: Array,
+               batched: bool) -> BaroSamples:
+        """The record of the samples at truth `rows` (times t_s) of R runs: scale factors sf (R,), bias and noise
+        (R, m) m; batched: the run axis is kept."""
+        rows = np.asarray(rows)
         if self.lag_s > 0.0:
-            dt = float(truth.t_s[1] - truth.t_s[0])
-            a = math.exp(-dt / self.lag_s)
-            m = int(math.ceil(10.0 * self.lag_s / dt))
-            b0 = 1.0 - self.lag_s * (1.0 - a) / dt
-            b1 = self.lag_s * (1.0 - a) / dt - a
-            w = np.concatenate([[b0], (a * b0 + b1) * a ** np.arange(m)])
-            w = w / w.sum()
-            idx = np.maximum(errors.rows[:, None] - np.arange(m + 1)[None, :], 0)
+            w = self.lag_weights(float(truth.t_s[1] - truth.t_s[0]))
+            p = truth.p_static_pa[np.maximum(rows[:, None] - np.arange(w.shape[0])[None, :], 0)]
+        else:
+            w = _NO_LAG
+            p = truth.p_static_pa[rows[:, None]]
+        c = np.ascontiguousarray
+        out = np.empty(np.shape(bias))
+        bk.baro_apply(c(p, dtype=float), float(self.setting_pa), _T0_OVER_LAPSE_M, _EXPONENT_INV, w,
+                      c(sf, dtype=float), c(bias, dtype=float), c(noise, dtype=float), out)
+        h = out if batched else out[0]
+        return BaroSamples(
+            t_s=t_s, h_baro_m=h, sigma_m=np.full(np.shape(t_s), self.noise_sigma_m),
+            valid=np.ones(h.shape, dtype=bool), fault=np.zeros(h.shape, dtype=np.int8),
+        )
+
+    def prepare(self, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> PreparedBaro:
+        """`errors` laid out for one sample at a time (base.prepare; the baro has no clock)."""
+        return PreparedBaro(self, errors)
+
+    def apply_reference(self, truth: Truth, errors: base.SensorErrors) -> BaroSamples:
+        """`apply` in numpy: the readable model (module docstring) and the kernel's test oracle."""
+        if self.lag_s > 0.0:
+            w = self.lag_weights(float(truth.t_s[1] - truth.t_s[0]))
+            idx = np.maximum(errors.rows[:, None] - np.arange(w.shape[0])[None, :], 0)
             # row-wise sum (not a matrix product: BLAS blocking would make one row differ from the batch)
             h_ind = np.sum(atmosphere.indicated_altitude_m(truth.p_static_pa[idx], self.setting_pa) * w, axis=-1)
         else:
@@ -92,3 +137,23 @@ class Baro:
         """apply(truth, draw(truth.t_s, rng)); noise=False gives the exact indicated altitude."""
         e = self.draw(truth.t_s, rng)
         return self.apply(truth, e if noise else e.zeroed())
+
+
+class PreparedBaro:
+    """A baro's drawn errors for one sample at a time (the closed loop's damping loop reads every baro sample):
+    at(truth, j) is Baro.apply(truth, errors.sample(j)) bit for bit (the same kernel on the same values), without
+    rebuilding the errors of sample j."""
+
+    def __init__(self, baro: Baro, errors: base.SensorErrors) -> None:
+        run = (lambda a: a) if errors.batched else (lambda a: a[None])
+        self.baro = baro
+        self.errors = errors
+        self.sf = np.ascontiguousarray(run(np.asarray(errors.constants["scale_factor"], dtype=float)))
+        self.bias = np.ascontiguousarray(run(errors.series["bias"]), dtype=float)
+        self.noise = np.ascontiguousarray(run(errors.series["noise"]), dtype=float)
+
+    def at(self, truth: Truth, j: int) -> BaroSamples:
+        """The record of sample j alone (one-sample axes)."""
+        sl = slice(j, j + 1)
+        e = self.errors
+        return self.baro.record(truth, e.rows[sl], e.t_s[sl], self.sf, self.bias[:, sl], self.noise[:, sl], e.batched)

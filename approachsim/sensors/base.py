@@ -21,9 +21,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.signal import lfilter
+
+from approachsim.sensors.kernels import noise as noise_kernels
 
 Array = np.ndarray
 RngLike = np.random.Generator | Sequence[np.random.Generator]
@@ -66,8 +69,23 @@ def gauss_markov(z: Array, sigma: float | Array, tau_s: float | Array, dt_s: flo
     x_0 = sigma z_0;  x_k = a x_{k-1} + sigma sqrt(1 - a^2) z_k,  a = exp(-dt / tau)
     (the exact discretization of dx/dt = -x / tau + w; seed 000 eq. 5 and seed 001 eq. 2 are its Euler
     form a = 1 - dt beta). sigma and tau broadcast over the trailing axes of z; tau = inf gives a random
-    constant, sigma = 0 gives zeros.
+    constant, sigma = 0 gives zeros. The recursion is compiled (sensors/kernels/noise.py first_order), bit-identical
+    to gauss_markov_reference.
     """
+    z = np.asarray(z, dtype=float)
+    sigma = np.broadcast_to(np.asarray(sigma, dtype=float), z.shape[1:])
+    a = np.exp(-dt_s / np.broadcast_to(np.asarray(tau_s, dtype=float), z.shape[1:]))
+    z2 = z.reshape(z.shape[0], -1)
+    out = np.empty(z2.shape)
+    noise_kernels.first_order(z2, np.ascontiguousarray(sigma.reshape(-1)),
+                              np.ascontiguousarray((sigma * np.sqrt(1.0 - a * a)).reshape(-1)),
+                              np.ascontiguousarray(np.asarray(a).reshape(-1)), out)
+    return out.reshape(z.shape)
+
+
+def gauss_markov_reference(z: Array, sigma: float | Array, tau_s: float | Array, dt_s: float) -> Array:
+    """gauss_markov in numpy and scipy (the oracle): the driving terms d_0 = sigma z_0, d_k = sigma sqrt(1 - a^2) z_k
+    filtered by scipy.signal.lfilter([1], [1, -a]) per column."""
     z = np.asarray(z, dtype=float)
     sigma = np.broadcast_to(np.asarray(sigma, dtype=float), z.shape[1:])
     tau = np.broadcast_to(np.asarray(tau_s, dtype=float), z.shape[1:])
@@ -116,6 +134,15 @@ class SensorErrors:
             constants=self.constants, batched=self.batched,
         )
 
+    def sample(self, j: int) -> SensorErrors:
+        """Sample j alone, as views of the arrays (no copy): the values of take(slice(j, j + 1)), for applying one
+        sample at a time (the closed loop)."""
+        sl = slice(j, j + 1)
+        series = {k: v[:, sl] for k, v in self.series.items()} if self.batched else {k: v[sl] for k, v in
+                                                                                     self.series.items()}
+        return SensorErrors(index=self.index[sl], rows=self.rows[sl], t_s=self.t_s[sl], dt_s=self.dt_s,
+                            series=series, constants=self.constants, batched=self.batched)
+
     def zeroed(self) -> SensorErrors:
         """The same structure with every error zero (for measure(..., noise=False)); constants that are not
         errors (NOT_ERRORS: a run's GPS epoch) are kept."""
@@ -149,3 +176,29 @@ def make_errors(
     return SensorErrors(
         index=index, rows=rows, t_s=t, dt_s=dt, series=series, constants=constants, batched=batched
     )
+
+
+class PreparedSensor:
+    """A sensor's drawn errors for applying one sample at a time: at(truth, j) is sensor.apply(truth,
+    errors.sample(j)) (ranging sensors: with the receiver clock's sample j, the clock given on the same samples).
+    Sensors with something to precompute define their own `prepare(errors, clock)` (GNSS: the satellite orbits;
+    faults.Faulted: the fault masks); `prepare` below picks it."""
+
+    def __init__(self, sensor: Any, errors: SensorErrors, clock: SensorErrors | None = None) -> None:
+        self.sensor = sensor
+        self.errors = errors
+        self.clock = clock
+
+    def at(self, truth: Any, j: int) -> Any:
+        """The record of sample j alone (one-sample axes)."""
+        if self.clock is None:
+            return self.sensor.apply(truth, self.errors.sample(j))
+        return self.sensor.apply(truth, self.errors.sample(j), clock=self.clock.sample(j))
+
+
+def prepare(sensor: Any, errors: SensorErrors, clock: SensorErrors | None = None) -> Any:
+    """An object whose at(truth, j) gives sensor.apply(truth, errors.sample(j)[, clock=clock.sample(j)]) bit for
+    bit: the sensor's own `prepare` when it has one, else PreparedSensor. `clock`: the receiver clock on the
+    sensor's samples (ranging sensors only)."""
+    own = getattr(sensor, "prepare", None)
+    return own(errors, clock) if own is not None else PreparedSensor(sensor, errors, clock)

@@ -127,8 +127,24 @@ class Faulted:
 
     def apply(self, truth: Any, errors: base.SensorErrors, *args: Any, **kwargs: Any) -> Any:
         """The wrapped sensor's apply with the faults of the samples in `errors` applied and labelled."""
-        masks = [f.sample_mask(errors.index, errors.t_s, errors.dt_s) for f in self.faults]
-        # noise faults first: scale the noise series of the chosen samples
+        masks = self._masks(errors)
+        rec = self.sensor.apply(truth, replace(errors, series=self._noise_faulted(errors, masks)), *args, **kwargs)
+        return self._label(rec, errors.t_s, errors.batched, masks)
+
+    def prepare(self, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> PreparedFaulted:
+        """`errors` laid out for one sample at a time (base.prepare): the fault masks and the noise faults of every
+        sample made once, the wrapped sensor prepared on the faulted noise; at(truth, j) = apply(truth,
+        errors.sample(j)[, clock=clock.sample(j)]) bit for bit (the record faults of sample j by the same code)."""
+        masks = self._masks(errors)
+        inner = base.prepare(self.sensor, replace(errors, series=self._noise_faulted(errors, masks)), clock)
+        return PreparedFaulted(self, inner, errors, masks)
+
+    def _masks(self, errors: base.SensorErrors) -> list[Array]:
+        """(m,) per fault: the samples of `errors` it touches."""
+        return [f.sample_mask(errors.index, errors.t_s, errors.dt_s) for f in self.faults]
+
+    def _noise_faulted(self, errors: base.SensorErrors, masks: list[Array]) -> dict[str, Array]:
+        """The error series with the noise faults (spike: k times, mni: sqrt(factor) times) on their samples."""
         series = dict(errors.series)
         noise_faults = [(f, m) for f, m in zip(self.faults, masks, strict=True) if f.kind in ("spike", "mni")]
         for f, m in noise_faults:
@@ -139,24 +155,27 @@ class Faulted:
             full = m.reshape(m.shape + (1,) * len(per_sample)) & ch
             mult = math.sqrt(f.factor) if f.kind == "mni" else f.k
             series[noise_name] = np.where(full, z * mult, z)
-        rec = self.sensor.apply(truth, replace(errors, series=series), *args, **kwargs)
+        return series
+
+    def _label(self, rec: Any, t_s: Array, batched: bool, masks: list[Array]) -> Any:
+        """The record with the value faults (iam, cbm, step, ramp, outage) of the samples at times t_s, labelled."""
         fault = np.array(rec.fault, copy=True)
         valid = np.array(rec.valid, copy=True)
         updates: dict[str, Array] = {}
         for f, m in zip(self.faults, masks, strict=True):
             fld, _ = self._target(f)
             val = np.array(updates.get(fld, getattr(rec, fld)), copy=True)
-            per_sample = val.shape[2:] if errors.batched else val.shape[1:]
+            per_sample = val.shape[2:] if batched else val.shape[1:]
             ch = _channel_mask(per_sample, f, self._channel_index(f))
             full = m.reshape(m.shape + (1,) * len(per_sample)) & ch
             if f.kind in ("iam", "cbm", "step"):
                 val = np.where(full, val + f.magnitude, val)
             elif f.kind == "ramp":
-                dt = (errors.t_s - f.start_s).reshape(m.shape + (1,) * len(per_sample))
+                dt = (t_s - f.start_s).reshape(m.shape + (1,) * len(per_sample))
                 val = np.where(full, val + f.rate * dt, val)
             updates[fld] = val
             # labels and validity live on the record's label shape (IMU: per sample; GNSS: per channel)
-            lab_ndim = fault.ndim - (1 if errors.batched else 0)
+            lab_ndim = fault.ndim - (1 if batched else 0)
             lab = full.reshape(full.shape[:lab_ndim] + (-1,)).any(axis=-1) if full.ndim > lab_ndim else full
             fault = np.where(lab, np.int8(FAULT_CODES[f.kind]), fault).astype(np.int8)
             if f.kind == "outage":
@@ -174,3 +193,22 @@ class Faulted:
         """apply(truth, draw(truth.t_s, rng), **kwargs) with the faults; noise=False zeroes the sensor errors."""
         e = self.draw(truth.t_s, rng)
         return self.apply(truth, e if noise else e.zeroed(), **kwargs)
+
+
+class PreparedFaulted:
+    """Faulted.prepare's result: the wrapped sensor's prepared errors (noise faults in) and the fault masks."""
+
+    def __init__(self, faulted: Faulted, inner: Any, errors: base.SensorErrors, masks: list[Array]) -> None:
+        self.faulted = faulted
+        self.inner = inner
+        self.errors = errors
+        self.masks = masks
+
+    def at(self, truth: Any, j: int) -> Any:
+        """The faulted record of sample j alone. A sample no fault touches is the wrapped sensor's record as it is:
+        labelling it would change no value (its invalid values are already nan)."""
+        sl = slice(j, j + 1)
+        rec = self.inner.at(truth, j)
+        if not any(m[j] for m in self.masks):
+            return rec
+        return self.faulted._label(rec, self.errors.t_s[sl], self.errors.batched, [m[sl] for m in self.masks])

@@ -95,27 +95,34 @@ class Imu:
 
     def apply(self, truth: Truth, errors: base.SensorErrors) -> ImuSamples:
         """Increments for the samples in `errors` (truth rows errors.rows and the rows before them); computed by
-        the compiled kernel (sensors/kernels.py imu_apply), equal to `apply_reference` to 1e-12 relative."""
-        dth_t, dv_t, dt = true_increments(truth, errors.rows)
-        s, k = errors.series, errors.constants
-        runs = (lambda a: a) if errors.batched else (lambda a: a[None])
+        the compiled kernel (sensors/kernels/imu.py imu_apply), equal to `apply_reference` to 1e-12 relative."""
+        return self.record(truth, errors.rows, errors.t_s, _run_axis(errors), errors.batched)
+
+    def record(self, truth: Truth, rows: Array, t_s: Array, e: dict[str, Array], batched: bool) -> ImuSamples:
+        """The record of the increments ending at truth `rows` (times t_s) from the errors `e` with a run axis
+        (_run_axis: constants (R, 3[, 3]), series (R, m, 3)); batched: the run axis is kept."""
+        dth_t, dv_t, dt = true_increments(truth, rows)
         g = self.grade
+        c = np.ascontiguousarray
 
         def one(true_inc: Array, m_err: Array, b0: Array, b: Array, n: Array, q: float) -> Array:
-            nz = np.ascontiguousarray(runs(n), dtype=float)
+            nz = c(n, dtype=float)
             out = np.empty(nz.shape)
-            sk.imu_apply(np.ascontiguousarray(true_inc, dtype=float), np.ascontiguousarray(runs(m_err), dtype=float),
-                         np.ascontiguousarray(runs(b0), dtype=float), np.ascontiguousarray(runs(b), dtype=float),
-                         nz, float(dt), float(q), out)
-            return out if errors.batched else out[0]
+            sk.imu_apply(c(true_inc, dtype=float), c(m_err, dtype=float), c(b0, dtype=float), c(b, dtype=float), nz,
+                         float(dt), float(q), out)
+            return out if batched else out[0]
 
-        dth = one(dth_t, k["gyro_m"], k["gyro_bias0"], s["gyro_bias"], s["gyro_noise"], g.gyro_quant_rad)
-        dv = one(dv_t, k["accel_m"], k["accel_bias0"], s["accel_bias"], s["accel_noise"], g.accel_quant_mps)
+        dth = one(dth_t, e["gyro_m"], e["gyro_bias0"], e["gyro_bias"], e["gyro_noise"], g.gyro_quant_rad)
+        dv = one(dv_t, e["accel_m"], e["accel_bias0"], e["accel_bias"], e["accel_noise"], g.accel_quant_mps)
         shape = dth.shape[:-1]
         return ImuSamples(
-            t_s=errors.t_s, dt_s=dt, dtheta_body=dth, dv_body=dv,
+            t_s=t_s, dt_s=dt, dtheta_body=dth, dv_body=dv,
             valid=np.ones(shape, dtype=bool), fault=np.zeros(shape, dtype=np.int8),
         )
+
+    def prepare(self, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> PreparedImu:
+        """`errors` laid out for one increment at a time (base.prepare; the IMU has no clock)."""
+        return PreparedImu(self, errors)
 
     def apply_reference(self, truth: Truth, errors: base.SensorErrors) -> ImuSamples:
         """`apply` in numpy: the readable version of the error model (module docstring) and the kernel's test
@@ -152,3 +159,27 @@ class Imu:
         ("dtheta", "dtheta_body", "gyro_noise"),
     )
     """Fault targets: (name, record field, noise series in the same units); the first is the default."""
+
+
+def _run_axis(errors: base.SensorErrors) -> dict[str, Array]:
+    """Series and constants of IMU errors by name, with a run axis (views for one run)."""
+    both = {**errors.series, **errors.constants}
+    return both if errors.batched else {k: np.asarray(v)[None] for k, v in both.items()}
+
+
+class PreparedImu:
+    """An IMU's drawn errors for one increment at a time (a closed loop whose IMU is quantized: not affine):
+    at(truth, j) is Imu.apply(truth, errors.sample(j)) bit for bit (the same kernel on the same values), without
+    rebuilding the errors of sample j."""
+
+    def __init__(self, imu: Imu, errors: base.SensorErrors) -> None:
+        self.imu = imu
+        self.errors = errors
+        self.e = {k: np.ascontiguousarray(v, dtype=float) for k, v in _run_axis(errors).items()}
+        self.series = tuple(errors.series)
+
+    def at(self, truth: Truth, j: int) -> ImuSamples:
+        """The record of increment sample j alone (one-sample axes)."""
+        sl = slice(j, j + 1)
+        e = {k: (v[:, sl] if k in self.series else v) for k, v in self.e.items()}
+        return self.imu.record(truth, self.errors.rows[sl], self.errors.t_s[sl], e, self.errors.batched)

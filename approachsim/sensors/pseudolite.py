@@ -25,6 +25,7 @@ from approachsim import geo
 from approachsim.records import PseudoliteSamples, Truth
 from approachsim.sensors import base
 from approachsim.sensors.gnss.clock import ClockModel
+from approachsim.sensors.kernels import pseudolite as plk
 
 Array = np.ndarray
 
@@ -84,12 +85,51 @@ class Pseudolite:
 
         return base.make_errors(t_s, self.rate_hz, rng, one)
 
+    def c_ecef_to_ned(self, r_published_ecef: Array) -> Array:
+        """Rotations ECEF -> local NED (p, 3, 3) at the published transmitter positions (p, 3)."""
+        lat, lon, _ = geo.ecef_to_geodetic(r_published_ecef)
+        return geo.c_ecef_to_ned(lat, lon)
+
     def apply(
         self, truth: Truth, errors: base.SensorErrors, clock: base.SensorErrors | None = None
     ) -> PseudoliteSamples:
-        """Pseudoranges at the truth rows of `errors`; `clock` the receiver clock (None: zero)."""
+        """Pseudoranges at the truth rows of `errors`; `clock` the receiver clock (None: zero). Compiled
+        (sensors/kernels/pseudolite.py), equal to apply_reference to 1e-12 relative."""
+        pub = self.r_published_ecef
+        e = _run_axis(errors, clock)
+        c_down = np.ascontiguousarray(self.c_ecef_to_ned(pub)[:, 2, :])
+        return self.record(truth, errors.rows, errors.t_s, e, errors.batched, pub, c_down)
+
+    def prepare(self, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> PreparedPseudolite:
+        """`errors` (and the receiver clock on the same samples) laid out for one sample at a time (base.prepare)."""
+        return PreparedPseudolite(self, errors, clock)
+
+    def record(self, truth: Truth, rows: Array, t_s: Array, e: dict[str, Array], batched: bool, pub: Array,
+               c_down: Array) -> PseudoliteSamples:
+        """The record of the samples at truth `rows` (times t_s) from the errors `e` with a run axis (_run_axis:
+        survey (R, p, 3), tropo_ppm (R, p), multipath, noise, pl_clock (R, m, p), bias (R, m)), the published
+        positions pub (p, 3) and the down rows c_down (p, 3) of their ECEF -> NED rotations."""
+        c = np.ascontiguousarray
+        mp = e["multipath"]
+        n_run, m, p = mp.shape
+        pr, valid, el = np.empty(mp.shape), np.empty(mp.shape, dtype=bool), np.empty((m, p))
+        plk.pseudolite_apply(c(truth.r_ecef[rows], dtype=float), pub, c_down, e["survey"], e["tropo_ppm"], c(mp),
+                             c(e["noise"]), c(e["pl_clock"]), c(e["bias"]), float(self.max_range_m),
+                             float(self.mask_rad), pr, valid, el)
+        sig = math.sqrt(self.code_noise_m**2 + self.multipath_m**2)
+        out = (lambda a: a) if batched else (lambda a: a[0])
+        return PseudoliteSamples(
+            t_s=t_s, r_pl_ecef=pub, pseudorange_m=out(pr), sigma_m=np.full(el.shape, sig), elevation_rad=el,
+            valid=out(valid), clock_bias_m=np.array(out(e["bias"])), fault=np.zeros(out(pr).shape, dtype=np.int8),
+        )
+
+    def apply_reference(
+        self, truth: Truth, errors: base.SensorErrors, clock: base.SensorErrors | None = None
+    ) -> PseudoliteSamples:
+        """`apply` in numpy: the readable model (module docstring) and the kernel's test oracle."""
+        pub = self.r_published_ecef
+        c_ned = self.c_ecef_to_ned(pub)
         r = truth.r_ecef[errors.rows]  # (m, 3)
-        pub = self.r_published_ecef  # (p, 3)
         surv = errors.constants["survey"]
         true_pl = pub + surv  # (p, 3) or (runs, p, 3)
         if errors.batched:
@@ -106,8 +146,6 @@ class Pseudolite:
         # visibility from the published geometry (what the transmitter / receiver geometry is)
         dp = pub[None, :, :] - r[:, None, :]
         rng_pub = np.linalg.norm(dp, axis=-1)
-        lat, lon, _ = geo.ecef_to_geodetic(pub)
-        c_ned = geo.c_ecef_to_ned(lat, lon)  # (p, 3, 3)
         up = -np.einsum("pij,mpj->mpi", c_ned, -dp)[..., 2]  # aircraft height above the transmitter plane
         el = np.arcsin(np.clip(up / rng_pub, -1.0, 1.0))
         ok = (rng_pub <= self.max_range_m) & (el >= self.mask_rad)
@@ -125,3 +163,35 @@ class Pseudolite:
         """apply(truth, draw(truth.t_s, rng), clock); noise=False gives the geometric range (plus the clock)."""
         e = self.draw(truth.t_s, rng)
         return self.apply(truth, e if noise else e.zeroed(), clock)
+
+
+def _run_axis(errors: base.SensorErrors, clock: base.SensorErrors | None) -> dict[str, Array]:
+    """Pseudolite errors by name with a run axis, contiguous: survey (R, p, 3), tropo_ppm (R, p), multipath, noise,
+    pl_clock (R, m, p), and the receiver clock bias (R, m) (zeros without a clock)."""
+    run = (lambda a: a) if errors.batched else (lambda a: np.asarray(a)[None])
+    out = {k: np.ascontiguousarray(run(errors.constants[k]), dtype=float) for k in ("survey", "tropo_ppm")}
+    out |= {k: np.ascontiguousarray(run(errors.series[k]), dtype=float) for k in ("multipath", "noise", "pl_clock")}
+    shape = out["multipath"].shape[:2]
+    out["bias"] = np.zeros(shape) if clock is None else np.ascontiguousarray(
+        np.broadcast_to(clock.series["bias"], shape), dtype=float)
+    return out
+
+
+class PreparedPseudolite:
+    """A pseudolite's drawn errors for one sample at a time: the published positions, their NED rotations and the
+    errors with a run axis made once; at(truth, j) is Pseudolite.apply(truth, errors.sample(j), clock.sample(j)) bit
+    for bit (the same kernel on the same values)."""
+
+    def __init__(self, pl: Pseudolite, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> None:
+        self.pl = pl
+        self.errors = errors
+        self.pub = np.ascontiguousarray(pl.r_published_ecef, dtype=float)
+        self.c_down = np.ascontiguousarray(pl.c_ecef_to_ned(self.pub)[:, 2, :])
+        self.e = _run_axis(errors, clock)
+
+    def at(self, truth: Truth, j: int) -> PseudoliteSamples:
+        """The record of sample j alone (one-sample axes; its own copy of the published positions)."""
+        sl = slice(j, j + 1)
+        e = {k: (v if k in ("survey", "tropo_ppm") else v[:, sl]) for k, v in self.e.items()}
+        return self.pl.record(truth, self.errors.rows[sl], self.errors.t_s[sl], e, self.errors.batched,
+                              self.pub.copy(), self.c_down)

@@ -41,6 +41,7 @@ from approachsim import units
 from approachsim.records import RadaltSamples, Truth
 from approachsim.seeding import substream
 from approachsim.sensors import base
+from approachsim.sensors.kernels import radalt as ra
 
 Array = np.ndarray
 
@@ -81,7 +82,34 @@ class RadarAltimeter:
         return base.make_errors(t_s, self.rate_hz, rng, one)
 
     def apply(self, truth: Truth, errors: base.SensorErrors) -> RadaltSamples:
-        """Measurements at the truth rows of `errors`; nan and valid=False out of range or attitude limits."""
+        """Measurements at the truth rows of `errors`; nan and valid=False out of range or attitude limits. Compiled
+        (sensors/kernels/radalt.py), bit-identical to apply_reference."""
+        bias = np.asarray(errors.constants["bias"], dtype=float)
+        run = (lambda a: a) if errors.batched else (lambda a: a[None])
+        return self.record(truth, errors.rows, errors.t_s, run(bias), run(errors.series["markov"]),
+                           run(errors.series["noise"]), errors.batched)
+
+    def record(self, truth: Truth, rows: Array, t_s: Array, bias: Array, markov: Array, noise: Array,
+               batched: bool) -> RadaltSamples:
+        """The record of the samples at truth `rows` (times t_s) of R runs: bias (R,) m, Markov error (R, m) m and
+        unit normals (R, m); batched: the run axis is kept."""
+        c = np.ascontiguousarray
+        shape = np.shape(markov)
+        meas, sig, valid = np.empty(shape), np.empty(shape), np.empty(shape, dtype=bool)
+        ra.radalt_apply(c(truth.h_agl_m[rows], dtype=float), c(truth.euler_rad[rows, 1], dtype=float),
+                        c(truth.euler_rad[rows, 0], dtype=float), c(bias, dtype=float), c(markov, dtype=float),
+                        c(noise, dtype=float), float(self.percent_sigma), self.floor_m**2, float(self.max_range_m),
+                        float(self.max_pitch_rad), float(self.max_roll_rad), meas, sig, valid)
+        run = (lambda a: a) if batched else (lambda a: a[0])
+        return RadaltSamples(t_s=t_s, h_agl_m=run(meas), sigma_m=run(sig), valid=run(valid),
+                             fault=np.zeros(run(meas).shape, dtype=np.int8))
+
+    def prepare(self, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> PreparedRadalt:
+        """`errors` laid out for one sample at a time (base.prepare; the altimeter has no clock)."""
+        return PreparedRadalt(self, errors)
+
+    def apply_reference(self, truth: Truth, errors: base.SensorErrors) -> RadaltSamples:
+        """`apply` in numpy: the readable model (module docstring) and the kernel's test oracle."""
         r = errors.rows
         h = truth.h_agl_m[r]
         sig = self.sigma_m(h)
@@ -106,3 +134,23 @@ class RadarAltimeter:
         """apply(truth, draw(truth.t_s, rng)); noise=False gives the exact height where valid."""
         e = self.draw(truth.t_s, rng)
         return self.apply(truth, e if noise else e.zeroed())
+
+
+class PreparedRadalt:
+    """A radar altimeter's drawn errors for one sample at a time: at(truth, j) is RadarAltimeter.apply(truth,
+    errors.sample(j)) bit for bit (the same kernel on the same values)."""
+
+    def __init__(self, ra_: RadarAltimeter, errors: base.SensorErrors) -> None:
+        run = (lambda a: a) if errors.batched else (lambda a: a[None])
+        self.ra = ra_
+        self.errors = errors
+        self.bias = np.ascontiguousarray(run(np.asarray(errors.constants["bias"], dtype=float)))
+        self.markov = np.ascontiguousarray(run(errors.series["markov"]), dtype=float)
+        self.noise = np.ascontiguousarray(run(errors.series["noise"]), dtype=float)
+
+    def at(self, truth: Truth, j: int) -> RadaltSamples:
+        """The record of sample j alone (one-sample axes)."""
+        sl = slice(j, j + 1)
+        e = self.errors
+        return self.ra.record(truth, e.rows[sl], e.t_s[sl], self.bias, self.markov[:, sl], self.noise[:, sl],
+                              e.batched)

@@ -12,6 +12,14 @@ bit-identical (tests/unit/sensors/test_suite.py).
     records = suite.measure(truth, seed=1, runs=range(100))         # {name: record}, run axis first
     errors = suite.draw(t_longest, seed=1, runs=[7])                # closed loop: draw once ...
     recs_k = suite.apply(truth, suite.take(errors, "baro", sl))     # ... apply sample by sample
+    prepared = suite.prepare(errors)                                # or: lay the draw out once per run ...
+    recs_k = prepared.at(truth, k, ("baro", "gnss"))                # ... the records of the sensors sampled at row k
+    baro_k = prepared.one("baro", truth, k)                         # ... one sensor's record at row k, or None
+
+`prepared.at(truth, k, names)` gives, for each named sensor with a sample at truth row k, exactly (bit for bit) the
+record `apply` gives for that one sample (tests/unit/sensors/test_prepared.py), with the work that does not depend on
+the truth done once per run: the GNSS satellite orbits of every sample, the receiver clock on each ranging sensor's
+samples, the fault masks and noise faults; each sample then skips the suite's bookkeeping.
 """
 
 from __future__ import annotations
@@ -41,6 +49,8 @@ CLOCK_STREAM = "receiver_clock"
 """Random stream of the GPS receiver clock shared by the GNSS and pseudolite channels."""
 EPOCH_STREAM = "gnss_epoch"
 """Random stream of each run's GPS constellation epoch offset."""
+RANGING = ("gnss", "pseudolite")
+"""Sensors whose measurements carry the receiver clock."""
 
 
 def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = ()) -> dict[str, Any]:
@@ -153,7 +163,7 @@ class SensorSuite:
         for name in names if names is not None else self.sensors:
             s = self.sensors[name]
             e = errors.sensors[name]
-            if name in ("gnss", "pseudolite"):
+            if name in RANGING:
                 clk = None if errors.clock is None else errors.clock.take(_clock_rows(errors.clock, e))
                 out[name] = s.apply(truth, e, clock=clk)
             else:
@@ -172,10 +182,79 @@ class SensorSuite:
             )
         return self.apply(truth, e)
 
+    def prepare(self, errors: SuiteErrors) -> PreparedSuite:
+        """The drawn errors laid out for applying one truth row at a time (module docstring; base.prepare)."""
+        prepared = {}
+        grids = {}
+        for name, e in errors.sensors.items():
+            clk = None
+            if name in RANGING and errors.clock is not None:
+                clk = errors.clock.take(_clock_rows(errors.clock, e))
+            prepared[name] = base.prepare(self.sensors[name], e, clk)
+            grids[name] = _RowIndex.of(e.rows)
+        return PreparedSuite(MappingProxyType(prepared), MappingProxyType(grids))
+
     @staticmethod
     def take(errors: SuiteErrors, name: str, sl: slice | Array) -> SuiteErrors:
         """The suite errors restricted to samples `sl` of sensor `name` (for sample-by-sample closed loops)."""
         return SuiteErrors(MappingProxyType({name: errors.sensors[name].take(sl)}), errors.clock)
+
+
+@dataclass(frozen=True)
+class _RowIndex:
+    """Truth row -> sample number of a sensor's grid: rows first + j step (j < count), or a lookup when irregular."""
+
+    first: int
+    step: int
+    count: int
+    lookup: Mapping[int, int] | None = None
+
+    @classmethod
+    def of(cls, rows: Array) -> _RowIndex:
+        rows = np.asarray(rows)
+        n = int(rows.shape[0])
+        if n == 0:
+            return cls(0, 1, 0)
+        step = int(rows[1] - rows[0]) if n > 1 else 1
+        if n > 1 and (step < 1 or not np.array_equal(rows, rows[0] + step * np.arange(n))):
+            return cls(0, 1, 0, MappingProxyType({int(r): j for j, r in enumerate(rows)}))
+        return cls(int(rows[0]), step, n)
+
+    def sample(self, k: int) -> int | None:
+        """The sample taken at truth row k, or None."""
+        if self.lookup is not None:
+            return self.lookup.get(k)
+        j, rem = divmod(k - self.first, self.step)
+        return j if rem == 0 and 0 <= j < self.count else None
+
+
+@dataclass(frozen=True)
+class PreparedSuite:
+    """A suite's drawn errors laid out for one truth row at a time (SensorSuite.prepare): per sensor the prepared
+    errors (base.prepare) and its row -> sample index."""
+
+    sensors: Mapping[str, Any]
+    grids: Mapping[str, _RowIndex]
+
+    def sample(self, name: str, k: int) -> int | None:
+        """Sensor `name`'s sample number at truth row k, or None (no sample there, or no such sensor)."""
+        g = self.grids.get(name)
+        return None if g is None else g.sample(k)
+
+    def at(self, truth: Any, k: int, names: Iterable[str] | None = None) -> dict[str, Any]:
+        """Records by sensor name (only `names` when given; sensors the suite lacks are skipped) of the sensors with
+        a sample at truth row k: each exactly apply(truth, <that one sample of the errors>)'s record."""
+        out = {}
+        for name in names if names is not None else self.sensors:
+            j = self.sample(name, k)
+            if j is not None:
+                out[name] = self.sensors[name].at(truth, j)
+        return out
+
+    def one(self, name: str, truth: Any, k: int) -> Any:
+        """Sensor `name`'s record at truth row k (as `at`), or None when it has no sample there or is not fitted."""
+        j = self.sample(name, k)
+        return None if j is None else self.sensors[name].at(truth, j)
 
 
 def _clock_rows(clock: base.SensorErrors, e: base.SensorErrors) -> Array:
@@ -186,4 +265,5 @@ def _clock_rows(clock: base.SensorErrors, e: base.SensorErrors) -> Array:
     return pos
 
 
-__all__ = ["CLOCK_STREAM", "EPOCH_STREAM", "SENSOR_NAMES", "SensorSuite", "SuiteErrors", "build_sensors"]
+__all__ = ["CLOCK_STREAM", "EPOCH_STREAM", "RANGING", "SENSOR_NAMES", "PreparedSuite", "SensorSuite", "SuiteErrors",
+           "build_sensors"]

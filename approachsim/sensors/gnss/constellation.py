@@ -18,6 +18,7 @@ from datetime import UTC, datetime
 import numpy as np
 
 from approachsim import geo
+from approachsim.sensors.kernels import gnss as gk
 
 Array = np.ndarray
 
@@ -76,12 +77,36 @@ class Constellation:
             prn=np.array([s[3] for s in SLOTS]),
         )
 
+    def epoch_phases(self, offset_s: float = 0.0) -> tuple[float, float, float]:
+        """Mean motion n (rad/s) and, offset_s (s) after the epoch, the argument-of-latitude advance n t_ep and the
+        Greenwich hour angle of the inertial x axis, both reduced mod 2 pi (rad), t_ep = epoch_s + offset_s."""
+        n_mot = math.sqrt(MU_GPS / self.a_m**3)
+        ep = self.epoch_s + float(offset_s)
+        # phases reduced mod 2 pi at the epoch first, so decades of propagation keep full precision
+        u_ep = math.fmod(n_mot * ep, 2.0 * math.pi)
+        g_ep = math.fmod(GHA_AT_REFERENCE_RAD + geo.OMEGA_E * ep, 2.0 * math.pi)
+        return n_mot, u_ep, g_ep
+
+    def orbits(self, t_s: Array, offsets_s: Array, with_velocity: bool = False) -> tuple[Array, Array | None]:
+        """Positions (S, m, 24, 3), ECEF, m, at run times t_s (m,) of the S skies offsets_s (S,) s after the epoch,
+        and with_velocity their velocities relative to the rotating Earth (same shape), m/s (else None).
+
+        The compiled kernel (sensors/kernels/gnss.py sv_orbits) of positions_ecef / velocities_ecef (the numpy
+        oracles, equal to 1e-12 relative): one sky's values do not depend on the others or on the times asked."""
+        t = np.ascontiguousarray(t_s, dtype=float)
+        offs = np.atleast_1d(np.asarray(offsets_s, dtype=float))
+        ph = np.array([self.epoch_phases(o) for o in offs]).reshape(-1, 3)
+        n_mot = math.sqrt(MU_GPS / self.a_m**3)
+        r = np.empty((offs.shape[0], t.shape[0], self.prn.shape[0], 3))
+        v = np.empty(r.shape if with_velocity else (0, 0, 0, 3))
+        gk.sv_orbits(np.ascontiguousarray(self.u0_rad, dtype=float), np.ascontiguousarray(self.raan_rad, dtype=float),
+                     float(self.a_m), math.cos(self.inclination_rad), math.sin(self.inclination_rad), n_mot,
+                     np.ascontiguousarray(ph[:, 1]), np.ascontiguousarray(ph[:, 2]), t, with_velocity, r, v)
+        return r, (v if with_velocity else None)
+
     def _angles(self, t_s: Array) -> tuple[Array, Array, float]:
         t = np.asarray(t_s, dtype=float)
-        n_mot = math.sqrt(MU_GPS / self.a_m**3)
-        # phases reduced mod 2 pi at the epoch first, so decades of propagation keep full precision
-        u_ep = math.fmod(n_mot * self.epoch_s, 2.0 * math.pi)
-        g_ep = math.fmod(GHA_AT_REFERENCE_RAD + geo.OMEGA_E * self.epoch_s, 2.0 * math.pi)
+        n_mot, u_ep, g_ep = self.epoch_phases()
         u = self.u0_rad[None, :] + u_ep + n_mot * t[:, None]
         lam = self.raan_rad[None, :] - (g_ep + geo.OMEGA_E * t[:, None])  # node longitude in ECEF
         return u, lam, n_mot

@@ -48,6 +48,13 @@ columns are drawn only when on, so receivers without it keep their exact draws (
 that receiver's pseudorange noise, reproducibly).
 Selection: "all" (every SV above the mask) or "best4" (the four of lowest PDOP, seed 002, chosen afresh at
 each epoch). Channels are the 24 slots, in SLOTS order; invisible or unselected channels are nan and invalid.
+
+Computation: `apply` runs the compiled kernels of sensors/kernels/gnss.py (orbits, look angles, selection, PDOP,
+pseudoranges) over every sky and sample at once; `apply_reference` (with `geometry`, `best_pdop_four_reference`)
+is the readable numpy version and the kernels' test oracle (values to 1e-12 relative, selections identical).
+`prepare(errors, clock)` lays one run's (or batch's) errors out for sample-at-a-time application in a closed
+loop: the satellite positions of every sample are computed once, and `.at(truth, j)` gives exactly the record
+`apply(truth, <sample j of errors>, <its clock sample>)` gives, bit for bit.
 """
 
 from __future__ import annotations
@@ -66,6 +73,7 @@ from approachsim.records import GnssSamples, Truth
 from approachsim.sensors import base
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
+from approachsim.sensors.kernels import gnss as gk
 
 Array = np.ndarray
 
@@ -158,7 +166,16 @@ def tropo_mapping(el_rad: Array) -> Array:
 
 
 def best_pdop_four(u_los: Array, visible: Array) -> Array:
-    """Selection mask (n, k): per epoch the four visible channels of lowest PDOP (all visible if < 4)."""
+    """Selection mask (n, k): per epoch the four visible channels of lowest PDOP (all visible if < 4); compiled
+    (sensors/kernels/gnss.py best_four), the same selection as best_pdop_four_reference."""
+    sel = np.zeros(np.shape(visible), dtype=bool)
+    gk.best_four_epochs(np.ascontiguousarray(u_los, dtype=float), np.ascontiguousarray(visible, dtype=bool), sel)
+    return sel
+
+
+def best_pdop_four_reference(u_los: Array, visible: Array) -> Array:
+    """best_pdop_four in numpy (the oracle): PDOP^2 = trace of the position block of inv(G'G) for every combination
+    of four visible channels (itertools order), the first minimum (argmin)."""
     n, k = visible.shape
     sel = np.zeros((n, k), dtype=bool)
     for i in range(n):
@@ -242,7 +259,8 @@ class GnssReceiver:
 
     def geometry(self, truth: Truth, rows: Array, t_s: Array, epoch_offset_s: float = 0.0) -> dict[str, Array]:
         """Satellite positions, ranges, lines of sight, look angles, visibility, selection and DOPs, with the
-        constellation epoch_offset_s (s) after the receiver's epoch (the run's own sky)."""
+        constellation epoch_offset_s (s) after the receiver's epoch (the run's own sky); numpy (apply_reference's
+        geometry, the oracle of the compiled sky kernel)."""
         const = self.geometry_constellation(epoch_offset_s)
         r_rx = truth.r_ecef[rows]
         r_sv = const.positions_ecef(t_s)
@@ -253,17 +271,17 @@ class GnssReceiver:
         if self.selection == "all":
             sel = visible
         elif self.selection == "best4":
-            sel = best_pdop_four(u, visible)
+            sel = best_pdop_four_reference(u, visible)
         else:  # best4-fixed: planned at the run start (truth row 0) for the next fixed_hold_s
             t_plan = truth.t_s[0] + np.arange(0.0, self.fixed_hold_s + 1.0, 60.0)
             r0 = np.repeat(truth.r_ecef[:1], t_plan.shape[0], axis=0)
             _, u0, el0, _ = look_angles(r0, const.positions_ecef(t_plan))
             stays = np.all(el0 >= self.mask_rad, axis=0, keepdims=True)
-            first = best_pdop_four(u0[:1], stays)[0]
+            first = best_pdop_four_reference(u0[:1], stays)[0]
             keep = np.all(visible[:, first], axis=1)
             sel = np.where(keep[:, None], first[None, :] & visible, False)
             if not np.all(keep):
-                sel[~keep] = best_pdop_four(u[~keep], visible[~keep])
+                sel[~keep] = best_pdop_four_reference(u[~keep], visible[~keep])
         _, pdop, _, _ = dops(u, sel, c_ned)
         out = {"r_sv": r_sv, "range": rng_m, "u": u, "el": el, "az": az, "visible": visible, "sel": sel,
                "pdop": pdop}
@@ -273,7 +291,7 @@ class GnssReceiver:
 
     def geometries(self, truth: Truth, errors: base.SensorErrors) -> dict[str, Array]:
         """geometry() at the samples of `errors`: one sky without an epoch offset; with per-run offsets
-        (constants["epoch_offset_s"], (runs,)) each run's own, stacked on a leading run axis."""
+        (constants["epoch_offset_s"], (runs,)) each run's own, stacked on a leading run axis (numpy reference)."""
         off = errors.constants.get("epoch_offset_s")
         if off is None or np.ndim(off) == 0:
             return self.geometry(truth, errors.rows, errors.t_s, 0.0 if off is None else float(off))
@@ -289,10 +307,88 @@ class GnssReceiver:
             + b.code_noise_m**2
         )
 
+    @staticmethod
+    def skies(errors: base.SensorErrors) -> tuple[Array, bool]:
+        """The epoch offsets (S,) s of the skies of `errors` and whether they are per run (S = runs, the record's
+        geometry then has a leading run axis) or one sky for all runs (S = 1; offset 0 without one)."""
+        off = errors.constants.get("epoch_offset_s")
+        if off is None:
+            return np.zeros(1), False
+        if np.ndim(off) == 0:
+            return np.array([float(off)]), False
+        offs = np.asarray(off, dtype=float)
+        runs = next(iter(errors.series.values())).shape[0] if errors.batched else 1
+        if not errors.batched or offs.shape != (runs,):
+            raise ValueError(f"per-run epoch offsets {offs.shape} need errors batched over as many runs ({runs})")
+        return offs, True
+
+    def plan(self, truth: Truth, offsets_s: Array) -> Array:
+        """The planned four (S, 24) of best4-fixed on each sky (offsets_s (S,) s): the best-PDOP four at truth row 0
+        among the satellites that stay above the mask over fixed_hold_s seen from there (sampled every 60 s);
+        all False for the other selections."""
+        k = self.constellation.prn.shape[0]
+        if self.selection != "best4-fixed":
+            return np.zeros((np.shape(offsets_s)[0], k), dtype=bool)
+        t_plan = truth.t_s[0] + np.arange(0.0, self.fixed_hold_s + 1.0, 60.0)
+        r0 = np.ascontiguousarray(np.repeat(truth.r_ecef[:1], t_plan.shape[0], axis=0), dtype=float)
+        r_sv, _ = self.constellation.orbits(t_plan, offsets_s)
+        _, u, el, _ = gk.look_angles(r0, r_sv)
+        stays = np.ascontiguousarray(np.all(el >= self.mask_rad, axis=1))
+        first = np.zeros(stays.shape, dtype=bool)
+        gk.best_four_epochs(np.ascontiguousarray(u[:, 0]), stays, first)
+        return first
+
     def apply(
         self, truth: Truth, errors: base.SensorErrors, clock: base.SensorErrors | None = None
     ) -> GnssSamples:
-        """Pseudoranges at the truth rows of `errors`; `clock` from draw_clock (None: a zero receiver clock)."""
+        """Pseudoranges at the truth rows of `errors`; `clock` from draw_clock (None: a zero receiver clock).
+        Compiled (sensors/kernels/gnss.py); equal to apply_reference to 1e-12 relative, the same selections."""
+        offs, per_run = self.skies(errors)
+        r_sv, v_sv = self.constellation.orbits(errors.t_s, offs, self.doppler)
+        series = _run_axis(errors)
+        bias, drift = _clock_arrays(clock, next(iter(series.values())).shape[:2])
+        return self.record(truth, errors.rows, errors.t_s, r_sv, v_sv, self.plan(truth, offs), series, bias, drift,
+                           per_run, errors.batched, errors.constants.get("epoch_offset_s"))
+
+    def record(self, truth: Truth, rows: Array, t_s: Array, r_sv: Array, v_sv: Array | None, plan: Array,
+               series: Mapping[str, Array], bias: Array, drift: Array, per_run: bool, batched: bool,
+               epoch_offset_s: Array | None) -> GnssSamples:
+        """The record of samples at truth `rows` (times t_s) from the satellites r_sv (and velocities v_sv) (S, m, 24,
+        3) of S skies, best4-fixed's plan (S, 24), the error series (R, m, 24) by name and the receiver clock bias
+        and drift (R, m); per_run: the geometry keeps its sky axis; batched: the run axis is kept."""
+        b = self.budget
+        mode = {"all": gk.MODE_ALL, "best4": gk.MODE_BEST4, "best4-fixed": gk.MODE_PLANNED}[self.selection]
+        c = np.ascontiguousarray
+        rng, u, el, az, vis, sel, pdop, f_iono, m_tropo, mp_scale, sigma = gk.sky(
+            c(truth.r_ecef[rows], dtype=float), c(r_sv), float(self.mask_rad), mode, c(plan), IONO_SHELL_M,
+            b.multipath_model == "do253", float(b.multipath_m), b.clock_ephemeris_m**2, float(b.iono_zenith_m),
+            float(b.tropo_zenith_m), b.code_noise_m**2)
+        pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, c(series["clock_ephemeris"]),
+                                    c(series["iono_zenith"]), c(series["tropo_zenith"]), c(series["multipath"]),
+                                    c(series["noise"]), c(bias))
+        prr = None
+        if self.doppler:
+            prr = gk.pseudorange_rates(u, c(v_sv), c(truth.lat_rad[rows], dtype=float),
+                                       c(truth.lon_rad[rows], dtype=float), c(truth.v_ned[rows], dtype=float), sel,
+                                       c(drift), c(series["rate_noise"]))
+        sky = (lambda a: a) if per_run else (lambda a: a[0])
+        run = (lambda a: a) if batched else (lambda a: a[0])
+        return GnssSamples(
+            t_s=t_s, prn=self.constellation.prn, r_sv_ecef=sky(r_sv), pseudorange_m=run(pr), sigma_m=sky(sigma),
+            elevation_rad=sky(el), azimuth_rad=sky(az), visible=sky(vis), valid=run(valid), pdop=sky(pdop),
+            clock_bias_m=np.array(run(bias)), clock_drift_mps=np.array(run(drift)),
+            fault=np.zeros(run(pr).shape, dtype=np.int8), pseudorange_rate_mps=None if prr is None else run(prr),
+            epoch_offset_s=epoch_offset_s,
+        )
+
+    def prepare(self, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> PreparedGnss:
+        """`errors` (and the receiver clock at the same samples) laid out for one sample at a time (closed loop)."""
+        return PreparedGnss(self, errors, clock)
+
+    def apply_reference(
+        self, truth: Truth, errors: base.SensorErrors, clock: base.SensorErrors | None = None
+    ) -> GnssSamples:
+        """`apply` in numpy: the readable model (module docstring) and the compiled kernels' test oracle."""
         geo_ = self.geometries(truth, errors)
         s = errors.series
         el = geo_["el"]
@@ -339,3 +435,54 @@ class GnssReceiver:
             e = e.zeroed()
             c = None if c is None else c.zeroed()
         return self.apply(truth, e, c)
+
+
+def _run_axis(errors: base.SensorErrors) -> dict[str, Array]:
+    """The error series of `errors` with a run axis: name -> (R, m, ...) (a view for one run)."""
+    return dict(errors.series) if errors.batched else {k: v[None] for k, v in errors.series.items()}
+
+
+def _clock_arrays(clock: base.SensorErrors | None, shape: tuple[int, ...]) -> tuple[Array, Array]:
+    """Receiver clock bias (m) and drift (m/s) broadcast to `shape` (R, m): zeros without a clock."""
+    if clock is None:
+        return np.zeros(shape), np.zeros(shape)
+    return (np.ascontiguousarray(np.broadcast_to(clock.series["bias"], shape)),
+            np.ascontiguousarray(np.broadcast_to(clock.series["drift"], shape)))
+
+
+class PreparedGnss:
+    """A receiver's drawn errors laid out for one sample at a time (the closed loop's 1 Hz epochs).
+
+    The satellite positions (and velocities) of every sample of every sky, the error series with a run axis and
+    the receiver clock at the GNSS samples are made once; best4-fixed's plan once per truth start (row 0).
+    at(truth, j) is GnssReceiver.apply(truth, errors.sample(j), clock.sample(j)), bit for bit: the same kernels
+    on the same values (tests/unit/sensors/test_prepared.py)."""
+
+    def __init__(self, rx: GnssReceiver, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> None:
+        self.rx = rx
+        self.errors = errors
+        self.offsets, self.per_run = rx.skies(errors)
+        self.r_sv, self.v_sv = rx.constellation.orbits(errors.t_s, self.offsets, rx.doppler)
+        self.series = _run_axis(errors)
+        self.bias, self.drift = _clock_arrays(clock, next(iter(self.series.values())).shape[:2])
+        self.epoch_offset_s = errors.constants.get("epoch_offset_s")
+        self._plan_at: tuple[float, bytes] | None = None
+        self._plan = np.zeros((self.offsets.shape[0], rx.constellation.prn.shape[0]), dtype=bool)
+
+    def plan(self, truth: Truth) -> Array:
+        """best4-fixed's plan for this truth's start (kept while row 0 is the same)."""
+        if self.rx.selection != "best4-fixed":
+            return self._plan
+        key = (float(truth.t_s[0]), truth.r_ecef[0].tobytes())
+        if key != self._plan_at:
+            self._plan, self._plan_at = self.rx.plan(truth, self.offsets), key
+        return self._plan
+
+    def at(self, truth: Truth, j: int) -> GnssSamples:
+        """The record of sample j alone (one-sample axes, as apply on errors.sample(j))."""
+        sl = slice(j, j + 1)
+        e = self.errors
+        return self.rx.record(
+            truth, e.rows[sl], e.t_s[sl], self.r_sv[:, sl], None if self.v_sv is None else self.v_sv[:, sl],
+            self.plan(truth), {k: v[:, sl] for k, v in self.series.items()}, self.bias[:, sl], self.drift[:, sl],
+            self.per_run, e.batched, self.epoch_offset_s)

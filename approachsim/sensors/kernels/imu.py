@@ -1,8 +1,5 @@
-"""Compiled sensor kernels (numba, cache=True): plain functions of float arrays, imported by the sensor models.
-
-    imu_apply   the IMU error application of sensors/imu.py (`Imu.apply`; `apply_reference` is the numpy
-                oracle, tests/unit/sensors/test_sensor_kernels.py checks they agree to 1e-12 relative)
-"""
+"""Compiled IMU error application (numba, cache=True): sensors/imu.py's `Imu.apply`; `Imu.apply_reference` is the
+numpy oracle (tests/unit/sensors/test_sensor_kernels.py checks they agree to 1e-12 relative)."""
 
 from __future__ import annotations
 

@@ -1,0 +1,33 @@
+"""Compiled barometric altimeter measurement (numba, cache=True): sensors/baro.py's `Baro.apply`; `Baro.apply_reference`
+is the numpy oracle (tests/unit/sensors/test_sensor_kernels.py). They agree to 1e-12 of the ISA scale T0 / L
+(44.3 km, i.e. 4.4e-8 m): the indication (T0 / L)(1 - x^e) cancels near sea level, so one rounding of the power
+(libm here, numpy's SIMD power there) can be 1e-11 m, a larger part of a small height than 1e-12."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def baro_apply(p_static: np.ndarray, setting_pa: float, t0_over_lapse_m: float, exponent: float,
+               weights: np.ndarray, sf: np.ndarray, bias: np.ndarray, noise: np.ndarray, out: np.ndarray) -> None:
+    """Baro heights of R runs at m samples, in place into out (R, m), m:
+
+        h_ind = (T0 / L) (1 - (p / p_set)^(R L / g0))        (ISA inverse, sensors/atmosphere.py)
+        h     = h_ind (1 + S_r) + B_ri + v_ri                  (sensors/baro.py)
+
+    p_static (m, n) the static pressure (Pa) of each sample's truth row (column 0) and, with a lag, of the n - 1 rows
+    before it; weights (n,) the lag's impulse response (h_ind = sum_l w_l h_ind(p_il), in l order), empty without a
+    lag; t0_over_lapse_m = T0 / L (m), exponent = R L / g0; scale factor sf (R,), bias and noise (R, m) m."""
+    m = p_static.shape[0]
+    lagged = weights.shape[0] > 0
+    for i in range(m):
+        if lagged:
+            h = 0.0
+            for q in range(weights.shape[0]):
+                h += t0_over_lapse_m * (1.0 - (p_static[i, q] / setting_pa) ** exponent) * weights[q]
+        else:
+            h = t0_over_lapse_m * (1.0 - (p_static[i, 0] / setting_pa) ** exponent)
+        for r in range(sf.shape[0]):
+            out[r, i] = h * (1.0 + sf[r]) + bias[r, i] + noise[r, i]

@@ -1,0 +1,369 @@
+"""Compiled GPS geometry and pseudoranges (numba, cache=True): sensors/gnss/receiver.py's `GnssReceiver.apply`.
+
+The numpy oracle is `GnssReceiver.apply_reference` (Constellation.positions_ecef / velocities_ecef, look_angles,
+best_pdop_four_reference, dops); tests/unit/sensors/test_gnss_kernels.py checks the kernels against it: values to
+1e-12 relative, selections identical. Axes: skies s (one per run with per-run epochs, else one), runs r, samples i,
+channels j innermost. Every value of a (sky, sample) or (run, sample) is computed by the same scalar code whatever
+the batch, so a run's bits do not depend on the runs it shares a call with, and one sample applied alone equals the
+same sample of a batch bit for bit.
+
+    sv_orbits          satellite positions (and velocities) on circular Kepler orbits at each sky's sample times
+    look_angles        range, line of sight, elevation and azimuth of every satellite from the receiver
+    sky                look angles, visibility, selection (all / best-PDOP four / a planned four), PDOP, mappings
+    pseudoranges       range + mapped errors + receiver clock for every run, nan where not selected
+    pseudorange_rates  line-of-sight range rate + clock drift + noise for every run
+    best_four_epochs   the best-PDOP four at each of a stack of epochs (best_four: one epoch)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from approachsim import geo
+
+A = geo.A_WGS84
+B = geo.B_WGS84
+E2 = geo.E2_WGS84
+EP2 = E2 / (1.0 - E2)
+OMEGA_E = geo.OMEGA_E
+TWO_PI = 2.0 * math.pi
+RAD_TO_DEG = 180.0 / math.pi
+
+MODE_ALL = 0
+"""Selection: every visible channel."""
+MODE_BEST4 = 1
+"""Selection: the best-PDOP four at every epoch."""
+MODE_PLANNED = 2
+"""Selection: the planned four (plan) while all four are visible, else the best-PDOP four."""
+
+
+@njit(cache=True)
+def sv_orbits(u0: np.ndarray, raan: np.ndarray, a_m: float, ci: float, si: float, n_mot: float, u_ep: np.ndarray,
+              g_ep: np.ndarray, t_s: np.ndarray, with_v: bool, r_out: np.ndarray, v_out: np.ndarray) -> None:
+    """ECEF positions r_out (S, m, k, 3), m, of k circular orbits of radius a_m and inclination (cos ci, sin si) at
+    the times t_s (m,) of each sky s, and when with_v their velocities relative to the rotating Earth v_out (same
+    shape), m/s (constellation.py):
+
+        u = u0 + u_ep[s] + n t  (argument of latitude),   l = raan - (g_ep[s] + OMEGA_E t)  (node longitude, ECEF)
+        r = a (cos u cos l - sin u cos i sin l,  cos u sin l + sin u cos i cos l,  sin u sin i),   v = dr/dt
+    """
+    ld = -OMEGA_E
+    for s in range(u_ep.shape[0]):
+        for i in range(t_s.shape[0]):
+            t = t_s[i]
+            nt = n_mot * t
+            lt = g_ep[s] + OMEGA_E * t
+            for j in range(u0.shape[0]):
+                u = u0[j] + u_ep[s] + nt
+                lam = raan[j] - lt
+                cu, su = math.cos(u), math.sin(u)
+                cl, sl = math.cos(lam), math.sin(lam)
+                r_out[s, i, j, 0] = a_m * (cu * cl - su * ci * sl)
+                r_out[s, i, j, 1] = a_m * (cu * sl + su * ci * cl)
+                r_out[s, i, j, 2] = a_m * (su * si)
+                if with_v:
+                    v_out[s, i, j, 0] = a_m * (-su * n_mot * cl - cu * sl * ld - cu * n_mot * ci * sl
+                                               - su * ci * cl * ld)
+                    v_out[s, i, j, 1] = a_m * (-su * n_mot * sl + cu * cl * ld + cu * n_mot * ci * cl
+                                               - su * ci * sl * ld)
+                    v_out[s, i, j, 2] = a_m * (cu * n_mot * si)
+
+
+@njit(cache=True)
+def geodetic_lat_lon(x: float, y: float, z: float) -> tuple[float, float]:
+    """Geodetic latitude and longitude (rad) of the ECEF point (x, y, z), m: geo.ecef_to_geodetic's Bowring start
+    and two refinements lat = atan2(z, p (1 - e^2 R_E / (R_E + h))), in the same order."""
+    lon = math.atan2(y, x)
+    p = math.hypot(x, y)
+    theta = math.atan2(z * A, p * B)
+    lat = math.atan2(z + EP2 * B * math.pow(math.sin(theta), 3.0), p - E2 * A * math.pow(math.cos(theta), 3.0))
+    for _ in range(2):
+        s = math.sin(lat)
+        r_e = A / math.sqrt(1.0 - E2 * (s * s))
+        c = abs(math.cos(lat))
+        h = p / max(c, 1e-300) - r_e if c > 1e-9 else abs(z) - B
+        lat = math.atan2(z, p * (1.0 - E2 * r_e / (r_e + h)))
+    return lat, lon
+
+
+@njit(cache=True)
+def c_ecef_to_ned(lat: float, lon: float, c: np.ndarray) -> None:
+    """The rotation ECEF -> local NED at (lat, lon), rad, into c (3, 3) (geo.c_ecef_to_ned)."""
+    sl, cl = math.sin(lat), math.cos(lat)
+    so, co = math.sin(lon), math.cos(lon)
+    c[0, 0], c[0, 1], c[0, 2] = -sl * co, -sl * so, cl
+    c[1, 0], c[1, 1], c[1, 2] = -so, co, 0.0
+    c[2, 0], c[2, 1], c[2, 2] = -cl * co, -cl * so, -sl
+
+
+@njit(cache=True)
+def _look(rx: np.ndarray, c: np.ndarray, r_sv: np.ndarray, rng: np.ndarray, u: np.ndarray, el: np.ndarray,
+          az: np.ndarray) -> None:
+    """One epoch (constellation.look_angles): d = r_sv - r_rx, range |d|, u = d / |d| (ECEF), u_ned = C u,
+    el = asin(-u_d) (clipped to [-1, 1]), az = atan2(u_e, u_n) mod 2 pi."""
+    for j in range(r_sv.shape[0]):
+        dx, dy, dz = r_sv[j, 0] - rx[0], r_sv[j, 1] - rx[1], r_sv[j, 2] - rx[2]
+        r = math.sqrt(dx * dx + dy * dy + dz * dz)
+        ux, uy, uz = dx / r, dy / r, dz / r
+        rng[j] = r
+        u[j, 0], u[j, 1], u[j, 2] = ux, uy, uz
+        n = c[0, 0] * ux + c[0, 1] * uy + c[0, 2] * uz
+        e = c[1, 0] * ux + c[1, 1] * uy + c[1, 2] * uz
+        d = c[2, 0] * ux + c[2, 1] * uy + c[2, 2] * uz
+        el[j] = math.asin(min(max(-d, -1.0), 1.0))
+        a = math.atan2(e, n)
+        if a < 0.0:
+            a += TWO_PI
+        elif a == 0.0:
+            a = 0.0  # numpy's mod gives +0 for -0
+        az[j] = a
+
+
+@njit(cache=True)
+def look_angles(r_rx: np.ndarray, r_sv: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Range (S, m, k) m, unit line of sight (S, m, k, 3) ECEF, elevation and azimuth (S, m, k) rad from the
+    receivers r_rx (m, 3) to the satellites r_sv (S, m, k, 3) of each sky (constellation.look_angles)."""
+    n_sky, m, k = r_sv.shape[0], r_sv.shape[1], r_sv.shape[2]
+    rng = np.empty((n_sky, m, k))
+    u = np.empty((n_sky, m, k, 3))
+    el = np.empty((n_sky, m, k))
+    az = np.empty((n_sky, m, k))
+    c = np.empty((3, 3))
+    for i in range(m):
+        lat, lon = geodetic_lat_lon(r_rx[i, 0], r_rx[i, 1], r_rx[i, 2])
+        c_ecef_to_ned(lat, lon, c)
+        for s in range(n_sky):
+            _look(r_rx[i], c, r_sv[s, i], rng[s, i], u[s, i], el[s, i], az[s, i])
+    return rng, u, el, az
+
+
+@njit(cache=True)
+def best_four(u: np.ndarray, visible: np.ndarray, sel: np.ndarray, idx: np.ndarray) -> None:
+    """The four visible channels of lowest PDOP at one epoch into sel (k,) (every visible one if <= 4 are).
+
+    Lines of sight u (k, 3); idx (k,) integer work space. For the four channels 0..3 with geometry rows [-u, 1]
+    (Kaplan eq. 7.46), PDOP^2 = trace of the position block of (G'G)^-1 = G^-1 G^-T. With a = u1 - u0,
+    b = u2 - u0, c = u3 - u0 and p = b x c, q = c x a, r = a x b, det = a . p, the position rows of G^-1 are
+    -(p, q, r) / det for channels 1..3 and (p + q + r) / det for channel 0, so
+
+        PDOP^2 = (|p|^2 + |q|^2 + |r|^2 + |p + q + r|^2) / det^2.
+
+    Combinations in itertools.combinations order of the visible channels; the first minimum wins (numpy's
+    argmin, as best_pdop_four_reference); a coplanar set (det = 0) has infinite PDOP."""
+    k = visible.shape[0]
+    n = 0
+    for j in range(k):
+        sel[j] = False
+        if visible[j]:
+            idx[n] = j
+            n += 1
+    if n <= 4:
+        for q in range(n):
+            sel[idx[q]] = True
+        return
+    best = math.inf
+    b0 = b1 = b2 = b3 = -1
+    for i0 in range(n - 3):
+        j0 = idx[i0]
+        x0, y0, z0 = u[j0, 0], u[j0, 1], u[j0, 2]
+        for i1 in range(i0 + 1, n - 2):
+            j1 = idx[i1]
+            ax, ay, az = u[j1, 0] - x0, u[j1, 1] - y0, u[j1, 2] - z0
+            for i2 in range(i1 + 1, n - 1):
+                j2 = idx[i2]
+                bx, by, bz = u[j2, 0] - x0, u[j2, 1] - y0, u[j2, 2] - z0
+                rx, ry, rz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx  # r = a x b
+                rr = rx * rx + ry * ry + rz * rz
+                for i3 in range(i2 + 1, n):
+                    j3 = idx[i3]
+                    cx, cy, cz = u[j3, 0] - x0, u[j3, 1] - y0, u[j3, 2] - z0
+                    px, py, pz = by * cz - bz * cy, bz * cx - bx * cz, bx * cy - by * cx  # p = b x c
+                    qx, qy, qz = cy * az - cz * ay, cz * ax - cx * az, cx * ay - cy * ax  # q = c x a
+                    det = ax * px + ay * py + az * pz
+                    sx, sy, sz = px + qx + rx, py + qy + ry, pz + qz + rz
+                    num = px * px + py * py + pz * pz + qx * qx + qy * qy + qz * qz + rr + sx * sx + sy * sy + sz * sz
+                    pdop2 = num / (det * det) if det != 0.0 else math.inf
+                    if pdop2 < best:
+                        best = pdop2
+                        b0, b1, b2, b3 = j0, j1, j2, j3
+    if b0 < 0:  # every set coplanar: the first one, as argmin over all-inf values
+        b0, b1, b2, b3 = idx[0], idx[1], idx[2], idx[3]
+    sel[b0] = sel[b1] = sel[b2] = sel[b3] = True
+
+
+@njit(cache=True)
+def best_four_epochs(u: np.ndarray, visible: np.ndarray, sel: np.ndarray) -> None:
+    """best_four at each epoch n of u (N, k, 3), visible (N, k), into sel (N, k)."""
+    idx = np.empty(visible.shape[1], dtype=np.int64)
+    for i in range(visible.shape[0]):
+        best_four(u[i], visible[i], sel[i], idx)
+
+
+@njit(cache=True)
+def pdop(u: np.ndarray, use: np.ndarray) -> float:
+    """PDOP of the channels `use` (k,) with lines of sight u (k, 3): sqrt(Q00 + Q11 + Q22), Q = (G'G)^-1, rows
+    [-u, 1] (Kaplan eq. 7.46; the trace is that of constellation.dops' NED block, rotation-invariant); G'G by
+    Cholesky G'G = L L', Q_ii = sum_j (L^-1)_ji^2. inf with fewer than 4 channels (or a singular geometry)."""
+    a = np.zeros((4, 4))
+    g = np.empty(4)
+    n = 0
+    for j in range(use.shape[0]):
+        if use[j]:
+            g[0], g[1], g[2], g[3] = -u[j, 0], -u[j, 1], -u[j, 2], 1.0
+            for p in range(4):
+                for q in range(p + 1):
+                    a[p, q] += g[p] * g[q]
+            n += 1
+    if n < 4:
+        return math.inf
+    for p in range(4):  # Cholesky, lower triangle in place
+        for q in range(p + 1):
+            v = a[p, q]
+            for t in range(q):
+                v -= a[p, t] * a[q, t]
+            if p == q:
+                if v <= 0.0:
+                    return math.inf
+                a[p, p] = math.sqrt(v)
+            else:
+                a[p, q] = v / a[q, q]
+    li = np.zeros((4, 4))  # L^-1 by forward substitution
+    for q in range(4):
+        li[q, q] = 1.0 / a[q, q]
+        for p in range(q + 1, 4):
+            v = 0.0
+            for t in range(q, p):
+                v -= a[p, t] * li[t, q]
+            li[p, q] = v / a[p, p]
+    tr = 0.0
+    for i in range(3):
+        for j in range(i, 4):
+            tr += li[j, i] * li[j, i]
+    return math.sqrt(tr)
+
+
+@njit(cache=True)
+def sky(r_rx: np.ndarray, r_sv: np.ndarray, mask_rad: float, mode: int, plan: np.ndarray, shell_m: float,
+        do253: bool, mp_sigma_m: float, ce2: float, iono_zenith_m: float, tropo_zenith_m: float,
+        cn2: float) -> tuple[np.ndarray, ...]:
+    """The geometry of every sky s and sample i (receiver.py): receivers r_rx (m, 3) m, satellites r_sv (S, m, k, 3).
+
+    Returns range (S, m, k) m, line of sight (S, m, k, 3), elevation, azimuth (S, m, k) rad, visible
+    (el >= mask_rad), selected (mode: MODE_ALL every visible; MODE_BEST4 best_four; MODE_PLANNED the sky's plan
+    (S, k) while all of it is visible, else best_four), PDOP (S, m) of the selection, and per channel the
+    ionospheric obliquity F = 1 / sqrt(1 - (R cos el / (R + shell_m))^2), the tropospheric mapping
+    M = 1.001 / sqrt(0.002001 + sin^2 el), the multipath scale (do253: 0.13 + 0.53 exp(-el / 10 deg); else 1) and
+    the nominal sigma sqrt(ce2 + (I_z F)^2 + (T_z M)^2 + sigma_mp^2 + cn2) (sigma_mp: the do253 curve, else
+    mp_sigma_m)."""
+    n_sky, m, k = r_sv.shape[0], r_sv.shape[1], r_sv.shape[2]
+    rng = np.empty((n_sky, m, k))
+    u = np.empty((n_sky, m, k, 3))
+    el = np.empty((n_sky, m, k))
+    az = np.empty((n_sky, m, k))
+    vis = np.empty((n_sky, m, k), dtype=np.bool_)
+    sel = np.empty((n_sky, m, k), dtype=np.bool_)
+    pd = np.empty((n_sky, m))
+    f_iono = np.empty((n_sky, m, k))
+    m_tropo = np.empty((n_sky, m, k))
+    mp_scale = np.empty((n_sky, m, k))
+    sigma = np.empty((n_sky, m, k))
+    c = np.empty((3, 3))
+    idx = np.empty(k, dtype=np.int64)
+    for i in range(m):
+        lat, lon = geodetic_lat_lon(r_rx[i, 0], r_rx[i, 1], r_rx[i, 2])
+        c_ecef_to_ned(lat, lon, c)
+        for s in range(n_sky):
+            _look(r_rx[i], c, r_sv[s, i], rng[s, i], u[s, i], el[s, i], az[s, i])
+            for j in range(k):
+                vis[s, i, j] = el[s, i, j] >= mask_rad
+            if mode == MODE_ALL:
+                for j in range(k):
+                    sel[s, i, j] = vis[s, i, j]
+            else:
+                keep = mode == MODE_PLANNED
+                if keep:
+                    for j in range(k):
+                        if plan[s, j] and not vis[s, i, j]:
+                            keep = False
+                if keep:
+                    for j in range(k):
+                        sel[s, i, j] = plan[s, j] and vis[s, i, j]
+                else:
+                    best_four(u[s, i], vis[s, i], sel[s, i], idx)
+            pd[s, i] = pdop(u[s, i], sel[s, i])
+            for j in range(k):
+                e = el[s, i, j]
+                x = A * math.cos(e) / (A + shell_m)
+                f = 1.0 / math.sqrt(1.0 - x * x)
+                sn = math.sin(e)
+                mt = 1.001 / math.sqrt(0.002001 + sn * sn)
+                if do253:
+                    msc = 0.13 + 0.53 * math.exp(-(e * RAD_TO_DEG) / 10.0)
+                    mps = msc
+                else:
+                    msc = 1.0
+                    mps = mp_sigma_m
+                f_iono[s, i, j] = f
+                m_tropo[s, i, j] = mt
+                mp_scale[s, i, j] = msc
+                fi = iono_zenith_m * f
+                tm = tropo_zenith_m * mt
+                sigma[s, i, j] = math.sqrt(ce2 + fi * fi + tm * tm + mps * mps + cn2)
+    return rng, u, el, az, vis, sel, pd, f_iono, m_tropo, mp_scale, sigma
+
+
+@njit(cache=True)
+def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_scale: np.ndarray, sel: np.ndarray,
+                 ce: np.ndarray, iono: np.ndarray, tropo: np.ndarray, mp: np.ndarray, noise: np.ndarray,
+                 bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pseudoranges (R, m, k) m and validity of every run r (receiver.py; run r on sky r, or on sky 0 when there
+    is one sky for all runs):
+
+        rho = |r_sv - r| + E + F I + M T + s_mp m + n + b_rx      (nan where the channel is not selected)
+
+    geometry (S, m, k) from `sky`, errors ce, iono, tropo, mp, noise (R, m, k), receiver clock bias (R, m)."""
+    n_run, m, k = ce.shape
+    one_sky = rng.shape[0] == 1
+    pr = np.empty((n_run, m, k))
+    valid = np.empty((n_run, m, k), dtype=np.bool_)
+    for r in range(n_run):
+        s = 0 if one_sky else r
+        for i in range(m):
+            b = bias[r, i]
+            for j in range(k):
+                p = (rng[s, i, j] + ce[r, i, j] + f_iono[s, i, j] * iono[r, i, j] + m_tropo[s, i, j] * tropo[r, i, j]
+                     + mp[r, i, j] * mp_scale[s, i, j] + noise[r, i, j])
+                v = sel[s, i, j]
+                valid[r, i, j] = v
+                pr[r, i, j] = p + b if v else math.nan
+    return pr, valid
+
+
+@njit(cache=True)
+def pseudorange_rates(u: np.ndarray, v_sv: np.ndarray, lat: np.ndarray, lon: np.ndarray, v_ned: np.ndarray,
+                      sel: np.ndarray, drift: np.ndarray, rate_noise: np.ndarray) -> np.ndarray:
+    """Pseudorange rates (R, m, k) m/s (receiver.py): u . (v_sv - v_rx) + d_rx + e, nan where not selected; line
+    of sight u and satellite velocity v_sv (S, m, k, 3), receiver velocity v_rx = C_ecef_to_ned(lat, lon)' v_ned
+    from the truth's lat, lon (m,) and v_ned (m, 3), clock drift (R, m), noise (R, m, k)."""
+    n_run, m, k = rate_noise.shape
+    one_sky = u.shape[0] == 1
+    out = np.empty((n_run, m, k))
+    c = np.empty((3, 3))
+    v_rx = np.empty(3)
+    for i in range(m):
+        c_ecef_to_ned(lat[i], lon[i], c)
+        for q in range(3):
+            v_rx[q] = c[0, q] * v_ned[i, 0] + c[1, q] * v_ned[i, 1] + c[2, q] * v_ned[i, 2]
+        for r in range(n_run):
+            s = 0 if one_sky else r
+            for j in range(k):
+                if not sel[s, i, j]:
+                    out[r, i, j] = math.nan
+                    continue
+                rr = (u[s, i, j, 0] * (v_sv[s, i, j, 0] - v_rx[0]) + u[s, i, j, 1] * (v_sv[s, i, j, 1] - v_rx[1])
+                      + u[s, i, j, 2] * (v_sv[s, i, j, 2] - v_rx[2]))
+                out[r, i, j] = rr + drift[r, i] + rate_noise[r, i, j]
+    return out
