@@ -14,8 +14,7 @@ errors to row k and runs the filter (system.NavSystem.aid). Guidance gets the na
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
-from types import MappingProxyType
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -29,7 +28,7 @@ from approachsim.nav.system import NavSystem
 from approachsim.records import ApproachErrors, Truth
 from approachsim.seeding import stream
 from approachsim.sensors.states import start_states
-from approachsim.sensors.suite import SensorSuite, SuiteErrors
+from approachsim.sensors.suite import SensorSuite
 
 Array = np.ndarray
 
@@ -61,8 +60,8 @@ class NavInTheLoop:
         t_max = self.max_time_s or max(60.0, 2.0 * self.profile.runway.start_distance_m / 40.0)
         self.t_s = np.arange(int(math.ceil(t_max / self.dt)) + 1) * self.dt
         self.errors = self.suite.draw(self.t_s, self.seed, self.run)
-        # truth row -> sample index, per sensor
-        self.sample_at = {name: {int(r): j for j, r in enumerate(e.rows)} for name, e in self.errors.sensors.items()}
+        self.prepared = self.suite.prepare(self.errors)
+        """The drawn errors laid out for one truth row at a time (sensors/suite.py PreparedSuite)."""
         self.epoch_rows = max(1, int(round(self.profile.rates.imu_hz / self.nav.nav.aiding_rate_hz)))
         self.gains = self.nav.loop_gains()
         self._imu_affine = self._imu_error_terms()
@@ -104,15 +103,9 @@ class NavInTheLoop:
                 np.ascontiguousarray(rec.dtheta_body, dtype=float), np.ascontiguousarray(rec.dv_body, dtype=float))
 
     def _apply(self, name: str, k: int, truth: Truth) -> Any:
-        """The record of sensor `name` at truth row k (one sample), or None when it has no sample there."""
-        j = self.sample_at.get(name, {}).get(k)
-        if j is None:
-            return None
-        e = self.errors.sensors[name]
-        one = replace(e, index=e.index[j:j + 1], rows=e.rows[j:j + 1], t_s=e.t_s[j:j + 1],
-                      series={k: v[j:j + 1] for k, v in e.series.items()})  # a view: no copy of the long draw
-        sub = SuiteErrors(MappingProxyType({name: one}), self.errors.clock)
-        return self.suite.apply(truth, sub, names=[name])[name]
+        """The record of sensor `name` at truth row k (one sample: exactly SensorSuite.apply's for that sample), or
+        None when it has no sample there."""
+        return self.prepared.one(name, truth, k)
 
     def _observations(self, k: int, truth: Truth) -> tuple[Observations, dict[str, Any]]:
         """The aiding sensors' samples at truth row k (their pre-drawn errors applied to the row)."""

@@ -74,6 +74,9 @@ Array = np.ndarray
 NAV_GROUPS = ("dp", "dv", "psi", "ac")
 """Error-state groups that are INS states: their true value is the INS error, their start estimate 0."""
 
+EIG_FLOOR = 1e-12
+"""Eigenvalues of the conditional covariance below this fraction of its largest are taken as 0 (`conditioner`)."""
+
 _PSD_TOL = 1e-9
 """Relative tolerance of the Pi_ss >= P_conv[s, s] check (eigenvalues of Pi^-1/2 P_conv Pi^-1/2 above 1)."""
 
@@ -209,8 +212,10 @@ def conditioner(P_conv: Array, Pi_ss: Array, s: Array) -> Conditioner:
         raise ValueError(f"converged start: conditional covariance not positive ({w.min():.3g})")
     # the symmetric square root L = V sqrt(Lambda) V' (L L' = C): unique, so continuous in C. A factor V sqrt(Lambda)
     # alone depends on the eigenvector basis, which rounding rotates freely within (near-)repeated eigenvalues:
-    # a rounding-level change of P_conv would then redraw the run
-    L = (V * np.sqrt(np.clip(w, 0.0, None))[None, :]) @ V.T
+    # a rounding-level change of P_conv would then redraw the run. Eigenvalues below EIG_FLOOR of the largest are
+    # rounding (C is singular by design) and taken as 0: a square root turns a rounding change d of a zero eigenvalue
+    # into a sqrt(d) change of the draw (1e-4 m on the 300 m clock prior's scale)
+    L = (V * np.sqrt(np.where(w > EIG_FLOOR * scale, w, 0.0))[None, :]) @ V.T
     return Conditioner(G, L, np.asarray(s), excess)
 
 
