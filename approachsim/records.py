@@ -135,6 +135,10 @@ class NavigationSource(Protocol):
     The flight loop calls step(k, truth) once per step, after writing row k of the (preallocated, being
     filled) truth arrays; the source may read rows <= k only. It returns the position (runway frame:
     along, cross, height above threshold, m) and NED velocity (m/s) that guidance should fly on.
+
+    A source may also offer `inloop()`, returning None or an object whose arrays the flight loop's compiled step
+    steps the navigation with (nav/kernels/inloop.py: nw, cg, ca, rows, snap, baro_j, baro_e, lag_w, dth, dv) and whose
+    act(k, truth, code) it calls at the rows the step asks for; step() is then not called (nav/closed_loop.py).
     """
 
     def step(self, k: int, truth: Truth) -> tuple[Array, Array]: ...

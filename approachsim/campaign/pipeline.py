@@ -249,7 +249,7 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunR
     out = []
     for i in runs:
         try:
-            source = NavInTheLoop(profile, seed, i)
+            source = NavInTheLoop(profile, seed, i, max_time_s=approach.time_budget_s)  # its draws cover the flight
             flight = approach.fly(seed=seed, run=i, nav_source=source)
             why = _reached_all(profile, flight)
             if why is not None:

@@ -194,6 +194,13 @@ class Approach:
         )
 
     @property
+    def time_budget_s(self) -> float:
+        """The longest a run of this approach may fly (s): twice the still-air time to the threshold at the approach
+        speed, at least 60 s; a run still flying then ends as "timeout". A navigation source sized for it
+        (NavInTheLoop(max_time_s=...)) covers every row the flight can have."""
+        return max(60.0, 2.0 * self.profile.runway.start_distance_m / self.aircraft.approach_speed_mps)
+
+    @property
     def linearization(self) -> Linearization:
         """FGLinearization in still air (the profile's temperature and pressure), trimmed on the glidepath
         1000 ft above the threshold (the top of the scored segment), approach configuration (computed once)."""
@@ -233,9 +240,8 @@ class Approach:
             )
         turb_seed = stream_int(seed, run, "turbulence")
         fdm.set_seed(turb_seed)
-        # time budget: twice the still-air time to the threshold, at least 60 s
         if max_time_s is None:
-            max_time_s = max(60.0, 2.0 * rw.start_distance_m / ac.approach_speed_mps)
+            max_time_s = self.time_budget_s
         n_max = int(math.ceil(max_time_s / dt)) + 1
         io = fdm.loop_io(fk.RAW_FIELDS, fk.GEAR_FIELDS, fk.GEAR_AIRBORNE)
         par, st, nu = self._kernel_vectors(fdm, ic, seed, run, n_max)
@@ -250,10 +256,20 @@ class Approach:
         # the loop: JSBSim's reads, one compiled call (fly_step: truth row, turbulence, termination and, guided by
         # the truth, the autopilot), the writes, JSBSim's step; a navigation source sees row k between fly_step
         # and the autopilot (fly_control)
+        # A source whose navigation runs compiled (`inloop()`, nav/closed_loop.py) is stepped inside the same call
+        # (fly_step_nav): Python acts only at the rows it asks for (start, baro samples, aiding epochs)
         guided = src is None
+        fused = None if src is None else getattr(src, "inloop", lambda: None)()
         read, read_near, run_step = io.read, io.read_near, io.run
-        step = _entry(fk.fly_step, 0, (0.0,) * (fk.N_RAW + len(fk.GEAR_FIELDS)), buf, nu, par, st, guided)
+        raw0 = (0.0,) * (fk.N_RAW + len(fk.GEAR_FIELDS))
+        step = _entry(fk.fly_step, 0, raw0, buf, nu, par, st, guided)
         control = None if guided else _entry(fk.fly_control, 0, guidance, buf, par, st)
+        if fused is not None:
+            nav_args = (guidance, fused.nw, fused.cg, fused.ca, fused.rows, fused.snap, fused.baro_j, fused.baro_e,
+                        fused.lag_w, fused.dth, fused.dv)
+            step_nav = _entry(fk.fly_step_nav, 0, raw0, buf, nu, par, st, *nav_args)
+            control_nav = _entry(fk.fly_control_nav, 0, guidance, buf, par, st, fused.nw)
+            act = fused.act
         set_de, set_da, set_dr, (set_thr0, set_thr1) = io.set_elevator, io.set_aileron, io.set_rudder, io.set_throttle
         set_gn, set_ge, set_gd = io.set_gust_fps
         set_terrain_ft = io.set_terrain_ft
@@ -261,17 +277,26 @@ class Approach:
         near = True
         k = 0
         for k in range(n_max):
-            code, de, da, dr, thr, gn, ge, gd, terr_ft, near = step(
-                k, read_near() if near else read(), buf, nu, par, st, guided)
-            if src is not None:
-                pos, vel = src.step(k, truth)
-                guidance[k, 0:3] = pos
-                guidance[k, 3:6] = vel
+            raw = read_near() if near else read()
+            if fused is not None:
+                code, ncode, de, da, dr, thr, gn, ge, gd, terr_ft, near = step_nav(k, raw, buf, nu, par, st,
+                                                                                   *nav_args)
+                if ncode:  # the source's Python part at this row, then the guidance and the autopilot
+                    act(k, truth, ncode)
+                    de, da, dr, thr = control_nav(k, guidance, buf, par, st, fused.nw)
                 if code:
                     break
-                de, da, dr, thr = control(k, guidance, buf, par, st)
-            elif code:
-                break
+            else:
+                code, de, da, dr, thr, gn, ge, gd, terr_ft, near = step(k, raw, buf, nu, par, st, guided)
+                if src is not None:
+                    pos, vel = src.step(k, truth)
+                    guidance[k, 0:3] = pos
+                    guidance[k, 3:6] = vel
+                    if code:
+                        break
+                    de, da, dr, thr = control(k, guidance, buf, par, st)
+                elif code:
+                    break
             set_de(de)
             set_da(da)
             set_dr(dr)

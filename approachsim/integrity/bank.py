@@ -191,24 +191,37 @@ def score_run(ep: BankEpochs, epoch_hz: float, start_height_m: float, dh_m: dict
 
 def run_bank(profile: Any, truth: Any, seed: int, run: int) -> tuple[BankEpochs, Any]:
     """Measure run `run` of the campaign seeded `seed` on `truth`, navigate it with the main filter and the
-    sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun)."""
+    sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun).
+
+    The copies share the run's IMU record and its INS (NavSystem.run(copies=True), feed-forward): the IMU is
+    drawn and applied once; the other sensors are measured for the K + 1 copies (the same draws: the same
+    streams), whose GNSS records then lose one channel each (bank_records)."""
+    from dataclasses import fields, replace
+
     from approachsim.nav.system import NavSystem
     from approachsim.seeding import stream
     from approachsim.sensors.states import start_states
     from approachsim.sensors.suite import SensorSuite
 
     suite = SensorSuite.from_profile(profile)
-    probe = suite.measure(truth, seed=seed, runs=[run])
-    if "gnss" not in probe:
+    errors = suite.draw(truth.t_s, seed, [run])
+    one = suite.apply(truth, errors)
+    if "gnss" not in one:
         raise ValueError("integrity bank: the profile has no GNSS receiver")
-    channels = used_channels(np.asarray(probe["gnss"].valid)[0])
+    channels = used_channels(np.asarray(one["gnss"].valid)[0])
     copies = len(channels) + 1
-    errors = suite.draw(truth.t_s, seed, [run] * copies)
-    recs = bank_records(suite.apply(truth, errors), channels)
     nav = NavSystem.from_profile(profile)
+    states = start_states(suite, truth, errors)
+    states = replace(states, **{f.name: np.repeat(getattr(states, f.name), copies, axis=0)
+                                for f in fields(states) if isinstance(getattr(states, f.name), np.ndarray)})
+    share = not nav.nav.feedback and "imu" in one
+    rest = suite.without("imu") if share else suite  # feed-forward: one IMU record for every copy
+    recs = rest.apply(truth, rest.draw(truth.t_s, seed, [run] * copies))
+    if share:
+        recs["imu"] = one["imu"]
+    recs = bank_records(recs, channels)
     # every copy starts from the main filter's converged state (the first copy's schedule: all channels)
     navs = nav.run(truth, recs, [stream(seed, run, "nav") for _ in range(copies)],
-                   shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors),
-                   copies=not nav.nav.feedback)
+                   shared_covariance=nav.shares_covariance(), states=states, copies=share)
     ep = bank_epochs(navs[0], navs[1:], channels, truth, profile.runway.heading_rad)
     return ep, navs[0]

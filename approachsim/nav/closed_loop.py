@@ -21,12 +21,14 @@ import numpy as np
 
 from approachsim import geo
 from approachsim.nav import ins
+from approachsim.nav.kernels import inloop as ik
 from approachsim.nav.kernels import strapdown as sk
 from approachsim.nav.navigator import Navigator, NavRun
 from approachsim.nav.observations import Observations
 from approachsim.nav.system import NavSystem
 from approachsim.records import ApproachErrors, Truth
 from approachsim.seeding import stream
+from approachsim.sensors.baro import Baro
 from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite
 
@@ -36,6 +38,33 @@ _EMPTY = np.zeros((1, 3))
 """Placeholder for the affine IMU terms when the increments come from `apply` (quantized or faulted IMU)."""
 
 _VEC3 = ("r_ecef", "v_ned", "euler_rad", "w_ib_body", "f_body", "r_rwy")
+
+
+@dataclass(frozen=True)
+class InLoop:
+    """The compiled per-row navigation of one closed-loop run (nav/kernels/inloop.py): the work vector nw (NW,),
+    the IMU error terms cg, ca (m, 3) by sample, the INS rows (1, n, 16), the snapshot index per row (n,), the baro
+    rows (n,) int8, scratch increments dth, dv (1, 1, 3), and act(k, truth, code): the source's Python part."""
+
+    nw: Array
+    cg: Array
+    ca: Array
+    rows3: Array
+    snap: Array
+    baro_j: Array
+    """(n,) int64 the baro sample at each truth row (-1: none)."""
+    baro_e: Array
+    """(m, 2) the baro's bias and noise by sample, m (for the samples made in the kernel)."""
+    lag_w: Array
+    """The baro's lag weights (empty: no lag)."""
+    dth: Array
+    dv: Array
+    act: Any
+
+    @property
+    def rows(self) -> Array:
+        """(n, 16) the one run's INS rows (a view)."""
+        return self.rows3[0]
 
 
 @dataclass
@@ -78,6 +107,7 @@ class NavInTheLoop:
         self._c_rwy = np.ascontiguousarray(self.profile.runway.frame.c_ecef_to_rwy)
         self._o_rwy = np.ascontiguousarray(self.profile.runway.frame.origin_ecef)
         self._h_thr = float(self.profile.runway.elevation_m)
+        self._inloop: InLoop | None = None
 
     def _imu_error_terms(self) -> tuple[Array, Array, Array, Array] | None:
         """The IMU error model is affine in the true increments (sensors/imu.py):
@@ -160,6 +190,90 @@ class NavInTheLoop:
         g = self._guide
         sk.guidance(navigator.x, self.x_nav, self._c_rwy, self._o_rwy, self._h_thr, g)  # feed-forward INS - x_hat
         return g[0:3].copy(), g[3:6].copy()  # copies: the kernel's buffer is rewritten at the next step
+
+    # --- the compiled row (nav/kernels/inloop.py): the flight loop steps the navigation in its own compiled call
+
+    def inloop(self) -> InLoop | None:
+        """The arrays of the compiled per-row navigation (records.NavigationSource), or None when the IMU errors
+        are not affine (quantized or faulted IMU: every sample goes through its model, `step`)."""
+        if self._imu_affine is None:
+            return None
+        if self._inloop is None:
+            m_g, m_a, c_g, c_a = self._imu_affine
+            n = self.t_s.shape[0]
+            nw = np.zeros(ik.NW)
+            nw[ik.W_LOOP:ik.W_LOOP + 6] = self._loop
+            nw[ik.W_HB] = math.nan
+            nw[ik.W_DT] = self.dt
+            nw[ik.W_MG:ik.W_MG + 9] = m_g.reshape(9)
+            nw[ik.W_MA:ik.W_MA + 9] = m_a.reshape(9)
+            nw[ik.W_CRWY:ik.W_CRWY + 6] = self._c_rwy[0:2].reshape(6)
+            nw[ik.W_ORWY:ik.W_ORWY + 3] = self._o_rwy
+            nw[ik.W_HTHR] = self._h_thr
+            nw[ik.W_EPOCH_ROWS] = self.epoch_rows
+            nw[ik.W_BARO_LOOP] = 1.0 if self.gains is not None else 0.0
+            baro_j = np.full(n, -1, dtype=np.int64)
+            baro_e, lag_w = np.zeros((0, 2)), np.zeros(0)
+            e = self.errors.sensors.get("baro")
+            if e is not None:
+                rows = np.asarray(e.rows)
+                keep = rows < n
+                baro_j[rows[keep]] = np.flatnonzero(keep)
+                baro = self.suite.sensors["baro"]
+                if type(baro) is Baro:  # a plain altimeter: its samples made in the kernel (a faulted one: Python)
+                    nw[ik.W_BARO_KERNEL] = 1.0
+                    nw[ik.W_BSET], nw[ik.W_BT0L], nw[ik.W_BEXP] = baro.kernel_constants()
+                    nw[ik.W_BSF] = float(np.ravel(e.constants["scale_factor"])[0])
+                    baro_e = np.ascontiguousarray(np.column_stack([e.series["bias"], e.series["noise"]]))
+                    lag_w = np.ascontiguousarray(baro.lag_weights(self.dt), dtype=float)
+            self._inloop = InLoop(nw, np.ascontiguousarray(c_g), np.ascontiguousarray(c_a),
+                                  np.full((1, n, ins.NX), np.nan), np.zeros(n, dtype=np.int64), baro_j, baro_e,
+                                  lag_w, np.zeros((1, 1, 3)), np.zeros((1, 1, 3)), self.act)
+        return self._inloop
+
+    def act(self, k: int, truth: Truth, code: int) -> None:
+        """What the compiled row leaves to Python at row k (its NAV_* bits): the start, an aiding epoch, a baro
+        sample of the damping loop; then row k is recorded again (the epoch may have corrected the INS)."""
+        lp = self._inloop
+        nw = lp.nw
+        nav = self.nav
+        if code & ik.NAV_START:
+            obs, recs = self._observations(0, truth)
+            el = recs["gnss"].elevation_rad[0] if "gnss" in recs else None
+            s, runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el, obs=obs,
+                                states=start_states(self.suite, truth, self.errors))
+            self.navigator = Navigator(nav, s, runs, float(truth.t_s[0]), self.t_s.shape[0])
+            self.navigator.bind(nw[ik.W_X:ik.W_X + 16].reshape(1, 16), nw[ik.W_FSUM:ik.W_FSUM + 3].reshape(1, 3),
+                                lp.rows3, lp.snap)
+            self._estimate_in_force()
+        navigator = self.navigator
+        run = navigator.runs[0]
+        if code & ik.NAV_EPOCH:
+            obs, _ = self._observations(k, truth)
+            if self.gains is not None:  # the kernel's loop held over the interval (no baro, or excluded)
+                obs = obs.with_loop_held([nw[ik.W_ANY_BARO] == 0.0])
+                nw[ik.W_ANY_BARO] = 0.0
+            navigator.epoch(k, float(truth.t_s[k]), obs, truth)
+            self._estimate_in_force()
+        if code & ik.NAV_BARO and (b := self._apply("baro", k, truth)) is not None:
+            # nan (an outage, or the baro excluded by FDE): the INS kernel's damping loop holds
+            held = run.baro_excluded() or not bool(np.ravel(b.valid)[0])
+            nw[ik.W_HB] = math.nan if held else float(np.ravel(b.h_baro_m)[0])
+            if k == 0 and nav.nav.initial_error.start == "prior" and math.isfinite(nw[ik.W_HB]):
+                nw[ik.W_X + 2] = nw[ik.W_HB]  # the converged start's height error stands
+        navigator.record_row(k)
+
+    def _estimate_in_force(self) -> None:
+        """The compiled row's copy of the filter's state: the estimate for the guidance, the bias feedback, the
+        snapshot index."""
+        nw = self._inloop.nw
+        run = self.navigator.runs[0]
+        nw[ik.W_XNAV:ik.W_XNAV + 9] = run.fs.x[0:9]
+        if self.nav.nav.feedback:
+            nw[ik.W_BG:ik.W_BG + 3] = run.bg_fb
+            nw[ik.W_BA:ik.W_BA + 3] = run.ba_fb
+        nw[ik.W_SNAP] = self.navigator.snap_index
+        nw[ik.W_BARO_EXCL] = 1.0 if run.baro_excluded() else 0.0
 
     def result(self, truth: Truth) -> NavRun:
         """The navigation run over the flown truth (call after the flight)."""

@@ -16,15 +16,19 @@ objects (the generic path), in processing order.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
 
+from approachsim import geo
+from approachsim.nav import errormodel as em
 from approachsim.nav import measurements as meas
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import KalmanFilter, UpdateStatus, optimal_policy, workspace
 from approachsim.nav.kernels import epoch as ke
 from approachsim.nav.observations import Observations
+from approachsim.sensors.gnss.receiver import IONO_SHELL_M
 
 Array = np.ndarray
 
@@ -32,6 +36,7 @@ _MAX_ROWS = 2 + 64 + 16
 """Rows an epoch can have: baro, radalt, GNSS channels, pseudolites (bounded by the layout below)."""
 
 
+@lru_cache(maxsize=512)
 def code_name(code: int) -> str:
     """The status-log name of a row code (kernels/epoch.py): "baro", "radalt", "gps07", "pl0"."""
     if code == ke.CODE_BARO:
@@ -95,15 +100,19 @@ class StatusBuffer:
 
 @dataclass(frozen=True)
 class RunDatabase:
-    """A run's terrain-database error as the engine's arrays (measurements.database_arrays)."""
+    """A run's terrain-database error as the engine's arrays (measurements.database_arrays), and the same on a run
+    axis of length one (dbp2 (1, 4), db_u2 (1, k))."""
 
     dbp: Array
     db_x: Array
     db_u: Array
+    dbp2: Array
+    db_u2: Array
 
     @classmethod
     def of(cls, config: tdb.TerrainDbConfig, error: tdb.TerrainDbError | None) -> RunDatabase:
-        return cls(*meas.database_arrays(config, error))
+        dbp, db_x, db_u = meas.database_arrays(config, error)
+        return cls(dbp, db_x, db_u, dbp[None].copy(), (db_u[None] if db_x.size else np.zeros((1, 0))).copy())
 
 
 class EpochEngine:
@@ -132,6 +141,23 @@ class EpochEngine:
         self._none2 = np.zeros((1, 0))
         self._none3 = np.zeros((0, 3))
         self._none1 = np.zeros(0)
+        self._code_sig = np.full(lay.n_sv, self.code_noise_m)  # with channel states: their white code noise
+        self._pl_sig = np.full(lay.n_pl, self.pl_sigma_states)  # with pseudolite states: code noise + survey
+        self._nu = np.zeros((1, _MAX_ROWS))
+        if g is not None:  # the channel-noise budget of kernels/epoch.channel_sigmas
+            bud = g.budget()
+            self._sky_budget = (geo.A_WGS84, IONO_SHELL_M, bud.clock_ephemeris_m, bud.iono_zenith_m,
+                                bud.tropo_zenith_m, bud.multipath_model == "do253", float(bud.multipath_m))
+        self.F, self.Qc, self.phi, self.qd = (np.zeros((n, n)) for _ in range(4))
+        self.loop = em.kernel_loop(system.loop_gains() if lay.has("ac") else None)
+        """The damping loop's constant gains (the engine runs constant or no loops only)."""
+
+    @staticmethod
+    def stack(dbs: list[RunDatabase]) -> tuple[Array, Array, Array]:
+        """The runs' databases as (dbp (N, 4), db_x (k,), db_u (N, k)) for singletons (once per pass)."""
+        db_x = dbs[0].db_x
+        return (np.stack([d.dbp for d in dbs]), db_x,
+                np.stack([d.db_u for d in dbs]) if db_x.size else np.zeros((len(dbs), 0)))
 
     @classmethod
     def of(cls, system: Any) -> EpochEngine | None:
@@ -141,37 +167,116 @@ class EpochEngine:
             return None
         return cls(system)
 
+    def _obs_args(self, obs: Observations, members: list[int], dbs: list[RunDatabase]) -> tuple:
+        """class_epoch's observation arguments of the members (kernels/epoch.py)."""
+        M = len(members)
+        if M == 1:
+            i = members[0]
+            sl = slice(i, i + 1)
+        else:
+            sl = np.asarray(members)
+        baro_h = obs.baro_h_m[sl] if obs.baro_h_m is not None else np.full(M, np.nan)
+        baro_r = float(obs.baro_sigma_m) ** 2 if obs.baro_h_m is not None else 0.0
+        radalt_h = obs.radalt_h_m[sl] if obs.radalt_h_m is not None else np.full(M, np.nan)
+        if obs.has_gnss:
+            rho = np.ascontiguousarray(obs.gnss_rho_m[sl])
+            r_sv, sig_nom, _ = obs.sky(members[0])
+            sig = self._code_sig if self.channel_states else np.ascontiguousarray(sig_nom, dtype=float)
+            r_sv = np.ascontiguousarray(r_sv, dtype=float)
+        else:
+            rho, r_sv, sig = np.zeros((M, 0)), self._none3, self._none1
+        if obs.pl_rho_m is not None:
+            pl_rho = np.ascontiguousarray(obs.pl_rho_m[sl])
+            r_pl = np.ascontiguousarray(obs.pl_r_ecef, dtype=float)
+            pl_sig = self._pl_sig if self.pl_states else np.ascontiguousarray(obs.pl_sigma_m, dtype=float)
+        else:
+            pl_rho, r_pl, pl_sig = np.zeros((M, 0)), self._none3, self._none1
+        if M == 1:
+            dbp, db_x, db_u = dbs[0].dbp2, dbs[0].db_x, dbs[0].db_u2
+        else:
+            dbp = np.stack([d.dbp for d in dbs])
+            db_x = dbs[0].db_x
+            db_u = np.stack([d.db_u for d in dbs]) if db_x.size else np.zeros((M, 0))
+        return (baro_h, baro_r, radalt_h, self.ra_pct, self.ra_floor), (self.tx, self.th, self.rwy, dbp, db_x, db_u,
+                                                                         rho, r_sv, sig, self.channel_states, pl_rho,
+                                                                         r_pl, pl_sig, self.pl_states)
+
     def epoch(self, X: Array, P: Array, phi: Array, qd: Array, own: bool, ref_y: Array, ins_y: Array,
               obs: Observations, members: list[int], t_s: float, statuses: list[StatusBuffer],
               dbs: list[RunDatabase], ref_agl_m: float = 0.0) -> None:
         """One epoch of the members (indices into obs's runs) with estimates X (M, n) and covariance P, in place
         (kernels/epoch.class_epoch); each member's status records go to its buffer."""
         M = len(members)
-        idx = np.asarray(members)
-        baro_h = obs.baro_h_m[idx] if obs.baro_h_m is not None else np.full(M, np.nan)
-        baro_r = float(obs.baro_sigma_m) ** 2 if obs.baro_h_m is not None else 0.0
-        radalt_h = obs.radalt_h_m[idx] if obs.radalt_h_m is not None else np.full(M, np.nan)
-        if obs.has_gnss:
-            rho = np.ascontiguousarray(obs.gnss_rho_m[idx])
-            r_sv, sig_nom, _ = obs.sky(members[0])
-            sig = np.full(rho.shape[1], self.code_noise_m) if self.channel_states else np.asarray(sig_nom, float)
-            r_sv = np.ascontiguousarray(r_sv, dtype=float)
-        else:
-            rho, r_sv, sig = np.zeros((M, 0)), self._none3, self._none1
-        if obs.pl_rho_m is not None:
-            pl_rho = np.ascontiguousarray(obs.pl_rho_m[idx])
-            r_pl = np.ascontiguousarray(obs.pl_r_ecef, dtype=float)
-            pl_sig = (np.full(pl_rho.shape[1], self.pl_sigma_states) if self.pl_states
-                      else np.asarray(obs.pl_sigma_m, float))
-        else:
-            pl_rho, r_pl, pl_sig = np.zeros((M, 0)), self._none3, self._none1
-        dbp = np.stack([d.dbp for d in dbs])
-        db_x = dbs[0].db_x
-        db_u = np.stack([d.db_u for d in dbs]) if db_x.size else np.zeros((M, 0))
-        nu = np.zeros((M, _MAX_ROWS))
-        k = ke.class_epoch(X, P, phi, qd, self.lay, own, ref_y, ins_y, baro_h, baro_r, radalt_h, self.ra_pct,
-                           self.ra_floor, ref_agl_m, self.tx, self.th, self.rwy, dbp, db_x, db_u, rho, r_sv, sig,
-                           self.channel_states, pl_rho, r_pl, pl_sig, self.pl_states, self.codes, nu, self.S,
-                           self.h, self.b, self.ws)
+        first, rest = self._obs_args(obs, members, dbs)
+        if self._nu.shape[0] < M:
+            self._nu = np.zeros((M, _MAX_ROWS))
+        nu = self._nu[:M]
+        k = ke.class_epoch(X, P, phi, qd, self.lay, own, ref_y, ins_y, *first, ref_agl_m, *rest, self.codes, nu,
+                           self.S, self.h, self.b, self.ws)
         for j in range(M):
             statuses[j].add_epoch(self.codes[:k], t_s, nu[j, :k], self.S[:k])
+
+    def own(self, X: Array, P: Array, y: Array, f_ned: Array, elevation_rad: Array | None, held: bool, dt: float,
+            obs: Observations, i: int, t_s: float, statuses: StatusBuffer, db: RunDatabase) -> bool:
+        """The per-run EKF's whole epoch of run i (kernels/epoch.own_epoch: its error model about its INS state y
+        (16,) with the mean specific force f_ned (3,), discretized over dt, then every update), in place on X (1, n)
+        and P. False when the model needs the numpy discretization (nothing changed: take the generic path)."""
+        q, gse, gmp = self.system.noise_model.kernel_arrays(elevation_rad)
+        first, rest = self._obs_args(obs, [i], [db])
+        nu = self._nu[:1]
+        k = ke.own_epoch(X, P, self.lay, q, gse, gmp, self.loop, held, dt, f_ned, y, self.F, self.Qc, self.phi,
+                         self.qd, *first, *rest, self.codes, nu, self.S, self.h, self.b, self.ws)
+        if k < 0:
+            return False
+        statuses.add_epoch(self.codes[:k], t_s, nu[0, :k], self.S[:k])
+        return True
+
+    def singletons(self, X: Array, P3: Array, phi2: Array, qd2: Array, held: Array, obs: Observations, t_s: float,
+                   dt: float, ins_y: Array, ref_y: Array, ref_agl_m: float, statuses: list[StatusBuffer],
+                   db_stack: tuple[Array, Array, Array]) -> None:
+        """The shared-mode epoch of N runs each its own class (kernels/epoch.singleton_epochs), in place on X (N, n)
+        and P3 (N, n, n); phi2, qd2 (2, n, n) the model without / with the damping loop held, held (N,) int; the
+        GPS channel states' Qd at each run's own elevations; db_stack: the runs' databases (`stack`)."""
+        N = X.shape[0]
+        lay = self.system.layout
+        baro_h = obs.baro_h_m if obs.baro_h_m is not None else np.full(N, np.nan)
+        baro_r = float(obs.baro_sigma_m) ** 2 if obs.baro_h_m is not None else 0.0
+        radalt_h = obs.radalt_h_m if obs.radalt_h_m is not None else np.full(N, np.nan)
+        if obs.has_gnss:
+            rho = np.ascontiguousarray(obs.gnss_rho_m)
+            k = rho.shape[1]
+            r_sv = np.ascontiguousarray(np.broadcast_to(obs.gnss_r_sv_ecef, (N, k, 3)), dtype=float)
+            if self.channel_states:
+                sig = np.ascontiguousarray(np.broadcast_to(self._code_sig, (N, k)))
+            else:
+                sig = np.ascontiguousarray(np.broadcast_to(obs.gnss_sigma_m, (N, k)), dtype=float)
+        else:
+            rho, r_sv, sig = np.zeros((N, 0)), np.zeros((N, 0, 3)), np.zeros((N, 0))
+        if obs.pl_rho_m is not None:
+            pl_rho = np.ascontiguousarray(obs.pl_rho_m)
+            r_pl = np.ascontiguousarray(obs.pl_r_ecef, dtype=float)
+            pl_sig = self._pl_sig if self.pl_states else np.ascontiguousarray(obs.pl_sigma_m, dtype=float)
+        else:
+            pl_rho, r_pl, pl_sig = np.zeros((N, 0)), self._none3, self._none1
+        if lay.has("gse") and obs.has_gnss and obs.per_run_sky:  # one sky: qd2 is already at its elevations
+            el = np.ascontiguousarray(obs.gnss_el_rad, dtype=float)
+            ch_gse, ch_gmp = np.empty(el.shape), np.empty(el.shape)
+            ke.channel_sigmas(el, *self._sky_budget, ch_gse, ch_gmp)
+            nz = self.system.noise_model.noise(None)
+            f_gse, f_gmp = (float(-np.expm1(-2.0 * dt / tau)) for tau in (nz.gse_tau_s, nz.gmp_tau_s))
+        else:
+            ch_gse = ch_gmp = np.zeros((N, 0))
+            f_gse = f_gmp = 0.0
+        dbp, db_x, db_u = db_stack
+        codes = np.zeros((N, _MAX_ROWS), dtype=np.int64)
+        nu = np.zeros((N, _MAX_ROWS))
+        S = np.zeros((N, _MAX_ROWS))
+        n_rows = np.zeros(N, dtype=np.int64)
+        ke.singleton_epochs(X, P3, phi2, qd2, held, ch_gse, ch_gmp, f_gse, f_gmp, self.qd, self.lay, ref_y,
+                            ref_agl_m, np.ascontiguousarray(ins_y), baro_h, baro_r, radalt_h, self.ra_pct,
+                            self.ra_floor, self.tx, self.th, self.rwy, dbp, db_x, db_u, rho, r_sv, sig,
+                            self.channel_states, pl_rho, r_pl, pl_sig, self.pl_states, codes, nu, S, n_rows, self.h,
+                            self.b, self.ws)
+        for i in range(N):
+            k = n_rows[i]
+            statuses[i].add_epoch(codes[i, :k], t_s, nu[i, :k], S[i, :k])

@@ -115,6 +115,15 @@ class RunFilter:
         return self.fde is not None and BARO in self.fde.excluded
 
 
+def true_error_rows(o: ins.InsState, truth: Truth, rows: Array) -> Array:
+    """(E, 9) output errors (dp NED, dv, psi) of states o (E,) against truth rows `rows` (E,)."""
+    dp = ins.position_error_ned(o.lat_rad, o.lon_rad, o.h_m, truth.lat_rad[rows], truth.lon_rad[rows],
+                                truth.h_m[rows])
+    dv = o.v_ned - truth.v_ned[rows]
+    psi = ins.attitude_error(o.c_bn, ins.cbn_from_quaternion(truth.q_nb[rows]))
+    return np.concatenate([dp, dv, psi], axis=-1)
+
+
 def true_error(o: ins.InsState, truth: Truth, row: int) -> Array:
     """(N, 9) output error (dp NED, dv, psi) against truth row `row`."""
     dp = ins.position_error_ned(o.lat_rad, o.lon_rad, o.h_m, truth.lat_rad[row], truth.lon_rad[row],
@@ -169,12 +178,30 @@ class Navigator:
         """The compiled epoch (nav/engine.py), or None: the generic path."""
         self.dbs = ([RunDatabase.of(system.nav.terrain_database, r.db_error) for r in runs]
                     if self.engine is not None else None)
-        self._hist: dict[str, list] = {"t": [], "x": [], "pd": [], "pnav": [], "err": []}
+        self.db_stack = EpochEngine.stack(self.dbs) if self.engine is not None else None
+        self._hist: dict[str, list] = {"t": [], "row": [], "snap": [], "pd": [], "pnav": []}
+        """Per epoch: time, truth row, snapshot index, each run's P diagonal (N, n) and navigation block
+        (N, 9, 9); the outputs' errors are made from the rows and snapshots in `results`."""
         self._snapshot()
 
     @property
     def n_runs(self) -> int:
         return len(self.runs)
+
+    @property
+    def snap_index(self) -> int:
+        """Index of the filter snapshot in force (what `snap` records for a row stepped now)."""
+        return len(self._snaps) - 1
+
+    def bind(self, x: Array, f_sum: Array, rows: Array, snap: Array) -> None:
+        """Keep the INS state (M, 16), the specific-force sum (M, 3), the rows (M, n_rows, 16) and the snapshot
+        index per row (n_rows,) in the caller's arrays from now on (their current values copied in): the closed
+        loop's compiled row (nav/kernels/inloop.py) steps them in place."""
+        x[...] = self.x
+        f_sum[...] = self.f_sum
+        rows[...] = self.rows
+        snap[...] = self.snap
+        self.x, self.f_sum, self.rows, self.snap = x, f_sum, rows, snap
 
     @property
     def x_nav(self) -> Array:
@@ -222,15 +249,12 @@ class Navigator:
             self.x[:] = ins.pack(s)
         self.f_sum[:] = 0.0
         self.t_last = t_s
-        self._snapshot()
+        self._snapshot(epoch=True)
         self.record_row(row)
-        o, P, x = self._output(s)
         h = self._hist
         h["t"].append(t_s)
-        h["x"].append(x)
-        h["pd"].append(np.diagonal(P, axis1=1, axis2=2))
-        h["pnav"].append(P[:, 0:9, 0:9])
-        h["err"].append(true_error(o, truth, row))
+        h["row"].append(row)
+        h["snap"].append(len(self._snaps) - 1)
 
     def loop_held(self, obs: Observations, i: int) -> bool:
         """Whether run i's damping loop held over the interval ending at this epoch (`loop_held`)."""
@@ -243,16 +267,24 @@ class Navigator:
         system = self.system
         lay = self.layout
         filt = system.filter
-        noise = None if obs.per_run_sky else system.noise(obs.elevations())
-        r_ins = ins.position_ecef(s)
+        r_ins = None
         for i, run in enumerate(self.runs):
-            if obs.per_run_sky:
-                noise = system.noise(obs.elevations(i))
+            held = self.loop_held(obs, i)
+            if self.engine is not None and run.fde is None:  # the whole epoch compiled (nav/engine.py)
+                X, P = run.fs.x.copy()[None], np.array(run.fs.P, dtype=float)
+                y = self.x[self.ins_of[i]]
+                if self.engine.own(X, P, y, np.ascontiguousarray(f_ned_mean[i]), obs.elevations(i), held,
+                                   dt_epoch, obs, i, t, run.statuses, self.dbs[i]):
+                    run.fs = FilterState(x=X[0], P=P, memory=run.fs.memory)
+                    continue
+            if r_ins is None:
+                r_ins = ins.position_ecef(s)
+            noise = system.noise(obs.elevations(i))
             gains = system.loop_slopes(run.fs, float(s.h_m[i]), noise)
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
-                                noise, gains, loop_held=self.loop_held(obs, i))
+                                noise, gains, loop_held=held)
             phi, qd = em.discretize(F, Qc, dt_epoch)
-            if self.engine is not None and run.fde is None:  # the compiled epoch (nav/engine.py)
+            if self.engine is not None and run.fde is None:  # the compiled updates on the numpy discretization
                 X, P = run.fs.x.copy()[None], np.array(run.fs.P, dtype=float)
                 y = self.x[self.ins_of[i]:self.ins_of[i] + 1]
                 self.engine.epoch(X, P, phi, qd, True, y[0], y, obs, [i], t, [run.statuses], [self.dbs[i]])
@@ -286,17 +318,23 @@ class Navigator:
 
     # --- output --------------------------------------------------------------------------------------------
 
-    def _output(self, s: ins.InsState) -> tuple[ins.InsState, Array, Array]:
-        """Corrected solution (feed-forward: INS - x_hat) and each run's P (N, n, n) and x_hat (N, n)."""
-        x = np.stack([r.fs.x for r in self.runs])
-        P = np.stack([self.system.filter.covariance(r.fs) for r in self.runs])
-        return ins.perturb(s, -x[:, 0:3], -x[:, 3:6], -x[:, 6:9]), P, x
-
-    def _snapshot(self) -> None:
-        """Keep x, the position block of P and the clock variance: the estimate in force until the next epoch."""
-        P = np.stack([self.system.filter.covariance(r.fs) for r in self.runs])
+    def _snapshot(self, epoch: bool = False) -> None:
+        """Keep x, the position block of P and the clock variance: the estimate in force until the next epoch; at an
+        epoch also each run's P diagonal and navigation block (the filter history)."""
         ic = self._ic
-        self._snaps.append((np.stack([r.fs.x for r in self.runs]), P[:, 0:3, 0:3].copy(), P[:, ic, ic].copy()))
+        xs, pp, pc, pd, pn = [], [], [], [], []
+        for r in self.runs:
+            P = self.system.filter.covariance(r.fs)
+            xs.append(r.fs.x)
+            pp.append(P[0:3, 0:3])
+            pc.append(P[ic, ic])
+            if epoch:
+                pd.append(np.diagonal(P))
+                pn.append(P[0:9, 0:9])
+        self._snaps.append((np.array(xs), np.array(pp), np.array(pc)))
+        if epoch:
+            self._hist["pd"].append(np.array(pd))
+            self._hist["pnav"].append(np.array(pn))
 
     def results(self, truth: Truth, n_rows: int | None = None, solutions: Any = True) -> list[NavRun]:
         """Each run's NavRun over the first n_rows rows (default: all): the solution at every row (INS - x_hat
@@ -312,6 +350,7 @@ class Navigator:
         has_clk = lay.has("clk")
         ic = self._ic
         h = self._hist
+        e_rows, e_snap = np.array(h["row"], dtype=int), np.array(h["snap"], dtype=int)
         out = []
         for i, r in enumerate(self.runs):
             sol = None
@@ -328,10 +367,15 @@ class Navigator:
                     clock_bias_sigma_m=np.sqrt(PC[:, i][snap]) if has_clk else np.full(n, np.nan),
                     **(r.fde.solution_fields(snap) if r.fde is not None else {}),
                 )
+            xe = XS[e_snap, i]  # (E, n) the estimate after each epoch
+            if e_rows.size:  # the output's error at the epochs: INS rows - x_hat against the truth rows
+                o = ins.perturb(ins.unpack(self.rows[self.ins_of[i], e_rows]), -xe[:, 0:3], -xe[:, 3:6], -xe[:, 6:9])
+                err = true_error_rows(o, truth, e_rows)
+            else:
+                err = np.zeros((0, 9))
             out.append(NavRun(
                 solution=sol, status=StatusLog.from_buffer(r.statuses), t_epoch_s=np.array(h["t"]),
-                x=np.array([x[i] for x in h["x"]]), P_diag=np.array([p[i] for p in h["pd"]]),
-                P_nav=np.array([p[i] for p in h["pnav"]]), true_error_nav=np.array([e[i] for e in h["err"]]),
-                layout=lay,
+                x=xe, P_diag=np.array([p[i] for p in h["pd"]]).reshape(-1, lay.n),
+                P_nav=np.array([p[i] for p in h["pnav"]]).reshape(-1, 9, 9), true_error_nav=err, layout=lay,
             ))
         return out

@@ -14,7 +14,7 @@ multipath); `noise` is a pure function of the configuration and the elevations a
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -59,12 +59,43 @@ class NoiseModel:
         if nz is None:
             if len(self._cache) > _CACHE_MAX:
                 self._cache.clear()
-            nz = self._build(elevation_rad)
+            nz = self._build(elevation_rad) if key is None else self._at_elevations(elevation_rad)
             for v in vars(nz).values():
                 if isinstance(v, np.ndarray):
                     v.flags.writeable = False
             self._cache[key] = nz
         return nz
+
+    def _channel_sigmas(self, elevation_rad: Array) -> tuple[Array, Array | float]:
+        """The GPS channel states' 1-sigma (m) at elevation_rad (k,): slow range error (clock/ephemeris, mapped
+        iono and tropo) and multipath (per channel under DO-253, one value under NRC 1995)."""
+        bud = self.sensors.gnss.budget()
+        el = np.maximum(np.nan_to_num(elevation_rad, nan=0.5), np.radians(2.0))
+        gse = np.sqrt(bud.clock_ephemeris_m**2 + (bud.iono_zenith_m * iono_obliquity(el)) ** 2
+                      + (bud.tropo_zenith_m * tropo_mapping(el)) ** 2)
+        gmp = bud.multipath_sigma_m(el) if bud.multipath_model == "do253" else bud.multipath_m
+        return gse, gmp
+
+    def _at_elevations(self, elevation_rad: Array) -> em.ErrorNoise:
+        """The noise with the GPS channel states' sigmas at elevation_rad: the elevation-free noise (cached) with
+        its channel arrays replaced (the same formulas as _build)."""
+        base = self.noise(None)
+        if self.sensors.gnss is None:
+            return base
+        gse, gmp = self._channel_sigmas(elevation_rad)
+        return replace(base, gse_sigma_m=gse, gmp_sigma_m=gmp)
+
+    def kernel_arrays(self, elevation_rad: Array | None) -> tuple[Array, Array, Array]:
+        """(q, gse_sigma (n_sv,), gmp_sigma (n_sv,)): errormodel.kernel_noise of noise(elevation_rad), without
+        building the noise object (the compiled epoch's per-epoch input, nav/engine.py)."""
+        n_sv = self.layout.n_sv
+        q = em.kernel_noise(self.noise(None), n_sv)[0]  # the scalars do not depend on the elevations
+        if elevation_rad is None or self.sensors.gnss is None or n_sv == 0:
+            return em.kernel_noise(self.noise(elevation_rad), n_sv)
+        gse, gmp = self._channel_sigmas(elevation_rad)
+        c = np.ascontiguousarray
+        return (q, c(np.broadcast_to(np.asarray(gse, dtype=float), (n_sv,))),
+                c(np.broadcast_to(np.asarray(gmp, dtype=float), (n_sv,))))
 
     def _build(self, elevation_rad: Array | None) -> em.ErrorNoise:
         g = PRESETS[self.sensors.imu.grade]

@@ -31,8 +31,8 @@ Array = np.ndarray
 class SharedCovariance:
     """One P per measurement-schedule class (module docstring); mutable, lives inside one pass."""
 
-    P: list
-    """(n, n) covariance of each class."""
+    P: Array
+    """(C, n, n) covariance of each class."""
     of_run: Array
     """(N,) class of each run."""
     f_ned_ref: Array
@@ -45,8 +45,13 @@ class SharedCovariance:
         n = len(runs)
         f_ref = np.einsum("nij,nj->ni", ins.cbn_from_quaternion(truth.q_nb[:m]), truth.f_body[:m])
         if per_run_sky:
-            return cls([r.fs.P for r in runs], np.arange(n), f_ref, epoch_rows)
-        return cls([runs[0].fs.P], np.zeros(n, dtype=int), f_ref, epoch_rows)
+            return cls(np.array([r.fs.P for r in runs], dtype=float), np.arange(n), f_ref, epoch_rows)
+        return cls(np.array([runs[0].fs.P], dtype=float), np.zeros(n, dtype=int), f_ref, epoch_rows)
+
+    @property
+    def singletons(self) -> bool:
+        """Every run is a class of its own (run i is class i): per-run skies, the integrity bank's copies."""
+        return self.P.shape[0] == self.of_run.shape[0] and bool(np.all(self.of_run == np.arange(len(self.of_run))))
 
     def predict_class(self, c: int, phi: Array, qd: Array) -> None:
         """P- = Phi P+ Phi' + Qd for class c (its own model: GPS sky, damping loop held or not)."""
@@ -55,20 +60,24 @@ class SharedCovariance:
 
     def split(self, schedule: Array) -> None:
         """Runs of one class whose schedules (rows of (N, k) bool) differ go to new classes (copies of P)."""
+        if self.singletons:  # a class of one run never splits
+            return
         keys: dict[tuple[int, bytes], int] = {}
-        new_P: list = []
+        parent: list[int] = []
         of_run = np.empty_like(self.of_run)
         for i, c in enumerate(self.of_run):
             k = (int(c), schedule[i].tobytes())
             if k not in keys:
-                keys[k] = len(new_P)
-                new_P.append(self.P[int(c)])
+                keys[k] = len(parent)
+                parent.append(int(c))
             of_run[i] = keys[k]
-        self.P, self.of_run = new_P, of_run
+        if len(parent) != self.P.shape[0]:
+            self.P = self.P[np.array(parent)]  # a copy of the parent's P for each new class
+        self.of_run = of_run
 
     def classes(self) -> list[tuple[int, list[int]]]:
         """(class, its runs) for every class."""
-        return [(c, [int(i) for i in np.flatnonzero(self.of_run == c)]) for c in range(len(self.P))]
+        return [(c, [int(i) for i in np.flatnonzero(self.of_run == c)]) for c in range(self.P.shape[0])]
 
     def aid(self, nav: Any, s: ins.InsState, t: float, dt_epoch: float, row: int, obs: Observations,
             truth: Truth) -> ins.InsState:
@@ -92,6 +101,9 @@ class SharedCovariance:
                                 noise, system.loop_gains(), loop_held=h)
             models[h] = em.discretize(F, Qc, dt_epoch)
         self.split(np.column_stack([obs.schedule(), np.array(held, dtype=bool)]))
+        if nav.engine is not None and self.singletons:  # every run its own class: one compiled call for all
+            self._aid_singletons(nav, ref, t, dt_epoch, obs, held, models)
+            return s
         if nav.engine is not None:  # the compiled epoch, class by class (nav/engine.py)
             self._aid_engine(nav, ref, t, dt_epoch, obs, held, models)
             return s
@@ -110,7 +122,7 @@ class SharedCovariance:
             ref_rows = system.rows.epoch(ref, 0, r_ref, system.rows.reference_obs(obs, i0, float(ref.h_m[0]), r_ref),
                                          t)
             own = {i: system.rows.epoch(s, i, r_ins[i], obs, t, db_error=runs[i].db_error) for i in members}
-            P = self.P[c]
+            P = np.array(self.P[c])
             for j, rr in enumerate(ref_rows):
                 m0 = rr.build(x0)
                 h0, r = m0.h, m0.r
@@ -148,10 +160,26 @@ class SharedCovariance:
             if obs.per_run_sky:
                 qd = system.noise_model.channel_qd(qd, obs.elevations(members[0]), dt_epoch)
             X = np.stack([runs[i].fs.x for i in members])
-            P = np.array(self.P[c], dtype=float)  # a copy: classes split from one share their P object
+            P = self.P[c]  # its own array (split copies)
             ins_y = nav.x[nav.ins_of[members]]
             nav.engine.epoch(X, P, phi, qd, False, ref_y[0], ins_y, obs, members, t,
                              [runs[i].statuses for i in members], [nav.dbs[i] for i in members], ref_agl)
-            self.P[c] = P
             for j, i in enumerate(members):
                 runs[i].fs = FilterState(x=X[j], P=P, memory=runs[i].fs.memory)
+
+    def _aid_singletons(self, nav: Any, ref: ins.InsState, t: float, dt_epoch: float, obs: Observations,
+                        held: list, models: dict) -> None:
+        """`_aid_engine` when every run is its own class: all runs in one kernels/epoch.singleton_epochs call (each
+        its own covariance, the channel Qd at its own sky)."""
+        system = nav.system
+        runs = nav.runs
+        ref_y = ins.pack(ref)[0]
+        r_ref = ins.position_ecef(ref)[0]
+        ref_agl = float(ref.h_m[0] - system.terrain_h(r_ref))
+        X = np.array([r.fs.x for r in runs])
+        phi2 = np.stack([models.get(False, models.get(True))[0], models.get(True, models.get(False))[0]])
+        qd2 = np.stack([models.get(False, models.get(True))[1], models.get(True, models.get(False))[1]])
+        nav.engine.singletons(X, self.P, phi2, qd2, np.array(held, dtype=np.int64), obs, t, dt_epoch,
+                              nav.x[nav.ins_of], ref_y, ref_agl, [r.statuses for r in runs], nav.db_stack)
+        for i, r in enumerate(runs):
+            r.fs = FilterState(x=X[i], P=self.P[i], memory=r.fs.memory)

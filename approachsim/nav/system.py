@@ -307,7 +307,8 @@ class NavSystem:
         shared = (SharedCovariance.start(runs, truth, m, epoch_rows, obs0.per_run_sky) if shared_covariance
                   else None)
         ins_of = None
-        if copies:  # one INS for all: every copy must start from the same INS state on the same increments
+        if copies:  # one INS for all: every copy must start from the same INS state on the same increments (the
+            # IMU record may hold one run for all)
             x0 = ins.pack(s)
             if self.nav.feedback or not (np.all(x0 == x0[:1]) and np.all(dth == dth[:1]) and np.all(dvb == dvb[:1])):
                 raise ValueError("run(copies=True): the runs are not copies of one feed-forward run (their start, "

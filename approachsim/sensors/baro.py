@@ -70,6 +70,11 @@ class Baro:
 
         return base.make_errors(t_s, self.rate_hz, rng, one)
 
+    def kernel_constants(self) -> tuple[float, float, float]:
+        """(setting Pa, ISA T0 / L m, exponent R L / g0): the indicated-altitude constants of the compiled sample
+        (sensors/kernels/baro.py; nav/kernels/inloop.py makes a closed loop's samples with them)."""
+        return float(self.setting_pa), _T0_OVER_LAPSE_M, _EXPONENT_INV
+
     def lag_weights(self, dt_s: float) -> Array:
         """The lag's impulse-response weights (M + 1,) on a truth step dt_s (s), renormalized to sum 1 (module
         docstring); empty without a lag."""

@@ -26,6 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
+from approachsim.nav.kernels import errormodel as ek
 from approachsim.nav.kernels import geodesy as gk
 from approachsim.nav.kernels import kalman as kk
 from approachsim.nav.kernels import measurements as km
@@ -185,3 +186,86 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
             nu_out[m, k] = nu[m]
         k += 1
     return k
+
+
+@njit(cache=True)
+def own_epoch(X: np.ndarray, P: np.ndarray, lay: np.ndarray, q: np.ndarray, gse: np.ndarray, gmp: np.ndarray,
+              loop: np.ndarray, held: bool, dt: float, f_ned: np.ndarray, y: np.ndarray, F: np.ndarray,
+              Qc: np.ndarray, phi: np.ndarray, qd: np.ndarray,
+              baro_h: np.ndarray, baro_r: float,
+              radalt_h: np.ndarray, ra_pct: float, ra_floor: float,
+              tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
+              db_u: np.ndarray,
+              rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
+              pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
+              codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray,
+              h: np.ndarray, b: np.ndarray, ws: tuple) -> int:
+    """The per-run EKF's whole epoch of one run: the error model linearized about its INS state y (16,) (packed,
+    kernels/strapdown.py) with the interval's mean specific force f_ned (3,) NED m/s^2 (kernels.errormodel
+    dynamics: lay, q, gse, gmp, loop, held as there), discretized over dt (s) into phi, qd (scratch F, Qc), then
+    class_epoch in own mode (X (1, n), the observation arguments as there). Returns the number of rows, or -1 when
+    the model is too large for the compiled discretization (X, P untouched: the caller takes the numpy path)."""
+    c_bn = y[6:15].reshape(3, 3)
+    ek.dynamics(lay, q, gse, gmp, y[0], y[2], y[3:6], f_ned, c_bn, loop, held, F, Qc)
+    if not ek.discretize(F, Qc, dt, phi, qd):
+        return -1
+    return class_epoch(X, P, phi, qd, lay, True, y, y.reshape(1, 16), baro_h, baro_r, radalt_h, ra_pct, ra_floor,
+                       0.0, tx, th, rwy, dbp, db_x, db_u, rho, r_sv, sig, channel_states, pl_rho, r_pl, pl_sig,
+                       pl_states, codes, nu_out, S_out, h, b, ws)
+
+
+@njit(cache=True)
+def singleton_epochs(X: np.ndarray, P3: np.ndarray, phi2: np.ndarray, qd2: np.ndarray, held: np.ndarray,
+                     ch_gse: np.ndarray, ch_gmp: np.ndarray, f_gse: float, f_gmp: float, qd_tmp: np.ndarray,
+                     lay: np.ndarray, ref: np.ndarray, ref_agl: float, ins: np.ndarray,
+                     baro_h: np.ndarray, baro_r: float,
+                     radalt_h: np.ndarray, ra_pct: float, ra_floor: float,
+                     tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
+                     db_u: np.ndarray,
+                     rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
+                     pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
+                     codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray, n_rows: np.ndarray,
+                     h: np.ndarray, b: np.ndarray, ws: tuple) -> None:
+    """class_epoch in shared mode for N runs that are each their own class (per-run GPS skies, the integrity bank's
+    copies): run i with X[i], P3[i] (its covariance), the model phi2[held[i]], qd2[held[i]] (the damping loop held
+    or not) whose GPS channel states' Qd entries are sigma^2 (1 - exp(-2 dt / tau)) at run i's elevations
+    (ch_gse, ch_gmp (N, k) sigmas, m; f_gse, f_gmp the factors; nothing changed when k = 0), its INS ins[i] and
+    observations row i of every per-run array (r_sv (N, s, 3), sig (N, s)); the rows at the reference ref (16,)
+    as class_epoch. Out per run: codes[i], nu_out[i], S_out[i] (R,) and n_rows[i]."""
+    N = X.shape[0]
+    ig, im = lay[ek.L_GSE], lay[ek.L_GMP]
+    for i in range(N):
+        hd = held[i]
+        qd_tmp[:, :] = qd2[hd]
+        if ig >= 0:
+            for c in range(ch_gse.shape[1]):
+                qd_tmp[ig + c, ig + c] = ch_gse[i, c] ** 2 * f_gse
+                qd_tmp[im + c, im + c] = ch_gmp[i, c] ** 2 * f_gmp
+        n_rows[i] = class_epoch(X[i:i + 1], P3[i], phi2[hd], qd_tmp, lay, False, ref, ins[i:i + 1],
+                                baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], ra_pct, ra_floor, ref_agl, tx, th, rwy,
+                                dbp[i:i + 1], db_x, db_u[i:i + 1], rho[i:i + 1], r_sv[i], sig[i], channel_states,
+                                pl_rho[i:i + 1], r_pl, pl_sig, pl_states, codes[i], nu_out[i:i + 1], S_out[i], h, b,
+                                ws)
+
+
+@njit(cache=True)
+def channel_sigmas(el: np.ndarray, a_m: float, shell_m: float, ce_m: float, iono_m: float, tropo_m: float,
+                   do253: bool, mp_m: float, gse: np.ndarray, gmp: np.ndarray) -> None:
+    """The GPS channel states' 1-sigma (m) at elevations el (N, k) rad, into gse, gmp (N, k), element by element
+    (nav/noise.py's numpy formulas; a run's values do not depend on the batch):
+
+        el <- max(el, 2 deg) (nan: 0.5 rad);  F = 1 / sqrt(1 - (a cos el / (a + h_I))^2);  M = 1.001 / sqrt(0.002001
+        + sin^2 el);  gse = sqrt(ce^2 + (I F)^2 + (T M)^2);  gmp = 0.13 + 0.53 exp(-el / 10 deg) (DO-253) or mp_m
+    """
+    lo = math.radians(2.0)
+    for i in range(el.shape[0]):
+        for c in range(el.shape[1]):
+            e = el[i, c]
+            e = 0.5 if e != e else e
+            e = max(e, lo)
+            x = a_m * math.cos(e) / (a_m + shell_m)
+            f = 1.0 / math.sqrt(1.0 - x * x)
+            s = math.sin(e)
+            m = 1.001 / math.sqrt(0.002001 + s * s)
+            gse[i, c] = math.sqrt(ce_m**2 + (iono_m * f) ** 2 + (tropo_m * m) ** 2)
+            gmp[i, c] = 0.13 + 0.53 * math.exp(-math.degrees(e) / 10.0) if do253 else mp_m

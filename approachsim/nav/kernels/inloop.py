@@ -1,0 +1,128 @@
+"""The closed loop's per-row navigation as a compiled kernel (numba, cache=True), called by the flight loop's
+compiled step (flight/kernels.py fly_step_nav) so that a closed-loop row costs no Python beyond JSBSim's reads and
+writes; Python runs only at the rows where the navigation needs it (the start, a baro sample of the damping loop,
+an aiding epoch: nav/closed_loop.py).
+
+Per truth row k (k > 0), with the flight's row buffer buf (flight/run.py columns: w_ib_body 17:20, f_body 20:23):
+
+    IMU increment of (k-1, k]: d = dt w(k-1) (rate or specific force of truth sample k-1 held, sensors/imu.py),
+                               dtheta = d + M_g d + c_g[k-1],  dv = d + M_a d + c_a[k-1]  (pre-drawn, affine)
+    INS step (kernels/strapdown.py) with the baro held in the work vector (nan: the damping loop holds)
+    rows[k] = the INS state; snap[k] = the filter snapshot in force
+    guidance = INS - x_hat (feed-forward) in the runway frame and NED (kernels/strapdown.guidance)
+
+The work vector nw (NW) holds the one run's INS state and the small constants (W_* offsets); nav/closed_loop.py
+builds it and keeps the Navigator's INS state, specific-force sum, rows and snapshot index as views of these
+arrays, so both see the same numbers. The numpy oracle is NavInTheLoop.step (the generic per-row path, kept for
+quantized or faulted IMUs): tests/unit/nav/test_system_closed_loop.py flies both.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from approachsim.nav.kernels import strapdown as sk
+
+W_X = 0
+"""Packed INS state (16,), kernels/strapdown.py layout."""
+W_XNAV = 16
+"""The estimated navigation errors in force (9,): dp NED m, dv m/s, psi rad."""
+W_FSUM = 25
+"""C_bn dv summed since the last epoch (3,), NED m/s."""
+W_BG, W_BA = 28, 31
+"""Bias feedback (3,) each: rad/s, m/s^2 (zeros feed-forward)."""
+W_LOOP = 34
+"""The damping loop (6,): ins.loop_vector."""
+W_HB = 40
+"""The baro height held for the next intervals, m (nan: none; the loop holds)."""
+W_DT = 41
+W_MG, W_MA = 42, 51
+"""IMU scale factor + misalignment matrices M_g, M_a (9,) each, row-major."""
+W_CRWY, W_ORWY, W_HTHR = 60, 66, 69
+"""Runway frame: the first two rows of C_ecef->rwy (6,), its ECEF origin (3,), the threshold height (m)."""
+W_SNAP = 70
+"""Index of the filter snapshot in force (the Navigator's)."""
+W_EPOCH_ROWS = 71
+W_ANY_BARO = 72
+"""1 when the INS had a baro at some interval since the last epoch (else the loop held throughout)."""
+W_BARO_LOOP = 73
+"""1 when the damping loop takes baro samples."""
+W_BARO_KERNEL = 74
+"""1 when the baro samples are made here (a plain barometric altimeter, sensors/baro.py), else by Python."""
+W_BARO_EXCL = 75
+"""1 when the online FDE has excluded the baro (the loop holds)."""
+W_BSET, W_BT0L, W_BEXP, W_BSF = 76, 77, 78, 79
+"""The baro's setting (Pa), ISA T0 / L (m), exponent R L / g0 and this run's scale factor (sensors/baro.py)."""
+NW = 80
+
+NAV_START, NAV_BARO, NAV_EPOCH = 1, 2, 4
+"""Bits of nav_row's code: the rows at which Python must act."""
+
+
+@njit(cache=True)
+def baro_sample(k: int, buf: np.ndarray, nw: np.ndarray, lag_w: np.ndarray, bias: float, noise: float) -> float:
+    """The barometric altimeter's sample at truth row k (sensors/kernels/baro.baro_apply for one run, the same
+    operations in order): h_ind = (T0 / L)(1 - (p / p_set)^(R L / g0)) of the static pressure at the IMU (buf column
+    23; with a lag, the weights lag_w over rows k, k - 1, ..., clipped at 0), h = h_ind (1 + S) + bias + noise."""
+    t0l, p_set, ex = nw[W_BT0L], nw[W_BSET], nw[W_BEXP]
+    if lag_w.shape[0] > 0:
+        h = 0.0
+        for q in range(lag_w.shape[0]):
+            h += t0l * (1.0 - (buf[max(k - q, 0), 23] / p_set) ** ex) * lag_w[q]
+    else:
+        h = t0l * (1.0 - (buf[k, 23] / p_set) ** ex)
+    return h * (1.0 + nw[W_BSF]) + bias + noise
+
+
+@njit(cache=True)
+def nav_row(k: int, buf: np.ndarray, nw: np.ndarray, cg: np.ndarray, ca: np.ndarray, rows: np.ndarray,
+            snap: np.ndarray, baro_j: np.ndarray, baro_e: np.ndarray, lag_w: np.ndarray, dth: np.ndarray,
+            dv: np.ndarray) -> int:
+    """Row k of the closed loop's navigation (module docstring); returns the NAV_* bits of what Python must do at
+    this row (0: nothing). cg, ca (m, 3) the IMU error terms by sample; rows (n, 16) the INS rows; snap (n,) int64;
+    baro_j (n,) int64 the baro sample at each row (-1: none), baro_e (m, 2) its bias and noise (m), lag_w its lag
+    weights (empty: none): a plain baro's samples of the damping loop are made here (baro_sample) except at the
+    start and at the epochs, where an exclusion by the online FDE may just have happened; dth, dv (1, 1, 3)
+    scratch."""
+    code = 0
+    if k == 0:
+        code = NAV_START
+    else:
+        dt = nw[W_DT]
+        w, f = buf[k - 1, 17:20], buf[k - 1, 20:23]
+        mg, ma = nw[W_MG:W_MG + 9], nw[W_MA:W_MA + 9]
+        for r in range(3):
+            d0, d1, d2 = dt * w[0], dt * w[1], dt * w[2]
+            d = d0 if r == 0 else (d1 if r == 1 else d2)
+            dth[0, 0, r] = d + (mg[3 * r] * d0 + mg[3 * r + 1] * d1 + mg[3 * r + 2] * d2) + cg[k - 1, r]
+            e0, e1, e2 = dt * f[0], dt * f[1], dt * f[2]
+            e = e0 if r == 0 else (e1 if r == 1 else e2)
+            dv[0, 0, r] = e + (ma[3 * r] * e0 + ma[3 * r + 1] * e1 + ma[3 * r + 2] * e2) + ca[k - 1, r]
+        hb = nw[W_HB:W_HB + 1].reshape(1, 1)
+        if hb[0, 0] == hb[0, 0]:
+            nw[W_ANY_BARO] = 1.0
+        sk.strapdown(nw[W_X:W_X + 16].reshape(1, 16), dth, dv, dt, nw[W_BG:W_BG + 3].reshape(1, 3),
+                     nw[W_BA:W_BA + 3].reshape(1, 3), hb, nw[W_LOOP:W_LOOP + 6], nw[W_FSUM:W_FSUM + 3].reshape(1, 3),
+                     np.empty((1, 0, 16)), 0)
+        if k % int(nw[W_EPOCH_ROWS]) == 0:
+            code |= NAV_EPOCH
+    j = baro_j[k]
+    if nw[W_BARO_LOOP] != 0.0 and j >= 0:
+        if nw[W_BARO_KERNEL] != 0.0 and code == 0:  # the held baro for the next intervals (nan: excluded)
+            nw[W_HB] = np.nan if nw[W_BARO_EXCL] != 0.0 else baro_sample(k, buf, nw, lag_w, baro_e[j, 0],
+                                                                          baro_e[j, 1])
+        else:
+            code |= NAV_BARO
+    for q in range(16):
+        rows[k, q] = nw[W_X + q]
+    snap[k] = int(nw[W_SNAP])
+    return code
+
+
+@njit(cache=True)
+def nav_guidance(nw: np.ndarray, out: np.ndarray) -> None:
+    """The guidance of the current INS state and estimate into out (6,): runway-frame position (m) and NED velocity
+    (m/s) of the feed-forward output INS - x_hat (kernels/strapdown.guidance)."""
+    c = nw[W_CRWY:W_CRWY + 6].reshape(2, 3)
+    sk.guidance(nw[W_X:W_X + 16].reshape(1, 16), nw[W_XNAV:W_XNAV + 9], c, nw[W_ORWY:W_ORWY + 3], nw[W_HTHR], out)
