@@ -166,13 +166,23 @@ def _gnss_closed_loop(source: Any, truth: Any) -> Any:
     return source.suite.sensors["gnss"].apply(truth, e.take(keep))
 
 
+_APPROACHES: dict = {}
+"""The Approach of each profile this worker process has flown (a profile's aircraft is parsed and its trimmed start
+solved once per process, not once per task: closed-loop tasks are one run each)."""
+
+
 def _approach(profile: Any) -> Any:
     from approachsim import units
     from approachsim.flight.run import Approach
 
-    lowest_dh_ft = min(profile.evaluation.dh_ft.values())
-    # fly a little below the lowest decision height so that its crossing is bracketed by samples
-    return Approach(profile, stop_height_m=max(lowest_dh_ft - 20.0, 5.0) * units.FT)
+    a = _APPROACHES.get(profile)
+    if a is None:
+        if len(_APPROACHES) > 8:
+            _APPROACHES.clear()
+        lowest_dh_ft = min(profile.evaluation.dh_ft.values())
+        # fly a little below the lowest decision height so that its crossing is bracketed by samples
+        a = _APPROACHES[profile] = Approach(profile, stop_height_m=max(lowest_dh_ft - 20.0, 5.0) * units.FT)
+    return a
 
 
 def _clock_truth(records: dict, k: int, t_s: Any) -> Any:

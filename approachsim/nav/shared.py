@@ -38,15 +38,19 @@ class SharedCovariance:
     f_ned_ref: Array
     """(rows, 3) the truth's specific force in NED at every row (the reference trajectory's), m/s^2."""
     epoch_rows: int
+    ref_cbn: Array
+    """(rows // epoch_rows + 1, 3, 3) the truth's body-to-NED matrix at every epoch row (the reference's attitude)."""
 
     @classmethod
     def start(cls, runs: list, truth: Truth, m: int, epoch_rows: int, per_run_sky: bool) -> SharedCovariance:
         """Classes at the start: one per run with per-run skies, else one for all (the runs' start covariance)."""
         n = len(runs)
-        f_ref = np.einsum("nij,nj->ni", ins.cbn_from_quaternion(truth.q_nb[:m]), truth.f_body[:m])
+        c_bn = ins.cbn_from_quaternion(truth.q_nb[:m + 1])
+        f_ref = np.einsum("nij,nj->ni", c_bn[:m], truth.f_body[:m])
+        ref_cbn = c_bn[::epoch_rows].copy()
         if per_run_sky:
-            return cls(np.array([r.fs.P for r in runs], dtype=float), np.arange(n), f_ref, epoch_rows)
-        return cls(np.array([runs[0].fs.P], dtype=float), np.zeros(n, dtype=int), f_ref, epoch_rows)
+            return cls(np.array([r.fs.P for r in runs], dtype=float), np.arange(n), f_ref, epoch_rows, ref_cbn)
+        return cls(np.array([runs[0].fs.P], dtype=float), np.zeros(n, dtype=int), f_ref, epoch_rows, ref_cbn)
 
     @property
     def singletons(self) -> bool:
@@ -88,9 +92,11 @@ class SharedCovariance:
         runs = nav.runs
         lay = system.layout
         ref = ins.InsState(truth.lat_rad[row:row + 1], truth.lon_rad[row:row + 1], truth.h_m[row:row + 1],
-                           truth.v_ned[row:row + 1], ins.cbn_from_quaternion(truth.q_nb[row:row + 1]), np.zeros(1))
+                           truth.v_ned[row:row + 1], self.ref_cbn[row // self.epoch_rows][None], np.zeros(1))
         f_ref = self.f_ned_ref[row - self.epoch_rows:row].mean(axis=0)
-        noise = system.noise(obs.elevations(0))
+        # per-run skies: every path below resets the GPS channel states' Qd to each class's own sky, so the model's
+        # noise is taken at the default elevations (cached) instead of being rebuilt for run 0's sky every epoch
+        noise = system.noise(None if obs.per_run_sky else obs.elevations(0))
         # the damping loop held in a run whose INS had no baro over the interval (kernels.strapdown): its own Phi,
         # Qd. Classes are split on this epoch's schedule and the hold together (splitting only copies P), so every
         # member of a class holds or none does, and then each class is predicted with its model
