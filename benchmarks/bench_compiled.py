@@ -5,6 +5,7 @@ and figures of the issue's table, with the machine's load (the machine is shared
     python benchmarks/bench_compiled.py ratios [--repeat 3] # closed loop / raw JSBSim, truth flight / raw,
                                                             # open-loop navigation us per 120 Hz step
     python benchmarks/bench_compiled.py scaling --ns 10 100 1000   # open loop end to end: wall, peak RSS
+    python benchmarks/bench_compiled.py scaling --accuracy-only --ns 10 100 1000 10000   # without the bank
     python benchmarks/bench_compiled.py dask --n 1000      # local pool vs Dask LocalCluster: same bits, efficiency
     python benchmarks/bench_compiled.py evaluate           # the default `approachsim evaluate` (20 closed-loop runs)
 
@@ -68,10 +69,11 @@ def bench_compile() -> None:
 
 
 def bench_ratios(repeat: int) -> None:
-    """Closed loop, truth flight, raw JSBSim (same steps), open-loop navigation pass; warm (compiled) process."""
+    """Raw JSBSim stepping, the truth flight, the closed loop (flight + sensors + INS + EKF + autopilot, and its
+    NavRun) and the open-loop navigation pass of the same approach, interleaved `repeat` times in one warm process;
+    min and median of wall and CPU time (the machine's speed drifts: the ratios of one pass are the figures)."""
     from approachsim.flight.fdm import FDM
     from approachsim.flight.run import Approach
-    from approachsim.flight.trim import start_condition
     from approachsim.nav.closed_loop import NavInTheLoop
     from approachsim.nav.system import NavSystem
     from approachsim.profile import load_profile
@@ -82,47 +84,71 @@ def bench_ratios(repeat: int) -> None:
     print(f"ratios: {load()}")
     prof = load_profile(PROFILE)
     a = Approach(prof)
+    budget = a.time_budget_s
     a.fly(seed=1, run=99, nav_source=NavInTheLoop(prof, seed=1, run=99, max_time_s=3.0), max_time_s=3.0)  # warm up
-    closed, truth_fly, raw, nav = [], [], [], []
+    a.fly(seed=1, run=99, max_time_s=3.0)
+    t = {k: [] for k in ("raw", "truth", "closed", "nav")}
+    c = {k: [] for k in ("raw", "truth", "closed", "nav")}
     n = 0
+
+    def timed(key: str, fn):  # wall and CPU time of fn()
+        w0, c0 = time.perf_counter(), time.process_time()
+        out = fn()
+        t[key].append(time.perf_counter() - w0)
+        c[key].append(time.process_time() - c0)
+        return out
+
     for i in range(repeat):
-        t0 = time.perf_counter()
-        res = a.fly(seed=1, run=i, nav_source=NavInTheLoop(prof, seed=1, run=i))
-        closed.append(time.perf_counter() - t0)
-        n = len(res.truth)
-        t0 = time.perf_counter()
-        r = a.fly(seed=1, run=i)
-        truth_fly.append(time.perf_counter() - t0)
+        r = timed("truth", lambda i=i: a.fly(seed=1, run=i))
+        n = len(r.truth)
         fdm = FDM(a.aircraft.jsbsim_model, a.dt_s)
-        t0 = time.perf_counter()
-        fdm.initialize_and_trim(start_condition(prof, a.aircraft))
-        fdm.set_seed(stream_int(1, i, "turbulence"))
-        step = fdm.run
-        for _ in range(len(r.truth) - 1):
-            step()
-        raw.append(time.perf_counter() - t0)
+
+        def raw(fdm=fdm, i=i, steps=n - 1):
+            fdm.initialize_and_trim(a.start())
+            fdm.set_seed(stream_int(1, i, "turbulence"))
+            step = fdm.run
+            for _ in range(steps):
+                step()
+
+        timed("raw", raw)
+
+        def closed(i=i):
+            src = NavInTheLoop(prof, seed=1, run=i, max_time_s=budget)
+            res = a.fly(seed=1, run=i, nav_source=src)
+            return src.result(res.truth)
+
+        timed("closed", closed)
         recs, st = measure_with_states(SensorSuite.from_profile(prof), r.truth, seed=1, runs=i)
-        t0 = time.perf_counter()
-        NavSystem.from_profile(prof).run(r.truth, recs, stream(1, i, "nav"), states=st)
-        nav.append((time.perf_counter() - t0) / len(r.truth))
+        nav = NavSystem.from_profile(prof)
+        timed("nav", lambda nav=nav, tr=r.truth, recs=recs, st=st, i=i: nav.run(tr, recs, stream(1, i, "nav"),
+                                                                               states=st))
     mn, md = min, statistics.median
-    print(f"  default profile, {n} steps at {prof.rates.imu_hz:g} Hz; min / median of {repeat}")
-    print(f"  closed loop (JSBSim + sensors + INS + EKF + autopilot): {mn(closed):.2f} / {md(closed):.2f} s")
-    print(f"  flown on truth (Approach.fly):                         {mn(truth_fly):.2f} / {md(truth_fly):.2f} s")
-    print(f"  raw JSBSim stepping (trim + run()):                    {mn(raw):.2f} / {md(raw):.2f} s")
-    print(f"  closed / raw JSBSim: {mn(closed) / mn(raw):.1f} (min) {md(closed) / md(raw):.1f} (median)  goal <= 2")
-    print(f"  truth flight / raw:  {mn(truth_fly) / mn(raw):.1f} (min) {md(truth_fly) / md(raw):.1f} (median)"
-          f"  goal <= 1.5")
-    print(f"  closed / truth flight: {md(closed) / md(truth_fly):.2f} (median)")
-    print(f"  open-loop navigation pass, one run: {mn(nav) * 1e6:.1f} / {md(nav) * 1e6:.1f} us per step  goal <= 10")
+    print(f"  default profile, {n} steps at {prof.rates.imu_hz:g} Hz; {repeat} interleaved repeats; wall (CPU) s, "
+          f"min / median")
+    for k, what in (("raw", "raw JSBSim stepping (trim + run())"), ("truth", "flown on truth (Approach.fly)"),
+                    ("closed", "closed loop (JSBSim + sensors + INS + EKF + autopilot, NavRun)"),
+                    ("nav", "open-loop navigation pass of one run (NavSystem.run)")):
+        print(f"  {what:66s} {mn(t[k]):.3f} / {md(t[k]):.3f}  ({mn(c[k]):.3f} / {md(c[k]):.3f})")
+    for k, goal in (("truth", 1.5), ("closed", 2.0)):
+        print(f"  {k} / raw JSBSim: wall {mn(t[k]) / mn(t['raw']):.2f} (min) {md(t[k]) / md(t['raw']):.2f} (median), "
+              f"CPU {mn(c[k]) / mn(c['raw']):.2f} (min)   goal <= {goal}")
+    print(f"  closed / truth flight: {md(t['closed']) / md(t['truth']):.2f} (median)")
+    print(f"  open-loop navigation pass, one run: {mn(t['nav']) / n * 1e6:.1f} / {md(t['nav']) / n * 1e6:.1f} us per "
+          f"120 Hz step (min / median)   goal <= 10")
     print(f"  {load()}")
 
 
-def _open_loop(n: int, scheduler: str | None = None):
+def _open_loop(n: int, scheduler: str | None = None, integrity: bool = True):
+    """n open-loop runs of the default profile end to end (no report); integrity False: accuracy only
+    (evaluation.integrity = []: no solution-separation bank)."""
+    import dataclasses
+
     from approachsim.campaign.evaluation import evaluate_profile
     from approachsim.profile import load_profile
 
     prof = load_profile(PROFILE)
+    if not integrity:
+        prof = dataclasses.replace(prof, evaluation=dataclasses.replace(prof.evaluation, integrity=()))
     with tempfile.TemporaryDirectory() as d:
         t = time.perf_counter()
         ev = evaluate_profile(prof, runs=n, seed=1, mode="open", out_dir=Path(d), workers=None if scheduler else 2,
@@ -130,17 +156,20 @@ def _open_loop(n: int, scheduler: str | None = None):
         return time.perf_counter() - t, ev
 
 
-def bench_scaling(ns: list[int]) -> None:
+def bench_scaling(ns: list[int], accuracy_only: bool) -> None:
     """Open loop end to end (flight, sensors, INS, filter, scoring, files) at each N; peak RSS of this process
     and of its largest child (a pool worker), each N in a fresh process."""
-    print(f"scaling: {load()}")
+    what = "accuracy only (evaluation.integrity = [])" if accuracy_only else "with the integrity bank (the default)"
+    print(f"scaling, {what}: {load()}")
     for n in ns:
-        out = subprocess.run([sys.executable, __file__, "_one", str(n)], capture_output=True, text=True, check=True)
+        out = subprocess.run([sys.executable, __file__, "_one", str(n)] + (["--accuracy-only"] if accuracy_only else
+                                                                            []),
+                             capture_output=True, text=True, check=True)
         print("  " + out.stdout.strip().splitlines()[-1])
 
 
-def _one(n: int) -> None:
-    wall, ev = _open_loop(n)
+def _one(n: int, accuracy_only: bool) -> None:
+    wall, ev = _open_loop(n, integrity=not accuracy_only)
     failed = sum(not r.ok for r in ev.results)
     print(f"N={n:6d}: {wall:7.1f} s ({wall / n * 1e3:6.1f} ms/run), {failed} failed, best "
           f"{ev.summary['best_category']}; peak RSS parent {rss_mb(resource.RUSAGE_SELF):6.0f} MB, largest worker "
@@ -183,19 +212,20 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--ns", type=int, nargs="+", default=[10, 100, 1000])
     ap.add_argument("--n", type=int, default=1000)
+    ap.add_argument("--accuracy-only", action="store_true", help="scaling: without the integrity bank")
     args = ap.parse_args()
     if args.part == "compile":
         bench_compile()
     elif args.part == "ratios":
         bench_ratios(args.repeat)
     elif args.part == "scaling":
-        bench_scaling(args.ns)
+        bench_scaling(args.ns, args.accuracy_only)
     elif args.part == "dask":
         bench_dask(args.n)
     elif args.part == "evaluate":
         bench_evaluate()
     else:
-        _one(args.n_one)
+        _one(args.n_one, args.accuracy_only)
 
 
 if __name__ == "__main__":
