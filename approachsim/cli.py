@@ -70,8 +70,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+"""Set to 1 by the console script unless the user set them (main): campaigns use one process per core, and BLAS
+threads would oversubscribe the cores (OpenBLAS's idle threads spin on them)."""
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `approachsim` console script; returns the exit status."""
+    for var in BLAS_THREAD_VARIABLES:  # before numpy loads its BLAS (the command modules import it)
+        os.environ.setdefault(var, "1")
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

@@ -25,6 +25,9 @@ import tempfile
 import time
 from pathlib import Path
 
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # as the console script (cli.main);
+    os.environ.setdefault(_var, "1")  # numpy is imported below, inside the parts
+
 ROOT = Path(__file__).resolve().parents[1]
 PROFILE = ROOT / "profiles" / "default.toml"
 

@@ -26,6 +26,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, TextIO
 
+from threadpoolctl import threadpool_limits
+
 from approachsim.campaign.result import RunResult
 from approachsim.campaign.store import CampaignStore
 from approachsim.config import ProfileError
@@ -61,7 +63,16 @@ def _one_line(e: BaseException) -> str:
 
 
 def run_task(run_fn: RunFn | None, group_fn: GroupFn | None, profile: Any, seed: int, runs: Sequence[int]) -> list:
-    """Execute a chunk of runs in the worker; every failure becomes a failed RunResult (never an exception)."""
+    """Execute a chunk of runs in the worker; every failure becomes a failed RunResult (never an exception).
+
+    BLAS runs single-threaded in the task (threadpoolctl): the campaign already uses every core with one worker
+    per core, and an idle OpenBLAS thread spins on a core the other worker needs (measured: a flight's CPU time
+    1.2x its wall time with the default two BLAS threads, equal with one)."""
+    with threadpool_limits(limits=1):
+        return _run_task(run_fn, group_fn, profile, seed, runs)
+
+
+def _run_task(run_fn: RunFn | None, group_fn: GroupFn | None, profile: Any, seed: int, runs: Sequence[int]) -> list:
     if group_fn is not None:
         try:
             out = list(group_fn(profile, seed, list(runs)))
