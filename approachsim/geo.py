@@ -7,7 +7,6 @@ frame (origin at the threshold, x along the landing direction, y to the right, z
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -196,22 +195,6 @@ def gravity_ned(lat_rad: ArrayLike, h_m: ArrayLike) -> Array:
     out[..., 1] = 0.0
     out[..., 2] = -cl * gp - sl * gz
     return out
-
-
-def gravity_nd_scalar(lat_rad: float, h_m: float) -> tuple[float, float]:
-    """gravity_ned's north and down components (m/s^2) for one point in plain float arithmetic (fast path
-    for the scalar INS step; the same equations, equal to rounding)."""
-    sl, cl = math.sin(lat_rad), math.cos(lat_rad)
-    r_e = A_WGS84 / math.sqrt(1.0 - E2_WGS84 * sl * sl)
-    p = (r_e + h_m) * cl
-    z = (r_e * (1.0 - E2_WGS84) + h_m) * sl
-    r2 = p * p + z * z
-    s2 = z * z / r2
-    pre = 1.5 * J2_JSBSIM * A_JSBSIM**2 / r2
-    k = -GM_JSBSIM / (r2 * math.sqrt(r2))
-    gp = k * (1.0 + pre * (1.0 - 5.0 * s2)) * p + OMEGA_JSBSIM**2 * p
-    gz = k * (1.0 + pre * (3.0 - 5.0 * s2)) * z
-    return -sl * gp + cl * gz, -cl * gp - sl * gz
 
 
 @dataclass(frozen=True)

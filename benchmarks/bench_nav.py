@@ -17,11 +17,11 @@ from pathlib import Path
 
 from approachsim.flight.fdm import FDM
 from approachsim.flight.run import Approach
-from approachsim.flight.trim import start_condition
 from approachsim.nav.closed_loop import NavInTheLoop
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream, stream_int
+from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -39,8 +39,9 @@ def main() -> None:
     n = 0
     for i in range(args.repeat):
         t0 = time.perf_counter()
-        src = NavInTheLoop(profile, seed=1, run=i)
+        src = NavInTheLoop(profile, seed=1, run=i, max_time_s=approach.time_budget_s)
         res = approach.fly(seed=1, run=i, nav_source=src)
+        src.result(res.truth)
         closed.append(time.perf_counter() - t0)
         print(f"run {i}: closed loop {res.termination}, lowest {res.lowest_height_ft:.0f} ft, {closed[-1]:.1f} s")
         n = len(res.truth)
@@ -49,17 +50,17 @@ def main() -> None:
         truth_fly.append(time.perf_counter() - t0)
         fdm = FDM(approach.aircraft.jsbsim_model, approach.dt_s)
         t0 = time.perf_counter()
-        fdm.initialize_and_trim(start_condition(profile, approach.aircraft))
+        fdm.initialize_and_trim(approach.start())
         fdm.set_seed(stream_int(1, i, "turbulence"))
         step = fdm.run
         for _ in range(n - 1):
             step()
         raw.append(time.perf_counter() - t0)
         t0 = time.perf_counter()
-        recs = SensorSuite.from_profile(profile).measure(r.truth, seed=1, runs=i)
+        recs, st = measure_with_states(SensorSuite.from_profile(profile), r.truth, seed=1, runs=i)
         sensors.append(time.perf_counter() - t0)
         t0 = time.perf_counter()
-        NavSystem.from_profile(profile).run(r.truth, recs, stream(1, i, "nav"))
+        NavSystem.from_profile(profile).run(r.truth, recs, stream(1, i, "nav"), states=st)
         open_nav.append(time.perf_counter() - t0)
     med = statistics.median
     hz = profile.rates.imu_hz

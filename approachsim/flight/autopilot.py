@@ -30,7 +30,7 @@ import math
 from dataclasses import dataclass
 
 from approachsim.flight.design import AutopilotGains
-from approachsim.geo import A_WGS84, E2_WGS84
+from approachsim.geo import radii
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,7 @@ class Autopilot:
         self.tan_gp = math.tan(geometry.glidepath_rad)
         self.tch_m = geometry.tch_m
         lat0 = geometry.threshold_lat_rad
-        r_e = A_WGS84 / math.sqrt(1.0 - E2_WGS84 * math.sin(lat0) ** 2)
+        r_e = float(radii(lat0)[1])
         self.conv_per_east_m = math.sin(lat0) / (r_e * math.cos(lat0))
         """Meridian convergence per metre east of the threshold, rad/m."""
         self.int_d = 0.0
