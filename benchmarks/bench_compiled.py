@@ -54,6 +54,21 @@ print(f"{t1 - t0:.3f} {t2 - t1:.3f}")
 """
 
 
+_FIRST_RUN = """
+import time
+t0 = time.perf_counter()
+from approachsim.campaign import pipeline
+from approachsim.profile import load_profile
+prof = load_profile(%r)
+t1 = time.perf_counter()
+pipeline.closed_loop_group(prof, 1, [0])  # a closed-loop run and its integrity bank: every kernel of the campaign
+t2 = time.perf_counter()
+pipeline.closed_loop_group(prof, 1, [1])
+t3 = time.perf_counter()
+print(f"{t1 - t0:.3f} {t2 - t1:.3f} {t3 - t2:.3f}")
+"""
+
+
 def bench_compile() -> None:
     """Import time of the kernel modules and the first strapdown call, with an empty numba cache and again
     with the cache it left (two fresh processes each)."""
@@ -67,6 +82,17 @@ def bench_compile() -> None:
             wall = time.perf_counter() - t
             print(f"  {label:22s}: import {float(out[0]):6.2f} s, first propagate {float(out[1]):6.2f} s, "
                   f"process {wall:6.2f} s")
+        size = sum(p.stat().st_size for p in Path(d).rglob("*") if p.is_file())
+        print(f"  cache: {sum(1 for _ in Path(d).rglob('*.nbi'))} index files, {size / 1e6:.1f} MB")
+    with tempfile.TemporaryDirectory() as d:  # every kernel a closed-loop campaign run calls
+        env = dict(os.environ, NUMBA_CACHE_DIR=d)
+        for label in ("cold cache (compiles)", "warm cache (loads)"):
+            t = time.perf_counter()
+            out = subprocess.run([sys.executable, "-c", _FIRST_RUN % str(PROFILE)], env=env, capture_output=True,
+                                 text=True, check=True).stdout.split()
+            wall = time.perf_counter() - t
+            print(f"  closed-loop run + bank, {label:22s}: import {float(out[0]):6.2f} s, first run "
+                  f"{float(out[1]):6.2f} s, second run {float(out[2]):6.2f} s, process {wall:6.2f} s")
         size = sum(p.stat().st_size for p in Path(d).rglob("*") if p.is_file())
         print(f"  cache: {sum(1 for _ in Path(d).rglob('*.nbi'))} index files, {size / 1e6:.1f} MB")
 

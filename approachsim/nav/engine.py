@@ -65,6 +65,13 @@ class StatusBuffer:
         weight 1)."""
         self._parts.append((np.array(codes), float(t_s), np.array(nu, dtype=float), np.array(S, dtype=float)))
 
+    def add_epochs(self, codes: Array, counts: Array, t_s: Array, nu: Array, S: Array) -> None:
+        """Many engine epochs at once: codes, nu, S (E, R) of which the first counts[e] of row e are the epoch's, at
+        times t_s (E,)."""
+        keep = np.arange(codes.shape[1])[None, :] < np.asarray(counts)[:, None]
+        t = np.broadcast_to(np.asarray(t_s, dtype=float)[:, None], codes.shape)
+        self._parts.append((codes[keep], t[keep], nu[keep].astype(float), S[keep].astype(float)))
+
     def __len__(self) -> int:
         return sum(1 if isinstance(p, UpdateStatus) else len(p[0]) for p in self._parts)
 
@@ -82,7 +89,7 @@ class StatusBuffer:
             else:
                 codes, ts, v, s = p
                 k = len(codes)
-                t.append(np.full(k, ts))
+                t.append(np.full(k, ts) if np.ndim(ts) == 0 else np.asarray(ts, dtype=float))
                 name.append(np.array([code_name(int(c)) for c in codes], dtype=object))
                 nu.append(v)
                 S.append(s)

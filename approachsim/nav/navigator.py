@@ -25,12 +25,14 @@ from typing import Any
 
 import numpy as np
 
+from approachsim import geo
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import FilterState, UpdateStatus
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer
 from approachsim.nav.fde import FdeState
+from approachsim.nav.kernels import epoch as ke
 from approachsim.nav.kernels import output as ko
 from approachsim.nav.observations import BARO, Observations
 from approachsim.records import NavSolution, Truth
@@ -316,6 +318,102 @@ class Navigator:
             r.fs = replace(r.fs, x=xn)
         return s
 
+    # --- the whole open-loop pass compiled (shared covariance, every run its own class) -------------------------
+
+    def can_pass(self) -> bool:
+        """Whether `compiled_pass` can run this pass: the compiled epoch, the shared covariance with per-run skies
+        (every run its own class from the start, whatever the batch: a run's bits do not depend on it; the integrity
+        bank's copies of a run with its own sky), feed-forward (the INS does not depend on the filter)."""
+        return (self.engine is not None and self.shared is not None and self.shared.per_run_sky
+                and self.shared.singletons and not self.system.nav.feedback)
+
+    def compiled_pass(self, records: Any, truth: Truth, batched: bool, dtheta: Array, dv: Array, dt_s: float,
+                      h_baro: Array | None, epoch_rows: int) -> bool:
+        """The whole open-loop pass in two compiled calls (`can_pass`): the INS over every row, then every epoch of
+        every run (kernels/epoch.shared_pass: the per-epoch path's arithmetic, nav/shared.py's singletons). Fills
+        the state `results` reads. False, with nothing changed but the INS rows, when an epoch's model is too
+        large for the compiled discretization (the caller then takes the per-epoch path from the start)."""
+        system, lay, sh, eng = self.system, self.layout, self.shared, self.engine
+        m = dtheta.shape[1]
+        x0 = self.x.copy()
+        self.propagate(dtheta, dv, dt_s, h_baro, 0)  # the INS over every row (feed-forward: the filter never acts)
+        e_rows = np.arange(epoch_rows, m + 1, epoch_rows)
+        N, E = self.n_runs, e_rows.shape[0]
+        t_e = np.asarray(truth.t_s, dtype=float)[e_rows]
+        dt = np.diff(np.concatenate([[self.t_last], t_e]))
+        tol = 0.25 * dt_s
+        # the damping loop held where the INS had no baro over the whole interval (as NavSystem.run's per-epoch path)
+        held = np.zeros((N, E), dtype=np.int64)
+        if lay.has("ac") and h_baro is not None:
+            for e, r in enumerate(e_rows):
+                held[:, e] = np.all(np.isnan(h_baro[:, r - epoch_rows:r]), axis=1)[self.ins_of]
+        # the reference: the truth at the epoch rows
+        ref = np.zeros((E, ins.NX))
+        ref[:, 0], ref[:, 1], ref[:, 2] = truth.lat_rad[e_rows], truth.lon_rad[e_rows], truth.h_m[e_rows]
+        ref[:, 3:6] = truth.v_ned[e_rows]
+        ref_cbn = np.ascontiguousarray(sh.ref_cbn[e_rows // epoch_rows])
+        ref[:, 6:15] = ref_cbn.reshape(E, 9)
+        f_ref = np.stack([sh.f_ned_ref[r - epoch_rows:r].mean(axis=0) for r in e_rows]) if E else np.zeros((0, 3))
+        r_ref = geo.geodetic_to_ecef(ref[:, 0], ref[:, 1], ref[:, 2])
+        ref_agl = ref[:, 2] - system.terrain_h(r_ref) if E else np.zeros(0)
+        o = _stacked_observations(records, t_e, tol, batched, N)
+        per_run_sky = o["per_run_sky"]
+        noise = system.noise(None if per_run_sky or o["el0"] is None else o["el0"])
+        q, gse, gmp = em.kernel_noise(noise, lay.n_sv)
+        loop = em.kernel_loop(system.loop_gains() if lay.has("ac") else None)
+        baro_h, baro_r, radalt_h = o["baro_h"], o["baro_r"], o["radalt_h"]
+        rho, r_sv, el = o["rho"], o["r_sv"], o["el"]
+        k = rho.shape[2]
+        sig = np.broadcast_to(eng._code_sig, (N, E, k)) if eng.channel_states else o["sig"]
+        sig = np.ascontiguousarray(sig, dtype=float)
+        pl_rho = o["pl_rho"]
+        r_pl = o["r_pl"] if o["r_pl"] is not None else eng._none3
+        pl_sig = np.ascontiguousarray(np.broadcast_to(eng._pl_sig if eng.pl_states else o["pl_sig"],
+                                                      (E, pl_rho.shape[2])), dtype=float)
+        # the channel states' Qd at each run's own sky (per-run skies; one sky: the model's own)
+        if lay.has("gse") and per_run_sky and k:
+            ch_gse, ch_gmp = np.empty((N * E, k)), np.empty((N * E, k))
+            ke.channel_sigmas(el.reshape(N * E, k), *eng._sky_budget, ch_gse, ch_gmp)
+            ch_gse, ch_gmp = ch_gse.reshape(N, E, k), ch_gmp.reshape(N, E, k)
+        else:
+            ch_gse = ch_gmp = np.zeros((N, E, 0))
+        nz = system.noise_model.noise(None)
+        f_gse = -np.expm1(-2.0 * dt / nz.gse_tau_s) if lay.has("gse") else np.zeros(E)
+        f_gmp = -np.expm1(-2.0 * dt / nz.gmp_tau_s) if lay.has("gse") else np.zeros(E)
+        dbp, db_x, db_u = self.db_stack
+        X = np.array([r.fs.x for r in self.runs])
+        P3 = sh.P.copy()
+        R = eng.codes.shape[0]
+        n = lay.n
+        codes, nu, S = np.zeros((N, E, R), dtype=np.int64), np.zeros((N, E, R)), np.zeros((N, E, R))
+        n_rows = np.zeros((N, E), dtype=np.int64)
+        x_out, p33, pcc = np.zeros((N, E, n)), np.zeros((N, E, 3, 3)), np.zeros((N, E))
+        pd, pnav = np.zeros((N, E, n)), np.zeros((N, E, 9, 9))
+        ins_y = np.ascontiguousarray(self.rows[self.ins_of][:, e_rows])
+        done = ke.shared_pass(X, P3, eng.lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse,
+                              ch_gmp, f_gse, f_gmp, ins_y, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
+                              eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho, r_sv, sig, eng.channel_states, pl_rho,
+                              r_pl, pl_sig, eng.pl_states, codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav, self._ic,
+                              eng.h, eng.b, eng.ws)
+        if done != E:
+            self.x[:] = x0
+            self.f_sum[:] = 0.0
+            return False
+        for e in range(E):  # what the per-epoch path keeps
+            self._snaps.append((x_out[:, e], p33[:, e], pcc[:, e]))
+            self._hist["pd"].append(pd[:, e])
+            self._hist["pnav"].append(pnav[:, e])
+        self._hist["t"].extend(t_e.tolist())
+        self._hist["row"].extend(e_rows.tolist())
+        self._hist["snap"].extend(range(1, E + 1))
+        self.snap[:] = np.searchsorted(e_rows, np.arange(self.snap.shape[0]), side="right")
+        sh.P = P3
+        for i, r in enumerate(self.runs):
+            r.fs = FilterState(x=X[i], P=P3[i], memory=r.fs.memory)
+            r.statuses.add_epochs(codes[i], n_rows[i], t_e, nu[i], S[i])
+        self.t_last = float(t_e[-1]) if E else self.t_last
+        return True
+
     # --- output --------------------------------------------------------------------------------------------
 
     def _snapshot(self, epoch: bool = False) -> None:
@@ -379,3 +477,65 @@ class Navigator:
                 P_nav=np.array([p[i] for p in h["pnav"]]).reshape(-1, 9, 9), true_error_nav=err, layout=lay,
             ))
         return out
+
+
+def _stacked_observations(records: Any, t_e: Array, tol: float, batched: bool, n_runs: int) -> dict[str, Any]:
+    """The measurements of every run at every epoch time t_e (E,) as arrays with the axes (runs, epochs, ...):
+    Observations.at's values for all epochs at once (nan where a record has no sample at the epoch or it is
+    invalid), plus each epoch's baro variance and whether the GNSS sky is per run."""
+    E = t_e.shape[0]
+
+    def index(t_rec: Array) -> tuple[Array, Array]:  # Observations' _epoch_index for every epoch
+        t_rec = np.asarray(t_rec, dtype=float)
+        i = np.searchsorted(t_rec, t_e - tol)
+        ok = i < t_rec.shape[0]
+        j = np.minimum(i, max(t_rec.shape[0] - 1, 0))
+        ok &= np.abs(t_rec[j] - t_e) <= tol if t_rec.shape[0] else False
+        return j, ok
+
+    def per_run(a: Array) -> Array:
+        return np.asarray(a) if batched else np.asarray(a)[None]
+
+    out: dict[str, Any] = {"per_run_sky": False, "el0": None, "r_pl": None, "pl_sig": None}
+    nan = np.full((n_runs, E), np.nan)
+    b = records.get("baro")
+    out["baro_h"], out["baro_r"] = nan.copy(), np.zeros(E)
+    if b is not None:
+        j, ok = index(b.t_s)
+        v = np.where(per_run(b.valid)[:, j], per_run(b.h_baro_m)[:, j], np.nan)
+        out["baro_h"] = np.where(ok[None, :], v, np.nan)
+        out["baro_r"] = np.where(ok, np.asarray(b.sigma_m, dtype=float)[j] ** 2, 0.0)
+    r = records.get("radalt")
+    out["radalt_h"] = nan.copy()
+    if r is not None:
+        j, ok = index(r.t_s)
+        v = np.where(per_run(r.valid)[:, j], per_run(r.h_agl_m)[:, j], np.nan)
+        out["radalt_h"] = np.where(ok[None, :], v, np.nan)
+    g = records.get("gnss")
+    if g is not None:
+        j, ok = index(g.t_s)
+        sky = batched and bool(g.per_run_sky)
+        rho = np.where(per_run(g.valid)[:, j], per_run(g.pseudorange_m)[:, j], np.nan)
+        out["rho"] = np.ascontiguousarray(np.where(ok[None, :, None], rho, np.nan))
+        k = rho.shape[2]
+        out["r_sv"] = np.ascontiguousarray(np.broadcast_to(g.r_sv_ecef[:, j] if sky else g.r_sv_ecef[j],
+                                                           (n_runs, E, k, 3)), dtype=float)
+        out["sig"] = np.ascontiguousarray(np.broadcast_to(g.sigma_m[:, j] if sky else g.sigma_m[j], (n_runs, E, k)),
+                                          dtype=float)
+        out["el"] = np.ascontiguousarray(np.broadcast_to(g.elevation_rad[:, j] if sky else g.elevation_rad[j],
+                                                         (n_runs, E, k)), dtype=float)
+        out["per_run_sky"] = sky
+        if E and not sky:
+            out["el0"] = np.asarray(g.elevation_rad[j[0]], dtype=float)
+    else:
+        out["rho"], out["r_sv"], out["sig"], out["el"] = (np.full((n_runs, E, 0), np.nan), np.zeros((n_runs, E, 0, 3)),
+                                                          np.zeros((n_runs, E, 0)), np.zeros((n_runs, E, 0)))
+    p = records.get("pseudolite")
+    out["pl_rho"], out["pl_sig"] = np.full((n_runs, E, 0), np.nan), np.zeros((E, 0))
+    if p is not None:
+        j, ok = index(p.t_s)
+        rho = np.where(per_run(p.valid)[:, j], per_run(p.pseudorange_m)[:, j], np.nan)
+        out["pl_rho"] = np.ascontiguousarray(np.where(ok[None, :, None], rho, np.nan))
+        out["r_pl"] = np.ascontiguousarray(p.r_pl_ecef, dtype=float)
+        out["pl_sig"] = np.ascontiguousarray(np.asarray(p.sigma_m, dtype=float)[j])
+    return out

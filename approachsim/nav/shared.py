@@ -40,6 +40,8 @@ class SharedCovariance:
     epoch_rows: int
     ref_cbn: Array
     """(rows // epoch_rows + 1, 3, 3) the truth's body-to-NED matrix at every epoch row (the reference's attitude)."""
+    per_run_sky: bool = False
+    """The runs have their own GPS skies: every run is its own class from the start, in any batch."""
 
     @classmethod
     def start(cls, runs: list, truth: Truth, m: int, epoch_rows: int, per_run_sky: bool) -> SharedCovariance:
@@ -49,7 +51,7 @@ class SharedCovariance:
         f_ref = np.einsum("nij,nj->ni", c_bn[:m], truth.f_body[:m])
         ref_cbn = c_bn[::epoch_rows].copy()
         if per_run_sky:
-            return cls(np.array([r.fs.P for r in runs], dtype=float), np.arange(n), f_ref, epoch_rows, ref_cbn)
+            return cls(np.array([r.fs.P for r in runs], dtype=float), np.arange(n), f_ref, epoch_rows, ref_cbn, True)
         return cls(np.array([runs[0].fs.P], dtype=float), np.zeros(n, dtype=int), f_ref, epoch_rows, ref_cbn)
 
     @property

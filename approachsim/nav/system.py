@@ -329,6 +329,9 @@ class NavSystem:
                 if not np.all((hb_full == hb_full[:1]) | (np.isnan(hb_full) & np.isnan(hb_full[:1]))):
                     raise ValueError("run(copies=True): the copies' baro records differ")
                 hb_full = hb_full[:1]
+        if nav.can_pass() and nav.compiled_pass(records, truth, batched, dth, dvb, dt, hb_full, epoch_rows):
+            results = nav.results(truth, solutions={0} if copies else True)
+            return results if batched else results[0]
         # the compiled INS steps every run over the rows between two epochs in one call; a run's numbers do not
         # depend on the batch it shares (the campaign relies on it: kernels/strapdown.py)
         j0 = 0

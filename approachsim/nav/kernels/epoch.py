@@ -269,3 +269,76 @@ def channel_sigmas(el: np.ndarray, a_m: float, shell_m: float, ce_m: float, iono
             m = 1.001 / math.sqrt(0.002001 + s * s)
             gse[i, c] = math.sqrt(ce_m**2 + (iono_m * f) ** 2 + (tropo_m * m) ** 2)
             gmp[i, c] = 0.13 + 0.53 * math.exp(-math.degrees(e) / 10.0) if do253 else mp_m
+
+
+@njit(cache=True)
+def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, gse: np.ndarray, gmp: np.ndarray,
+                loop: np.ndarray, dt: np.ndarray, ref: np.ndarray, ref_cbn: np.ndarray, f_ref: np.ndarray,
+                ref_agl: np.ndarray, held: np.ndarray, ch_gse: np.ndarray, ch_gmp: np.ndarray, f_gse: np.ndarray,
+                f_gmp: np.ndarray, ins: np.ndarray,
+                baro_h: np.ndarray, baro_r: np.ndarray,
+                radalt_h: np.ndarray, ra_pct: float, ra_floor: float,
+                tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
+                db_u: np.ndarray,
+                rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
+                pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
+                codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray, n_rows: np.ndarray,
+                x_out: np.ndarray, p33_out: np.ndarray, pcc_out: np.ndarray, pd_out: np.ndarray,
+                pnav_out: np.ndarray, ic: int, h: np.ndarray, b: np.ndarray, ws: tuple) -> int:
+    """The whole open-loop pass of N runs that are each their own shared-covariance class (per-run GPS skies, the
+    integrity bank's copies): E epochs of singleton_epochs in one call, the model along the reference made here.
+
+    Per epoch e: F, Qc = kernels.errormodel.dynamics at the reference (ref (E, 16) packed truth rows, ref_cbn (E, 3,
+    3), f_ref (E, 3) the interval's mean specific force NED m/s^2; lay, q, gse, gmp, loop the model's arrays), without
+    and (when a run's damping loop held: held (N, E) int) with the loop held; Phi, Qd over dt[e] (s) by Van Loan; then
+    every run i as singleton_epochs (ch_gse, ch_gmp (N, E, k) its channel sigmas, f_gse, f_gmp (E,) their factors;
+    ins (N, E, 16) its INS at the epoch; the observations indexed [i, e]: baro_h (N, E) with baro_r (E,) m^2, radalt_h
+    (N, E), rho (N, E, s), r_sv (N, E, s, 3), sig (N, E, s), pl_rho (N, E, p), pl_sig (E, p); ref_agl (E,) m; db
+    per run). Out per
+    run and epoch: codes, nu_out, S_out (N, E, R), n_rows (N, E), and after the epoch's updates x_out (N, E, n),
+    p33_out (N, E, 3, 3), pcc_out (N, E) (P[ic, ic]), pd_out (N, E, n), pnav_out (N, E, 9, 9). Returns -1 - e when
+    epoch e's model is too large for the compiled discretization (nothing of epoch e done), else E."""
+    N, n = X.shape
+    E = dt.shape[0]
+    F = np.empty((n, n))
+    Qc = np.empty((n, n))
+    phi2 = np.empty((2, n, n))
+    qd2 = np.empty((2, n, n))
+    qd_tmp = np.empty((n, n))
+    ig, im = lay[ek.L_GSE], lay[ek.L_GMP]
+    for e in range(E):
+        y = ref[e]
+        any_held = False
+        for i in range(N):
+            if held[i, e] != 0:
+                any_held = True
+        for hd in range(2):
+            if hd == 1 and not any_held:
+                break
+            ek.dynamics(lay, q, gse, gmp, y[0], y[2], y[3:6], f_ref[e], ref_cbn[e], loop, hd == 1, F, Qc)
+            if not ek.discretize(F, Qc, dt[e], phi2[hd], qd2[hd]):
+                return -1 - e
+        for i in range(N):
+            hd = held[i, e]
+            qd_tmp[:, :] = qd2[hd]
+            if ig >= 0:
+                for c in range(ch_gse.shape[2]):
+                    qd_tmp[ig + c, ig + c] = ch_gse[i, e, c] ** 2 * f_gse[e]
+                    qd_tmp[im + c, im + c] = ch_gmp[i, e, c] ** 2 * f_gmp[e]
+            P = P3[i]
+            n_rows[i, e] = class_epoch(X[i:i + 1], P, phi2[hd], qd_tmp, lay, False, y, ins[i, e:e + 1],
+                                       baro_h[i, e:e + 1], baro_r[e], radalt_h[i, e:e + 1], ra_pct, ra_floor,
+                                       ref_agl[e], tx, th, rwy, dbp[i:i + 1], db_x, db_u[i:i + 1], rho[i, e:e + 1],
+                                       r_sv[i, e], sig[i, e], channel_states, pl_rho[i, e:e + 1], r_pl, pl_sig[e],
+                                       pl_states, codes[i, e], nu_out[i, e:e + 1], S_out[i, e], h, b, ws)
+            for a in range(n):
+                x_out[i, e, a] = X[i, a]
+                pd_out[i, e, a] = P[a, a]
+            for a in range(3):
+                for c in range(3):
+                    p33_out[i, e, a, c] = P[a, c]
+            for a in range(9):
+                for c in range(9):
+                    pnav_out[i, e, a, c] = P[a, c]
+            pcc_out[i, e] = P[ic, ic]
+    return E

@@ -83,3 +83,37 @@ def test_engine_is_off_where_the_generic_path_is_needed():
         nav = NavSystem.from_profile(replace(DEFAULT, nav=replace(DEFAULT.nav, **kw)))
         assert engine.EpochEngine.of(nav) is None, kw
     assert engine.EpochEngine.of(NavSystem.from_profile(DEFAULT)) is not None
+
+
+@pytest.mark.parametrize("kind", ["default", "pseudolite", "baro-outage"])
+def test_whole_pass_equals_the_per_epoch_engine(kind, monkeypatch):
+    """Per-run skies with the shared covariance: the whole open-loop pass in one kernel call (Navigator.compiled_pass)
+    against the epoch-by-epoch engine it replaces (the same arithmetic: equal to rounding), with a damping loop held
+    during a baro outage and pseudolites with their states."""
+    from approachsim.nav.navigator import Navigator
+
+    prof = _profile("pseudolite" if kind == "pseudolite" else "default")
+    if kind == "baro-outage":
+        prof = replace(prof, faults=(FaultSpec(sensor="baro", kind="outage", start_s=10.0, end_s=16.0),))
+    assert prof.nav.baro_loop == "constant"
+    passed = []
+    orig = Navigator.compiled_pass
+
+    def spy(self, *a, **k):
+        passed.append(orig(self, *a, **k))
+        return passed[-1]
+
+    with monkeypatch.context() as m:
+        m.setattr(Navigator, "compiled_pass", spy)
+        whole = _navigate(prof, True, False, monkeypatch)
+    assert passed == [True]
+    with monkeypatch.context() as m:
+        m.setattr(Navigator, "can_pass", lambda self: False)
+        epochs = _navigate(prof, True, False, monkeypatch)
+    for f, s in zip(whole, epochs, strict=True):
+        assert list(f.status.name) == list(s.status.name)
+        _close(f.status.innovation, s.status.innovation, "innovation", rtol=1e-12)
+        _close(f.x, s.x, "x", rtol=1e-12)
+        _close(f.P_diag, s.P_diag, "P diag", rtol=1e-12)
+        _close(f.true_error_nav, s.true_error_nav, "output error", rtol=1e-12)
+        np.testing.assert_array_equal(f.solution.P_pos_ned, s.solution.P_pos_ned)
