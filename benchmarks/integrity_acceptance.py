@@ -1,14 +1,17 @@
 """Issue 11 acceptance, faulted part: a pseudorange ramp (0.1, 0.5, 2 m/s) or step (10-100 m) on one used GPS
 satellite, starting at a random time on final, scored by the solution-separation bank (integrity.campaign).
 
-    PYTHONPATH=. python benchmarks/integrity_acceptance.py KIND RUNS [--seed S] [--out FILE.json]
+    PYTHONPATH=. python benchmarks/integrity_acceptance.py KIND RUNS [--seed S] [--out FILE.json] [--closed]
 
 KIND: ramp0.1 | ramp0.5 | ramp2 | step. Open loop on the default profile (flown truth shared by groups of
 evaluation.flight_group runs, as the campaign does); per run the onset is uniform between 30 s after the
 start and 60 s before the CAT I decision height, the satellite uniform among the channels the receiver used
 at the onset, the step magnitude uniform in 10-100 m, all from the run's own stream "acceptance_fault".
 Prints and writes the details.json-style `integrity` block (time to alert, missed detections, MI / HMI) and
-the per-run table. (The fault-free figures come from the campaign itself: approachsim evaluate
+the per-run table. --closed: each run flies closed loop on the navigation with the online FDE ([nav.fde] enabled,
+the profile's category allocation) and the fault, the bank scores the flown truth; the per-run flight result (failed
+approaches with their reason, the FTE at the decision heights, the FDE's exclusion delay) is added: the aircraft
+keeps flying on the protected solution. (The fault-free figures come from the campaign itself: approachsim evaluate
 profiles/default.toml --mode open --runs N.)
 """
 
@@ -24,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from approachsim import units
-from approachsim.campaign.pipeline import _approach
+from approachsim.campaign.pipeline import _approach, closed_loop_group
 from approachsim.campaign.result import RunResult
 from approachsim.integrity.campaign import campaign_integrity, score_with_bank
 from approachsim.profile import load_profile
@@ -43,12 +46,15 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--profile", type=Path, default=Path(__file__).resolve().parents[1] / "profiles/default.toml")
+    ap.add_argument("--closed", action="store_true", help="fly closed loop with the online FDE on")
     a = ap.parse_args()
     base = load_profile(a.profile)
     kind, rate = KINDS[a.kind]
     size = base.evaluation.flight_group
     truths: dict[int, object] = {}
     rows, cols, results = [], {}, []
+    failed: list[dict] = []
+    flights: list[dict] = []
     t_start = time.time()
     for i in range(a.runs):
         first = (i // size) * size
@@ -68,7 +74,18 @@ def main() -> None:
         spec = FaultSpec(sensor="gnss", kind=kind, start_s=onset, target="pseudorange", channel=prn,
                          magnitude=mag, rate=rate or 0.0)
         prof = dataclasses.replace(base, faults=(spec,))
-        s, _, _ = score_with_bank(prof, truth, a.seed, i)
+        if a.closed:  # the aircraft flies on the navigation with the online FDE; the bank scores its flown truth
+            prof = dataclasses.replace(prof, nav=dataclasses.replace(
+                prof.nav, fde=dataclasses.replace(prof.nav.fde, enabled=True)))
+            r = closed_loop_group(prof, a.seed, [i])[0]
+            if not r.ok:
+                failed.append({"run": i, "error": r.error})
+                print(f"run {i}: FAILED {r.error}", flush=True)
+                continue
+            s = dict(r.scalars)
+            flights.append({k: s[k] for k in s if "fte" in k or k.startswith("fde_")})
+        else:
+            s, _, _ = score_with_bank(prof, truth, a.seed, i)
         for k, v in s.items():
             cols.setdefault(k, []).append(v)
         results.append(RunResult(run=i, ok=True, scalars=s))
@@ -82,8 +99,15 @@ def main() -> None:
     out = campaign_integrity(cols, {}, base.evaluation, faulted=True)
     for c in out["categories"].values():
         c.pop("stanford_hist", None)
-    res = {"kind": a.kind, "runs": a.runs, "seed": a.seed, "integrity": out, "per_run": rows,
-           "wall_s": time.time() - t_start}
+    res = {"kind": a.kind, "runs": a.runs, "seed": a.seed, "closed_loop": a.closed, "integrity": out,
+           "per_run": rows, "wall_s": time.time() - t_start}
+    if a.closed:
+        fte = {k: float(np.sqrt(np.nanmean(np.square([f[k] for f in flights])))) for k in (flights[0] if flights
+                                                                                            else {}) if "fte" in k}
+        res["flight"] = {"failed_runs": failed, "completed": len(flights), "fte_rms_m": fte,
+                         "fde_delay_s": [f.get("fde_delay_s") for f in flights]}
+        print("closed loop:", len(flights), "completed,", len(failed), "failed approaches; FTE RMS (m):",
+              json.dumps({k: round(v, 3) for k, v in fte.items()}))
     text = json.dumps(res, indent=1, allow_nan=False)
     if a.out is not None:
         a.out.write_text(text + "\n")
