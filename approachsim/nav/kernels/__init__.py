@@ -8,7 +8,10 @@ nothing of the stages (import-linter contract in pyproject.toml).
 
     geodesy       WGS-84 radii, geodetic -> ECEF, the simulated world's gravity (geo.py's equations, scalar)
     strapdown     the strapdown INS mechanization over many runs and many IMU intervals (nav/ins.py's `step`)
-    imu           the IMU error application (sensors/imu.py's `apply`)
+    inloop        the closed loop's navigation row inside the flight loop's compiled step (nav/closed_loop.py)
+    output        the navigation output of every row, INS - x_hat (ins.perturb + geo.geodetic_to_ecef)
+    epoch         a filter epoch of one run or of a shared-covariance class in one call, and the whole open-loop
+                  pass of runs with their own skies (nav/navigator.py and nav/shared.py's numpy paths)
     errormodel    the error model's F, Qc and their discretization Phi, Qd (nav/errormodel.py's
                   dynamics_reference, discretize_reference)
     kalman        the filter epoch: sparse predict, O(n^2) scalar Joseph update, shared-covariance update, the
@@ -25,4 +28,9 @@ from kalman.workspace(n)):
     kalman.predict(x, P, phi, qd, ws)
     nu, r = measurements.pseudorange(lay, x, r_ins, c_en, r_sv, rho, sigma, sv, -1, h)   # or baro, radalt
     S = kalman.update(x, P, h, nu, r, b, ws)       # optimal; kalman.gain + kalman.joseph with a gain policy
+
+Numba's cache (`cache=True`) is keyed to each kernel's own source file: a kernel that calls a function of another
+module keeps its cached machine code when only that other module changes. After editing a kernel module, delete the
+cached files (`find approachsim -name "*.nbi" -delete -o -name "*.nbc" -delete`) or touch the modules that call it;
+a fresh clone (CI) always compiles afresh.
 """
