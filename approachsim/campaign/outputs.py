@@ -78,10 +78,12 @@ def touchdown_lines(td: dict) -> list[str]:
         e = q[name]
         return f"{_f(e.get('mean'), '.1f').strip()} +- {_f(e.get('sd'), '.1f').strip()} {e['unit']}"
 
+    ob = q["outboard_gear_y_ft"]
+    far = None if not ob.get("n") else max(abs(ob["min"]), abs(ob["max"]))
     lines = [
         f"touchdown: {td['landings']} landings of {td['runs']} runs ({td['failed_runs']} failed, counted as "
-        f"exceedances); main gear {ms('x_ft')} past the threshold, centre {ms('y_ft')} right, outboard gear "
-        f"{ms('outboard_gear_y_ft')}, sink {ms('sink_fps')}, bank {ms('bank_deg')}",
+        f"exceedances); main gear {ms('x_ft')} past the threshold, centre {ms('y_ft')} right (outboard gear at most "
+        f"{_f(far, '.1f').strip()} ft out), sink {ms('sink_fps')}, bank {ms('bank_deg')}, crab {ms('crab_deg')}",
         f"{'criterion':16} {'limit':>14} {'mark':>4} | {'exceed':>7} | {'z limit':>7} {'z req':>6} | "
         f"{'P normal':>9} {'upper':>9} {'required':>9} | outcome / verdict",
     ]

@@ -34,9 +34,11 @@ confidence mark as in the project's reference notes: V read in the source, S sec
   (z ~ 2.3 at N = 50); beyond that the probability is the normal model's, not the runs'. A heavier tail (turbulence
   outliers, a flare law's nonlinearity) would be invisible to both and make Phi(-z) optimistic
   (tests/unit/evaluate/test_touchdown.py measures it on Student-t data).
-* outcome: `exceeds` when the empirical or the normal lower bound is above the required probability, `within`
-  when there is no exceedance, the normal upper bound is within it, normality is not rejected and at least
-  stats.MIN_RUNS landings completed; `indeterminate` otherwise, with the landings that would likely decide it.
+* outcome: `exceeds` when the empirical lower bound is above the required probability, or the normal one is and
+  normality is not rejected; `within` when there is no exceedance, the normal upper bound is within it,
+  normality is not rejected and at least stats.MIN_RUNS landings completed; `indeterminate` otherwise, with the
+  landings that would likely decide it. The outboard gear is scored on two normals, the right gear's upper tail
+  and the left gear's lower tail (the signed outboard position is bimodal by construction).
 * verdict: the outcome as `meets` / `fails` / `indeterminate` only for a limit marked V; for any other limit the
   verdict is `unverified_limit` whatever the numbers say: an unverified criterion never meets.
 
@@ -168,21 +170,26 @@ class Criterion:
     """V: read in the source named; S: secondary source only; U: not found (a candidate kept to be checked)."""
     source: str
     what: str
+    lower_quantity: str | None = None
+    """abs_above only: the quantity whose lower tail (x < -limit) counts, when it is not `quantity` (the outboard
+    gear: the right gear's upper tail and the left gear's lower tail; their signed outboard value is bimodal)."""
 
     @property
     def verified(self) -> bool:
         """True when the limit and its probability were read in the standard itself (mark V)."""
         return self.mark == "V"
 
-    def exceeded(self, x: Array) -> Array:
-        """Boolean array: which values pass the limit (nan: False)."""
+    def exceeded(self, x: Array, x_low: Array | None = None) -> Array:
+        """Boolean array: which values pass the limit (nan: False); x_low: the lower-tail values of an abs_above
+        criterion with a lower_quantity (default x)."""
         x = np.asarray(x, dtype=float)
+        xl = x if x_low is None else np.asarray(x_low, dtype=float)
         with np.errstate(invalid="ignore"):
             if self.side == "below":
                 return x < self.limit
             if self.side == "above":
                 return x > self.limit
-            return np.abs(x) > self.limit
+            return (x > self.limit) | (xl < -self.limit)
 
 
 CRITERIA = (
@@ -198,11 +205,13 @@ CRITERIA = (
               SMAC + "p4 = prob(|YTP| > 15 m), lateral deviation at the touchdown point, average risk < 1e-6 (the "
               "file does not say which point of the aircraft; applied here to the main-gear centre)",
               "main-gear centre more than 15 m (49 ft) from the centreline"),
-    Criterion("outboard_gear", "td_outboard_gear_y_m", "abs_above", 70.0 * units.FT, "ft", 1e-6, "U",
+    Criterion("outboard_gear", "td_right_gear_y_m", "abs_above", 70.0 * units.FT, "ft", 1e-6, "U",
               "candidate only: '70 ft' for the outboard gear (a 150 ft runway's edge less 5 ft) is commonly "
               "attributed to AC 120-28D but was not seen in any source (shared/reference/integrity-envelope.md "
               "sec. 4), nor its probability",
-              "outboard main gear more than 70 ft from the centreline (unverified candidate)"),
+              "outboard main gear more than 70 ft from the centreline (unverified candidate): the right gear "
+              "right of +70 ft or the left gear left of -70 ft",
+              lower_quantity="td_left_gear_y_m"),
     Criterion("sink", "td_sink_mps", "above", 10.0 * units.FPS, "ft/s", 1e-6, "S",
               SMAC + "p3 = prob(VZTP > 10 ft/s), vertical speed at touchdown, average risk < 1e-6. The AC's "
               "structural-limit wording: U",
@@ -224,7 +233,10 @@ CRITERIA = (
 QUANTITIES = {
     "td_x_m": ("x_ft", "ft", "longitudinal touchdown point of the main gear, past the threshold"),
     "td_y_m": ("y_ft", "ft", "main-gear centre, right of the centreline"),
-    "td_outboard_gear_y_m": ("outboard_gear_y_ft", "ft", "outboard main gear, right of the centreline"),
+    "td_left_gear_y_m": ("left_gear_y_ft", "ft", "left main gear, right of the centreline"),
+    "td_right_gear_y_m": ("right_gear_y_ft", "ft", "right main gear, right of the centreline"),
+    "td_outboard_gear_y_m": ("outboard_gear_y_ft", "ft", "outboard main gear (the one farther out), right of the "
+                             "centreline: bimodal by construction, not normal"),
     "td_sink_mps": ("sink_fps", "ft/s", "sink rate of the main gear that touched"),
     "td_imu_x_m": ("imu_x_ft", "ft", "IMU point past the threshold at main-gear touchdown"),
     "td_imu_y_m": ("imu_y_ft", "ft", "IMU point right of the centreline"),
@@ -307,20 +319,28 @@ def upper_tail_bounds_wald(z: float, n: int, level: float) -> tuple[float, float
     return float(sps.norm.sf(z)), float(sps.norm.sf(z + half)), float(sps.norm.sf(z - half))
 
 
-def _tail_zs(crit: Criterion, mean: float, sd: float) -> tuple[float, ...]:
-    """Per tail of the criterion, its limit's distance from the mean in sd towards that tail."""
+Fit = tuple[float, float]
+"""(mean, sd) of a fitted normal, SI."""
+
+
+def _tail_zs(crit: Criterion, fit: Fit, low: Fit | None = None) -> tuple[float, ...]:
+    """Per tail of the criterion, its limit's distance from the mean in sd towards that tail (abs_above: the
+    lower tail from `low` when given, the lower quantity's fit)."""
+    mean, sd = fit
     if crit.side == "above":
         return ((crit.limit - mean) / sd,)
     if crit.side == "below":
         return ((mean - crit.limit) / sd,)
-    return ((crit.limit - mean) / sd, (crit.limit + mean) / sd)
+    ml, sl = fit if low is None else low
+    return ((crit.limit - mean) / sd, (crit.limit + ml) / sl)
 
 
-def tail_bounds(crit: Criterion, mean: float, sd: float, n: int, level: float,
-                exact: bool = True) -> tuple[float, float, float]:
+def tail_bounds(crit: Criterion, mean: float, sd: float, n: int, level: float, exact: bool = True,
+                low: Fit | None = None) -> tuple[float, float, float]:
     """(point, lower, upper) of the criterion's exceedance probability under the fitted normal (two-sided
-    criteria: both tails added, each bounded at 1 - (1 - level) / 2); exact=False: the Wald form."""
-    zs = _tail_zs(crit, mean, sd)
+    criteria: both tails added, each bounded at 1 - (1 - level) / 2; low: the lower quantity's (mean, sd));
+    exact=False: the Wald form."""
+    zs = _tail_zs(crit, (mean, sd), low)
     lvl = level if len(zs) == 1 else 1.0 - (1.0 - level) / 2.0
     f = upper_tail_bounds if exact else upper_tail_bounds_wald
     parts = [f(z, n, lvl) for z in zs]
@@ -329,10 +349,10 @@ def tail_bounds(crit: Criterion, mean: float, sd: float, n: int, level: float,
     return (sum(p[0] for p in parts), max(p[1] for p in parts), min(1.0, sum(p[2] for p in parts)))
 
 
-def z_of_limit(crit: Criterion, mean: float, sd: float) -> float:
+def z_of_limit(crit: Criterion, mean: float, sd: float, low: Fit | None = None) -> float:
     """The limit's distance from the mean in standard deviations, on the exceedance side (two-sided: the
     nearer limit); larger is safer."""
-    return min(_tail_zs(crit, mean, sd))
+    return min(_tail_zs(crit, (mean, sd), low))
 
 
 def z_required(probability: float) -> float:
@@ -341,18 +361,23 @@ def z_required(probability: float) -> float:
     return float(sps.norm.isf(probability))
 
 
-def runs_to_decide(crit: Criterion, mean: float, sd: float, level: float, n_max: int = 10**9) -> int | None:
+def runs_to_decide(crit: Criterion, mean: float, sd: float, level: float, n_max: int = 10**9,
+                   low: Fit | None = None) -> int | None:
     """Landings at which the normal bounds would likely decide the criterion if the mean and sd stayed where
     they are (Wald form of the bounds): towards `within` when the point probability is within the required one
     (the upper bound reaches it), towards `exceeds` otherwise (the lower bound passes it); None when the point
     probability equals the requirement or more than n_max landings would be needed."""
-    p = tail_bounds(crit, mean, sd, 3, level, exact=False)[0]
+
+    def bounds(n: int) -> tuple[float, float, float]:
+        return tail_bounds(crit, mean, sd, n, level, exact=False, low=low)
+
+    p = bounds(3)[0]
     if p == crit.probability:
         return None
     if p < crit.probability:
-        ok = lambda n: tail_bounds(crit, mean, sd, n, level, exact=False)[2] <= crit.probability  # noqa: E731
+        ok = lambda n: bounds(n)[2] <= crit.probability  # noqa: E731
     else:
-        ok = lambda n: tail_bounds(crit, mean, sd, n, level, exact=False)[1] > crit.probability  # noqa: E731
+        ok = lambda n: bounds(n)[1] > crit.probability  # noqa: E731
     if not ok(n_max):
         return None
     lo, hi = 3, n_max
@@ -400,21 +425,26 @@ def quantity_stats(x_si: Array, factor: float) -> dict:
     return out
 
 
-def criterion_result(crit: Criterion, x_si: Array, failed_runs: int, level: float) -> dict:
-    """One criterion over the completed landings' values x_si (SI) and the failed runs (counted as
-    exceedances): empirical and normal-tail figures, outcome and verdict (module docstring), JSON-safe, display
-    unit."""
+def criterion_result(crit: Criterion, x_si: Array, failed_runs: int, level: float,
+                     x_low_si: Array | None = None) -> dict:
+    """One criterion over the completed landings' values x_si (SI; x_low_si: the lower_quantity's, same runs)
+    and the failed runs (counted as exceedances): empirical and normal-tail figures, outcome and verdict (module
+    docstring), JSON-safe, display unit."""
     x = np.asarray(x_si, dtype=float)
-    x = x[np.isfinite(x)]
+    xl = x if x_low_si is None else np.asarray(x_low_si, dtype=float)
+    ok = np.isfinite(x) & np.isfinite(xl)
+    x, xl = x[ok], xl[ok]
+    two = x_low_si is not None and crit.side == "abs_above"
     n = int(x.size)
     runs = n + int(failed_runs)
-    k = int(np.count_nonzero(crit.exceeded(x))) + int(failed_runs)
+    k = int(np.count_nonzero(crit.exceeded(x, xl if two else None))) + int(failed_runs)
     e_lo, e_hi = clopper_pearson(k, runs, level)
     f = DISPLAY[crit.unit]
     z_req = z_required(crit.probability)
     res: dict = {
         "what": crit.what,
         "quantity": crit.quantity,
+        **({"lower_quantity": crit.lower_quantity} if two else {}),
         "side": crit.side,
         "limit": crit.limit * f,
         "unit": crit.unit,
@@ -430,33 +460,44 @@ def criterion_result(crit: Criterion, x_si: Array, failed_runs: int, level: floa
     }
     normal: dict | None = None
     sd = float(np.std(x, ddof=1)) if n > 1 else 0.0
+    sd_l = float(np.std(xl, ddof=1)) if n > 1 else 0.0
     norm_check = normality(x)
-    if n >= 3 and sd > 0.0:
+    if two:
+        low_check = normality(xl)
+        if low_check["rejected"] is not None:
+            norm_check = {"upper": norm_check, "lower": low_check,
+                          "rejected": bool(norm_check["rejected"] or low_check["rejected"])}
+    if n >= 3 and sd > 0.0 and sd_l > 0.0:
         mean = float(np.mean(x))
-        p, p_lo, p_hi = tail_bounds(crit, mean, sd, n, level)
+        low = (float(np.mean(xl)), sd_l) if two else None
+        p, p_lo, p_hi = tail_bounds(crit, mean, sd, n, level, low=low)
         normal = {
-            "n": n, "mean": mean * f, "sd": sd * f, "z_limit": z_of_limit(crit, mean, sd),
+            "n": n, "mean": mean * f, "sd": sd * f,
+            **({"lower_mean": low[0] * f, "lower_sd": low[1] * f} if low else {}),
+            "z_limit": z_of_limit(crit, mean, sd, low),
             "probability": p, "probability_lower": p_lo, "probability_upper": p_hi,
-            "runs_needed": runs_to_decide(crit, mean, sd, level),
+            "runs_needed": runs_to_decide(crit, mean, sd, level, low=low),
             "normality": norm_check,
         }
     res["normal"] = normal
     if e_lo > crit.probability:
         outcome, why = "exceeds", (f"{k} of {runs} runs exceeded (failed runs count): the empirical lower bound "
                                    f"{e_lo:.2g} is above {crit.probability:g}")
-    elif normal is not None and normal["probability_lower"] > crit.probability:
-        outcome, why = "exceeds", (f"the fitted normal's lower bound {normal['probability_lower']:.2g} is above "
-                                   f"{crit.probability:g}")
     elif normal is None:
         outcome, why = "indeterminate", "fewer than 3 distinct completed landings: no tail to fit"
+    elif norm_check["rejected"]:
+        sw = min(c["shapiro_p"] for c in (norm_check.get("upper", norm_check), norm_check.get("lower", norm_check)))
+        outcome, why = "indeterminate", (f"normality rejected (Shapiro-Wilk p = {sw:.3g}): the normal tail does not "
+                                         "extrapolate")
+    elif normal["probability_lower"] > crit.probability:
+        outcome, why = "exceeds", (f"the limit lies {normal['z_limit']:.2f} sd from the mean (required {z_req:.2f}): "
+                                   f"the fitted normal's lower bound {normal['probability_lower']:.2g} is above "
+                                   f"{crit.probability:g}")
     elif normal["probability_upper"] > crit.probability:
         outcome, why = "indeterminate", (
             f"the limit lies {normal['z_limit']:.2f} sd from the mean (required {z_req:.2f} for "
             f"{crit.probability:g}); the upper bound {normal['probability_upper']:.2g} from {n} landings is above "
             f"{crit.probability:g}")
-    elif norm_check["rejected"]:
-        outcome, why = "indeterminate", (f"normality rejected (Shapiro-Wilk p = {norm_check['shapiro_p']:.3g}): the "
-                                         "normal tail does not extrapolate")
     elif n < MIN_RUNS:
         outcome, why = "indeterminate", f"fewer than {MIN_RUNS} completed landings"
     else:
@@ -492,8 +533,11 @@ def touchdown_details(columns: Mapping[str, Array], *, runs: int, failed_runs: i
         x = np.asarray(columns.get(col, np.empty(0)), dtype=float)
         factor = 1.0 / units.KT if unit == "kt" else DISPLAY[unit]
         quantities[name] = {"unit": unit, "what": what, **quantity_stats(x, factor)}
-    crit = {c.key: criterion_result(c, np.asarray(columns.get(c.quantity, np.empty(0)), dtype=float), failed_runs,
-                                    level) for c in criteria}
+    def col(name: str | None) -> Array | None:
+        return None if name is None else np.asarray(columns.get(name, np.empty(0)), dtype=float)
+
+    crit = {c.key: criterion_result(c, col(c.quantity), failed_runs, level, col(c.lower_quantity))
+            for c in criteria}
     landings = int(np.count_nonzero(np.isfinite(np.asarray(columns.get("td_x_m", np.empty(0)), dtype=float))))
     return {
         "runs": int(runs),

@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 from scipy import stats as sps
 
 from approachsim import units
@@ -135,6 +136,7 @@ def fig_touchdown(results: list[RunResult], td: dict) -> Figure:
                            label=f"{key}: {_limit_label(c)}")
     a_sink.set_xlabel("main-gear sink rate at touchdown, ft/s")
     a_sink.set_ylabel("runs")
+    a_sink.yaxis.set_major_locator(MaxNLocator(integer=True))
     a_sink.set_title("Sink rate", fontsize=10)
     a_sink.legend(fontsize=7)
     a_sink.grid(True, alpha=0.3)
@@ -162,6 +164,15 @@ def _f(x, fmt: str) -> str:
     return "--" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, fmt)
 
 
+def _shapiro(normality: dict | None) -> float | None:
+    """The Shapiro-Wilk p of a criterion's fit (two fits: the smaller)."""
+    if not normality:
+        return None
+    ps = [normality.get(k, {}).get("shapiro_p") for k in ("upper", "lower")] + [normality.get("shapiro_p")]
+    ps = [p for p in ps if p is not None]
+    return min(ps) if ps else None
+
+
 def touchdown_table(td: dict) -> str:
     """The report's HTML table of the touchdown criteria, then each criterion's source and reason."""
     rows = []
@@ -173,7 +184,7 @@ def touchdown_table(td: dict) -> str:
                      f"{c['probability_required']:g}", f"{c['exceedances']}/{c['runs']}",
                      _f(c["empirical"]["upper"], ".2g"), _f(n.get("z_limit"), ".2f"), f"{c['z_required']:.2f}",
                      _f(n.get("probability"), ".2g"), _f(n.get("probability_upper"), ".2g"),
-                     _f((n.get("normality") or {}).get("shapiro_p"), ".3g"), _f(n.get("runs_needed"), "d"),
+                     _f(_shapiro(n.get("normality")), ".3g"), _f(n.get("runs_needed"), "d"),
                      c["outcome"], c["verdict"]])
         notes.append(f"<li><b>{html.escape(key)}</b> [{c['mark']}]: {html.escape(c['source'])}. "
                      f"<i>{html.escape(c['why'])}</i></li>")

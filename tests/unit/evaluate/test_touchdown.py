@@ -250,6 +250,22 @@ def test_below_and_two_sided_criteria_use_their_own_tails():
     assert p == pytest.approx(sps.norm.sf(6.5) + sps.norm.sf(8.5), rel=1e-12)
 
 
+def test_the_outboard_gear_is_two_normal_tails_not_one_bimodal_fit():
+    """The outboard gear: the right gear's upper tail plus the left gear's lower tail, each fitted on its own; the
+    signed outboard position (whichever gear is farther out) is bimodal and fails the normality test."""
+    crit = next(c for c in CRITERIA if c.key == "outboard_gear")
+    centre = _sample(200, -1.0, 2.7)
+    left, right = centre - 2.54, centre + 2.54
+    r = criterion_result(crit, right, 0, 0.95, x_low_si=left)
+    lim = 70.0 * units.FT
+    assert r["lower_quantity"] == "td_left_gear_y_m"
+    assert r["normal"]["probability"] == pytest.approx(sps.norm.sf((lim - right.mean()) / right.std(ddof=1))
+                                                       + sps.norm.sf((lim + left.mean()) / left.std(ddof=1)))
+    assert r["normal"]["z_limit"] == pytest.approx((lim + left.mean()) / 2.7)  # the left gear is the nearer
+    outboard = np.where(np.abs(right) > np.abs(left), right, left)
+    assert sps.shapiro(outboard).pvalue < 1e-3
+
+
 def test_overall_verdict():
     def res(*v):
         return {str(i): {"verdict": x} for i, x in enumerate(v)}
