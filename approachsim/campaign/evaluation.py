@@ -42,12 +42,15 @@ def evaluate_profile(
     """Run and score a campaign; writes the run store, summary.json and details.json into out_dir."""
     spec = spec if spec is not None else spec_for(profile, mode)
     meta = {"profile": profile.name, "profile_digest": profile_digest(profile), "seed": seed, "mode": mode}
+    if spec.land:
+        meta["land"] = True  # a landing campaign is another campaign (--resume compares it; absent otherwise)
     res = run_campaign(
         profile, seed=seed, runs=runs, group_fn=spec.group_fn, group_size=spec.group_size, out_dir=out_dir,
         meta=meta, resume=resume, workers=workers, scheduler=scheduler, progress=progress,
     )
     summary, det = evaluate_results(
-        res.results, profile.evaluation, profile=profile.name, seed=seed, closed_loop=spec.closed_loop
+        res.results, profile.evaluation, profile=profile.name, seed=seed, closed_loop=spec.closed_loop,
+        land=spec.land,
     )
     det["wall_s"] = res.wall_s
     write_json(Path(out_dir) / "summary.json", summary)

@@ -28,9 +28,11 @@ def columns(results: list[RunResult]) -> dict[str, np.ndarray]:
 
 
 def evaluate_results(
-    results: list[RunResult], cfg: EvaluationConfig, *, profile: str, seed: int, closed_loop: bool
+    results: list[RunResult], cfg: EvaluationConfig, *, profile: str, seed: int, closed_loop: bool,
+    land: bool = False,
 ) -> tuple[dict, dict]:
-    """(summary, details) of a finished campaign."""
+    """(summary, details) of a finished campaign; land: a landing campaign, whose touchdown statistics go to
+    details.json "touchdown" and their headline to summary.json "touchdown" (docs/contract.md)."""
     cols = columns(results)
     failed = sum(not r.ok for r in results)
     # open loop: the runs of one flight group share one flown truth (pipeline.open_loop_group)
@@ -46,6 +48,11 @@ def evaluate_results(
     geom = gnss_geometry([r.run for r in results if r.ok], cols)
     if geom is not None:
         det["gnss_geometry"] = geom
+    if land:
+        from approachsim.evaluate.touchdown import touchdown_details, touchdown_summary
+
+        det["touchdown"] = touchdown_details(cols, runs=len(results), failed_runs=failed, level=cfg.confidence)
+        summary["touchdown"] = touchdown_summary(det["touchdown"])
     return summary, det
 
 
@@ -59,6 +66,42 @@ def _shared_truth_note(det: dict) -> str:
     neff = [a["n_eff"] for a in axes if a.get("n_eff") is not None]
     return (f"the bounds use the effective run count of the clustered runs (between-group correlation up to "
             f"{max(rho):.2f}, effective runs down to {min(neff):.0f})")
+
+
+def touchdown_lines(td: dict) -> list[str]:
+    """The printed touchdown block of a landing campaign: the dispersion, then per criterion its limit (with
+    its source mark), the exceedances, where the limit lies in standard deviations against where it must lie,
+    the normal tail's probability with its upper bound against the required one, and the outcome / verdict."""
+    q = td["quantities"]
+
+    def ms(name: str) -> str:
+        e = q[name]
+        return f"{_f(e.get('mean'), '.1f').strip()} +- {_f(e.get('sd'), '.1f').strip()} {e['unit']}"
+
+    ob = q["outboard_gear_y_ft"]
+    far = None if not ob.get("n") else max(abs(ob["min"]), abs(ob["max"]))
+    lines = [
+        f"touchdown: {td['landings']} landings of {td['runs']} runs ({td['failed_runs']} failed, counted as "
+        f"exceedances); main gear {ms('x_ft')} past the threshold, centre {ms('y_ft')} right (outboard gear at most "
+        f"{_f(far, '.1f').strip()} ft out), sink {ms('sink_fps')}, bank {ms('bank_deg')}, crab {ms('crab_deg')}",
+        f"{'criterion':16} {'limit':>14} {'mark':>4} | {'exceed':>7} | {'z limit':>7} {'z req':>6} | "
+        f"{'P normal':>9} {'upper':>9} {'required':>9} | outcome / verdict",
+    ]
+    for key, c in td["criteria"].items():
+        n = c["normal"] or {}
+        sign = {"below": "<", "above": ">", "abs_above": "|x|>"}[c["side"]]
+        lines.append(
+            f"{key:16} {sign + format(c['limit'], '.4g') + ' ' + c['unit']:>14} {c['mark']:>4} | "
+            f"{c['exceedances']:>3}/{c['runs']:<3} | {_f(n.get('z_limit'), '7.2f')} {c['z_required']:6.2f} | "
+            f"{_f(n.get('probability'), '9.1e')} {_f(n.get('probability_upper'), '9.1e')} "
+            f"{c['probability_required']:9.0e} | {c['outcome']} / {c['verdict']}"
+        )
+    lines.append(
+        f"touchdown verdict: {td['verdict']} ({td['criteria_verified']} of {len(td['criteria'])} criteria have a "
+        "limit read in the standard: marks V / S / U, docs/touchdown.md; probabilities beyond the runs are a normal "
+        "tail's, bounds at the campaign confidence)"
+    )
+    return lines
 
 
 def write_json(path: Path, data: Any) -> None:
@@ -127,6 +170,8 @@ def verdict_table(summary: dict, det: dict) -> str:
             + (f", TTA <= {tt['tta_required_s']:g} s in {tt['within_tta']}/{tt['exceeded_pl']} runs whose error "
                f"exceeded the PL, {tt['missed_detections']} missed" if tt else "")
         )
+    if "touchdown" in det:
+        lines.extend(touchdown_lines(det["touchdown"]))
     ta = det.get("time_averaged_rms_ft", {})
     if ta:
         lines.append(

@@ -20,6 +20,12 @@ covariance is one per run (measured: the open-loop navigation about 3-4x slower 
 A run's numbers depend only on (seed, run, group size), not on the executor or the batch it shared (checked:
 NavSystem.run gives bit-identical runs in a batch of 1 and of 6, with one sky and with per-run skies).
 Closed loop: each run flies on its own navigation solution, one run per task.
+Landing (closed loop, `evaluate --land`): each run flies on through the flare to main-gear touchdown
+(Approach(profile, land=True)); its navigation is scored on the record down to where an approach run stops (the
+lowest decision height less 20 ft: the same decision-height crossings, time averages and integrity epochs as an
+approach campaign), and evaluate.touchdown scores the touchdown row (main-gear position and sink from the IMU
+point's state and the main gears' lever arms). A run that does not put its main gear down on the runway is a
+failed run with its reason ("failed landing: touchdown short of the threshold ..."), never dropped.
 Integrity ([evaluation] integrity lists a category): after the flight, each run is also navigated by the
 solution-separation bank (integrity.campaign.score_with_bank: K + 1 filters in one batched pass, open loop on the
 run's flown truth with the run's own sensor draws): measured 1.86x the wall time of the default 20-run closed-loop
@@ -28,12 +34,15 @@ campaign, about 3x an open-loop one.
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import importlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from approachsim.campaign.result import RunResult
+from approachsim.config import ProfileError
 
 STAGES = (
     ("approachsim.flight.run", "Approach", "flight (JSBSim truth)"),
@@ -69,17 +78,25 @@ class PipelineSpec:
     group_fn: Any
     group_size: int
     closed_loop: bool
+    land: bool = False
+    """Each run flies on to touchdown and its touchdown is scored (closed loop only)."""
 
 
-def spec_for(profile: Any, mode: str) -> PipelineSpec:
-    """The campaign functions of `mode` ("closed" or "open") for this profile (after require_stages)."""
+def spec_for(profile: Any, mode: str, land: bool = False) -> PipelineSpec:
+    """The campaign functions of `mode` ("closed" or "open") for this profile (after require_stages); land: fly
+    every run to touchdown (closed loop only: ProfileError naming --land otherwise)."""
+    if land and mode != "closed":
+        raise ProfileError("--land: landing runs are flown closed loop only (each run lands on its own navigation); "
+                           "use --mode closed")
     require_stages(mode)
-    _approach(profile)  # the aircraft file and the approach envelope: a profile outside it is refused (exit 2) here,
-    # not as one failed run per worker
+    _approach(profile, land)  # the aircraft file and the approach envelope: a profile outside it is refused (exit 2)
+    # here, not as one failed run per worker
     size = profile.evaluation.flight_group
     if mode == "open":
         return PipelineSpec(open_loop_group, size, False)
     # closed loop shares no flight: one run per task, so each run is stored (and resumable) as it finishes
+    if land:
+        return PipelineSpec(functools.partial(closed_loop_group, land=True), 1, True, land=True)
     return PipelineSpec(closed_loop_group, 1, True)
 
 
@@ -171,18 +188,86 @@ _APPROACHES: dict = {}
 solved once per process, not once per task: closed-loop tasks are one run each)."""
 
 
-def _approach(profile: Any) -> Any:
-    from approachsim import units
+def _approach(profile: Any, land: bool = False) -> Any:
     from approachsim.flight.run import Approach
 
-    a = _APPROACHES.get(profile)
+    a = _APPROACHES.get((profile, land))
     if a is None:
         if len(_APPROACHES) > 8:
             _APPROACHES.clear()
-        lowest_dh_ft = min(profile.evaluation.dh_ft.values())
-        # fly a little below the lowest decision height so that its crossing is bracketed by samples
-        a = _APPROACHES[profile] = Approach(profile, stop_height_m=max(lowest_dh_ft - 20.0, 5.0) * units.FT)
+        if land:
+            a = Approach(profile, land=True)
+        else:
+            # fly a little below the lowest decision height so that its crossing is bracketed by samples
+            a = Approach(profile, stop_height_m=approach_stop_height_m(profile))
+        _APPROACHES[(profile, land)] = a
     return a
+
+
+def approach_stop_height_m(profile: Any) -> float:
+    """Where an approach run (not a landing) stops: the IMU 20 ft below the lowest decision height, at least 5 ft
+    above the threshold, m."""
+    from approachsim import units
+
+    return max(min(profile.evaluation.dh_ft.values()) - 20.0, 5.0) * units.FT
+
+
+_GEAR: dict = {}
+"""The main gears' lever arms of each aircraft model and IMU location this worker process has read."""
+
+
+def main_gear_lever_arms_m(approach: Any) -> Any:
+    """(2, 3) the left and right main-gear contact points relative to the IMU, body axes (x forward, y right,
+    z down), m: JSBSim's gear/unit[1] and unit[2] locations (structural frame: in, x aft, y right, z up; the flight
+    stage's GEAR_FIELDS order) less the aircraft file's IMU location. Read here, once per process and model, until
+    the flight stage's Aircraft carries the gear geometry itself."""
+    import numpy as np
+
+    from approachsim.flight.aircraft import IN
+    from approachsim.flight.fdm import FDM
+
+    ac = approach.aircraft
+    key = (ac.jsbsim_model, ac.imu_location_struct_m)
+    arms = _GEAR.get(key)
+    if arms is None:
+        fdm = FDM(ac.jsbsim_model, approach.dt_s)
+        imu = np.asarray(ac.imu_location_struct_m, dtype=float)
+        rows = []
+        for unit in (1, 2):
+            g = np.array([fdm[f"gear/unit[{unit}]/{c}-position"] for c in "xyz"]) * IN
+            d = g - imu
+            rows.append((-d[0], d[1], -d[2]))  # structural (x aft, y right, z up) -> body (x fwd, y right, z down)
+        arms = _GEAR[key] = np.array(rows)
+        if not arms[0, 1] < 0.0 < arms[1, 1]:
+            raise RuntimeError(f"JSBSim model {ac.jsbsim_model!r}: gear units 1 and 2 are not the left and right "
+                               f"main gear (y {arms[0, 1]:.2f}, {arms[1, 1]:.2f} m)")
+    return arms
+
+
+def _head(truth: Any, nav: Any, flight: Any, height_m: float) -> tuple[Any, Any, Any]:
+    """The landing run's truth, navigation solution and flight result cut after the first row whose IMU height
+    above the threshold is at or below height_m (where an approach run stops); unchanged when there is none."""
+    import dataclasses
+
+    import numpy as np
+
+    below = np.flatnonzero(truth.r_rwy[:, 2] <= height_m)
+    if below.size == 0:
+        return truth, nav, flight
+    m = int(below[0]) + 1
+    n = len(truth)
+    t_end = float(truth.t_s[m - 1])
+    nav_kw = {}
+    for f in dataclasses.fields(nav):
+        v = getattr(nav, f.name)
+        if isinstance(v, np.ndarray) and v.shape[:1] == (n,):
+            nav_kw[f.name] = v[:m]
+        elif f.name == "exclusions":
+            nav_kw[f.name] = tuple(e for e in v if e.t_s <= t_end)
+    head = truth.slice(slice(0, m))
+    fl = dataclasses.replace(flight, truth=head, guidance_r_rwy=flight.guidance_r_rwy[:m],
+                             guidance_v_ned=flight.guidance_v_ned[:m])
+    return head, dataclasses.replace(nav, **nav_kw), fl
 
 
 def _clock_truth(records: dict, k: int, t_s: Any) -> Any:
@@ -197,12 +282,14 @@ def _clock_truth(records: dict, k: int, t_s: Any) -> Any:
     return np.interp(t_s, g.t_s, np.asarray(g.clock_bias_m)[k])
 
 
-def _reached_all(profile: Any, flight: Any) -> str | None:
+def _reached_all(profile: Any, flight: Any, land: bool = False) -> str | None:
     """None when the flight was a successful approach through every decision height, else why not (a failed
-    approach, flight.envelope's criteria, counts as a failed run with its reason)."""
-    if not flight.ok:
-        return f"failed approach: {flight.termination} (lowest {flight.lowest_height_ft:.0f} ft)"
+    approach, flight.envelope's criteria, counts as a failed run with its reason; land: a landing run that failed
+    below the lowest decision height is a failed landing)."""
     low = min(profile.evaluation.dh_ft.values())
+    if not flight.ok:
+        what = "failed landing" if land and flight.lowest_height_ft < low else "failed approach"
+        return f"{what}: {flight.termination} (lowest {flight.lowest_height_ft:.0f} ft)"
     if flight.lowest_height_ft < low:
         return None
     return (f"flight ended above the {low:g} ft decision height ({flight.termination}, "
@@ -248,27 +335,38 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     return out
 
 
-def closed_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunResult]:
+def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool = False) -> list[RunResult]:
     """Each run flies on its own navigation solution (nav.closed_loop.NavInTheLoop as the flight's navigation
-    source); the aircraft is parsed and linearized once per task."""
+    source); the aircraft is parsed and linearized once per task. land: each run flies on to touchdown, its
+    navigation is scored down to where an approach run stops and its touchdown is scored (module docstring)."""
     import numpy as np
 
     from approachsim.nav.closed_loop import NavInTheLoop
 
-    approach = _approach(profile)
+    approach = _approach(profile, land)
+    gear = main_gear_lever_arms_m(approach) if land else None
     out = []
     for i in runs:
         try:
             source = NavInTheLoop(profile, seed, i, max_time_s=approach.time_budget_s)  # its draws cover the flight
             flight = approach.fly(seed=seed, run=i, nav_source=source)
-            why = _reached_all(profile, flight)
+            why = _reached_all(profile, flight, land)
             if why is not None:
                 raise RuntimeError(why)
             truth = flight.truth
             nav = source.result(truth).solution
+            td = {}
+            if land:
+                from approachsim.evaluate.touchdown import touchdown_scalars
+
+                td = touchdown_scalars(truth, gear)
+                truth, nav, flight = _head(truth, nav, flight, approach_stop_height_m(profile))
             clk = source.errors.clock
             clock_true = None if clk is None else np.interp(truth.t_s, clk.t_s, np.asarray(clk.series["bias"]))
-            out.append(_score(profile, i, truth, nav, clock_true, _gnss_closed_loop(source, truth), flight, seed))
+            r = _score(profile, i, truth, nav, clock_true, _gnss_closed_loop(source, truth), flight, seed)
+            if td:
+                r = dataclasses.replace(r, scalars={**r.scalars, **td})
+            out.append(r)
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out

@@ -1,6 +1,6 @@
 """Campaign results on disk: appended as runs finish, so an interrupted campaign resumes losing nothing.
 
-    DIR/campaign.json     identity of the campaign (profile digest, seed, mode) and the runs asked for
+    DIR/campaign.json     identity of the campaign (profile digest, seed, mode, landing) and the runs asked for
     DIR/runs.jsonl        one JSON line per finished run (RunResult.record), appended and flushed
     DIR/series/run_NNNNNN.parquet   time series of the runs that keep them
     DIR/runs.parquet      the per-run table (run, ok, error, every scalar), written at the end
@@ -24,8 +24,9 @@ import numpy as np
 from approachsim.campaign.result import RunResult
 from approachsim.config import ProfileError
 
-IDENTITY_KEYS = ("profile_digest", "seed", "mode")
-"""What must match for --resume to continue a campaign (the number of runs may grow)."""
+IDENTITY_KEYS = ("profile_digest", "seed", "mode", "land")
+"""What must match for --resume to continue a campaign (the number of runs may grow); "land" is present (true)
+only in landing campaigns (evaluate --land)."""
 
 
 def profile_digest(profile: Any) -> str:

@@ -1,6 +1,7 @@
-"""`approachsim evaluate PROFILE [--runs N] [--seed S] [--out DIR] [--mode closed|open] [--workers K]
+"""`approachsim evaluate PROFILE [--runs N] [--seed S] [--out DIR] [--mode closed|open] [--land] [--workers K]
 [--scheduler ADDR] [--resume | --overwrite] [--no-report] [--require CAT]`: the Monte Carlo evaluation of
-a profile against CAT I / II / III.
+a profile against CAT I / II / III; with --land (closed loop) every run also flies the flare to touchdown and the
+touchdown dispersion is scored against the autoland touchdown criteria (evaluate/touchdown.py, docs/touchdown.md).
 
 Writes DIR/summary.json (design.md's output contract), DIR/details.json (intervals, ICAO columns,
 integrity, FTE / TSE, time-averaged RMS), DIR/runs.parquet (one row per run), DIR/heights.parquet (per-run
@@ -38,7 +39,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "figures and report.html, and prints the verdict table.",
         examples=["approachsim evaluate profiles/default.toml --runs 4 --out out/quick",
                   "approachsim evaluate ~/approaches/default.toml --runs 200 --out out/full --workers 2",
-                  "approachsim evaluate ~/approaches/default.toml --out out/full --resume"],
+                  "approachsim evaluate ~/approaches/default.toml --out out/full --resume",
+                  "approachsim evaluate profiles/default.toml --runs 50 --land --out out/landing"],
     )
     p.add_argument("profile", type=Path, help="approach profile (TOML)")
     p.add_argument("--runs", type=int, default=None, help="Monte Carlo runs (default: the profile's run.runs)")
@@ -46,6 +48,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, default=None, help="output directory (default: evaluate-<profile name>)")
     p.add_argument("--mode", choices=("closed", "open"), default=None,
                    help="closed: each run flies on its own navigation; open: truth shared (default: profile)")
+    p.add_argument("--land", action="store_true",
+                   help="closed loop: fly every run on through the flare to touchdown and score the touchdown "
+                        "dispersion (details.json touchdown, docs/touchdown.md)")
     p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler (tcp://host:port)")
     p.add_argument("--resume", action="store_true", help="continue the campaign in --out, keeping finished runs")
@@ -89,6 +94,9 @@ def check_options(args: argparse.Namespace, profile) -> tuple[int, int, str, Pat
     if not 0 <= seed < 2**63:
         raise ProfileError(f"--seed: must be in [0, 2^63), got {seed}")
     mode = profile.run.mode if args.mode is None else args.mode
+    if getattr(args, "land", False) and mode != "closed":
+        raise ProfileError("--land: landing runs are flown closed loop only (each run lands on its own navigation); "
+                           f"use --mode closed (the mode is {mode})")
     if args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
         raise ProfileError(f"--workers: must be in [1, {MAX_WORKERS}], got {args.workers}")
     if args.scheduler is not None:
@@ -126,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
     runs, seed, mode, out = check_options(args, profile)
     require = parse_require(getattr(args, "require", None))
     try:
-        spec = spec_for(profile, mode)
+        spec = spec_for(profile, mode, land=getattr(args, "land", False))
     except PipelineUnavailable as e:
         sys.stderr.write(f"approachsim evaluate: {e}\n")
         return 1

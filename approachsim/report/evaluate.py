@@ -10,7 +10,9 @@ Figures (PNG files in DIR and embedded as base64 in DIR/report.html):
   the runs that kept time series) with the CAT I alert limit, and the all-run region counts;
 * availability.png: fraction of runs whose protection levels are within each category's alert limits,
   against height;
-* sky_dop.png (when the series carry GPS geometry): sky plot of the satellites and PDOP of one run.
+* sky_dop.png (when the series carry GPS geometry): sky plot of the satellites and PDOP of one run;
+* touchdown.png (landing campaigns, `evaluate --land`): report/touchdown.py's dispersion box, sink-rate histogram
+  and normal probability plots, with the criteria table.
 
 With integrity on (evaluation.integrity), stanford.png and availability.png (covariance K_V / K_H levels) give
 way to report/integrity.py's solution-separation figures (integrity_stanford, integrity_availability,
@@ -43,6 +45,8 @@ from approachsim.evaluate.limits import CATEGORIES, LIMITS
 from approachsim.evaluate.score import CATEGORY_KEYS, HEIGHT_GRID_FT
 from approachsim.report.integrity import CAPTIONS as INTEGRITY_CAPTIONS
 from approachsim.report.integrity import INTEGRITY_HEADER, integrity_figures, integrity_rows
+from approachsim.report.touchdown import CAPTIONS as TOUCHDOWN_CAPTIONS
+from approachsim.report.touchdown import touchdown_figures, touchdown_table
 
 COLORS = {"CAT I": "tab:green", "CAT II": "tab:orange", "CAT III": "tab:red"}
 
@@ -368,6 +372,7 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
     sky = next((x for x in _series(out_dir) if "pdop" in x), None)
     if sky is not None:
         imgs["sky_dop"] = fig_sky(sky)
+    imgs.update(touchdown_figures(results, det))  # landing campaigns (evaluate --land)
     b64 = _render_all(imgs, out_dir)
     verdict_rows = []
     for cat, e in summary["decision_heights"].items():
@@ -417,11 +422,12 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
         *([_table(INTEGRITY_HEADER, integrity_rows(det))] if "integrity" in det else []),
         "<h2>Time-averaged RMS over the approach (Gray &amp; Maybeck Tables 3-6 quantity), ft</h2>",
         _table(list(ta), [list(ta.values())]),
+        *([touchdown_table(det["touchdown"])] if "touchdown" in det else []),
     ]
     if failures:
         parts.append("<h2>Failed runs</h2>" + _table(["run", "reason"], [[k, v] for k, v in failures.items()]))
     for k in imgs:
-        title, caption = FIGURE_CAPTIONS.get(k) or INTEGRITY_CAPTIONS[k]
+        title, caption = FIGURE_CAPTIONS.get(k) or INTEGRITY_CAPTIONS.get(k) or TOUCHDOWN_CAPTIONS[k]
         parts.append(f"<h2>{html.escape(title)}</h2><figure><img alt='{k}' src='data:image/png;base64,{b64[k]}'>"
                      f"<figcaption>{html.escape(caption)} (file {k}.png)</figcaption></figure>")
     parts.append("</body></html>")
