@@ -5,6 +5,8 @@ Everything inside the library is SI (m, s, rad, Pa, K). Convert at the edges onl
 
 FT = 0.3048
 """Metres per foot (exact)."""
+IN = 0.0254
+"""Metres per inch (exact; JSBSim's structural-frame lengths)."""
 NMI = 1852.0
 """Metres per nautical mile (exact)."""
 KT = NMI / 3600.0

@@ -212,43 +212,15 @@ def approach_stop_height_m(profile: Any) -> float:
     return max(min(profile.evaluation.dh_ft.values()) - 20.0, 5.0) * units.FT
 
 
-_GEAR: dict = {}
-"""The main gears' lever arms of each aircraft model and IMU location this worker process has read."""
-
-
 def main_gear_lever_arms_m(approach: Any) -> Any:
-    """(2, 3) the left and right main-gear contact points relative to the IMU, body axes (x forward, y right,
-    z down), m: JSBSim's gear/unit[1] and unit[2] locations (structural frame: in, x aft, y right, z up; the flight
-    stage's GEAR_FIELDS order) less the aircraft file's IMU location. Read here, once per process and model, until
-    the flight stage's Aircraft carries the gear geometry itself."""
-    import numpy as np
-
-    from approachsim.flight.aircraft import IN
-    from approachsim.flight.fdm import FDM
-
-    ac = approach.aircraft
-    key = (ac.jsbsim_model, ac.imu_location_struct_m)
-    arms = _GEAR.get(key)
-    if arms is None:
-        fdm = FDM(ac.jsbsim_model, approach.dt_s)
-        imu = np.asarray(ac.imu_location_struct_m, dtype=float)
-        rows = []
-        for unit in (1, 2):
-            g = np.array([fdm[f"gear/unit[{unit}]/{c}-position"] for c in "xyz"]) * IN
-            d = g - imu
-            rows.append((-d[0], d[1], -d[2]))  # structural (x aft, y right, z up) -> body (x fwd, y right, z down)
-        arms = _GEAR[key] = np.array(rows)
-        if not arms[0, 1] < 0.0 < arms[1, 1]:
-            raise RuntimeError(f"JSBSim model {ac.jsbsim_model!r}: gear units 1 and 2 are not the left and right "
-                               f"main gear (y {arms[0, 1]:.2f}, {arms[1, 1]:.2f} m)")
-    return arms
+    """(2, 3) the main gears' contact points relative to the IMU, body axes, m (the flight stage's
+    Approach.main_gear_lever_arms_m, read once per Approach and so once per worker process and profile)."""
+    return approach.main_gear_lever_arms_m
 
 
 def _head(truth: Any, nav: Any, flight: Any, height_m: float) -> tuple[Any, Any, Any]:
     """The landing run's truth, navigation solution and flight result cut after the first row whose IMU height
     above the threshold is at or below height_m (where an approach run stops); unchanged when there is none."""
-    import dataclasses
-
     import numpy as np
 
     below = np.flatnonzero(truth.r_rwy[:, 2] <= height_m)

@@ -18,7 +18,7 @@ from approachsim.flight.design import AutopilotGains
 from approachsim.flight.envelope import TURBULENCE_ORDER, ApproachLimits
 from approachsim.profile import Profile
 
-IN = 0.0254
+IN = units.IN
 """Metres per inch (exact)."""
 
 

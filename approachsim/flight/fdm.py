@@ -192,6 +192,11 @@ class FDM:
         vn, ve, vd = f["velocities/v-north-fps"], f["velocities/v-east-fps"], f["velocities/v-down-fps"]
         return float(f["velocities/vc-kts"]) * units.KT, math.atan2(-vd, math.hypot(vn, ve))
 
+    def gear_location_struct_m(self, unit: int) -> np.ndarray:
+        """Gear unit `unit`'s contact point in the model's structural frame (x aft, y right, z up), m:
+        gear/unit[i]/{x,y,z}-position (in)."""
+        return np.array([float(self._fdm[f"gear/unit[{unit}]/{c}-position"]) for c in "xyz"]) * units.IN
+
     def linearize(self, gamma_rad: float) -> Linearization:
         """JSBSim's FGLinearization at the current (trimmed, still-air) state."""
         lin = jsbsim.FGLinearization(self._fdm)

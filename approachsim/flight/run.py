@@ -171,6 +171,7 @@ class Approach:
         """Fly on through a flare to touchdown (main gear on the ground) instead of stopping at stop_height_m."""
         self._lin: Linearization | None = None
         self._start: InitialCondition | None = None
+        self._gear: Array | None = None
 
     def start(self) -> InitialCondition:
         """The initial-condition command that JSBSim trims at the approach CAS on the glidepath in the profile's
@@ -199,6 +200,22 @@ class Approach:
         speed, at least 60 s; a run still flying then ends as "timeout". A navigation source sized for it
         (NavInTheLoop(max_time_s=...)) covers every row the flight can have."""
         return max(60.0, 2.0 * self.profile.runway.start_distance_m / self.aircraft.approach_speed_mps)
+
+    @property
+    def main_gear_lever_arms_m(self) -> Array:
+        """(2, 3) the left and right main gears' contact points relative to the IMU, body axes (x forward, y right,
+        z down), m: the JSBSim model's gear/unit[1] and unit[2] (FDM.gear_location_struct_m) less the aircraft
+        file's IMU location (read once per Approach)."""
+        if self._gear is None:
+            fdm = FDM(self.aircraft.jsbsim_model, self.dt_s)
+            imu = np.asarray(self.aircraft.imu_location_struct_m, dtype=float)
+            d = np.array([fdm.gear_location_struct_m(u) - imu for u in (1, 2)])
+            arms = np.column_stack((-d[:, 0], d[:, 1], -d[:, 2]))  # structural (x aft, y right, z up) -> body
+            if not arms[0, 1] < 0.0 < arms[1, 1]:
+                raise RuntimeError(f"JSBSim model {self.aircraft.jsbsim_model!r}: gear units 1 and 2 are not the "
+                                   f"left and right main gear (y {arms[0, 1]:.2f}, {arms[1, 1]:.2f} m)")
+            self._gear = arms
+        return self._gear
 
     @property
     def linearization(self) -> Linearization:
