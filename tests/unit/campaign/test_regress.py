@@ -73,6 +73,9 @@ def test_verdict_and_failures_are_regressions():
         (["--add", str(PROFILES / "default.toml")], "--add"),
         (["--update", "--add", "/nonexistent.toml"], "--add"),
         (["--mode", "x"], "--mode"),
+        (["--add-paper", "gray-maybeck"], "--add-paper"),
+        (["--update", "--add-paper", "gray-maybeck", "--mode", "open"], "--add-paper"),
+        (["--add-paper", "other"], "--add-paper"),
     ],
 )
 def test_bad_regress_options_exit_2(argv, needle, capsys, tmp_path):
@@ -97,17 +100,45 @@ def test_committed_baselines_are_valid():
     from pathlib import Path
 
     from approachsim.campaign.regress import read_baseline
+    from approachsim.commands.regress import PAPER_REF, baseline_profile
+    from approachsim.papers.gray_maybeck import CASES
     from approachsim.profile import load_profile
 
     root = Path(__file__).resolve().parents[3]
     files = sorted((root / "baselines").glob("*.json"))
     assert files, "no committed baselines"
+    paper = set()
     for f in files:
         doc = read_baseline(f)
-        prof = load_profile(root / doc["profile"])
-        assert doc["summary"]["profile"] == prof.name == f.stem
+        if doc["profile"].startswith(PAPER_REF):
+            roman = doc["profile"][len(PAPER_REF):]
+            prof = baseline_profile(doc["profile"], root)
+            assert f.stem == f"gray-maybeck-{roman}" and doc["mode"] == "closed"
+            assert doc["summary"]["profile"] == prof.name == f"gray-maybeck[case {roman}]"
+            paper.add(roman)
+        else:
+            prof = load_profile(root / doc["profile"])
+            assert doc["summary"]["profile"] == prof.name == f.stem
         assert (doc["summary"]["runs"], doc["summary"]["seed"]) == (doc["runs"], doc["seed"])
         assert set(doc["summary"]["decision_heights"]) == {"CAT I", "CAT II", "CAT III"}
+    # the study's small-N version guards every case of Table 2
+    assert paper == {c.roman for c in CASES}
+
+
+def test_paper_baseline_references():
+    """`paper:gray-maybeck:<case>` resolves to that case's profile (the radar altimeter of case IV, not of case
+    III); any other paper reference or case is bad input naming the field."""
+    from pathlib import Path
+
+    from approachsim.commands.regress import baseline_profile
+    from approachsim.config import ProfileError
+
+    iv, iii = (baseline_profile(f"paper:gray-maybeck:{c}", Path(".")) for c in ("IV", "III"))
+    assert iv.name == "gray-maybeck[case IV]" and iii.name == "gray-maybeck[case III]"
+    assert iv.sensors.radalt is not None and iii.sensors.radalt is None
+    for bad, needle in (("paper:other:I", "paper reference"), ("paper:gray-maybeck:XVII", "Table 2")):
+        with pytest.raises(ProfileError, match=needle):
+            baseline_profile(bad, Path("."))
 
 
 # --- the paired (common random numbers) test of schema-/2 baselines ---------------------------------------------
