@@ -13,9 +13,9 @@ multipath); `noise` is a pure function of the configuration and the elevations a
 The receiver's budget gives it (receiver.GnssErrorBudget.channel_sigmas_m and slow_tau_s): stand-alone, the slow
 state is clock/ephemeris + iono + tropo, the fast one the multipath; with GBAS corrections (sensors/gnss/gbas.py)
 the slow state is the ground + iono + tropo residual and the fast one the airborne multipath + smoothed receiver
-noise (no white code noise is left: the budget's code_noise_m is 0). The GBAS iono and tropo residuals grow with
-the aircraft's distance from and height above the reference point; the elevation-only noise here takes them at
-gbas.REFERENCE_GEOMETRY (the start of a 10 nmi final), conservative closer in.
+noise (the white code noise left is the 2 mm carrier-phase noise: the budget's code_noise_m). The GBAS iono and
+tropo residuals grow with the aircraft's distance from and height above the reference point; the elevation-only
+noise here takes them at gbas.REFERENCE_GEOMETRY (the start of a 10 nmi final), conservative closer in.
 """
 
 from __future__ import annotations

@@ -4,9 +4,10 @@ A GBAS ground station (M reference receivers around a surveyed reference point n
 pseudorange correction per satellite; the aircraft applies it to its 100 s carrier-smoothed code. The receiver
 (receiver.py, `corrections = "gbas"`) then measures
 
-    rho_i = |r_sv,i - r| + b_rx + s_gnd g_i + s_iono I_i + s_tropo T_i + s_mp m_i + s_noise n_i
+    rho_i = |r_sv,i - r| + b_rx + s_gnd g_i + s_iono I_i + s_tropo T_i + s_mp m_i + s_noise n_i + w_i
 
-with g, I, T, m, n unit-variance first-order Gauss-Markov series per channel and the scales (1-sigma, m) below, at
+with g, I, T, m, n unit-variance first-order Gauss-Markov series per channel, w white (CARRIER_NOISE_M) and the
+scales (1-sigma, m) below, at
 the channel's elevation theta, the aircraft's distance x_air to the reference point, its height dh above it and
 its horizontal speed v_air (all from the truth). Marks as in shared/reference/integrity-envelope.md: [V] seen in
 the source named, [S] only in a secondary source (named), [D] derived here, [U] not verified.
@@ -43,8 +44,12 @@ sigma_noise^2 (Stanford MAAST af_cnmp_mops.m [V], reference section 8):
   the 2001 values predating the designators of the current standards. Annex 10 Att. D 7.5.7 [V] (A10-2006,
   aero.cn 10769_91): the receiver contribution a GBAS provider assumes is RMS_pr_air of AAD-A.
   Correlation: the noise of code smoothed by a first-order filter of time constant tau = 100 s is the raw white noise
-  low-passed: a Gauss-Markov of time constant tau [D]. No white part is left (the carrier-phase noise, millimetres,
-  is left out): the budget's white code noise is 0 under GBAS.
+  low-passed: a Gauss-Markov of time constant tau [D]. What the smoothing passes unfiltered is the carrier phase's
+  own tracking noise: the white w_i, CARRIER_NOISE_M = 2 mm, the PLL thermal jitter (lambda / 2 pi) sqrt(B_n / (C/N0)
+  (1 + 1 / (2 T C/N0))) (Kaplan & Hegarty, Understanding GPS, PLL thermal noise jitter [U]: the formula from memory)
+  at 35 dB-Hz, B_n = 10 Hz, T = 20 ms: 0.0565 rad = 1.7 mm, rounded up [D]. It is the budget's white code noise
+  under GBAS (code_noise_m: the white R of the navigation filter's pseudorange rows, which a U-D update needs
+  positive).
 
 Satellite clock and ephemeris: the same at the reference point and the aircraft, removed by the correction. The
   orbit error decorrelates with the separation (Annex 10 Att. D 7.5.9 [V]): a satellite-position error dr moves the
@@ -82,11 +87,12 @@ Troposphere (the refractivity left uncorrected between the reference point's hei
   below the CAT I decision height the term is under 2 cm at every elevation above 5 deg, 2.6 cm at the zenith at
   1000 ft [D]). Correlation: the stand-alone tropospheric correlation time (tropo_tau_s, 1 h).
 
-Nominal 1-sigma (the record's sigma_m): sqrt(s_gnd^2 + s_iono^2 + s_tropo^2 + s_mp^2 + s_noise^2), the Annex's
-sigma_i^2 = sigma_pr_gnd^2 + sigma_tropo^2 + sigma_pr_air^2 + sigma_iono^2.
+Nominal 1-sigma (the record's sigma_m): sqrt(s_gnd^2 + s_iono^2 + s_tropo^2 + s_mp^2 + s_noise^2 + w^2), the
+Annex's sigma_i^2 = sigma_pr_gnd^2 + sigma_tropo^2 + sigma_pr_air^2 + sigma_iono^2 (and the 2 mm white).
 
 The navigation filter's channel states (nav/noise.py): the slow state carries ground + iono + tropo (correlation time
-the shortest of theirs), the fast state the airborne multipath and noise (both correlated over the smoothing time).
+the shortest of theirs), the fast state the airborne multipath and noise (both correlated over the smoothing time),
+the white w is the pseudorange rows' R.
 The iono and tropo terms depend on where the aircraft is; `channel_sigmas_m` takes that geometry, and without it
 (the elevation-only noise the filter uses today) evaluates them at REFERENCE_GEOMETRY, the start of a 10 nmi final
 on a 3 deg path at 140 kt: the largest residual such an approach sees (conservative closer in).
@@ -126,6 +132,8 @@ AADS = tuple(AAD_TABLE)
 SMOOTHING_TAU_S = 100.0
 """The airborne carrier-smoothing time constant, s (DO-253 / Annex 10 100 s smoothing): the tau of 2 tau v_air and
 the correlation time of the smoothed receiver noise."""
+CARRIER_NOISE_M = 0.002
+"""White noise left on the smoothed code, m: the carrier-phase tracking jitter (module docstring)."""
 TROPO_MAPPING_A = 0.002
 """The GBAS tropospheric mapping 1 / sqrt(0.002 + sin^2 theta) (module docstring)."""
 REFERENCE_GEOMETRY = (10.0 * units.NMI, 10.0 * units.NMI * math.tan(math.radians(3.0)) + 50.0 * units.FT,
@@ -196,7 +204,8 @@ class GbasModel:
                 * np.abs(-np.expm1(-np.asarray(dh_m, dtype=float) / h0)))
 
     def scales(self, el_rad: Array, x_air_m: Array, dh_m: Array, v_air_mps: Array) -> dict[str, Array]:
-        """The five scales of the module docstring (m) and their RSS `sigma`, broadcast over the arguments."""
+        """The five scales of the module docstring (m) and `sigma`, their RSS with CARRIER_NOISE_M, broadcast over the
+        arguments."""
         from approachsim.sensors.gnss.receiver import do253_multipath_sigma_m
 
         out = {"ground": self.ground_sigma_m(el_rad), "iono": self.iono_sigma_m(el_rad, x_air_m, v_air_mps),
@@ -204,7 +213,7 @@ class GbasModel:
                "noise": self.airborne_noise_sigma_m(el_rad)}
         out = {k: np.broadcast_to(v, np.broadcast_shapes(*(np.shape(u) for u in out.values()))) for k, v in out.items()}
         out["sigma"] = np.sqrt(out["ground"] ** 2 + out["iono"] ** 2 + out["tropo"] ** 2 + out["multipath"] ** 2
-                               + out["noise"] ** 2)
+                               + out["noise"] ** 2 + CARRIER_NOISE_M**2)
         return out
 
     def sigma_m(self, el_rad: Array, x_air_m: Array, dh_m: Array, v_air_mps: Array) -> Array:

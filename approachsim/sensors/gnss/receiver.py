@@ -37,13 +37,14 @@ Selectable on top of a preset (make_budget; the profile's [sensors.gnss] multipa
 Corrections (the profile's [sensors.gnss] corrections): "none" is the stand-alone model above; "gbas" (gbas.py)
 replaces every term but the receiver clock by the residual of a GBAS-corrected, 100 s carrier-smoothed code:
 
-    rho_i = |r_sv,i - r| + b_rx + s_gnd g_i + s_iono I_i + s_tropo T_i + s_mp m_i + s_noise n_i
+    rho_i = |r_sv,i - r| + b_rx + s_gnd g_i + s_iono I_i + s_tropo T_i + s_mp m_i + s_noise n_i + w_i
 
 g (ground, ground_tau_s), I (iono_tau_s), T (tropo_tau_s), m (multipath_tau_s), n (the 100 s smoothing) unit
 Gauss-Markov series drawn from the same standard normals, in the same columns, as the stand-alone clock/ephemeris,
 iono, tropo, multipath and noise (common random numbers between the two); the scales at each channel's elevation and
-the aircraft's distance, height and speed relative to the GBAS reference point (station_ecef). No white noise is left
-(budget code_noise_m = 0). The record's sigma_m is the corrected nominal sigma there.
+the aircraft's distance, height and speed relative to the GBAS reference point (station_ecef). w is the 2 mm white
+carrier-phase noise the smoothing passes (gbas.CARRIER_NOISE_M, budget code_noise_m), from normals drawn after all
+the others. The record's sigma_m is the corrected nominal sigma there.
 
 Epoch: every run's sky is the constellation at epoch_utc + its own offset (errors.constants["epoch_offset_s"],
 drawn by the sensor suite from the run's "gnss_epoch" stream); a batch of runs with offsets gives per-run geometry
@@ -84,7 +85,7 @@ from approachsim.records import GnssSamples, Truth
 from approachsim.sensors import base
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
-from approachsim.sensors.gnss.gbas import SMOOTHING_TAU_S, GbasModel, station_geometry
+from approachsim.sensors.gnss.gbas import CARRIER_NOISE_M, SMOOTHING_TAU_S, GbasModel, station_geometry
 from approachsim.sensors.kernels import gnss as gk
 
 Array = np.ndarray
@@ -123,8 +124,8 @@ class GnssErrorBudget:
     multipath_model: str = "nrc1995"
     """"nrc1995": multipath_m at every elevation; "do253": sigma_mp(el) (multipath_m unused)."""
     gbas: GbasModel | None = None
-    """GBAS corrections (gbas.py): every stand-alone term above but the multipath curve is replaced and code_noise_m
-    is 0 (make_budget); None: stand-alone ranging."""
+    """GBAS corrections (gbas.py): every stand-alone term above but the multipath curve is replaced, code_noise_m is
+    the white carrier-phase noise left on the smoothed code (make_budget); None: stand-alone ranging."""
 
     @property
     def corrections(self) -> str:
@@ -170,8 +171,8 @@ def make_budget(code: str, multipath_model: str = "nrc1995", clock_ephemeris: st
                 multipath_tau_s: float | None = None, gbas: GbasModel | None = None) -> GnssErrorBudget:
     """The code preset with the chosen multipath model and clock/ephemeris budget (module docstring); tau None:
     the model's default (preset 60 s for nrc1995, DO253_MULTIPATH_TAU_S for do253). With `gbas` the GBAS-corrected
-    budget (gbas.py): the stand-alone fields are kept (unused by the sensor), code_noise_m is 0 (no white noise left
-    on the smoothed code) and the airframe multipath must be "do253"."""
+    budget (gbas.py): the stand-alone fields are kept (unused by the sensor), code_noise_m is the white carrier-phase
+    noise left on the smoothed code (gbas.CARRIER_NOISE_M) and the airframe multipath must be "do253"."""
     if multipath_model not in MULTIPATH_MODELS:
         raise ValueError(f"multipath_model must be one of {', '.join(MULTIPATH_MODELS)}; got {multipath_model!r}")
     if clock_ephemeris not in CLOCK_EPHEMERIS_M:
@@ -184,7 +185,7 @@ def make_budget(code: str, multipath_model: str = "nrc1995", clock_ephemeris: st
         multipath_tau_s = DO253_MULTIPATH_TAU_S if multipath_model == "do253" else b.multipath_tau_s
     b = replace(b, multipath_model=multipath_model, clock_ephemeris_m=CLOCK_EPHEMERIS_M[clock_ephemeris],
                 multipath_tau_s=multipath_tau_s)
-    return b if gbas is None else replace(b, code_noise_m=0.0, gbas=gbas)
+    return b if gbas is None else replace(b, code_noise_m=CARRIER_NOISE_M, gbas=gbas)
 
 
 def draw_epoch_offsets(window_s: float, rng: base.RngLike) -> Array:
@@ -292,7 +293,8 @@ class GnssReceiver:
         """series (m, 24) m: clock_ephemeris, iono_zenith, tropo_zenith, multipath, noise (+ rate_noise m/s);
         multipath is unit-sigma under the do253 model (apply scales it by sigma_mp at the channel's elevation).
         GBAS budget: ground, iono, tropo, multipath, noise, all unit-sigma Gauss-Markov (apply scales them; module
-        docstring), from the same standard normals as the stand-alone series in the same place."""
+        docstring), from the same standard normals as the stand-alone series in the same place, and white (m), the
+        carrier-phase noise, from normals drawn after those."""
         b = self.budget
         k = self.constellation.prn.shape[0]
 
@@ -303,6 +305,7 @@ class GnssReceiver:
             extra = {"rate_noise": self.doppler_noise_mps * z[:, 5 * k : 6 * k]} if self.doppler else {}
             if b.gbas is not None:
                 return extra | {
+                    "white": b.code_noise_m * g.standard_normal((m, k)),  # after the others: theirs stay the same
                     "ground": base.gauss_markov(z[:, 0:k], 1.0, b.gbas.ground_tau_s, dt),
                     "iono": base.gauss_markov(z[:, k : 2 * k], 1.0, b.iono_tau_s, dt),
                     "tropo": base.gauss_markov(z[:, 2 * k : 3 * k], 1.0, b.tropo_tau_s, dt),
@@ -474,10 +477,10 @@ class GnssReceiver:
             s_gnd, s_iono, s_tropo, s_mp, s_noise, sigma = gk.gbas_scales(
                 el, c(x_air), c(dh), c(v_air), g.gad_params(), float(g.reference_receivers), g.aad_params(),
                 float(g.sigma_vig_per_m), SMOOTHING_TAU_S, float(g.refractivity_sigma), float(g.scale_height_m),
-                IONO_SHELL_M)
+                IONO_SHELL_M, b.code_noise_m**2)
             pr, valid = gk.pseudoranges_gbas(rng, s_gnd, s_iono, s_tropo, s_mp, s_noise, sel, c(series["ground"]),
                                              c(series["iono"]), c(series["tropo"]), c(series["multipath"]),
-                                             c(series["noise"]), c(bias))
+                                             c(series["noise"]), c(series["white"]), c(bias))
         prr = None
         if self.doppler:
             prr = gk.pseudorange_rates(u, c(v_sv), c(truth.lat_rad[rows], dtype=float),
@@ -509,7 +512,7 @@ class GnssReceiver:
             geom = tuple(a[:, None] for a in self.station_geometry(truth, errors.rows))  # (m, 1) against (.., m, k)
             sc = self.budget.gbas.scales(el, *geom)
             pr = (geo_["range"] + sc["ground"] * s["ground"] + sc["iono"] * s["iono"] + sc["tropo"] * s["tropo"]
-                  + sc["multipath"] * s["multipath"] + sc["noise"] * s["noise"])
+                  + sc["multipath"] * s["multipath"] + sc["noise"] * s["noise"] + s["white"])
         else:
             mp = (s["multipath"] * do253_multipath_sigma_m(el) if self.budget.multipath_model == "do253"
                   else s["multipath"])

@@ -346,8 +346,8 @@ def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_sc
 
 @njit(cache=True)
 def gbas_scales(el: np.ndarray, x_air: np.ndarray, dh: np.ndarray, v_air: np.ndarray, gad: np.ndarray, n_ref: float,
-                aad: np.ndarray, sigma_vig: float, tau_s: float, sigma_n: float, h0_m: float,
-                shell_m: float) -> tuple[np.ndarray, ...]:
+                aad: np.ndarray, sigma_vig: float, tau_s: float, sigma_n: float, h0_m: float, shell_m: float,
+                w2: float) -> tuple[np.ndarray, ...]:
     """The GBAS-corrected residual's scales (S, m, k), m, at elevations el (S, m, k) rad and the aircraft's slant
     distance x_air, height dh above and horizontal speed v_air relative to the reference point (m,) (gnss/gbas.py;
     its GbasModel.scales is the oracle):
@@ -359,7 +359,7 @@ def gbas_scales(el: np.ndarray, x_air: np.ndarray, dh: np.ndarray, v_air: np.nda
         mp      0.13 + 0.53 exp(-el / 10 deg) (DO-253 airframe multipath)
         noise   a0 + a1 exp(-el / th0) (aad: a0, a1, th0 rad)
 
-    and sigma = sqrt(ground^2 + iono^2 + tropo^2 + mp^2 + noise^2)."""
+    and sigma = sqrt(ground^2 + iono^2 + tropo^2 + mp^2 + noise^2 + w2) (w2: the white noise's variance)."""
     n_sky, m, k = el.shape
     s_gnd = np.empty((n_sky, m, k))
     s_iono = np.empty((n_sky, m, k))
@@ -391,19 +391,21 @@ def gbas_scales(el: np.ndarray, x_air: np.ndarray, dh: np.ndarray, v_air: np.nda
                 s_tropo[s, i, j] = tr
                 s_mp[s, i, j] = mp
                 s_noise[s, i, j] = nz
-                sigma[s, i, j] = math.sqrt(g * g + io * io + tr * tr + mp * mp + nz * nz)
+                sigma[s, i, j] = math.sqrt(g * g + io * io + tr * tr + mp * mp + nz * nz + w2)
     return s_gnd, s_iono, s_tropo, s_mp, s_noise, sigma
 
 
 @njit(cache=True)
 def pseudoranges_gbas(rng: np.ndarray, s_gnd: np.ndarray, s_iono: np.ndarray, s_tropo: np.ndarray, s_mp: np.ndarray,
                       s_noise: np.ndarray, sel: np.ndarray, gnd: np.ndarray, iono: np.ndarray, tropo: np.ndarray,
-                      mp: np.ndarray, noise: np.ndarray, bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                      mp: np.ndarray, noise: np.ndarray, white: np.ndarray,
+                      bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """GBAS-corrected pseudoranges (R, m, k) m and validity of every run r (run r on sky r, or on sky 0 for one sky):
 
-        rho = |r_sv - r| + s_gnd g + s_iono I + s_tropo T + s_mp m + s_noise n + b_rx      (nan where not selected)
+        rho = |r_sv - r| + s_gnd g + s_iono I + s_tropo T + s_mp m + s_noise n + w + b_rx   (nan where not selected)
 
-    geometry and scales (S, m, k) from `sky` and `gbas_scales`, unit series (R, m, k), receiver clock bias (R, m)."""
+    geometry and scales (S, m, k) from `sky` and `gbas_scales`, unit series and the white noise w (m) (R, m, k),
+    receiver clock bias (R, m)."""
     n_run, m, k = gnd.shape
     one_sky = rng.shape[0] == 1
     pr = np.empty((n_run, m, k))
@@ -415,7 +417,7 @@ def pseudoranges_gbas(rng: np.ndarray, s_gnd: np.ndarray, s_iono: np.ndarray, s_
             for j in range(k):
                 p = (rng[s, i, j] + s_gnd[s, i, j] * gnd[r, i, j] + s_iono[s, i, j] * iono[r, i, j]
                      + s_tropo[s, i, j] * tropo[r, i, j] + s_mp[s, i, j] * mp[r, i, j]
-                     + s_noise[s, i, j] * noise[r, i, j])
+                     + s_noise[s, i, j] * noise[r, i, j] + white[r, i, j])
                 v = sel[s, i, j]
                 valid[r, i, j] = v
                 pr[r, i, j] = p + b if v else math.nan

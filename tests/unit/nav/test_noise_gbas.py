@@ -2,7 +2,8 @@
 
 The slow state carries the ground + iono + tropo residuals (correlation time the ground's 300 s), the fast state the
 airborne multipath + smoothed receiver noise (100 s); the elevation-only noise takes the distance-dependent terms at
-gbas.REFERENCE_GEOMETRY; no white code noise is left. Stand-alone ranging keeps its formulas bit for bit."""
+gbas.REFERENCE_GEOMETRY; the white code noise is the 2 mm carrier-phase noise. Stand-alone ranging keeps its
+formulas bit for bit."""
 
 from __future__ import annotations
 
@@ -55,7 +56,7 @@ def test_channel_noise_is_the_corrected_budget(navs):
     np.testing.assert_allclose(nz.gse_sigma_m, gse, rtol=1e-12)
     np.testing.assert_allclose(nz.gmp_sigma_m, gmp, rtol=1e-12)
     assert nz.gse_tau_s == 300.0 and nz.gmp_tau_s == 100.0
-    assert nav.sensors.gnss.budget().code_noise_m == 0.0  # the white pseudorange noise of the channel-state rows
+    assert nav.sensors.gnss.budget().code_noise_m == 0.002  # the white pseudorange noise of the channel-state rows
     # the arrays the compiled epoch takes and P0's channel entries are the same sigmas
     _, k_gse, k_gmp = nav.noise_model.kernel_arrays(el)
     np.testing.assert_array_equal(k_gse, nz.gse_sigma_m)

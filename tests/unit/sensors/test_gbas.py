@@ -34,7 +34,10 @@ from approachsim.sensors.suite import SensorSuite, SuiteErrors
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 DEFAULT = PROFILES / "default.toml"
-TERMS = ("ground", "iono", "tropo", "multipath", "noise")
+SCALED = ("ground", "iono", "tropo", "multipath", "noise")
+"""The unit Gauss-Markov series the kernel scales."""
+TERMS = (*SCALED, "white")
+"""Every error series of a GBAS receiver (the white carrier-phase noise in m)."""
 DEG = math.pi / 180.0
 
 
@@ -113,7 +116,7 @@ def test_budget_is_monotone_where_the_physics_says():
     model = gb.GbasModel()
     el = np.radians(np.linspace(5.0, 90.0, 86))
     s = model.scales(el, 10e3, 500.0, 70.0)
-    for name in (*TERMS, "sigma"):
+    for name in (*SCALED, "sigma"):
         d = np.diff(s[name])
         assert np.all(d <= 0.0) and np.all(d[30:] < 0.0) if name == "ground" else np.all(d < 0.0), name
     for gad in "AB":
@@ -133,7 +136,7 @@ def test_corrected_sigma_is_an_order_below_stand_alone_ranging():
     corr = rx.sigma_m(el, 2000.0, 100.0, 70.0)
     stand_alone = replace(rx, budget=make_budget("P(Y)", "do253", "current"), station_ecef=None).sigma_m(el)
     assert np.all(corr < 0.5) and np.all(corr > 0.15) and np.all(stand_alone > 2.4)
-    assert rx.budget.code_noise_m == 0.0 and rx.budget.corrections == "gbas"
+    assert rx.budget.code_noise_m == gb.CARRIER_NOISE_M == 0.002 and rx.budget.corrections == "gbas"
 
 
 # --- the drawn residual's statistics -------------------------------------------------------------------------------
@@ -174,6 +177,8 @@ def _expected(term, el, x, dh, v):
         return 30.0 * 7350.0 * 1e-6 / math.sqrt(0.002 + math.sin(el) ** 2) * abs(1.0 - math.exp(-dh / 7350.0))
     if term == "multipath":
         return 0.13 + 0.53 * math.exp(-th / 10.0)
+    if term == "white":
+        return 0.002
     return 0.11 + 0.13 * math.exp(-th / 4.0)
 
 
@@ -226,6 +231,8 @@ def test_each_term_decorrelates_over_its_time(drawn, term, tau_s):
     n = z.shape[0] * z.shape[2]
     assert abs(rho - want) < 5.0 * (1.0 - want**2) / math.sqrt(n)
     assert z.std() == pytest.approx(1.0, rel=0.02)
+    w = out["near"]["e"].series["white"]  # the carrier-phase noise: white, 2 mm
+    assert abs(np.corrcoef(w[:, 0].ravel(), w[:, 1].ravel())[0, 1]) < 5.0 / math.sqrt(n)
 
 
 def test_total_error_is_the_sum_of_the_terms_with_the_records_sigma(drawn):
@@ -254,9 +261,9 @@ def test_gbas_scales_kernel_equals_numpy():
                 model = gb.GbasModel(gad=gad, aad=aad, reference_receivers=m, sigma_vig_per_m=6e-6)
                 got = gk.gbas_scales(el, x, dh, v, model.gad_params(), float(m), model.aad_params(),
                                      model.sigma_vig_per_m, gb.SMOOTHING_TAU_S, model.refractivity_sigma,
-                                     model.scale_height_m, 350e3)
+                                     model.scale_height_m, 350e3, gb.CARRIER_NOISE_M**2)
                 ref = model.scales(el, x[:, None], dh[:, None], v[:, None])
-                for name, a in zip((*TERMS, "sigma"), got, strict=True):
+                for name, a in zip((*SCALED, "sigma"), got, strict=True):
                     np.testing.assert_allclose(a, ref[name], rtol=1e-12, atol=0, err_msg=f"{gad} {aad} {m} {name}")
 
 
@@ -329,8 +336,8 @@ def test_none_is_the_stand_alone_receiver_and_gbas_draws_the_same_normals():
 
 
 def test_realized_channel_states_add_up_to_the_pseudorange_error():
-    """sensors/states.py under GBAS: gse + gmp + the receiver clock is the pseudorange error at the start row
-    (no white noise is left on the corrected, smoothed code)."""
+    """sensors/states.py under GBAS: gse + gmp + the receiver clock + the white carrier-phase noise is the pseudorange
+    error at the start row."""
     p = _profile(corrections="gbas", selection="all")
     suite = SensorSuite.from_profile(p)
     truth = synthetic.glidepath_descent(p.runway.frame, rate_hz=10.0, start_distance_m=3000.0,
@@ -342,7 +349,9 @@ def test_realized_channel_states_add_up_to_the_pseudorange_error():
     ok = rec.valid[:, 0]
     assert ok.sum() >= 18
     err = rec.pseudorange_m[:, 0] - exact.pseudorange_m[:, 0]
-    np.testing.assert_allclose(err[ok], (st.gse + st.gmp + st.clk[:, :1])[ok], atol=1e-6)
+    white = errors.sensors["gnss"].series["white"][:, 0]
+    assert np.std(white[ok]) < 0.005
+    np.testing.assert_allclose(err[ok], (st.gse + st.gmp + st.clk[:, :1] + white)[ok], atol=1e-6)
     assert np.all(np.abs(st.gse[ok]) < 3.0) and np.all(np.abs(st.gmp[ok]) < 3.0)
 
 
