@@ -283,6 +283,12 @@ class GnssReceiver:
         if self.station_ecef is not None:
             h = float(geo.ecef_to_geodetic(np.asarray(self.station_ecef, dtype=float))[2])
         object.__setattr__(self, "_station_h_m", h)
+        g = self.budget.gbas
+        # gbas_scales' constant arguments after the truth's (sensors/kernels/gnss.py), made once
+        object.__setattr__(self, "_gbas_args", None if g is None else (
+            np.asarray(self.station_ecef, dtype=float), h, g.gad_params(), float(g.reference_receivers),
+            g.aad_params(), float(g.sigma_vig_per_m), SMOOTHING_TAU_S, float(g.refractivity_sigma),
+            float(g.scale_height_m), IONO_SHELL_M, self.budget.code_noise_m**2))
 
     @property
     def station_h_m(self) -> float:
@@ -463,8 +469,9 @@ class GnssReceiver:
         b = self.budget
         mode = {"all": gk.MODE_ALL, "best4": gk.MODE_BEST4, "best4-fixed": gk.MODE_PLANNED}[self.selection]
         c = np.ascontiguousarray
+        r_rx = c(truth.r_ecef[rows], dtype=float)
         rng, u, el, az, vis, sel, pdop, f_iono, m_tropo, mp_scale, sigma = gk.sky(
-            c(truth.r_ecef[rows], dtype=float), c(r_sv), float(self.mask_rad), mode, c(plan), IONO_SHELL_M,
+            r_rx, c(r_sv), float(self.mask_rad), mode, c(plan), IONO_SHELL_M,
             b.multipath_model == "do253", float(b.multipath_m), b.clock_ephemeris_m**2, float(b.iono_zenith_m),
             float(b.tropo_zenith_m), b.code_noise_m**2)
         if b.gbas is None:
@@ -472,12 +479,9 @@ class GnssReceiver:
                                         c(series["iono_zenith"]), c(series["tropo_zenith"]), c(series["multipath"]),
                                         c(series["noise"]), c(bias))
         else:
-            g = b.gbas
-            x_air, dh, v_air = self.station_geometry(truth, rows)
             s_gnd, s_iono, s_tropo, s_mp, s_noise, sigma = gk.gbas_scales(
-                el, c(x_air), c(dh), c(v_air), g.gad_params(), float(g.reference_receivers), g.aad_params(),
-                float(g.sigma_vig_per_m), SMOOTHING_TAU_S, float(g.refractivity_sigma), float(g.scale_height_m),
-                IONO_SHELL_M, b.code_noise_m**2)
+                el, r_rx, c(truth.h_m[rows], dtype=float), c(truth.v_ned[rows], dtype=float),
+                *self._gbas_args)  # type: ignore[attr-defined]
             pr, valid = gk.pseudoranges_gbas(rng, s_gnd, s_iono, s_tropo, s_mp, s_noise, sel, c(series["ground"]),
                                              c(series["iono"]), c(series["tropo"]), c(series["multipath"]),
                                              c(series["noise"]), c(series["white"]), c(bias))

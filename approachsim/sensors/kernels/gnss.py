@@ -345,12 +345,14 @@ def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_sc
 
 
 @njit(cache=True)
-def gbas_scales(el: np.ndarray, x_air: np.ndarray, dh: np.ndarray, v_air: np.ndarray, gad: np.ndarray, n_ref: float,
-                aad: np.ndarray, sigma_vig: float, tau_s: float, sigma_n: float, h0_m: float, shell_m: float,
-                w2: float) -> tuple[np.ndarray, ...]:
-    """The GBAS-corrected residual's scales (S, m, k), m, at elevations el (S, m, k) rad and the aircraft's slant
-    distance x_air, height dh above and horizontal speed v_air relative to the reference point (m,) (gnss/gbas.py;
-    its GbasModel.scales is the oracle):
+def gbas_scales(el: np.ndarray, r_rx: np.ndarray, h_m: np.ndarray, v_ned: np.ndarray, station: np.ndarray,
+                station_h_m: float, gad: np.ndarray, n_ref: float, aad: np.ndarray, sigma_vig: float, tau_s: float,
+                sigma_n: float, h0_m: float, shell_m: float, w2: float) -> tuple[np.ndarray, ...]:
+    """The GBAS-corrected residual's scales (S, m, k), m, at elevations el (S, m, k) rad, for receivers at r_rx (m, 3)
+    ECEF m with ellipsoid heights h_m (m,) and NED velocities v_ned (m, 3) m/s, the reference point at `station` (3,)
+    ECEF m, station_h_m high (gnss/gbas.py; its station_geometry and GbasModel.scales are the oracle): with the
+    slant distance x_air = |r_rx - station|, the height dh = h_m - station_h_m and the horizontal speed
+    v_air = |v_ned[:2]|,
 
         ground  sqrt((a0 + a1 exp(-el / th0))^2 / M + a2^2), the row above or at/below gad[0] (gad: split, a0, a1,
                 th0, a2 above, a0, a1, th0, a2 at/below; angles rad)
@@ -369,8 +371,11 @@ def gbas_scales(el: np.ndarray, x_air: np.ndarray, dh: np.ndarray, v_air: np.nda
     sigma = np.empty((n_sky, m, k))
     for s in range(n_sky):
         for i in range(m):
-            path = sigma_vig * (x_air[i] + 2.0 * tau_s * v_air[i])
-            hfac = sigma_n * h0_m * 1e-6 * abs(-math.expm1(-dh[i] / h0_m))
+            dx, dy, dz = r_rx[i, 0] - station[0], r_rx[i, 1] - station[1], r_rx[i, 2] - station[2]
+            x_air = math.sqrt(dx * dx + dy * dy + dz * dz)
+            v_air = math.hypot(v_ned[i, 0], v_ned[i, 1])
+            path = sigma_vig * (x_air + 2.0 * tau_s * v_air)
+            hfac = sigma_n * h0_m * 1e-6 * abs(-math.expm1(-(h_m[i] - station_h_m) / h0_m))
             for j in range(k):
                 e = el[s, i, j]
                 if e > gad[0]:

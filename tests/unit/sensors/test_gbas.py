@@ -250,18 +250,27 @@ def test_total_error_is_the_sum_of_the_terms_with_the_records_sigma(drawn):
 # --- the compiled path, the stand-alone path, the channel states ---------------------------------------------------
 
 def test_gbas_scales_kernel_equals_numpy():
-    """gbas_scales against GbasModel.scales on random elevations (-10..90 deg) and geometries (dh of both signs),
-    every designator, M = 2..4: to 1e-12 relative."""
+    """gbas_scales against gbas.station_geometry and GbasModel.scales on random elevations (-10..90 deg) and aircraft
+    positions around the runway (heights below and above the reference point), every designator, M = 2..4: to 1e-12
+    relative."""
+    p = load_profile(DEFAULT)
     rng = np.random.default_rng(3)
     el = np.radians(rng.uniform(-10.0, 90.0, (2, 30, 24)))
-    x, dh, v = rng.uniform(0.0, 40e3, 30), rng.uniform(-300.0, 3000.0, 30), rng.uniform(0.0, 120.0, 30)
+    rwy = np.stack([rng.uniform(-40e3, 3e3, 30), rng.uniform(-2e3, 2e3, 30), rng.uniform(-300.0, 3000.0, 30)], -1)
+    r_rx = p.runway.frame.to_ecef(rwy)
+    h = np.array([float(p.runway.frame.threshold_h_m) + z for z in rwy[:, 2]])
+    v_ned = rng.uniform(-120.0, 120.0, (30, 3))
     for gad in gb.GADS:
         for aad in gb.AADS:
             for m in (2, 3, 4):
-                model = gb.GbasModel(gad=gad, aad=aad, reference_receivers=m, sigma_vig_per_m=6e-6)
-                got = gk.gbas_scales(el, x, dh, v, model.gad_params(), float(m), model.aad_params(),
+                model = gb.GbasModel(gad=gad, aad=aad, reference_receivers=m, sigma_vig_per_m=6e-6,
+                                     station_rwy_m=(300.0, -150.0, 5.0))
+                st = np.asarray(model.station_ecef(p.runway.frame))
+                st_h = float(p.runway.frame.threshold_h_m) + 5.0
+                got = gk.gbas_scales(el, r_rx, h, v_ned, st, st_h, model.gad_params(), float(m), model.aad_params(),
                                      model.sigma_vig_per_m, gb.SMOOTHING_TAU_S, model.refractivity_sigma,
                                      model.scale_height_m, 350e3, gb.CARRIER_NOISE_M**2)
+                x, dh, v = gb.station_geometry(r_rx, h, v_ned, st, st_h)
                 ref = model.scales(el, x[:, None], dh[:, None], v[:, None])
                 for name, a in zip((*SCALED, "sigma"), got, strict=True):
                     np.testing.assert_allclose(a, ref[name], rtol=1e-12, atol=0, err_msg=f"{gad} {aad} {m} {name}")
