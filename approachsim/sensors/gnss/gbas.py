@@ -98,7 +98,8 @@ The iono and tropo terms depend on where the aircraft is; `channel_sigmas_m` tak
 on a 3 deg path at 140 kt: the largest residual such an approach sees (conservative closer in).
 
 `GbasModel` holds the configuration and the numpy formulas, the oracle of the compiled kernels
-(sensors/kernels/gnss.py gbas_scales, pseudoranges_gbas).
+(sensors/kernels/gnss.py gbas_scales, pseudoranges_gbas, and gbas_channel_sigmas: the filter's channel sigmas for a
+compiled navigation epoch, called with channel_kernel_args()).
 """
 
 from __future__ import annotations
@@ -254,6 +255,14 @@ class GbasModel:
         """(3,): a0, a1 m, theta0 rad of the AAD curve."""
         a0, a1, th0 = AAD_TABLE[self.aad]
         return np.array([a0, a1, math.radians(th0)])
+
+    def channel_kernel_args(self) -> tuple:
+        """The constant arguments of sensors/kernels/gnss.gbas_channel_sigmas between the geometry and the outputs:
+        gbas_channel_sigmas(el, x_air, dh, v_air, *model.channel_kernel_args(), gse, gmp)."""
+        from approachsim.sensors.gnss.receiver import IONO_SHELL_M
+
+        return (self.gad_params(), float(self.reference_receivers), self.aad_params(), float(self.sigma_vig_per_m),
+                SMOOTHING_TAU_S, float(self.refractivity_sigma), float(self.scale_height_m), IONO_SHELL_M)
 
 
 def _gad_row(th_deg: Array, row: tuple[float, float, float, float, float]) -> tuple[Array, float]:

@@ -12,6 +12,7 @@ same sample of a batch bit for bit.
     sky                look angles, visibility, selection (all / best-PDOP four / a planned four), PDOP, mappings
     pseudoranges       range + mapped errors + receiver clock for every run, nan where not selected
     gbas_scales        the GBAS-corrected residual's scales and nominal sigma per channel (gnss/gbas.py)
+    gbas_channel_sigmas the navigation filter's GPS channel-state sigmas under GBAS, element by element
     pseudoranges_gbas  range + scaled GBAS residual series + receiver clock for every run
     pseudorange_rates  line-of-sight range rate + clock drift + noise for every run
     best_four_epochs   the best-PDOP four at each of a stack of epochs (best_four: one epoch)
@@ -345,6 +346,47 @@ def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_sc
 
 
 @njit(cache=True)
+def _gbas_terms(e: float, path: float, hfac: float, gad: np.ndarray, n_ref: float, aad: np.ndarray,
+                shell_m: float) -> tuple[float, float, float, float, float]:
+    """The five GBAS scales (ground, iono, tropo, multipath, noise), m, of one channel at elevation e (rad), with
+    path = sigma_vig (x_air + 2 tau v_air) and hfac = sigma_n h0 1e-6 |1 - exp(-dh / h0)| (gbas_scales)."""
+    if e > gad[0]:
+        a = gad[1] + gad[2] * math.exp(-e / gad[3])
+        a2 = gad[4]
+    else:
+        a = gad[5] + gad[6] * math.exp(-e / gad[7])
+        a2 = gad[8]
+    x = A * math.cos(e) / (A + shell_m)
+    sn = math.sin(e)
+    return (math.sqrt(a * a / n_ref + a2 * a2), path / math.sqrt(1.0 - x * x), hfac / math.sqrt(0.002 + sn * sn),
+            0.13 + 0.53 * math.exp(-(e * RAD_TO_DEG) / 10.0), aad[0] + aad[1] * math.exp(-e / aad[2]))
+
+
+@njit(cache=True)
+def gbas_channel_sigmas(el: np.ndarray, x_air: np.ndarray, dh: np.ndarray, v_air: np.ndarray, gad: np.ndarray,
+                        n_ref: float, aad: np.ndarray, sigma_vig: float, tau_s: float, sigma_n: float, h0_m: float,
+                        shell_m: float, gse: np.ndarray, gmp: np.ndarray) -> None:
+    """The GPS channel states' 1-sigma (m) under GBAS at elevations el (N, k) rad and each row's distance x_air, height
+    dh and speed v_air relative to the reference point (N,), into gse, gmp (N, k), element by element (the compiled
+    twin of receiver.GnssErrorBudget.channel_sigmas_m, with nav/noise.py's elevation guard; a row's values do not
+    depend on the others):
+
+        el <- max(el, 2 deg) (nan: 0.5 rad);  gse = sqrt(ground^2 + iono^2 + tropo^2);  gmp = sqrt(mp^2 + noise^2)
+    """
+    lo = math.radians(2.0)
+    for i in range(el.shape[0]):
+        path = sigma_vig * (x_air[i] + 2.0 * tau_s * v_air[i])
+        hfac = sigma_n * h0_m * 1e-6 * abs(-math.expm1(-dh[i] / h0_m))
+        for c in range(el.shape[1]):
+            e = el[i, c]
+            e = 0.5 if e != e else e
+            e = max(e, lo)
+            g, io, tr, mp, nz = _gbas_terms(e, path, hfac, gad, n_ref, aad, shell_m)
+            gse[i, c] = math.sqrt(g * g + io * io + tr * tr)
+            gmp[i, c] = math.sqrt(mp * mp + nz * nz)
+
+
+@njit(cache=True)
 def gbas_scales(el: np.ndarray, r_rx: np.ndarray, h_m: np.ndarray, v_ned: np.ndarray, station: np.ndarray,
                 station_h_m: float, gad: np.ndarray, n_ref: float, aad: np.ndarray, sigma_vig: float, tau_s: float,
                 sigma_n: float, h0_m: float, shell_m: float, w2: float) -> tuple[np.ndarray, ...]:
@@ -377,20 +419,7 @@ def gbas_scales(el: np.ndarray, r_rx: np.ndarray, h_m: np.ndarray, v_ned: np.nda
             path = sigma_vig * (x_air + 2.0 * tau_s * v_air)
             hfac = sigma_n * h0_m * 1e-6 * abs(-math.expm1(-(h_m[i] - station_h_m) / h0_m))
             for j in range(k):
-                e = el[s, i, j]
-                if e > gad[0]:
-                    a = gad[1] + gad[2] * math.exp(-e / gad[3])
-                    a2 = gad[4]
-                else:
-                    a = gad[5] + gad[6] * math.exp(-e / gad[7])
-                    a2 = gad[8]
-                g = math.sqrt(a * a / n_ref + a2 * a2)
-                x = A * math.cos(e) / (A + shell_m)
-                io = path / math.sqrt(1.0 - x * x)
-                sn = math.sin(e)
-                tr = hfac / math.sqrt(0.002 + sn * sn)
-                mp = 0.13 + 0.53 * math.exp(-(e * RAD_TO_DEG) / 10.0)
-                nz = aad[0] + aad[1] * math.exp(-e / aad[2])
+                g, io, tr, mp, nz = _gbas_terms(el[s, i, j], path, hfac, gad, n_ref, aad, shell_m)
                 s_gnd[s, i, j] = g
                 s_iono[s, i, j] = io
                 s_tropo[s, i, j] = tr

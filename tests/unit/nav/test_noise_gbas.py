@@ -105,6 +105,33 @@ def test_the_budget_takes_the_aircraft_geometry_when_given(navs):
     assert bud.channel_sigmas_m(el, *gb.REFERENCE_GEOMETRY)[0] == bud.channel_sigmas_m(el)[0]
 
 
+def test_compiled_channel_sigmas_equal_the_budget(navs):
+    """sensors/kernels/gnss.gbas_channel_sigmas (for a compiled navigation epoch: per-run elevations and geometry)
+    equals the budget's numpy channel_sigmas_m behind nav/noise.py's elevation guard (nan -> 0.5 rad, >= 2 deg), to
+    1e-12 relative, each row independent of the others."""
+    from approachsim.sensors.kernels import gnss as gk
+
+    _, nav = navs
+    bud = nav.sensors.gnss.budget()
+    rng = np.random.default_rng(9)
+    el = np.radians(rng.uniform(-5.0, 90.0, (7, 24)))
+    el[2, 3] = np.nan
+    x, dh, v = rng.uniform(0.0, 30e3, 7), rng.uniform(-50.0, 1500.0, 7), rng.uniform(50.0, 90.0, 7)
+    gse, gmp = np.empty(el.shape), np.empty(el.shape)
+    gk.gbas_channel_sigmas(el, x, dh, v, *bud.gbas.channel_kernel_args(), gse, gmp)
+    guard = np.maximum(np.nan_to_num(el, nan=0.5), np.radians(2.0))
+    ref = bud.channel_sigmas_m(guard, x[:, None], dh[:, None], v[:, None])
+    np.testing.assert_allclose(gse, ref[0], rtol=1e-12)
+    np.testing.assert_allclose(gmp, ref[1], rtol=1e-12)
+    one_g, one_m = np.empty((1, 24)), np.empty((1, 24))
+    gk.gbas_channel_sigmas(el[4:5], x[4:5], dh[4:5], v[4:5], *bud.gbas.channel_kernel_args(), one_g, one_m)
+    np.testing.assert_array_equal(one_g[0], gse[4])
+    # at REFERENCE_GEOMETRY it is the elevation-only noise nav/noise.py gives today
+    ones = np.ones(7)
+    gk.gbas_channel_sigmas(el, *(r * ones for r in gb.REFERENCE_GEOMETRY), *bud.gbas.channel_kernel_args(), gse, gmp)
+    np.testing.assert_allclose(gse[2], nav.noise(el[2]).gse_sigma_m, rtol=1e-12)
+
+
 def test_stand_alone_channel_noise_keeps_its_formula():
     """corrections = "none": sqrt(ce^2 + (I_z F)^2 + (T_z M)^2) and the DO-253 curve, bit for bit; tau the shortest of
     clock/ephemeris, iono, tropo."""
