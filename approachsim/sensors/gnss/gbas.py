@@ -24,12 +24,13 @@ Ground (reference receivers' noise and multipath), the ground accuracy designato
   (a MATLAB `PR_err.m` found through the code index, repository not named by it: err_gnd = sqrt(pr_gnd^2 / M +
   err_SIS^2)), consistent with the same Annex page's requirement for SBAS ranging sources, RMS_pr_gnd <= 1.8 / sqrt(M)
   m [V]. Unverified [U]: the clause's own text (whether M is M(theta), the receivers used at that elevation; here
-  the installed number, 2-4: the Type 2 message codes 2, 3 or 4 receivers [V], A10-2006 p. APP B-98). Below 5 deg
+  the installed number, 2-4: the Type 2 message codes 2, 3 or 4 receivers [V], A10-2006 aero.cn 10768_138, the
+  reference's section 1c). Below 5 deg
   (a mask under 5 deg) the 5 deg row is continued (engineering choice). The curve is the designator's accuracy
   *requirement*: the residual is modelled at that limit (a ground subsystem that just meets its designator).
   Correlation: Gauss-Markov, ground_tau_s (default 300 s; engineering choice [D]): static reference antennas see
   multipath whose phase 4 pi h sin(theta) / lambda turns at 4 pi h cos(theta) theta_dot / lambda, with a reflector
-  h = 2 m below the antenna, lambda = 0.19 m and a GPS elevation rate up to 1.5e-4 rad/s a period of 330 s or
+  h = 2 m below the antenna, lambda = 0.19 m and a GPS elevation rate up to 1.5e-4 rad/s a period of 320 s or
   more; 100 s smoothing passes it, so the broadcast correction's error decorrelates over some 300 s.
 
 Airborne (receiver noise and airframe multipath on the 100 s smoothed code), sigma_air^2 = sigma_multipath^2 +
@@ -66,9 +67,10 @@ smoothing filter accumulated along its path):
 
     s_iono = F(theta) sigma_vig (x_air + 2 tau v_air)
 
-  the DO-253 / Annex 10 App. B 3.6.5.5 GBAS form (clause number [U]; the form and its variables -- x_air the
-  distance to the reference point, v_air the aircraft's speed -- as a NAVIGATION (ION) paper states them for its
-  GBAS error model, Table 2, navi.ion.org [S]); F the thin-shell obliquity at 350 km (receiver.iono_obliquity, the
+  the GBAS form of DO-253 / Annex 10 App. B 3.6.5.5 [U: the form written from memory, its clause not read]; its
+  variables -- x_air the distance between the aircraft and the reference point, v_air the aircraft's speed, the
+  gradient sigma -- as a NAVIGATION (ION) paper's GBAS error model lists them after RTCA DO-245A (Table 2,
+  navi.ion.org) [S]; F the thin-shell obliquity at 350 km (receiver.iono_obliquity, the
   Annex's F_pp with the WGS-84 semi-major axis for R_e = 6378.1363 km: 0.7 m apart), tau = 100 s (the smoothing time
   constant), sigma_vig default 4 mm/km, the nominal mid-latitude (CONUS) vertical gradient (Lee et al., as cited in
   GPS Solutions s10291-024-01669-9 [S]; the NAVIGATION table uses the same 0.004 m/km). x_air: the slant distance
@@ -84,8 +86,9 @@ Troposphere (the refractivity left uncorrected between the reference point's hei
   height above the reference point (absolute value: an aircraft below a station on a hill), h0 the troposphere scale
   height, default 7350 m, that of the ITU-R P.453 exponential reference atmosphere N(h) = 315 exp(-h / 7.35 km) [U];
   sigma_n the refractivity uncertainty, default 30 N-units (engineering choice [U]: a conservative broadcast value;
-  below the CAT I decision height the term is under 2 cm at every elevation above 5 deg, 2.6 cm at the zenith at
-  1000 ft [D]). Correlation: the stand-alone tropospheric correlation time (tropo_tau_s, 1 h).
+  below the CAT I decision height the term is under 2 cm at every elevation above 5 deg; 10 nmi out, 985 m above the
+  station, 2.8 cm at the zenith and 28 cm at 5 deg [D]). Correlation: the stand-alone tropospheric correlation time
+  (tropo_tau_s, 1 h).
 
 Nominal 1-sigma (the record's sigma_m): sqrt(s_gnd^2 + s_iono^2 + s_tropo^2 + s_mp^2 + s_noise^2 + w^2), the
 Annex's sigma_i^2 = sigma_pr_gnd^2 + sigma_tropo^2 + sigma_pr_air^2 + sigma_iono^2 (and the 2 mm white).

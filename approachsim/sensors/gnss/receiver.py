@@ -25,8 +25,9 @@ Selectable on top of a preset (make_budget; the profile's [sensors.gnss] multipa
             code of DO-253 / DO-229 airborne receivers, and the smoothing filter, not the few seconds in which raw
             airframe multipath decorrelates on a moving aircraft, sets the correlation of that residual
             (multipath_tau_s; a shorter time lets the navigation filter average it down faster).
-            The AAD-B receiver-noise curve 0.11 + 0.13 exp(-el / 4 deg) is not adopted: it describes smoothed code
-            noise correlated over the same 100 s, whereas the code noise here is the preset's white raw-code noise.
+            The AAD-B receiver-noise curve 0.11 + 0.13 exp(-el / 4 deg) is not adopted here: it describes smoothed code
+            noise correlated over the same 100 s, whereas the code noise here is the preset's white raw-code noise
+            (GBAS corrections, below, do adopt the AAD curves, on the smoothed code they describe).
   clock/ephemeris "nrc1995": the preset's 3.6 m (1995 constellation);
             "current": 2.4 m, the GPS URE (accuracy / continuity sigma) of the draft ICAO Annex 10 default ARAIM
             integrity support data, June 2024, as set in Stanford's MAAST for ARAIM (main_maast_araim.m,
