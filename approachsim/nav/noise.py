@@ -10,6 +10,12 @@ The filter knows the sensors' error budgets, not their realizations: the same bu
 (sensors/presets.py, sensors/gnss/receiver.py, sensors/gnss/clock.py), so a consistent filter is the default.
 The GPS channel states' noise depends on each channel's elevation (iono obliquity, tropo mapping, DO-253
 multipath); `noise` is a pure function of the configuration and the elevations and is cached per elevation vector.
+The receiver's budget gives it (receiver.GnssErrorBudget.channel_sigmas_m and slow_tau_s): stand-alone, the slow
+state is clock/ephemeris + iono + tropo, the fast one the multipath; with GBAS corrections (sensors/gnss/gbas.py)
+the slow state is the ground + iono + tropo residual and the fast one the airborne multipath + smoothed receiver
+noise (the white code noise left is the 2 mm carrier-phase noise: the budget's code_noise_m). The GBAS iono and
+tropo residuals grow with the aircraft's distance from and height above the reference point; the elevation-only
+noise here takes them at gbas.REFERENCE_GEOMETRY (the start of a 10 nmi final), conservative closer in.
 """
 
 from __future__ import annotations
@@ -23,7 +29,6 @@ from approachsim.nav import errormodel as em
 from approachsim.nav.config import NavConfig
 from approachsim.sensors.config import SensorsConfig
 from approachsim.sensors.gnss.clock import ClockModel
-from approachsim.sensors.gnss.receiver import iono_obliquity, tropo_mapping
 from approachsim.sensors.presets import PRESETS
 
 Array = np.ndarray
@@ -69,12 +74,8 @@ class NoiseModel:
     def _channel_sigmas(self, elevation_rad: Array) -> tuple[Array, Array | float]:
         """The GPS channel states' 1-sigma (m) at elevation_rad (k,): slow range error (clock/ephemeris, mapped
         iono and tropo) and multipath (per channel under DO-253, one value under NRC 1995)."""
-        bud = self.sensors.gnss.budget()
         el = np.maximum(np.nan_to_num(elevation_rad, nan=0.5), np.radians(2.0))
-        gse = np.sqrt(bud.clock_ephemeris_m**2 + (bud.iono_zenith_m * iono_obliquity(el)) ** 2
-                      + (bud.tropo_zenith_m * tropo_mapping(el)) ** 2)
-        gmp = bud.multipath_sigma_m(el) if bud.multipath_model == "do253" else bud.multipath_m
-        return gse, gmp
+        return self.sensors.gnss.budget().channel_sigmas_m(el)
 
     def _at_elevations(self, elevation_rad: Array) -> em.ErrorNoise:
         """The noise with the GPS channel states' sigmas at elevation_rad: the elevation-free noise (cached) with
@@ -105,14 +106,9 @@ class NoiseModel:
             bud = self.sensors.gnss.budget()
             el = np.full(24, np.radians(30.0)) if elevation_rad is None else np.nan_to_num(elevation_rad, nan=0.5)
             el = np.maximum(el, np.radians(2.0))
-            kw.update(
-                gse_sigma_m=np.sqrt(bud.clock_ephemeris_m**2 + (bud.iono_zenith_m * iono_obliquity(el)) ** 2
-                                    + (bud.tropo_zenith_m * tropo_mapping(el)) ** 2),
-                gse_tau_s=min(bud.clock_ephemeris_tau_s, bud.iono_tau_s, bud.tropo_tau_s),
-                # per channel at its elevation under do253 (the sensor's sigma_mp), one value under nrc1995
-                gmp_sigma_m=(bud.multipath_sigma_m(el) if bud.multipath_model == "do253" else bud.multipath_m),
-                gmp_tau_s=bud.multipath_tau_s,
-            )
+            # per channel at its elevation (do253: the sensor's sigma_mp), one multipath value under nrc1995
+            gse, gmp = bud.channel_sigmas_m(el)
+            kw.update(gse_sigma_m=gse, gse_tau_s=bud.slow_tau_s, gmp_sigma_m=gmp, gmp_tau_s=bud.multipath_tau_s)
         if self.sensors.pseudolite is not None:
             p = self.sensors.pseudolite
             kw.update(pmp_sigma_m=p.multipath_m, pmp_tau_s=p.multipath_tau_s)

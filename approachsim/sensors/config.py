@@ -18,6 +18,7 @@ from approachsim.config import ProfileError, Section
 from approachsim.sensors.faults import FAULT_KINDS, FaultSpec
 from approachsim.sensors.gnss.clock import OSCILLATORS
 from approachsim.sensors.gnss.constellation import parse_epoch
+from approachsim.sensors.gnss.gbas import AADS, GADS, GbasModel
 from approachsim.sensors.gnss.receiver import (
     CLOCK_EPHEMERIS_M,
     CODE_PRESETS,
@@ -91,10 +92,15 @@ class GnssConfig:
     multipath_tau_s: float | None = None
     """None: the model's default (receiver.make_budget)."""
     clock_ephemeris: str = "current"
+    corrections: str = "none"
+    """"none": stand-alone ranging; "gbas": GBAS-corrected pseudoranges (sensors/gnss/gbas.py, the `gbas` model)."""
+    gbas: GbasModel | None = None
+    """[sensors.gnss.gbas]: the ground station and airborne equipment (set exactly when corrections = "gbas")."""
 
     def budget(self) -> GnssErrorBudget:
-        """The error budget these settings select (code preset, multipath model, clock/ephemeris budget)."""
-        return make_budget(self.code, self.multipath_model, self.clock_ephemeris, self.multipath_tau_s)
+        """The error budget these settings select (code preset, multipath model, clock/ephemeris budget, GBAS
+        corrections)."""
+        return make_budget(self.code, self.multipath_model, self.clock_ephemeris, self.multipath_tau_s, self.gbas)
 
     def epoch_window(self) -> float:
         """Width (s) of the per-run epoch window; 0 for a fixed epoch."""
@@ -103,6 +109,8 @@ class GnssConfig:
 
 EPOCH_MODES = ("per-run", "fixed")
 """[sensors.gnss] epoch: one sky per run over the window, or the one epoch_utc."""
+CORRECTIONS = ("none", "gbas")
+"""[sensors.gnss] corrections: stand-alone ranging, or GBAS differential corrections."""
 
 
 @dataclass(frozen=True)
@@ -212,9 +220,14 @@ def parse_sensors(s: Section) -> SensorsConfig:
             multipath_tau_s=g.number("multipath_tau_s", make_budget(code, mp).multipath_tau_s, lo=0.0,
                                      lo_open=True, hi=1e5, unit="s"),
             clock_ephemeris=g.string("clock_ephemeris", "current", choices=tuple(CLOCK_EPHEMERIS_M)),
+            corrections=(corr := g.string("corrections", "none", choices=CORRECTIONS)),
+            gbas=_parse_gbas(g, corr),
         )
         if gnss.epoch == "fixed" and g.has("epoch_window_h"):
             raise ProfileError(f"{g.path}.epoch_window_h: only used with epoch = \"per-run\" (epoch is \"fixed\")")
+        if corr == "gbas" and mp != "do253":
+            raise ProfileError(f"{g.path}.multipath_model: corrections = \"gbas\" needs \"do253\" (the airframe "
+                               f"multipath of the 100 s smoothed code), got {mp!r}")
     g.done()
 
     p = s.section("pseudolite")
@@ -244,6 +257,29 @@ def parse_sensors(s: Section) -> SensorsConfig:
     p.done()
     s.done()
     return SensorsConfig(imu=imu, baro=baro, radalt=radalt, gnss=gnss, pseudolite=pseudolite)
+
+
+def _parse_gbas(g: Section, corrections: str) -> GbasModel | None:
+    """[sensors.gnss.gbas] (only with corrections = "gbas"; the table is an error otherwise)."""
+    t = g.section("gbas")
+    if corrections != "gbas":
+        if g.has("gbas"):
+            raise ProfileError(f"{t.path}: only used with corrections = \"gbas\" (corrections is {corrections!r})")
+        return None
+    model = GbasModel(
+        gad=t.string("gad", "C", choices=GADS),
+        aad=t.string("aad", "B", choices=AADS),
+        reference_receivers=t.integer("reference_receivers", 4, lo=2, hi=4),
+        sigma_vig_per_m=t.number("sigma_vig_mm_per_km", 4.0, lo=0.0, hi=500.0, unit="mm/km") * 1e-6,
+        refractivity_sigma=t.number("refractivity_sigma", 30.0, lo=0.0, hi=255.0, unit="N-units"),
+        scale_height_m=t.number("scale_height_m", 7350.0, lo=0.0, lo_open=True, hi=25500.0, unit="m"),
+        ground_tau_s=t.number("ground_tau_s", 300.0, lo=0.0, lo_open=True, hi=1e5, unit="s"),
+        station_rwy_m=(t.number("station_along_ft", 0.0, lo=-200000.0, hi=50000.0, unit="ft") * units.FT,
+                       t.number("station_cross_ft", 0.0, lo=-50000.0, hi=50000.0, unit="ft") * units.FT,
+                       t.number("station_height_ft", 0.0, lo=-500.0, hi=2000.0, unit="ft") * units.FT),
+    )
+    t.done()
+    return model
 
 
 FAULT_PARAMETERS: Mapping[str, tuple[str, ...]] = MappingProxyType({

@@ -8,8 +8,9 @@ Each field is one filter state group (nav/errormodel.py StateLayout names), the 
 estimate exactly at `row`; None when the suite has no such sensor. Signs follow the measurement rows
 (nav/measurements.py): every state is the error the sensor *adds* to its measurement.
 
-    gse  (N, 24) m    clock/ephemeris + F(el) iono + M(el) tropo of each GPS channel (receiver.py), el at `row`
-    gmp  (N, 24) m    multipath of each channel
+    gse  (N, 24) m    clock/ephemeris + F(el) iono + M(el) tropo of each GPS channel (receiver.py), el at `row`;
+                      GBAS corrections: the ground + iono + tropo residuals (gbas.py)
+    gmp  (N, 24) m    multipath of each channel; GBAS: the airborne multipath + smoothed receiver noise
     clk  (N, 2)       receiver clock bias (m) and drift (m/s) (clock.py; shared by GPS and pseudolites)
     bb   (N,)   m     baro Gauss-Markov bias; sb (N,) its scale factor (baro.py, h_B = h (1 + S) + B + v)
     bg   (N, 3) rad/s gyro bias in body axes as the INS sees it over the increment after `row`: turn-on +
@@ -37,7 +38,6 @@ import numpy as np
 
 from approachsim.sensors import base
 from approachsim.sensors.gnss.constellation import look_angles
-from approachsim.sensors.gnss.receiver import iono_obliquity, tropo_mapping
 
 Array = np.ndarray
 
@@ -126,29 +126,30 @@ def _gnss_el(at: _At, e: base.SensorErrors, j: int) -> Array:
     return el[0] if off is None else el
 
 
-def _gmp(at: _At) -> Array | None:
-    """Multipath of each channel, m: the drawn series, scaled by sigma_mp(el) under the do253 model (its series
-    is unit-sigma, receiver.py)."""
+def _channels(at: _At) -> tuple[Array, Array] | None:
+    """(gse, gmp) of each channel, m: the receiver's channel_errors of the drawn series at the sample's elevations
+    and (GBAS) the aircraft's geometry relative to the reference point (receiver.py)."""
     s = at.sample("gnss")
     if s is None:
         return None
     e, j = s
-    mp = np.asarray(e.series["multipath"])[:, j]
-    b = at.suite.sensors["gnss"].budget
-    if b.multipath_model != "do253":
-        return mp
-    return mp * b.multipath_sigma_m(_gnss_el(at, e, j))
+    rx = at.suite.sensors["gnss"]
+    el = _gnss_el(at, e, j)
+    ser = {k: np.asarray(v)[:, j] for k, v in e.series.items() if k != "rate_noise"}
+    geom = rx.station_geometry(at.truth, e.rows[j:j + 1]) if rx.budget.gbas is not None else (None, None, None)
+    return rx.channel_errors(ser, el, *geom)
+
+
+def _gmp(at: _At) -> Array | None:
+    """Multipath of each channel, m: the drawn series, scaled by sigma_mp(el) under the do253 model (its series
+    is unit-sigma, receiver.py); GBAS: with the smoothed receiver noise."""
+    c = _channels(at)
+    return None if c is None else c[1]
 
 
 def _gse(at: _At) -> Array | None:
-    s = at.sample("gnss")
-    if s is None:
-        return None
-    e, j = s
-    el = _gnss_el(at, e, j)
-    ser = e.series
-    return (np.asarray(ser["clock_ephemeris"])[:, j] + iono_obliquity(el) * np.asarray(ser["iono_zenith"])[:, j]
-            + tropo_mapping(el) * np.asarray(ser["tropo_zenith"])[:, j])
+    c = _channels(at)
+    return None if c is None else c[0]
 
 
 def _clk(at: _At) -> Array | None:

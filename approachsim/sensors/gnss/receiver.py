@@ -25,14 +25,27 @@ Selectable on top of a preset (make_budget; the profile's [sensors.gnss] multipa
             code of DO-253 / DO-229 airborne receivers, and the smoothing filter, not the few seconds in which raw
             airframe multipath decorrelates on a moving aircraft, sets the correlation of that residual
             (multipath_tau_s; a shorter time lets the navigation filter average it down faster).
-            The AAD-B receiver-noise curve 0.11 + 0.13 exp(-el / 4 deg) is not adopted: it describes smoothed code
-            noise correlated over the same 100 s, whereas the code noise here is the preset's white raw-code noise.
+            The AAD-B receiver-noise curve 0.11 + 0.13 exp(-el / 4 deg) is not adopted here: it describes smoothed code
+            noise correlated over the same 100 s, whereas the code noise here is the preset's white raw-code noise
+            (GBAS corrections, below, do adopt the AAD curves, on the smoothed code they describe).
   clock/ephemeris "nrc1995": the preset's 3.6 m (1995 constellation);
             "current": 2.4 m, the GPS URE (accuracy / continuity sigma) of the draft ICAO Annex 10 default ARAIM
             integrity support data, June 2024, as set in Stanford's MAAST for ARAIM (main_maast_araim.m,
             isd.ure_gps = 2.4 m, Blanch et al.); a conservative modern figure: the measured GPS signal-in-space
             URE RMS of recent years is lower still (Renfro et al., "An Analysis of Global Positioning System
             (GPS) Standard Positioning Service Performance for 2019", ARL:UT TR-SGL-20-02, 2020).
+
+Corrections (the profile's [sensors.gnss] corrections): "none" is the stand-alone model above; "gbas" (gbas.py)
+replaces every term but the receiver clock by the residual of a GBAS-corrected, 100 s carrier-smoothed code:
+
+    rho_i = |r_sv,i - r| + b_rx + s_gnd g_i + s_iono I_i + s_tropo T_i + s_mp m_i + s_noise n_i + w_i
+
+g (ground, ground_tau_s), I (iono_tau_s), T (tropo_tau_s), m (multipath_tau_s), n (the 100 s smoothing) unit
+Gauss-Markov series drawn from the same standard normals, in the same columns, as the stand-alone clock/ephemeris,
+iono, tropo, multipath and noise (common random numbers between the two); the scales at each channel's elevation and
+the aircraft's distance, height and speed relative to the GBAS reference point (station_ecef). w is the 2 mm white
+carrier-phase noise the smoothing passes (gbas.CARRIER_NOISE_M, budget code_noise_m), from normals drawn after all
+the others. The record's sigma_m is the corrected nominal sigma there.
 
 Epoch: every run's sky is the constellation at epoch_utc + its own offset (errors.constants["epoch_offset_s"],
 drawn by the sensor suite from the run's "gnss_epoch" stream); a batch of runs with offsets gives per-run geometry
@@ -73,6 +86,7 @@ from approachsim.records import GnssSamples, Truth
 from approachsim.sensors import base
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
+from approachsim.sensors.gnss.gbas import CARRIER_NOISE_M, SMOOTHING_TAU_S, GbasModel, station_geometry
 from approachsim.sensors.kernels import gnss as gk
 
 Array = np.ndarray
@@ -110,12 +124,43 @@ class GnssErrorBudget:
     multipath_tau_s: float = 60.0
     multipath_model: str = "nrc1995"
     """"nrc1995": multipath_m at every elevation; "do253": sigma_mp(el) (multipath_m unused)."""
+    gbas: GbasModel | None = None
+    """GBAS corrections (gbas.py): every stand-alone term above but the multipath curve is replaced, code_noise_m is
+    the white carrier-phase noise left on the smoothed code (make_budget); None: stand-alone ranging."""
+
+    @property
+    def corrections(self) -> str:
+        """"none" or "gbas"."""
+        return "none" if self.gbas is None else "gbas"
 
     def multipath_sigma_m(self, el_rad: Array) -> Array:
         """1-sigma multipath (m) at elevation el_rad (rad) of this budget's model."""
         if self.multipath_model == "do253":
             return do253_multipath_sigma_m(el_rad)
         return np.full(np.shape(el_rad), self.multipath_m)
+
+    @property
+    def slow_tau_s(self) -> float:
+        """Correlation time (s) of the navigation filter's slow channel state: the shortest of the slow terms'
+        (stand-alone: clock/ephemeris, iono, tropo; GBAS: ground, iono, tropo residuals)."""
+        first = self.clock_ephemeris_tau_s if self.gbas is None else self.gbas.ground_tau_s
+        return min(first, self.iono_tau_s, self.tropo_tau_s)
+
+    def channel_sigmas_m(self, el_rad: Array, x_air_m: Array | None = None, dh_m: Array | None = None,
+                         v_air_mps: Array | None = None) -> tuple[Array, Array | float]:
+        """The navigation filter's channel-state 1-sigmas (m) at elevations el_rad (rad): the slow range error and
+        the fast one (nav/noise.py).
+
+        Stand-alone: slow sqrt(ce^2 + (I_z F)^2 + (T_z M)^2), fast the multipath (per channel under do253, the one
+        value multipath_m under nrc1995); the geometry arguments are not used. GBAS: gbas.GbasModel.channel_sigmas_m
+        at the aircraft's distance x_air_m, height dh_m above and speed v_air_mps relative to the reference point
+        (None: gbas.REFERENCE_GEOMETRY)."""
+        if self.gbas is not None:
+            return self.gbas.channel_sigmas_m(el_rad, x_air_m, dh_m, v_air_mps)
+        gse = np.sqrt(self.clock_ephemeris_m**2 + (self.iono_zenith_m * iono_obliquity(el_rad)) ** 2
+                      + (self.tropo_zenith_m * tropo_mapping(el_rad)) ** 2)
+        gmp = self.multipath_sigma_m(el_rad) if self.multipath_model == "do253" else self.multipath_m
+        return gse, gmp
 
 
 def do253_multipath_sigma_m(el_rad: Array) -> Array:
@@ -124,18 +169,24 @@ def do253_multipath_sigma_m(el_rad: Array) -> Array:
 
 
 def make_budget(code: str, multipath_model: str = "nrc1995", clock_ephemeris: str = "nrc1995",
-                multipath_tau_s: float | None = None) -> GnssErrorBudget:
+                multipath_tau_s: float | None = None, gbas: GbasModel | None = None) -> GnssErrorBudget:
     """The code preset with the chosen multipath model and clock/ephemeris budget (module docstring); tau None:
-    the model's default (preset 60 s for nrc1995, DO253_MULTIPATH_TAU_S for do253)."""
+    the model's default (preset 60 s for nrc1995, DO253_MULTIPATH_TAU_S for do253). With `gbas` the GBAS-corrected
+    budget (gbas.py): the stand-alone fields are kept (unused by the sensor), code_noise_m is the white carrier-phase
+    noise left on the smoothed code (gbas.CARRIER_NOISE_M) and the airframe multipath must be "do253"."""
     if multipath_model not in MULTIPATH_MODELS:
         raise ValueError(f"multipath_model must be one of {', '.join(MULTIPATH_MODELS)}; got {multipath_model!r}")
     if clock_ephemeris not in CLOCK_EPHEMERIS_M:
         raise ValueError(f"clock_ephemeris must be one of {', '.join(CLOCK_EPHEMERIS_M)}; got {clock_ephemeris!r}")
+    if gbas is not None and multipath_model != "do253":
+        raise ValueError(f"GBAS corrections need the do253 airframe multipath of the smoothed code; got "
+                         f"multipath_model {multipath_model!r}")
     b = CODE_PRESETS[code]
     if multipath_tau_s is None:
         multipath_tau_s = DO253_MULTIPATH_TAU_S if multipath_model == "do253" else b.multipath_tau_s
-    return replace(b, multipath_model=multipath_model, clock_ephemeris_m=CLOCK_EPHEMERIS_M[clock_ephemeris],
-                   multipath_tau_s=multipath_tau_s)
+    b = replace(b, multipath_model=multipath_model, clock_ephemeris_m=CLOCK_EPHEMERIS_M[clock_ephemeris],
+                multipath_tau_s=multipath_tau_s)
+    return b if gbas is None else replace(b, code_noise_m=CARRIER_NOISE_M, gbas=gbas)
 
 
 def draw_epoch_offsets(window_s: float, rng: base.RngLike) -> Array:
@@ -215,6 +266,8 @@ class GnssReceiver:
     doppler: bool = False
     doppler_noise_mps: float = 0.05
     fixed_hold_s: float = 1800.0
+    station_ecef: tuple[float, float, float] | None = None
+    """The GBAS reference point, ECEF m (needed with a GBAS budget: gbas.GbasModel.station_ecef)."""
     name: str = "gnss"
 
     fault_targets: ClassVar[tuple[tuple[str, str, str], ...]] = (
@@ -225,10 +278,30 @@ class GnssReceiver:
     def __post_init__(self) -> None:
         if self.selection not in SELECTIONS:
             raise ValueError(f"selection must be one of {', '.join(SELECTIONS)}; got {self.selection!r}")
+        if self.budget.gbas is not None and self.station_ecef is None:
+            raise ValueError("a GBAS budget needs station_ecef, the reference point (GbasModel.station_ecef)")
+        h = math.nan
+        if self.station_ecef is not None:
+            h = float(geo.ecef_to_geodetic(np.asarray(self.station_ecef, dtype=float))[2])
+        object.__setattr__(self, "_station_h_m", h)
+        g = self.budget.gbas
+        # gbas_scales' constant arguments after the truth's (sensors/kernels/gnss.py), made once
+        object.__setattr__(self, "_gbas_args", None if g is None else (
+            np.asarray(self.station_ecef, dtype=float), h, g.gad_params(), float(g.reference_receivers),
+            g.aad_params(), float(g.sigma_vig_per_m), SMOOTHING_TAU_S, float(g.refractivity_sigma),
+            float(g.scale_height_m), IONO_SHELL_M, self.budget.code_noise_m**2))
+
+    @property
+    def station_h_m(self) -> float:
+        """Ellipsoid height of the GBAS reference point, m (nan without one)."""
+        return self._station_h_m  # type: ignore[attr-defined]
 
     def draw(self, t_s: Array, rng: base.RngLike) -> base.SensorErrors:
         """series (m, 24) m: clock_ephemeris, iono_zenith, tropo_zenith, multipath, noise (+ rate_noise m/s);
-        multipath is unit-sigma under the do253 model (apply scales it by sigma_mp at the channel's elevation)."""
+        multipath is unit-sigma under the do253 model (apply scales it by sigma_mp at the channel's elevation).
+        GBAS budget: ground, iono, tropo, multipath, noise, all unit-sigma Gauss-Markov (apply scales them; module
+        docstring), from the same standard normals as the stand-alone series in the same place, and white (m), the
+        carrier-phase noise, from normals drawn after those."""
         b = self.budget
         k = self.constellation.prn.shape[0]
 
@@ -237,6 +310,15 @@ class GnssReceiver:
         def one(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
             z = g.standard_normal((m, (6 if self.doppler else 5) * k))
             extra = {"rate_noise": self.doppler_noise_mps * z[:, 5 * k : 6 * k]} if self.doppler else {}
+            if b.gbas is not None:
+                return extra | {
+                    "white": b.code_noise_m * g.standard_normal((m, k)),  # after the others: theirs stay the same
+                    "ground": base.gauss_markov(z[:, 0:k], 1.0, b.gbas.ground_tau_s, dt),
+                    "iono": base.gauss_markov(z[:, k : 2 * k], 1.0, b.iono_tau_s, dt),
+                    "tropo": base.gauss_markov(z[:, 2 * k : 3 * k], 1.0, b.tropo_tau_s, dt),
+                    "multipath": base.gauss_markov(z[:, 3 * k : 4 * k], 1.0, b.multipath_tau_s, dt),
+                    "noise": base.gauss_markov(z[:, 4 * k : 5 * k], 1.0, SMOOTHING_TAU_S, dt),
+                }
             return extra | {
                 "clock_ephemeris": base.gauss_markov(z[:, 0:k], b.clock_ephemeris_m, b.clock_ephemeris_tau_s, dt),
                 "iono_zenith": base.gauss_markov(z[:, k : 2 * k], b.iono_zenith_m, b.iono_tau_s, dt),
@@ -298,9 +380,38 @@ class GnssReceiver:
         per = [self.geometry(truth, errors.rows, errors.t_s, float(o)) for o in np.asarray(off)]
         return {k: np.stack([g[k] for g in per]) for k in per[0]}
 
-    def sigma_m(self, el_rad: Array) -> Array:
-        """Nominal 1-sigma pseudorange error at elevation el (m): RSS of the budget with its mappings."""
+    def station_geometry(self, truth: Truth, rows: Array) -> tuple[Array, Array, Array]:
+        """(x_air, dh, v_air) (m,) at truth `rows`: slant distance to the GBAS reference point (m), height above it
+        (m), horizontal speed (m/s) (gbas.station_geometry; nan without a reference point)."""
+        if self.station_ecef is None:
+            nan = np.full(np.shape(rows), np.nan)
+            return nan, nan, nan
+        return station_geometry(truth.r_ecef[rows], truth.h_m[rows], truth.v_ned[rows],
+                                np.asarray(self.station_ecef), self.station_h_m)
+
+    def channel_errors(self, series: Mapping[str, Array], el_rad: Array, x_air_m: Array | None = None,
+                       dh_m: Array | None = None, v_air_mps: Array | None = None) -> tuple[Array, Array]:
+        """The realized errors (m) of the navigation filter's slow and fast channel states (sensors/states.py) from
+        one sample's error series (name -> (..., 24)) at elevations el_rad (rad): stand-alone E + F I + M T and the
+        (scaled) multipath; GBAS s_gnd g + s_iono I + s_tropo T and s_mp m + s_noise n at the aircraft's geometry
+        (x_air_m, dh_m, v_air_mps, broadcast against el_rad)."""
         b = self.budget
+        if b.gbas is None:
+            slow = series["clock_ephemeris"] + iono_obliquity(el_rad) * series["iono_zenith"] + (
+                tropo_mapping(el_rad) * series["tropo_zenith"])
+            mp = series["multipath"]
+            return slow, (mp * b.multipath_sigma_m(el_rad) if b.multipath_model == "do253" else mp)
+        sc = b.gbas.scales(el_rad, x_air_m, dh_m, v_air_mps)
+        return (sc["ground"] * series["ground"] + sc["iono"] * series["iono"] + sc["tropo"] * series["tropo"],
+                sc["multipath"] * series["multipath"] + sc["noise"] * series["noise"])
+
+    def sigma_m(self, el_rad: Array, x_air_m: Array | None = None, dh_m: Array | None = None,
+                v_air_mps: Array | None = None) -> Array:
+        """Nominal 1-sigma pseudorange error at elevation el (m): RSS of the budget with its mappings (GBAS: of the
+        corrected residual at the aircraft's geometry, broadcast against el_rad; gbas.GbasModel.sigma_m)."""
+        b = self.budget
+        if b.gbas is not None:
+            return b.gbas.sigma_m(el_rad, x_air_m, dh_m, v_air_mps)
         return np.sqrt(
             b.clock_ephemeris_m**2 + (b.iono_zenith_m * iono_obliquity(el_rad)) ** 2
             + (b.tropo_zenith_m * tropo_mapping(el_rad)) ** 2 + b.multipath_sigma_m(el_rad) ** 2
@@ -359,13 +470,22 @@ class GnssReceiver:
         b = self.budget
         mode = {"all": gk.MODE_ALL, "best4": gk.MODE_BEST4, "best4-fixed": gk.MODE_PLANNED}[self.selection]
         c = np.ascontiguousarray
+        r_rx = c(truth.r_ecef[rows], dtype=float)
         rng, u, el, az, vis, sel, pdop, f_iono, m_tropo, mp_scale, sigma = gk.sky(
-            c(truth.r_ecef[rows], dtype=float), c(r_sv), float(self.mask_rad), mode, c(plan), IONO_SHELL_M,
+            r_rx, c(r_sv), float(self.mask_rad), mode, c(plan), IONO_SHELL_M,
             b.multipath_model == "do253", float(b.multipath_m), b.clock_ephemeris_m**2, float(b.iono_zenith_m),
             float(b.tropo_zenith_m), b.code_noise_m**2)
-        pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, c(series["clock_ephemeris"]),
-                                    c(series["iono_zenith"]), c(series["tropo_zenith"]), c(series["multipath"]),
-                                    c(series["noise"]), c(bias))
+        if b.gbas is None:
+            pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, c(series["clock_ephemeris"]),
+                                        c(series["iono_zenith"]), c(series["tropo_zenith"]), c(series["multipath"]),
+                                        c(series["noise"]), c(bias))
+        else:
+            s_gnd, s_iono, s_tropo, s_mp, s_noise, sigma = gk.gbas_scales(
+                el, r_rx, c(truth.h_m[rows], dtype=float), c(truth.v_ned[rows], dtype=float),
+                *self._gbas_args)  # type: ignore[attr-defined]
+            pr, valid = gk.pseudoranges_gbas(rng, s_gnd, s_iono, s_tropo, s_mp, s_noise, sel, c(series["ground"]),
+                                             c(series["iono"]), c(series["tropo"]), c(series["multipath"]),
+                                             c(series["noise"]), c(series["white"]), c(bias))
         prr = None
         if self.doppler:
             prr = gk.pseudorange_rates(u, c(v_sv), c(truth.lat_rad[rows], dtype=float),
@@ -392,11 +512,19 @@ class GnssReceiver:
         geo_ = self.geometries(truth, errors)
         s = errors.series
         el = geo_["el"]
-        mp = s["multipath"] * do253_multipath_sigma_m(el) if self.budget.multipath_model == "do253" else s["multipath"]
-        pr = (
-            geo_["range"] + s["clock_ephemeris"] + iono_obliquity(el) * s["iono_zenith"]
-            + tropo_mapping(el) * s["tropo_zenith"] + mp + s["noise"]
-        )
+        geom: tuple[Array | None, ...] = (None, None, None)
+        if self.budget.gbas is not None:
+            geom = tuple(a[:, None] for a in self.station_geometry(truth, errors.rows))  # (m, 1) against (.., m, k)
+            sc = self.budget.gbas.scales(el, *geom)
+            pr = (geo_["range"] + sc["ground"] * s["ground"] + sc["iono"] * s["iono"] + sc["tropo"] * s["tropo"]
+                  + sc["multipath"] * s["multipath"] + sc["noise"] * s["noise"] + s["white"])
+        else:
+            mp = (s["multipath"] * do253_multipath_sigma_m(el) if self.budget.multipath_model == "do253"
+                  else s["multipath"])
+            pr = (
+                geo_["range"] + s["clock_ephemeris"] + iono_obliquity(el) * s["iono_zenith"]
+                + tropo_mapping(el) * s["tropo_zenith"] + mp + s["noise"]
+            )
         shape_t = pr.shape[:-1]
         if clock is None:
             cb = np.zeros(shape_t)
@@ -416,7 +544,7 @@ class GnssReceiver:
             prr = np.where(valid, rr + cd_[..., None] + s["rate_noise"], np.nan)
         return GnssSamples(
             t_s=errors.t_s, prn=self.constellation.prn, r_sv_ecef=geo_["r_sv"],
-            pseudorange_m=np.where(valid, pr, np.nan), sigma_m=self.sigma_m(el), elevation_rad=el,
+            pseudorange_m=np.where(valid, pr, np.nan), sigma_m=self.sigma_m(el, *geom), elevation_rad=el,
             azimuth_rad=geo_["az"], visible=geo_["visible"], valid=valid, pdop=geo_["pdop"],
             clock_bias_m=np.array(cb), clock_drift_mps=np.array(cd), fault=np.zeros(pr.shape, dtype=np.int8),
             pseudorange_rate_mps=prr, epoch_offset_s=errors.constants.get("epoch_offset_s"),

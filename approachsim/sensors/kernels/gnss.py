@@ -11,6 +11,9 @@ same sample of a batch bit for bit.
     look_angles        range, line of sight, elevation and azimuth of every satellite from the receiver
     sky                look angles, visibility, selection (all / best-PDOP four / a planned four), PDOP, mappings
     pseudoranges       range + mapped errors + receiver clock for every run, nan where not selected
+    gbas_scales        the GBAS-corrected residual's scales and nominal sigma per channel (gnss/gbas.py)
+    gbas_channel_sigmas the navigation filter's GPS channel-state sigmas under GBAS, element by element
+    pseudoranges_gbas  range + scaled GBAS residual series + receiver clock for every run
     pseudorange_rates  line-of-sight range rate + clock drift + noise for every run
     best_four_epochs   the best-PDOP four at each of a stack of epochs (best_four: one epoch)
 """
@@ -336,6 +339,119 @@ def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_sc
             for j in range(k):
                 p = (rng[s, i, j] + ce[r, i, j] + f_iono[s, i, j] * iono[r, i, j] + m_tropo[s, i, j] * tropo[r, i, j]
                      + mp[r, i, j] * mp_scale[s, i, j] + noise[r, i, j])
+                v = sel[s, i, j]
+                valid[r, i, j] = v
+                pr[r, i, j] = p + b if v else math.nan
+    return pr, valid
+
+
+@njit(cache=True)
+def _gbas_terms(e: float, path: float, hfac: float, gad: np.ndarray, n_ref: float, aad: np.ndarray,
+                shell_m: float) -> tuple[float, float, float, float, float]:
+    """The five GBAS scales (ground, iono, tropo, multipath, noise), m, of one channel at elevation e (rad), with
+    path = sigma_vig (x_air + 2 tau v_air) and hfac = sigma_n h0 1e-6 |1 - exp(-dh / h0)| (gbas_scales)."""
+    if e > gad[0]:
+        a = gad[1] + gad[2] * math.exp(-e / gad[3])
+        a2 = gad[4]
+    else:
+        a = gad[5] + gad[6] * math.exp(-e / gad[7])
+        a2 = gad[8]
+    x = A * math.cos(e) / (A + shell_m)
+    sn = math.sin(e)
+    return (math.sqrt(a * a / n_ref + a2 * a2), path / math.sqrt(1.0 - x * x), hfac / math.sqrt(0.002 + sn * sn),
+            0.13 + 0.53 * math.exp(-(e * RAD_TO_DEG) / 10.0), aad[0] + aad[1] * math.exp(-e / aad[2]))
+
+
+@njit(cache=True)
+def gbas_channel_sigmas(el: np.ndarray, x_air: np.ndarray, dh: np.ndarray, v_air: np.ndarray, gad: np.ndarray,
+                        n_ref: float, aad: np.ndarray, sigma_vig: float, tau_s: float, sigma_n: float, h0_m: float,
+                        shell_m: float, gse: np.ndarray, gmp: np.ndarray) -> None:
+    """The GPS channel states' 1-sigma (m) under GBAS at elevations el (N, k) rad and each row's distance x_air, height
+    dh and speed v_air relative to the reference point (N,), into gse, gmp (N, k), element by element (the compiled
+    twin of receiver.GnssErrorBudget.channel_sigmas_m, with nav/noise.py's elevation guard; a row's values do not
+    depend on the others):
+
+        el <- max(el, 2 deg) (nan: 0.5 rad);  gse = sqrt(ground^2 + iono^2 + tropo^2);  gmp = sqrt(mp^2 + noise^2)
+    """
+    lo = math.radians(2.0)
+    for i in range(el.shape[0]):
+        path = sigma_vig * (x_air[i] + 2.0 * tau_s * v_air[i])
+        hfac = sigma_n * h0_m * 1e-6 * abs(-math.expm1(-dh[i] / h0_m))
+        for c in range(el.shape[1]):
+            e = el[i, c]
+            e = 0.5 if e != e else e
+            e = max(e, lo)
+            g, io, tr, mp, nz = _gbas_terms(e, path, hfac, gad, n_ref, aad, shell_m)
+            gse[i, c] = math.sqrt(g * g + io * io + tr * tr)
+            gmp[i, c] = math.sqrt(mp * mp + nz * nz)
+
+
+@njit(cache=True)
+def gbas_scales(el: np.ndarray, r_rx: np.ndarray, h_m: np.ndarray, v_ned: np.ndarray, station: np.ndarray,
+                station_h_m: float, gad: np.ndarray, n_ref: float, aad: np.ndarray, sigma_vig: float, tau_s: float,
+                sigma_n: float, h0_m: float, shell_m: float, w2: float) -> tuple[np.ndarray, ...]:
+    """The GBAS-corrected residual's scales (S, m, k), m, at elevations el (S, m, k) rad, for receivers at r_rx (m, 3)
+    ECEF m with ellipsoid heights h_m (m,) and NED velocities v_ned (m, 3) m/s, the reference point at `station` (3,)
+    ECEF m, station_h_m high (gnss/gbas.py; its station_geometry and GbasModel.scales are the oracle): with the
+    slant distance x_air = |r_rx - station|, the height dh = h_m - station_h_m and the horizontal speed
+    v_air = |v_ned[:2]|,
+
+        ground  sqrt((a0 + a1 exp(-el / th0))^2 / M + a2^2), the row above or at/below gad[0] (gad: split, a0, a1,
+                th0, a2 above, a0, a1, th0, a2 at/below; angles rad)
+        iono    F sigma_vig (x_air + 2 tau v_air), F = 1 / sqrt(1 - (R cos el / (R + shell_m))^2)
+        tropo   sigma_n h0 1e-6 / sqrt(0.002 + sin^2 el) |1 - exp(-dh / h0)|
+        mp      0.13 + 0.53 exp(-el / 10 deg) (DO-253 airframe multipath)
+        noise   a0 + a1 exp(-el / th0) (aad: a0, a1, th0 rad)
+
+    and sigma = sqrt(ground^2 + iono^2 + tropo^2 + mp^2 + noise^2 + w2) (w2: the white noise's variance)."""
+    n_sky, m, k = el.shape
+    s_gnd = np.empty((n_sky, m, k))
+    s_iono = np.empty((n_sky, m, k))
+    s_tropo = np.empty((n_sky, m, k))
+    s_mp = np.empty((n_sky, m, k))
+    s_noise = np.empty((n_sky, m, k))
+    sigma = np.empty((n_sky, m, k))
+    for s in range(n_sky):
+        for i in range(m):
+            dx, dy, dz = r_rx[i, 0] - station[0], r_rx[i, 1] - station[1], r_rx[i, 2] - station[2]
+            x_air = math.sqrt(dx * dx + dy * dy + dz * dz)
+            v_air = math.hypot(v_ned[i, 0], v_ned[i, 1])
+            path = sigma_vig * (x_air + 2.0 * tau_s * v_air)
+            hfac = sigma_n * h0_m * 1e-6 * abs(-math.expm1(-(h_m[i] - station_h_m) / h0_m))
+            for j in range(k):
+                g, io, tr, mp, nz = _gbas_terms(el[s, i, j], path, hfac, gad, n_ref, aad, shell_m)
+                s_gnd[s, i, j] = g
+                s_iono[s, i, j] = io
+                s_tropo[s, i, j] = tr
+                s_mp[s, i, j] = mp
+                s_noise[s, i, j] = nz
+                sigma[s, i, j] = math.sqrt(g * g + io * io + tr * tr + mp * mp + nz * nz + w2)
+    return s_gnd, s_iono, s_tropo, s_mp, s_noise, sigma
+
+
+@njit(cache=True)
+def pseudoranges_gbas(rng: np.ndarray, s_gnd: np.ndarray, s_iono: np.ndarray, s_tropo: np.ndarray, s_mp: np.ndarray,
+                      s_noise: np.ndarray, sel: np.ndarray, gnd: np.ndarray, iono: np.ndarray, tropo: np.ndarray,
+                      mp: np.ndarray, noise: np.ndarray, white: np.ndarray,
+                      bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """GBAS-corrected pseudoranges (R, m, k) m and validity of every run r (run r on sky r, or on sky 0 for one sky):
+
+        rho = |r_sv - r| + s_gnd g + s_iono I + s_tropo T + s_mp m + s_noise n + w + b_rx   (nan where not selected)
+
+    geometry and scales (S, m, k) from `sky` and `gbas_scales`, unit series and the white noise w (m) (R, m, k),
+    receiver clock bias (R, m)."""
+    n_run, m, k = gnd.shape
+    one_sky = rng.shape[0] == 1
+    pr = np.empty((n_run, m, k))
+    valid = np.empty((n_run, m, k), dtype=np.bool_)
+    for r in range(n_run):
+        s = 0 if one_sky else r
+        for i in range(m):
+            b = bias[r, i]
+            for j in range(k):
+                p = (rng[s, i, j] + s_gnd[s, i, j] * gnd[r, i, j] + s_iono[s, i, j] * iono[r, i, j]
+                     + s_tropo[s, i, j] * tropo[r, i, j] + s_mp[s, i, j] * mp[r, i, j]
+                     + s_noise[s, i, j] * noise[r, i, j] + white[r, i, j])
                 v = sel[s, i, j]
                 valid[r, i, j] = v
                 pr[r, i, j] = p + b if v else math.nan
