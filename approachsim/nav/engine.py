@@ -151,13 +151,33 @@ class EpochEngine:
         self._code_sig = np.full(lay.n_sv, self.code_noise_m)  # with channel states: their white code noise
         self._pl_sig = np.full(lay.n_pl, self.pl_sigma_states)  # with pseudolite states: code noise + survey
         self._nu = np.zeros((1, _MAX_ROWS))
-        if g is not None:  # the channel-noise budget of kernels/epoch.channel_sigmas
+        self._gbas = None
+        if g is not None:  # the channel-noise budget of channel_sigmas
             bud = g.budget()
             self._sky_budget = (geo.A_WGS84, IONO_SHELL_M, bud.clock_ephemeris_m, bud.iono_zenith_m,
                                 bud.tropo_zenith_m, bud.multipath_model == "do253", float(bud.multipath_m))
+            if bud.gbas is not None:
+                self._gbas = bud.gbas.channel_kernel_args()
         self.F, self.Qc, self.phi, self.qd = (np.zeros((n, n)) for _ in range(4))
         self.loop = em.kernel_loop(system.loop_gains() if lay.has("ac") else None)
         """The damping loop's constant gains (the engine runs constant or no loops only)."""
+
+    def channel_sigmas(self, el: Array) -> tuple[Array, Array]:
+        """The GPS channel states' slow and fast 1-sigma (m) at elevations el (N, k) rad, each element on its own:
+        the receiver budget's channel_sigmas_m with nav/noise.py's elevation guard, compiled. Stand-alone:
+        kernels/epoch.channel_sigmas; GBAS corrections: sensors/kernels/gnss.gbas_channel_sigmas at
+        gbas.REFERENCE_GEOMETRY (the filter's elevation-only channel noise, as nav/noise.py builds it)."""
+        el = np.ascontiguousarray(el, dtype=float)
+        gse, gmp = np.empty(el.shape), np.empty(el.shape)
+        if self._gbas is None:
+            ke.channel_sigmas(el, *self._sky_budget, gse, gmp)
+        else:
+            from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
+            from approachsim.sensors.kernels.gnss import gbas_channel_sigmas
+
+            x, dh, v = (np.full(el.shape[0], g) for g in REFERENCE_GEOMETRY)
+            gbas_channel_sigmas(el, x, dh, v, *self._gbas, gse, gmp)
+        return gse, gmp
 
     @staticmethod
     def stack(dbs: list[RunDatabase]) -> tuple[Array, Array, Array]:
@@ -267,8 +287,7 @@ class EpochEngine:
             pl_rho, r_pl, pl_sig = np.zeros((N, 0)), self._none3, self._none1
         if lay.has("gse") and obs.has_gnss and obs.per_run_sky:  # one sky: qd2 is already at its elevations
             el = np.ascontiguousarray(obs.gnss_el_rad, dtype=float)
-            ch_gse, ch_gmp = np.empty(el.shape), np.empty(el.shape)
-            ke.channel_sigmas(el, *self._sky_budget, ch_gse, ch_gmp)
+            ch_gse, ch_gmp = self.channel_sigmas(el)
             nz = self.system.noise_model.noise(None)
             f_gse, f_gmp = (float(-np.expm1(-2.0 * dt / tau)) for tau in (nz.gse_tau_s, nz.gmp_tau_s))
         else:

@@ -372,8 +372,7 @@ class Navigator:
                                                       (E, pl_rho.shape[2])), dtype=float)
         # the channel states' Qd at each run's own sky (per-run skies; one sky: the model's own)
         if lay.has("gse") and per_run_sky and k:
-            ch_gse, ch_gmp = np.empty((N * E, k)), np.empty((N * E, k))
-            ke.channel_sigmas(el.reshape(N * E, k), *eng._sky_budget, ch_gse, ch_gmp)
+            ch_gse, ch_gmp = eng.channel_sigmas(el.reshape(N * E, k))
             ch_gse, ch_gmp = ch_gse.reshape(N, E, k), ch_gmp.reshape(N, E, k)
         else:
             ch_gse = ch_gmp = np.zeros((N, E, 0))

@@ -18,6 +18,7 @@ from approachsim.profile import load_profile
 from approachsim.seeding import stream
 from approachsim.sensors.config import PseudoliteConfig
 from approachsim.sensors.faults import FaultSpec
+from approachsim.sensors.gnss.gbas import GbasModel
 from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
@@ -30,6 +31,9 @@ def _profile(kind: str):
     if kind == "fixed-sky-fault":
         p = replace(p, sensors=replace(p.sensors, gnss=replace(p.sensors.gnss, epoch="fixed", selection="all")),
                     faults=(FaultSpec(sensor="baro", kind="outage", start_s=12.0, end_s=20.0),))
+    if kind == "gbas":  # GBAS corrections: the channel noise from its budget (sensors/kernels/gnss.gbas_channel_sigmas)
+        p = replace(p, sensors=replace(p.sensors, gnss=replace(p.sensors.gnss, corrections="gbas", gbas=GbasModel(),
+                                                               selection="all")))
     if kind == "pseudolite":
         pl = PseudoliteConfig(positions_rwy=((0.0, -150.0, 9.0), (-3000.0, 200.0, 30.0)), synchronized=False)
         p = replace(p, sensors=replace(p.sensors, pseudolite=pl))
@@ -60,7 +64,7 @@ def _close(a, b, what, rtol=1e-10):
     assert np.max(np.abs(a - b)) <= rtol * scale, f"{what}: {np.max(np.abs(a - b)) / scale:.2e}"
 
 
-@pytest.mark.parametrize("kind", ["default", "fixed-sky-fault", "pseudolite"])
+@pytest.mark.parametrize("kind", ["default", "fixed-sky-fault", "pseudolite", "gbas"])
 @pytest.mark.parametrize("shared", [False, True])
 def test_engine_equals_the_generic_path(kind, shared, monkeypatch):
     prof = _profile(kind)
@@ -85,14 +89,14 @@ def test_engine_is_off_where_the_generic_path_is_needed():
     assert engine.EpochEngine.of(NavSystem.from_profile(DEFAULT)) is not None
 
 
-@pytest.mark.parametrize("kind", ["default", "pseudolite", "baro-outage"])
+@pytest.mark.parametrize("kind", ["default", "pseudolite", "baro-outage", "gbas"])
 def test_whole_pass_equals_the_per_epoch_engine(kind, monkeypatch):
     """Per-run skies with the shared covariance: the whole open-loop pass in one kernel call (Navigator.compiled_pass)
     against the epoch-by-epoch engine it replaces (the same arithmetic: equal to rounding), with a damping loop held
     during a baro outage and pseudolites with their states."""
     from approachsim.nav.navigator import Navigator
 
-    prof = _profile("pseudolite" if kind == "pseudolite" else "default")
+    prof = _profile(kind if kind in ("pseudolite", "gbas") else "default")
     if kind == "baro-outage":
         prof = replace(prof, faults=(FaultSpec(sensor="baro", kind="outage", start_s=10.0, end_s=16.0),))
     assert prof.nav.baro_loop == "constant"
