@@ -146,8 +146,7 @@ def touchdown_scalars(truth: Truth, main_gear_body_m: Array) -> dict[str, float]
 
 # --- criteria ----------------------------------------------------------------------------------------------------
 
-SMAC = ("ONERA SMAC toolbox, Civil Aircraft Landing Challenge benchmark (public copy: github.com/ruidaidev/CALC, "
-        "CALC/MCplots.m, commit 013d63e): ")
+SMAC = "ONERA SMAC toolbox, Civil Aircraft Landing Challenge benchmark (its Monte Carlo plotting script): "
 """Where the [S] limits come from: a research benchmark's own statement of the risks to demonstrate, not the AC."""
 
 DISPLAY = {"ft": 1.0 / units.FT, "ft/s": 1.0 / units.FPS, "deg": 180.0 / math.pi}
