@@ -156,6 +156,24 @@ class GnssErrorBudget:
         first = self.clock_ephemeris_tau_s if self.gbas is None else self.gbas.ground_tau_s
         return min(first, self.iono_tau_s, self.tropo_tau_s)
 
+    @property
+    def slow_tau_no_iono_s(self) -> float:
+        """Correlation time (s) of the slow channel state when the ionosphere has its own (carrier phase): the
+        shorter of clock/ephemeris (GBAS: ground) and tropo."""
+        first = self.clock_ephemeris_tau_s if self.gbas is None else self.gbas.ground_tau_s
+        return min(first, self.tropo_tau_s)
+
+    def carrier_channel_sigmas_m(self, el_rad: Array, x_air_m: Array | None = None, dh_m: Array | None = None,
+                                 v_air_mps: Array | None = None) -> tuple[Array, Array, Array | float]:
+        """channel_sigmas_m with the ionosphere split off (the navigation filter's states under carrier phase): the
+        slow range error without it, the ionospheric error, the fast one, m. Stand-alone sqrt(ce^2 + (T_z M)^2),
+        I_z F; GBAS sqrt(gnd^2 + tropo^2), iono (gbas.GbasModel.carrier_channel_sigmas_m)."""
+        if self.gbas is not None:
+            return self.gbas.carrier_channel_sigmas_m(el_rad, x_air_m, dh_m, v_air_mps)
+        slow = np.sqrt(self.clock_ephemeris_m**2 + (self.tropo_zenith_m * tropo_mapping(el_rad)) ** 2)
+        gmp = self.multipath_sigma_m(el_rad) if self.multipath_model == "do253" else self.multipath_m
+        return slow, self.iono_zenith_m * iono_obliquity(el_rad), gmp
+
     def channel_sigmas_m(self, el_rad: Array, x_air_m: Array | None = None, dh_m: Array | None = None,
                          v_air_mps: Array | None = None) -> tuple[Array, Array | float]:
         """The navigation filter's channel-state 1-sigmas (m) at elevations el_rad (rad): the slow range error and
@@ -427,6 +445,18 @@ class GnssReceiver:
         sc = b.gbas.scales(el_rad, x_air_m, dh_m, v_air_mps)
         return (sc["ground"] * series["ground"] + sc["iono"] * series["iono"] + sc["tropo"] * series["tropo"],
                 sc["multipath"] * series["multipath"] + sc["noise"] * series["noise"])
+
+    def carrier_channel_errors(self, series: Mapping[str, Array], el_rad: Array, x_air_m: Array | None = None,
+                               dh_m: Array | None = None, v_air_mps: Array | None = None) -> tuple[Array, Array, Array]:
+        """channel_errors with the ionosphere split off (carrier phase: the filter's gse, gio, gmp), m: stand-alone
+        E + M T, F I and the multipath; GBAS s_gnd g + s_tropo T, s_iono I and s_mp m + s_noise n."""
+        b = self.budget
+        slow, fast = self.channel_errors(series, el_rad, x_air_m, dh_m, v_air_mps)
+        if b.gbas is None:
+            slow = series["clock_ephemeris"] + tropo_mapping(el_rad) * series["tropo_zenith"]
+            return slow, iono_obliquity(el_rad) * series["iono_zenith"], fast
+        sc = b.gbas.scales(el_rad, x_air_m, dh_m, v_air_mps)
+        return sc["ground"] * series["ground"] + sc["tropo"] * series["tropo"], sc["iono"] * series["iono"], fast
 
     def sigma_m(self, el_rad: Array, x_air_m: Array | None = None, dh_m: Array | None = None,
                 v_air_mps: Array | None = None) -> Array:
