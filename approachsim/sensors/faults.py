@@ -238,7 +238,16 @@ class PreparedFaulted:
     def at(self, truth: Any, j: int) -> Any:
         """The faulted record of sample j alone. A sample no fault touches is the wrapped sensor's record as it is:
         labelling it would change no value (its invalid values are already nan) -- except carrier arcs after an
-        outage, which continue from sample to sample (taken in order, as the receiver's)."""
+        outage, which continue from sample to sample (in increasing order, skipped ones run first, as the
+        receiver's)."""
+        if self.carrier is not None:
+            from approachsim.sensors.gnss.receiver import carrier_gap
+
+            for jj in carrier_gap(self._carrier, j):
+                self._one(truth, jj)
+        return self._one(truth, j)
+
+    def _one(self, truth: Any, j: int) -> Any:
         sl = slice(j, j + 1)
         rec = self.inner.at(truth, j)
         carrier = None

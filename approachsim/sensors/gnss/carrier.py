@@ -32,8 +32,10 @@ always has a new id, so the navigation filter resets its ambiguity state wheneve
 an arc is drawn ahead as a pool, one value per sample and channel (`ambiguity_m`): the arc that begins at sample j
 on channel i takes pool[j, i], so a closed loop applying one sample at a time draws exactly the batch's values.
 
-Draws (receiver.draw): the multipath, noise and ambiguity normals of the carrier come after every other normal of the
-receiver, so receivers without carrier phase keep their draws bit for bit.
+Draws (receiver.draw): the multipath, noise and ambiguity normals of the carrier come from the child stream "carrier"
+of the receiver's generator (seeding.substream, which draws nothing from the parent), so receivers without carrier
+phase keep their draws bit for bit, and the carrier draws of a record are the first samples of a longer record's
+(a closed loop draws its errors for a longer flight than it flies).
 The arithmetic is vectorized numpy over runs, samples and channels (no per-sample Python loop): no compiled kernel.
 """
 

@@ -67,7 +67,8 @@ an arc), S_i the slow errors the code has with the same sign (stand-alone E + M 
 realizations), I_i the code's ionospheric term, here with the opposite sign, c_i the carrier multipath (Gauss-Markov,
 1 cm, 5 s), w_i white tracking noise (2 mm). The record adds carrier_phase_m, carrier_arc (the sample index at which
 the arc began, -1 where invalid) and carrier_sigma_m. Its normals are drawn after all the others (receivers without
-it keep their draws bit for bit); `prepare(...).at` continues the arcs from sample to sample (samples in order).
+it keep their draws bit for bit: they come from the child stream "carrier" of the receiver's, seeding.substream);
+`prepare(...).at` continues the arcs from sample to sample (samples in order).
 Selection: "all" (every SV above the mask) or "best4" (the four of lowest PDOP, seed 002, chosen afresh at
 each epoch). Channels are the 24 slots, in SLOTS order; invisible or unselected channels are nan and invalid.
 
@@ -92,6 +93,7 @@ import numpy as np
 
 from approachsim import geo
 from approachsim.records import GnssSamples, Truth
+from approachsim.seeding import substream
 from approachsim.sensors import base
 from approachsim.sensors.gnss.carrier import CarrierModel, ambiguities, carrier_arcs
 from approachsim.sensors.gnss.clock import ClockModel
@@ -332,8 +334,10 @@ class GnssReceiver:
         multipath is unit-sigma under the do253 model (apply scales it by sigma_mp at the channel's elevation).
         GBAS budget: ground, iono, tropo, multipath, noise, all unit-sigma Gauss-Markov (apply scales them; module
         docstring), from the same standard normals as the stand-alone series in the same place, and white (m), the
-        carrier-phase noise, from normals drawn after those. With carrier phase (carrier.py), after all of those:
-        carrier_multipath (m), carrier_noise (m) and ambiguity (m, the pool of arc ambiguities)."""
+        carrier-phase noise, from normals drawn after those. With carrier phase (carrier.py): carrier_multipath (m),
+        carrier_noise (m) and ambiguity (m, the pool of arc ambiguities) from the child stream "carrier" of the
+        receiver's generator (seeding.substream): its own draws stay as they are, and the carrier's draws for a
+        shorter record are the first samples of a longer record's (the closed loop draws for a longer flight)."""
         b = self.budget
         k = self.constellation.prn.shape[0]
 
@@ -342,8 +346,8 @@ class GnssReceiver:
         def one(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
             out = code(g, m, dt)
             c = self.carrier
-            if c is not None:  # after every other draw: receivers without carrier phase keep theirs
-                zc = g.standard_normal((m, 3 * k))
+            if c is not None:  # from a child stream: the receiver's draws untouched, a prefix of a longer record's
+                zc = substream(g, "carrier").standard_normal((m, 3 * k))
                 out |= {"carrier_multipath": base.gauss_markov(zc[:, 0:k], c.multipath_m, c.multipath_tau_s, dt),
                         "carrier_noise": c.noise_m * zc[:, k : 2 * k], "ambiguity": c.ambiguity_pool(zc[:, 2 * k :])}
             return out
@@ -696,8 +700,15 @@ class PreparedGnss:
 
     def at(self, truth: Truth, j: int) -> GnssSamples:
         """The record of sample j alone (one-sample axes, as apply on errors.sample(j)). With carrier phase the
-        samples are taken in order (0, 1, 2, ...; the last one may be given again): the arcs continue from the
-        previous sample's, so at(truth, j) equals sample j of apply's record."""
+        arcs continue from the previous sample's: samples come in increasing order (the last one may be given
+        again), samples skipped since the last one are run first (their validity decides the arcs), so at(truth, j)
+        equals sample j of apply's record."""
+        if self.rx.carrier is not None:
+            for jj in carrier_gap(self._carrier, j):
+                self._one(truth, jj)
+        return self._one(truth, j)
+
+    def _one(self, truth: Truth, j: int) -> GnssSamples:
         sl = slice(j, j + 1)
         e = self.errors
         carrier = None
@@ -712,6 +723,11 @@ class PreparedGnss:
         return rec
 
 
+def carrier_gap(last: tuple | None, j: int) -> range:
+    """The samples between the last one given (carrier_continuation's `last`) and j, to be run before j."""
+    return range(0 if last is None else last[0] + 1, j)
+
+
 def carrier_continuation(last: tuple | None, j: int, pool: Array) -> tuple:
     """record()'s carrier argument (j, valid and arc at j - 1, pool) for sample j after the last sample given, `last`
     = (j_last, valid, arc, the state before j_last) (None: none yet, j must be 0). The same j again (a repeated
@@ -724,7 +740,8 @@ def carrier_continuation(last: tuple | None, j: int, pool: Array) -> tuple:
     if j == j_last:
         return (j, *before, pool)
     if j != j_last + 1:
-        raise ValueError(f"carrier phase: samples are taken in order; got {j} after {j_last}")
+        raise ValueError(f"carrier phase: samples are taken in increasing order (skipped ones run first: "
+                         f"carrier_gap); got {j} after {j_last}")
     return (j, valid, arc, pool)
 
 

@@ -154,6 +154,13 @@ def test_an_outage_ends_the_arcs_and_reacquisition_draws_a_new_ambiguity():
         np.testing.assert_array_equal(one.carrier_phase_m[:, 0], rec.carrier_phase_m[:, j])
         np.testing.assert_array_equal(one.carrier_arc[:, 0], rec.carrier_arc[:, j])
         np.testing.assert_array_equal(one.pseudorange_m[:, 0], rec.pseudorange_m[:, j])
+    skipping = rx.prepare(e)  # a caller that asks for every third sample only: the skipped ones decide the arcs too
+    for j in range(0, len(t), 3):
+        one = skipping.at(truth, j)
+        np.testing.assert_array_equal(one.carrier_phase_m[:, 0], rec.carrier_phase_m[:, j])
+        np.testing.assert_array_equal(one.carrier_arc[:, 0], rec.carrier_arc[:, j])
+    with pytest.raises(ValueError, match="increasing order"):
+        skipping.at(truth, 3)
 
 
 @pytest.mark.parametrize("gnss", [{}, {"corrections": "gbas", "selection": "all"}, {"doppler": True}])
