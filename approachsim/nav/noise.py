@@ -28,7 +28,10 @@ arc's ambiguity: an honest prior), reset at every new arc (nav/navigator.py). Th
 is measurement noise, not a state (`carrier_sigma_m`): its white equivalent sigma^2 (1 + a) / (1 - a), a = exp(-dt /
 tau), at the filter's carrier interval dt, has the long-run average of the Gauss-Markov (the quantity the float
 ambiguity and the position integrate), while over a few epochs it is conservative; carried as a state it would add
-24 more states for errors three orders below the code's that set the position error.
+24 more states for errors three orders below the code's that set the position error. Measured (GBAS candidate with
+carrier, 40 open-loop runs, 200 s): a 0.5 s multipath correlation time (inflation 1.3 instead of 10) leaves the
+filter's vertical sigma at the end at 0.2223 m against 0.2224 m, the true RMS 0.243 against 0.244 m: the carrier's
+fast error does not limit the position, so the simpler, conservative form is kept.
 """
 
 from __future__ import annotations

@@ -272,3 +272,14 @@ def test_closed_loop_step_by_step_equals_the_open_loop_pass_with_carrier():
     np.testing.assert_allclose(closed.x, open_.x, rtol=1e-6, atol=1e-6)
     arcs = recs["gnss"].carrier_arc
     assert np.any(arcs[12] == 12)  # the outage ended the arcs: new ones at its end
+
+
+@pytest.mark.parametrize("nav", [{"gps_coupling": "loose"}, {"channel_states": False}])
+def test_carrier_without_channel_states_fails_when_the_profile_loads(nav):
+    from approachsim.config import ProfileError
+
+    path = PROFILES / "gbas-carrier-cat3-candidate.toml"
+    d = tomllib.loads(path.read_text(encoding="utf-8"))
+    d.setdefault("nav", {}).update(nav)
+    with pytest.raises(ProfileError, match="carrier_phase"):
+        parse_profile(d, source=path)
