@@ -326,6 +326,10 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
     faults = parse_faults(fault_items, sensors, duration_s=duration, imu_hz=rates.imu_hz)
     nav = parse_nav(top.section("nav"))
     top.done()
+    if sensors.gnss is not None and sensors.gnss.carrier is not None and not (
+            nav.gps_coupling == "tight" and nav.channel_states):
+        raise ProfileError("sensors.gnss.carrier_phase: needs [nav] gps_coupling = \"tight\" and channel_states = "
+                           "true (the float ambiguities are per-channel filter states)")
     return Profile(
         name=name,
         description=description,

@@ -238,6 +238,14 @@ class GnssSamples:
     """() or (runs,): each run's constellation epoch after the profile's epoch_utc, s; None: one fixed sky.
     With per-run offsets in a batch the geometry fields (r_sv_ecef, sigma_m, elevation_rad, azimuth_rad,
     visible, pdop) also carry the leading run axis (`per_run_sky`)."""
+    carrier_phase_m: Array | None = None
+    """(m, 24) per run: L1 carrier phase in metres with its float ambiguity (sensors/gnss/carrier.py), nan where not
+    valid; None if not modelled."""
+    carrier_arc: Array | None = None
+    """(m, 24) per run, int64: the carrier arc id of each channel, the sample index at which its current arc (one
+    constant ambiguity) began; -1 where not valid. A changed id is a new ambiguity. None if not modelled."""
+    carrier_sigma_m: float | None = None
+    """Nominal 1-sigma of the carrier's fast errors (multipath and tracking noise), m; None if not modelled."""
 
     @property
     def per_run_sky(self) -> bool:
@@ -257,6 +265,7 @@ class GnssSamples:
             pdop=self.pdop[k] if sky else self.pdop, clock_bias_m=pick(self.clock_bias_m, 2),
             clock_drift_mps=pick(self.clock_drift_mps, 2), fault=pick(self.fault, 3),
             pseudorange_rate_mps=pick(self.pseudorange_rate_mps, 3), epoch_offset_s=pick(self.epoch_offset_s, 1),
+            carrier_phase_m=pick(self.carrier_phase_m, 3), carrier_arc=pick(self.carrier_arc, 3),
         )
 
 

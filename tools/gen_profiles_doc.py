@@ -136,6 +136,7 @@ def exercise() -> dict[str, list[Key]]:
     full["sensors"]["pseudolite"] = {"enabled": True, "units": [{"along_ft": 0.0, "cross_ft": -500.0}]}
     full["sensors"]["gnss"]["doppler"] = True
     full["sensors"]["gnss"]["corrections"] = "gbas"
+    full["sensors"]["gnss"]["carrier_phase"] = True
     full["terrain"] = {"distance_nmi": [10.0, 0.0], "height_ft": [13.0, 13.0]}
     full["evaluation"] = {}
     full["aircraft"].update(approach_speed_kt=140.0, flaps_norm=1.0)

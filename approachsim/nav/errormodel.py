@@ -21,6 +21,10 @@ States (a `StateLayout` says which are present and where):
     ram  (1)  radar-altimeter Markov error, m (Gauss-Markov, seed 000 eq. 5)
     tdb  (1)  terrain-database along-track error, unit Gauss-Markov u (the error is sigma(x) u, nav/terrain_db.py)
               in time with tau = L / ground speed (exact for a constant speed along the track)
+    gio  (k)  per-GPS-channel ionospheric range error of the code, m, Gauss-Markov (carrier phase only: then gse
+              leaves the ionosphere out; the carrier sees -gio, nav/measurements.py)
+    amb  (k)  per-GPS-channel carrier float ambiguity, m (random constant, reset to its prior at a new arc: carrier
+              phase only)
 
 The channel states are what make the filter honest about time-correlated range errors: seed 002's 2-state
 GPS model absorbed them in a tuned R; here they are carried (and decoupled, so discretized exactly).
@@ -77,6 +81,9 @@ class StateLayout:
     radalt_markov: bool = False
     terrain_db: bool = False
     """Radar-altimeter / terrain-database error states rab, ram, tdb (module docstring)."""
+    carrier: bool = False
+    """GPS carrier phase: per-channel ionospheric (gio) and float-ambiguity (amb) states after every other group
+    (needs n_sv channels)."""
     index: dict[str, slice] = field(init=False, compare=False)
     n: int = field(init=False, compare=False)
 
@@ -96,6 +103,10 @@ class StateLayout:
                 sizes.append(("pclk", 2 * self.n_pl))
         sizes += [(g, 1) for g, on in (("rab", self.radalt_bias), ("ram", self.radalt_markov),
                                        ("tdb", self.terrain_db)) if on]
+        if self.carrier:  # last: every other group keeps its index (the compiled kernels' layout)
+            if not self.n_sv:
+                raise ValueError("StateLayout: carrier-phase states need the GPS channel states (n_sv > 0)")
+            sizes += [("gio", self.n_sv), ("amb", self.n_sv)]
         index, i = {}, 0
         for name, k in sizes:
             index[name] = slice(i, i + k)
@@ -163,6 +174,9 @@ class ErrorNoise:
     ram_tau_s: float = 10.0
     tdb_correlation_m: float = 300.0
     """Along-track correlation length of the terrain-database error, m (tau = L / max(ground speed, 1 m/s))."""
+    gio_sigma_m: float | Array = 0.0
+    """Per-channel ionospheric range-error 1-sigma (scalar or (n_sv,) by elevation), m (carrier phase only)."""
+    gio_tau_s: float = 1800.0
 
     @cached_property
     def _kernel_arrays(self) -> dict[int, tuple[Array, Array, Array]]:
@@ -259,7 +273,15 @@ def dynamics(
     ek.dynamics(lay, q, gse, gmp, float(lat_rad), float(h_m), np.ascontiguousarray(v_ned, dtype=float),
                 np.ascontiguousarray(f_ned, dtype=float), np.ascontiguousarray(c_bn, dtype=float), lv,
                 bool(loop_held), F, Qc)
+    _carrier_states(layout, noise, F, Qc)
     return F, Qc
+
+
+def _carrier_states(layout: StateLayout, noise: ErrorNoise, F: Array, Qc: Array) -> None:
+    """The carrier-phase groups, after every kernel-known group (in place): gio Gauss-Markov; amb random constants
+    (zero rows, as the kernel left them)."""
+    if layout.has("gio"):
+        _markov(F, Qc, layout.index["gio"], noise.gio_sigma_m, noise.gio_tau_s)
 
 
 def dynamics_reference(
@@ -347,6 +369,7 @@ def dynamics_reference(
         _markov(F, Qc, ix["ram"], noise.ram_sigma_m, noise.ram_tau_s)
     if layout.has("tdb"):
         _markov(F, Qc, ix["tdb"], 1.0, noise.tdb_correlation_m / max(float(np.hypot(vn, ve)), 1.0))
+    _carrier_states(layout, noise, F, Qc)
     if layout.has("ac"):
         if loop is None:
             raise ValueError("layout has the loop state 'ac' but no loop gains were given")

@@ -21,7 +21,8 @@ correlated in time, so the real rate is lower).
 
 Identification and exclusion: the residual test names argmax |w_j|, the moving sum the measurement whose sum
 fired (largest ratio); its source (a GNSS channel, a pseudolite unit, the baro, the radar altimeter) is
-excluded from every later update. A slow fault has contaminated the state before it is detected, so the
+excluded from every later update (a GNSS satellite's code and carrier rows together: `Source.unit`). A slow
+fault has contaminated the state before it is detected, so the
 filter is rolled back: it restarts from its state `rollback_epochs` epochs ago and re-runs the stored epochs
 (predictions, rows) without the excluded source (with feedback, the corrections the INS received in between
 are subtracted as they were applied: y+ = y - c_e). Then the epoch is tested again (several exclusions per
@@ -96,8 +97,9 @@ class FdeConfig:
 
 
 def _ranging(sources: set[Source]) -> int:
-    """Ranging sources among `sources` (a loose-coupling GNSS fix counts as a full fix)."""
-    n = sum(1 for s in sources if s.ranging)
+    """Ranging sources among `sources`, a satellite's code and carrier as one (a loose-coupling GNSS fix counts as a
+    full fix)."""
+    n = len({s.unit for s in sources if s.ranging})
     return n + (MIN_RANGING if any(s.kind == FIX for s in sources) else 0)
 
 
@@ -174,7 +176,7 @@ class FdeState:
     # --- statistics -----------------------------------------------------------------------------------------
 
     def _rows(self, rows: list[Row], x: Array) -> list[tuple[Source, ScalarMeasurement]]:
-        return [(r.source, r.build(x)) for r in rows if r.source.name not in self.excluded]
+        return [(r.source, r.build(x)) for r in rows if r.source.unit not in self.excluded]
 
     @staticmethod
     def _test(filt: NavFilter, fs: FilterState, built: list[tuple[Source, ScalarMeasurement]]) -> _Test | None:
@@ -238,7 +240,7 @@ class FdeState:
             fs = filt.predict(fs, e.phi, e.qd)
             self._commit(e.index, self._test(filt, fs, self._rows(e.rows, fs.x)))
             for r in e.rows:
-                if r.source.name not in self.excluded:
+                if r.source.unit not in self.excluded:
                     fs, _ = filt.update(fs, r.build(fs.x))
             if e.correction is not None:  # the INS was corrected by c_e then: y+ = y - c_e
                 fs = FilterState(x=fs.x - e.correction, P=fs.P, U=fs.U, d=fs.d, memory=fs.memory)
@@ -264,18 +266,18 @@ class FdeState:
             if hit is None:
                 break
             src, kind, stat, thr = hit
-            if len(set(test.sources)) <= 1:  # nothing left to compare it with
+            if len({s.unit for s in test.sources}) <= 1:  # nothing left to compare it with
                 unprotectable = True
                 break
-            self.excluded.add(src.name)
-            self.events.append(ExclusionEvent(t_s, src.name, src.channel, kind, stat, thr))
+            self.excluded.add(src.unit)  # a satellite's code and carrier go together (observations.Source.unit)
+            self.events.append(ExclusionEvent(t_s, src.unit, src.channel, kind, stat, thr))
             fs = filt.predict(self._rollback(filt), phi, qd)
         self._commit(k, test)
         statuses: list[UpdateStatus] = []
         used: set[Source] = set()
         for r in rows:
             m = r.build(fs.x)
-            if r.source.name in self.excluded:
+            if r.source.unit in self.excluded:
                 P = filt.covariance(fs)
                 nu = float(m.z - m.h @ fs.x)
                 s = float(m.h @ P @ m.h + m.r)

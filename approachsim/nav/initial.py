@@ -58,7 +58,7 @@ steps build a start with exactly that structure.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -97,6 +97,9 @@ def _segment(system: Any, truth: Any, obs: Observations, row: int, P0: Array) ->
     x0 = np.zeros(lay.n)
     t = float(truth.t_s[row])
     ref_obs = system.rows.reference_obs(obs, 0, float(ref.h_m[0]), r_ref)
+    # code only: the carrier's arcs begin at the approach's first sample (sensors/gnss/carrier.py), so the segment
+    # flown before it has no carrier, and the float ambiguities start at their prior, uncorrelated
+    ref_obs = replace(ref_obs, gnss_phi_m=None, gnss_arc=None)
     rows = [r.build(x0) for r in system.rows.epoch(ref, 0, r_ref, ref_obs, t)]
     return phi, qd, rows
 

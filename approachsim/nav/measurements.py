@@ -12,6 +12,9 @@ Rows (index names from errormodel.StateLayout):
     radalt    z = (h_ins - T(ins)) - h_R = -dp_D - grad T . dp_h - rab - ram - sigma_db(x) tdb + v,
               R = (0.01 h)^2 + floor^2 (seed 002; rab, ram, tdb: errormodel, nav/terrain_db.py)
     range     z = |r_ins - r_tx| - rho  = e . dp - clk - gse - gmp (+ pseudolite terms) + v   (seed 002 sec. 6)
+              (- gio too with carrier phase, whose states split the ionosphere off gse: nav/noise.py)
+    carrier   z = |r_ins - r_sv| - phi  = e . dp - clk - gse + gio - amb + v                 (sensors/gnss/carrier.py:
+              the code's geometry, clock and slow error, the ionosphere with the opposite sign, the arc's ambiguity)
     position  z = p_ins - p_gps (NED, per axis)  (loosely-coupled option)
 
 The baro, radalt and range rows have compiled versions in nav/kernels/measurements.py that write h into a buffer
@@ -149,6 +152,8 @@ def pseudorange(
     if sv is not None and layout.has("gse"):
         h[layout.i("gse", sv)] = -1.0
         h[layout.i("gmp", sv)] = -1.0
+        if layout.has("gio"):
+            h[layout.i("gio", sv)] = -1.0
     if pl is not None and layout.has("pmp"):
         h[layout.i("pmp", pl)] = -1.0
         h[layout.i("ptr", pl)] = -rng_hat
@@ -164,6 +169,31 @@ def pseudorange(
     else:
         g_hat = rng_ins - rng_hat + float(lin @ x_hat)  # exact in dp, linear in the rest
     return ScalarMeasurement(z=float(z - g_hat + h @ x_hat), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
+
+
+def carrier_phase(layout: StateLayout, x_hat: Array, r_ins_ecef: Array, c_ecef_ned: Array, r_sv_ecef: Array,
+                  phi_m: float, sigma_m: float, t_s: float, name: str, sv: int) -> ScalarMeasurement:
+    """A GPS channel's carrier phase (channel sv; the layout's carrier states), tightly coupled.
+
+    z = |r_ins - r_sv| - phi ; g(x) = |r_ins - r_sv| - |r_ins - C' dp - r_sv| - clk - gse + gio - amb;
+    h: e' at dp as the code's row, -1 at the clock, gse and amb, +1 at gio (the ionosphere advances the phase).
+    R = sigma^2: the carrier's white-equivalent noise (nav/noise.py carrier_sigma_m), m."""
+    h = _row(layout)
+    dp_hat = x_hat[layout.index["dp"]]
+    d_hat = r_ins_ecef - c_ecef_ned.T @ dp_hat - r_sv_ecef
+    rng_hat = float(np.linalg.norm(d_hat))
+    h[layout.index["dp"]] = c_ecef_ned @ (d_hat / rng_hat)
+    if layout.has("clk"):
+        h[layout.i("clk")] = -1.0
+    h[layout.i("gse", sv)] = -1.0
+    h[layout.i("gio", sv)] = 1.0
+    h[layout.i("amb", sv)] = -1.0
+    rng_ins = float(np.linalg.norm(r_ins_ecef - r_sv_ecef))
+    lin = h.copy()
+    lin[layout.index["dp"]] = 0.0
+    g_hat = rng_ins - rng_hat + float(lin @ x_hat)  # exact in dp, linear in the rest
+    return ScalarMeasurement(z=float(rng_ins - phi_m - g_hat + h @ x_hat), h=h, r=float(sigma_m**2), name=name,
+                             t_s=t_s)
 
 
 def gps_position(layout: StateLayout, dp_ins_minus_gps_ned: Array, sigma_ned_m: Array, t_s: float

@@ -107,6 +107,9 @@ class RunFilter:
     """Online fault detection and exclusion ([nav.fde] enabled), else None."""
     db_error: tdb.TerrainDbError | None = None
     """This run's terrain-database error (None: the database is the truth terrain)."""
+    arcs: Array | None = None
+    """(k,) int: the carrier arc id of each GPS channel at the last epoch that had its carrier (-1: none yet;
+    carrier phase only)."""
 
     def __post_init__(self) -> None:
         if not isinstance(self.statuses, StatusBuffer):
@@ -286,6 +289,8 @@ class Navigator:
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
                                 noise, gains, loop_held=held)
             phi, qd = em.discretize(F, Qc, dt_epoch)
+            if lay.has("amb") and obs.gnss_arc is not None:
+                phi, qd = self._new_arcs(run, obs.gnss_arc[i], phi, qd)
             if self.engine is not None and run.fde is None:  # the compiled updates on the numpy discretization
                 X, P = run.fs.x.copy()[None], np.array(run.fs.P, dtype=float)
                 y = self.x[self.ins_of[i]:self.ins_of[i] + 1]
@@ -303,6 +308,27 @@ class Navigator:
                 run.statuses.append(st)
             run.fs = fs
         return s
+
+    def _new_arcs(self, run: RunFilter, arc: Array, phi: Array, qd: Array) -> tuple[Array, Array]:
+        """The epoch's Phi, Qd with the float ambiguity of every GPS channel whose carrier arc id changed (a new arc:
+        a new ambiguity) reset to its prior: row and column of Phi zeroed (estimate 0, no correlation kept) and
+        the prior variance put in Qd, so P- = Phi P+ Phi' + Qd holds the prior there. A reset as part of the
+        prediction: every filter form and the FDE's stored epochs (re-run after a rollback) take it as it is."""
+        arc = np.asarray(arc, dtype=np.int64)
+        if run.arcs is None:
+            run.arcs = np.full(arc.shape, -1, dtype=np.int64)
+        new = np.flatnonzero((arc >= 0) & (arc != run.arcs))
+        if new.size:
+            idx = self.layout.index["amb"].start + new
+            prior = self.system.sensors.gnss.carrier.ambiguity_sigma_m ** 2  # nav/noise.py's P0 of amb
+            phi, qd = phi.copy(), qd.copy()
+            phi[idx, :] = 0.0
+            phi[:, idx] = 0.0
+            qd[idx, :] = 0.0
+            qd[:, idx] = 0.0
+            qd[idx, idx] = prior
+        run.arcs = np.where(arc >= 0, arc, run.arcs)
+        return phi, qd
 
     def _feedback(self, s: ins.InsState) -> ins.InsState:
         """Closed-loop correction: INS -= estimated nav error; bias estimates go to the increments; reset."""

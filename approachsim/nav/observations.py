@@ -21,9 +21,9 @@ import numpy as np
 
 Array = np.ndarray
 
-BARO, RADALT, GPS, PL, FIX = "baro", "radalt", "gps", "pl", "gnss"
+BARO, RADALT, GPS, PL, FIX, CP = "baro", "radalt", "gps", "pl", "gnss", "cp"
 """Source kinds: baro altitude, radar altitude, a GNSS channel's pseudorange, a pseudolite's pseudorange, a
-loosely coupled GNSS position fix."""
+loosely coupled GNSS position fix, a GNSS channel's carrier phase."""
 
 
 @dataclass(frozen=True)
@@ -41,12 +41,20 @@ class Source:
             return f"gps{self.channel:02d}"
         if self.kind == PL:
             return f"pl{self.channel}"
+        if self.kind == CP:
+            return f"cp{self.channel:02d}"
         return self.kind
 
     @property
+    def unit(self) -> str:
+        """What an exclusion removes (nav/fde.py): the satellite for a GNSS channel's code and carrier alike
+        ("gps07" for both), else the source's own name."""
+        return Source(GPS, self.channel).name if self.kind == CP else self.name
+
+    @property
     def ranging(self) -> bool:
-        """A GNSS channel or a pseudolite (a range to a transmitter)."""
-        return self.kind in (GPS, PL)
+        """A GNSS channel or a pseudolite (a range to a transmitter; a channel's carrier is the same range)."""
+        return self.kind in (GPS, PL, CP)
 
 
 def _epoch_index(t_rec: Array, t: float, tol: float) -> int | None:
@@ -86,6 +94,10 @@ class Observations:
     """(p,) their nominal 1-sigma, m."""
     loop_held: Array | None = None
     """(N,) bool: the INS damping loop had no baro over the interval ending at this epoch (None: no loop)."""
+    gnss_phi_m: Array | None = None
+    """(N, k) carrier phase of each GNSS channel, m (nan where not valid; None: no carrier phase)."""
+    gnss_arc: Array | None = None
+    """(N, k) int: its carrier arc id (-1 where not valid; a changed id is a new ambiguity)."""
 
     @classmethod
     def at(cls, records: Mapping[str, Any], t: float, tol: float, batched: bool) -> Observations:
@@ -109,6 +121,10 @@ class Observations:
         g = records.get("gnss")
         if g is not None and (j := _epoch_index(g.t_s, t, tol)) is not None:
             kw["gnss_rho_m"] = np.where(per_run(g.valid)[:, j], per_run(g.pseudorange_m)[:, j], np.nan)
+            if g.carrier_phase_m is not None:
+                ok = per_run(g.valid)[:, j]
+                kw["gnss_phi_m"] = np.where(ok, per_run(g.carrier_phase_m)[:, j], np.nan)
+                kw["gnss_arc"] = np.where(ok, per_run(g.carrier_arc)[:, j], -1)
             sky = batched and bool(g.per_run_sky)
             kw.update(gnss_r_sv_ecef=g.r_sv_ecef[:, j] if sky else g.r_sv_ecef[j],
                       gnss_sigma_m=g.sigma_m[:, j] if sky else g.sigma_m[j],
@@ -143,7 +159,7 @@ class Observations:
     def run(self, i: int) -> Observations:
         """Run i alone: its values on a run axis of length 1, its own sky as one shared sky."""
         kw: dict[str, Any] = {"n_runs": 1}
-        for k in ("baro_h_m", "radalt_h_m", "gnss_rho_m", "pl_rho_m", "loop_held"):
+        for k in ("baro_h_m", "radalt_h_m", "gnss_rho_m", "pl_rho_m", "loop_held", "gnss_phi_m", "gnss_arc"):
             v = getattr(self, k)
             if v is not None:
                 kw[k] = np.asarray(v)[i:i + 1]
@@ -161,7 +177,7 @@ class Observations:
         pseudolite): runs with equal rows take the same scalar updates in the same order."""
         n = self.n_runs
         cols = [np.zeros((n, 0), dtype=bool)]
-        for v in (self.baro_h_m, self.radalt_h_m, self.gnss_rho_m, self.pl_rho_m):
+        for v in (self.baro_h_m, self.radalt_h_m, self.gnss_rho_m, self.pl_rho_m, self.gnss_phi_m):
             if v is not None:
                 cols.append(np.isfinite(np.asarray(v, dtype=float)).reshape(n, -1))
         return np.concatenate(cols, axis=1)

@@ -29,7 +29,7 @@ from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import ScalarMeasurement
 from approachsim.nav.config import NavConfig
 from approachsim.nav.errormodel import StateLayout
-from approachsim.nav.observations import BARO, FIX, GPS, PL, RADALT, Observations, Source
+from approachsim.nav.observations import BARO, CP, FIX, GPS, PL, RADALT, Observations, Source
 from approachsim.sensors.config import SensorsConfig
 
 Array = np.ndarray
@@ -76,6 +76,13 @@ class MeasurementRows:
     runway: geo.RunwayFrame
     terrain_h: Callable[[Array], Array]
 
+    @property
+    def carrier_sigma_m(self) -> float:
+        """The carrier rows' white 1-sigma, m (nav/noise.py NoiseModel.carrier_sigma_m)."""
+        from approachsim.nav.noise import NoiseModel
+
+        return NoiseModel(self.sensors, self.nav, self.layout).carrier_sigma_m()
+
     def radalt_sigma_m(self, h_agl_m: float) -> float:
         """The radar altimeter's white-noise 1-sigma at height h_agl_m: sqrt((p h)^2 + floor^2), m (seed 002)."""
         r = self.sensors.radalt
@@ -120,6 +127,13 @@ class MeasurementRows:
                 sk = float(sig if np.isscalar(sig) else sig[k])
                 out.append(Row(Source(GPS, k), lambda x, k=k, sk=sk, rk=float(rho[k]), rs=r_sv[k]: meas.pseudorange(
                     lay, x, r_ins, c_en, rs, rk, sk, t, Source(GPS, k).name, sv=k if channel_states else None)))
+            if obs.gnss_phi_m is not None and lay.has("amb"):  # the carrier rows, after every code row
+                phi = obs.gnss_phi_m[i]
+                sc = self.carrier_sigma_m
+                for k in np.flatnonzero(np.isfinite(phi)):
+                    k = int(k)
+                    out.append(Row(Source(CP, k), lambda x, k=k, pk=float(phi[k]), rs=r_sv[k]: meas.carrier_phase(
+                        lay, x, r_ins, c_en, rs, pk, sc, t, Source(CP, k).name, k)))
         if obs.pl_rho_m is not None:
             rho, r_pl = obs.pl_rho_m[i], obs.pl_r_ecef
             p = self.sensors.pseudolite

@@ -72,6 +72,10 @@ def layout_for(nav: NavConfig, sensors: SensorsConfig) -> em.StateLayout:
     """The error-state layout of a navigation configuration (errormodel.StateLayout)."""
     n_sv = 24 if sensors.gnss is not None and nav.channel_states and nav.gps_coupling == "tight" else 0
     n_pl = len(sensors.pseudolite.positions_rwy) if sensors.pseudolite is not None and nav.channel_states else 0
+    carrier = sensors.gnss is not None and sensors.gnss.carrier is not None
+    if carrier and not n_sv:
+        raise ValueError("[sensors.gnss] carrier_phase needs tight GPS coupling with channel states ([nav] "
+                         "gps_coupling = \"tight\", channel_states = true): the float ambiguities are channel states")
     return em.StateLayout(
         baro_scale=sensors.baro is not None and sensors.baro.scale_factor_sigma > 0.0,
         clock=(sensors.gnss is not None and nav.gps_coupling == "tight") or sensors.pseudolite is not None,
@@ -79,6 +83,7 @@ def layout_for(nav: NavConfig, sensors: SensorsConfig) -> em.StateLayout:
         n_sv=n_sv,
         n_pl=n_pl,
         pl_clock=n_pl > 0 and not sensors.pseudolite.synchronized,
+        carrier=carrier,
         **_radalt_states(sensors, nav),
     )
 
@@ -162,10 +167,12 @@ class NavSystem:
         """Whether runs on one truth can share one covariance (`run(..., shared_covariance=True)`): the optimal
         'ekf' filter, tightly coupled GPS (the loose fix's covariance depends on each run's ranges), and a baro
         loop the error model sees with constant gains (the adaptive forms linearize about each run's
-        estimate). Decided from the configuration alone, so a campaign picks it once per profile."""
+        estimate). Decided from the configuration alone, so a campaign picks it once per profile. Not with carrier
+        phase: each run resets its ambiguities at its own arcs (nav/navigator.py), and the compiled epoch
+        (nav/engine.py, which needs this too) does not carry the carrier states: the generic per-run path."""
         g = self.loop_gains()
         return (self.nav.filter == "ekf" and self.nav.gps_coupling == "tight" and not self.nav.fde.enabled
-                and (g is None or g.form == "constant"))
+                and (g is None or g.form == "constant") and not self.layout.has("amb"))
 
     # --- the start -----------------------------------------------------------------------------------------
 

@@ -30,11 +30,13 @@ dtheta = dt w_ib_body[k-1], dv = dt f_body[k-1], body axes); apply for increment
 
 Random streams: each sensor draws from its own named stream approachsim.seeding.stream(seed, run, name),
 name = "imu", "baro", "radalt", "gnss", "pseudolite", plus "receiver_clock" for the GPS receiver clock the
-GNSS and pseudolite channels share (suite.py). Adding or removing a sensor leaves the others bit-identical.
+GNSS and pseudolite channels share (suite.py). Adding or removing a sensor leaves the others bit-identical. A model
+part added later draws from a child of its sensor's stream (seeding.substream: the GNSS carrier phase "carrier", the
+radar-altimeter bias), so the sensor's existing draws stay as they were.
 
 Faults: faults.Faulted wraps any sensor with the same interface; the profile's [[faults]] declare them.
 
-Modules: imu (+ presets), baro (+ atmosphere), radalt, gnss (constellation, clock, receiver), pseudolite,
+Modules: imu (+ presets), baro (+ atmosphere), radalt, gnss (constellation, clock, receiver, gbas, carrier), pseudolite,
 faults, suite (builds everything from a Profile), config (parses [sensors] and [[faults]]), states (a run's error
 states for the filter), kernels (the compiled IMU, Gauss-Markov and GNSS loops; their numpy oracles stay in the
 modules above).

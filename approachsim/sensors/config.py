@@ -16,6 +16,7 @@ from types import MappingProxyType
 from approachsim import units
 from approachsim.config import ProfileError, Section
 from approachsim.sensors.faults import FAULT_KINDS, FaultSpec
+from approachsim.sensors.gnss.carrier import L1_WAVELENGTH_M, CarrierModel
 from approachsim.sensors.gnss.clock import OSCILLATORS
 from approachsim.sensors.gnss.constellation import parse_epoch
 from approachsim.sensors.gnss.gbas import AADS, GADS, GbasModel
@@ -96,6 +97,8 @@ class GnssConfig:
     """"none": stand-alone ranging; "gbas": GBAS-corrected pseudoranges (sensors/gnss/gbas.py, the `gbas` model)."""
     gbas: GbasModel | None = None
     """[sensors.gnss.gbas]: the ground station and airborne equipment (set exactly when corrections = "gbas")."""
+    carrier: CarrierModel | None = None
+    """carrier_phase = true: L1 carrier phase with float ambiguities (sensors/gnss/carrier.py); None: code only."""
 
     def budget(self) -> GnssErrorBudget:
         """The error budget these settings select (code preset, multipath model, clock/ephemeris budget, GBAS
@@ -222,6 +225,7 @@ def parse_sensors(s: Section) -> SensorsConfig:
             clock_ephemeris=g.string("clock_ephemeris", "current", choices=tuple(CLOCK_EPHEMERIS_M)),
             corrections=(corr := g.string("corrections", "none", choices=CORRECTIONS)),
             gbas=_parse_gbas(g, corr),
+            carrier=_parse_carrier(g),
         )
         if gnss.epoch == "fixed" and g.has("epoch_window_h"):
             raise ProfileError(f"{g.path}.epoch_window_h: only used with epoch = \"per-run\" (epoch is \"fixed\")")
@@ -257,6 +261,28 @@ def parse_sensors(s: Section) -> SensorsConfig:
     p.done()
     s.done()
     return SensorsConfig(imu=imu, baro=baro, radalt=radalt, gnss=gnss, pseudolite=pseudolite)
+
+
+CARRIER_KEYS = ("carrier_multipath_m", "carrier_multipath_tau_s", "carrier_noise_m", "carrier_ambiguity_sigma_m")
+"""[sensors.gnss] keys of the carrier-phase model (only with carrier_phase = true)."""
+
+
+def _parse_carrier(g: Section) -> CarrierModel | None:
+    """[sensors.gnss] carrier_phase and its model's keys (an error without carrier_phase = true)."""
+    if not g.boolean("carrier_phase", False):
+        for k in CARRIER_KEYS:
+            if g.has(k):
+                raise ProfileError(f"{g.path}.{k}: only used with carrier_phase = true")
+        return None
+    d = CarrierModel()
+    return CarrierModel(
+        multipath_m=g.number("carrier_multipath_m", d.multipath_m, lo=0.0, hi=L1_WAVELENGTH_M / 4.0, unit="m"),
+        multipath_tau_s=g.number("carrier_multipath_tau_s", d.multipath_tau_s, lo=0.0, lo_open=True, hi=1e5,
+                                 unit="s"),
+        noise_m=g.number("carrier_noise_m", d.noise_m, lo=0.0, hi=0.05, unit="m"),
+        ambiguity_sigma_m=g.number("carrier_ambiguity_sigma_m", d.ambiguity_sigma_m, lo=0.0, lo_open=True, hi=1e4,
+                                   unit="m"),
+    )
 
 
 def _parse_gbas(g: Section, corrections: str) -> GbasModel | None:

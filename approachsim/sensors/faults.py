@@ -129,7 +129,15 @@ class Faulted:
         """The wrapped sensor's apply with the faults of the samples in `errors` applied and labelled."""
         masks = self._masks(errors)
         rec = self.sensor.apply(truth, replace(errors, series=self._noise_faulted(errors, masks)), *args, **kwargs)
-        return self._label(rec, errors.t_s, errors.batched, masks)
+        return self._label(rec, errors.t_s, errors.batched, masks, self._carrier_start(errors))
+
+    def _carrier_start(self, errors: base.SensorErrors) -> tuple | None:
+        """The carrier arcs' start (j0 = 0, no previous sample, the ambiguity pool with a run axis) when the record
+        carries carrier phase that an outage can interrupt, else None."""
+        if "ambiguity" not in errors.series or not any(f.kind == "outage" for f in self.faults):
+            return None
+        pool = errors.series["ambiguity"]
+        return (0, None, None, pool if errors.batched else pool[None])
 
     def prepare(self, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> PreparedFaulted:
         """`errors` laid out for one sample at a time (base.prepare): the fault masks and the noise faults of every
@@ -157,8 +165,10 @@ class Faulted:
             series[noise_name] = np.where(full, z * mult, z)
         return series
 
-    def _label(self, rec: Any, t_s: Array, batched: bool, masks: list[Array]) -> Any:
-        """The record with the value faults (iam, cbm, step, ramp, outage) of the samples at times t_s, labelled."""
+    def _label(self, rec: Any, t_s: Array, batched: bool, masks: list[Array], carrier: tuple | None = None) -> Any:
+        """The record with the value faults (iam, cbm, step, ramp, outage) of the samples at times t_s, labelled.
+        carrier (_carrier_start, or the closed loop's continuation): an outage ends the carrier arcs of its channels
+        and the channel begins a new arc, with a new ambiguity, when it is valid again (gnss/carrier.py)."""
         fault = np.array(rec.fault, copy=True)
         valid = np.array(rec.valid, copy=True)
         updates: dict[str, Array] = {}
@@ -187,12 +197,30 @@ class Faulted:
                     continue
                 vmask = valid.reshape(valid.shape + (1,) * (val.ndim - valid.ndim))
                 updates[fld] = np.where(vmask, val, np.nan)
+        if carrier is not None and getattr(rec, "carrier_arc", None) is not None:
+            updates["carrier_phase_m"], updates["carrier_arc"] = rearc(
+                updates.get("carrier_phase_m", rec.carrier_phase_m), rec.carrier_arc, valid, batched, carrier)
         return replace(rec, fault=fault, valid=valid, **updates)
 
     def measure(self, truth: Any, rng: base.RngLike, *, noise: bool = True, **kwargs: Any) -> Any:
         """apply(truth, draw(truth.t_s, rng), **kwargs) with the faults; noise=False zeroes the sensor errors."""
         e = self.draw(truth.t_s, rng)
         return self.apply(truth, e if noise else e.zeroed(), **kwargs)
+
+
+def rearc(phi: Array, arc: Array, valid: Array, batched: bool, carrier: tuple) -> tuple[Array, Array]:
+    """Carrier phase and arcs (gnss/carrier.py) after faults left `valid`: the arcs made afresh from valid (carrier =
+    (j0, prev_valid, prev_arc, pool) as carrier.carrier_arcs and carrier.ambiguities take them), and where a channel's
+    arc changed, its old arc's ambiguity replaced by the new one's (nan where not valid)."""
+    from approachsim.sensors.gnss.carrier import ambiguities, carrier_arcs
+
+    one = (lambda a: a) if batched else (lambda a: np.asarray(a)[None])
+    j0, pv, pa, pool = carrier
+    old = one(arc)
+    new = carrier_arcs(one(valid), j0, pv, pa)
+    p = one(phi)
+    p = np.where(new == old, p, p - ambiguities(old, pool) + ambiguities(new, pool))
+    return (p, new) if batched else (p[0], new[0])
 
 
 class PreparedFaulted:
@@ -203,12 +231,34 @@ class PreparedFaulted:
         self.inner = inner
         self.errors = errors
         self.masks = masks
+        self.carrier = faulted._carrier_start(errors)
+        self._carrier: tuple | None = None
+        """Carrier arcs after the outages: the state after the last sample (gnss/receiver.carrier_continuation)."""
 
     def at(self, truth: Any, j: int) -> Any:
         """The faulted record of sample j alone. A sample no fault touches is the wrapped sensor's record as it is:
-        labelling it would change no value (its invalid values are already nan)."""
+        labelling it would change no value (its invalid values are already nan) -- except carrier arcs after an
+        outage, which continue from sample to sample (in increasing order, skipped ones run first, as the
+        receiver's)."""
+        if self.carrier is not None:
+            from approachsim.sensors.gnss.receiver import carrier_gap
+
+            for jj in carrier_gap(self._carrier, j):
+                self._one(truth, jj)
+        return self._one(truth, j)
+
+    def _one(self, truth: Any, j: int) -> Any:
         sl = slice(j, j + 1)
         rec = self.inner.at(truth, j)
-        if not any(m[j] for m in self.masks):
+        carrier = None
+        if self.carrier is not None:
+            from approachsim.sensors.gnss.receiver import carrier_continuation, carrier_last
+
+            carrier = carrier_continuation(self._carrier, j, self.carrier[3])
+        elif not any(m[j] for m in self.masks):
             return rec
-        return self.faulted._label(rec, self.errors.t_s[sl], self.errors.batched, [m[sl] for m in self.masks])
+        rec = self.faulted._label(rec, self.errors.t_s[sl], self.errors.batched, [m[sl] for m in self.masks],
+                                  carrier)
+        if carrier is not None:
+            self._carrier = carrier_last(j, rec.valid, rec.carrier_arc, carrier)
+        return rec

@@ -11,6 +11,11 @@ estimate exactly at `row`; None when the suite has no such sensor. Signs follow 
     gse  (N, 24) m    clock/ephemeris + F(el) iono + M(el) tropo of each GPS channel (receiver.py), el at `row`;
                       GBAS corrections: the ground + iono + tropo residuals (gbas.py)
     gmp  (N, 24) m    multipath of each channel; GBAS: the airborne multipath + smoothed receiver noise
+    gio  (N, 24) m    with carrier phase only: the ionospheric part of the code's slow error (F I; GBAS s_iono I),
+                      which gse then leaves out (the carrier sees it with the opposite sign)
+    amb  (N, 24) m    with carrier phase only: the float ambiguity of an arc beginning at the row's sample (the
+                      receiver's pool entry there: exactly the ambiguity of every channel valid at the record's first
+                      sample, where every arc begins; gnss/carrier.py)
     clk  (N, 2)       receiver clock bias (m) and drift (m/s) (clock.py; shared by GPS and pseudolites)
     bb   (N,)   m     baro Gauss-Markov bias; sb (N,) its scale factor (baro.py, h_B = h (1 + S) + B + v)
     bg   (N, 3) rad/s gyro bias in body axes as the INS sees it over the increment after `row`: turn-on +
@@ -60,6 +65,8 @@ class SensorStates:
     rab: Array | None = None
     ram: Array | None = None
     tdb: Array | None = None
+    gio: Array | None = None
+    amb: Array | None = None
 
     @property
     def runs(self) -> int:
@@ -126,9 +133,10 @@ def _gnss_el(at: _At, e: base.SensorErrors, j: int) -> Array:
     return el[0] if off is None else el
 
 
-def _channels(at: _At) -> tuple[Array, Array] | None:
+def _channels(at: _At) -> tuple[Array, ...] | None:
     """(gse, gmp) of each channel, m: the receiver's channel_errors of the drawn series at the sample's elevations
-    and (GBAS) the aircraft's geometry relative to the reference point (receiver.py)."""
+    and (GBAS) the aircraft's geometry relative to the reference point (receiver.py); with carrier phase (gse, gmp,
+    gio), gse without the ionosphere (carrier_channel_errors)."""
     s = at.sample("gnss")
     if s is None:
         return None
@@ -137,7 +145,23 @@ def _channels(at: _At) -> tuple[Array, Array] | None:
     el = _gnss_el(at, e, j)
     ser = {k: np.asarray(v)[:, j] for k, v in e.series.items() if k != "rate_noise"}
     geom = rx.station_geometry(at.truth, e.rows[j:j + 1]) if rx.budget.gbas is not None else (None, None, None)
+    if getattr(rx, "carrier", None) is not None:
+        slow, iono, fast = rx.carrier_channel_errors(ser, el, *geom)
+        return slow, fast, iono
     return rx.channel_errors(ser, el, *geom)
+
+
+def _gio(at: _At) -> Array | None:
+    c = _channels(at)
+    return None if c is None or len(c) < 3 else c[2]
+
+
+def _amb(at: _At) -> Array | None:
+    s = at.sample("gnss")
+    if s is None or "ambiguity" not in s[0].series:
+        return None
+    e, j = s
+    return np.asarray(e.series["ambiguity"])[:, j]
 
 
 def _gmp(at: _At) -> Array | None:
@@ -205,6 +229,8 @@ _EXTRACT: dict[str, Callable[[_At], Array | None]] = {
         at.sample("radalt")[0].constants["bias"], dtype=float).reshape(-1),
     "ram": lambda at: _series(at, "radalt", "markov"),
     "tdb": lambda at: None,  # filled by NavSystem.start from its database draw
+    "gio": _gio,
+    "amb": _amb,
 }
 """Filter state group -> its realized value from the drawn errors (one entry per group)."""
 

@@ -77,6 +77,7 @@ def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterab
             clock=ClockModel.named(g.oscillator, g.clock_bias0_sigma_m, g.clock_drift0_sigma_mps),
             mask_rad=g.mask_rad, selection=g.selection, rate_hz=g.rate_hz, doppler=g.doppler,
             doppler_noise_mps=g.doppler_noise_mps, station_ecef=None if g.gbas is None else g.gbas.station_ecef(runway),
+            carrier=g.carrier,
         )
     if cfg.pseudolite is not None:
         p = cfg.pseudolite

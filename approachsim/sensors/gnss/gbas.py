@@ -236,6 +236,18 @@ class GbasModel:
         return (np.sqrt(s["ground"] ** 2 + s["iono"] ** 2 + s["tropo"] ** 2),
                 np.sqrt(s["multipath"] ** 2 + s["noise"] ** 2))
 
+    def carrier_channel_sigmas_m(self, el_rad: Array, x_air_m: Array | None = None, dh_m: Array | None = None,
+                                 v_air_mps: Array | None = None) -> tuple[Array, Array, Array]:
+        """channel_sigmas_m with the ionosphere split off (carrier phase, whose ionospheric term has the opposite
+        sign): slow sqrt(gnd^2 + tropo^2), iono, fast sqrt(mp^2 + noise^2), m."""
+        rx, rh, rv = REFERENCE_GEOMETRY
+        x = rx if x_air_m is None else x_air_m
+        dh = rh if dh_m is None else dh_m
+        v = rv if v_air_mps is None else v_air_mps
+        s = self.scales(el_rad, x, dh, v)
+        return (np.sqrt(s["ground"] ** 2 + s["tropo"] ** 2), s["iono"],
+                np.sqrt(s["multipath"] ** 2 + s["noise"] ** 2))
+
     # --- geometry and the compiled kernels' parameters ---------------------------------------------------------
 
     def station_ecef(self, runway: geo.RunwayFrame) -> tuple[float, float, float]:

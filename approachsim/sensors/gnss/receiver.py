@@ -59,6 +59,16 @@ receiver clock drift and white noise e (doppler_noise_mps, default 0.05 m/s: car
 typical receiver, engineering choice); the slow range errors' rates are neglected. Off by default; its noise
 columns are drawn only when on, so receivers without it keep their exact draws (switching it on reshuffles
 that receiver's pseudorange noise, reproducibly).
+Carrier phase (optional, carrier_phase = true; carrier.py gives the model, its sources and its arcs):
+    phi_i = |r_sv,i - r| + b_rx + lambda N_a(i) + S_i - I_i + c_i + w_i
+lambda N_a(i) the float ambiguity of the channel's current arc (a new one whenever the channel becomes valid after not
+being valid: rising satellite, end of an outage (faults.py re-arcs after outages), re-selection; no cycle slips within
+an arc), S_i the slow errors the code has with the same sign (stand-alone E + M T, GBAS s_gnd g + s_tropo T: the same
+realizations), I_i the code's ionospheric term, here with the opposite sign, c_i the carrier multipath (Gauss-Markov,
+1 cm, 5 s), w_i white tracking noise (2 mm). The record adds carrier_phase_m, carrier_arc (the sample index at which
+the arc began, -1 where invalid) and carrier_sigma_m. Its normals are drawn after all the others (receivers without
+it keep their draws bit for bit: they come from the child stream "carrier" of the receiver's, seeding.substream);
+`prepare(...).at` continues the arcs from sample to sample (samples in order).
 Selection: "all" (every SV above the mask) or "best4" (the four of lowest PDOP, seed 002, chosen afresh at
 each epoch). Channels are the 24 slots, in SLOTS order; invisible or unselected channels are nan and invalid.
 
@@ -83,7 +93,9 @@ import numpy as np
 
 from approachsim import geo
 from approachsim.records import GnssSamples, Truth
+from approachsim.seeding import substream
 from approachsim.sensors import base
+from approachsim.sensors.gnss.carrier import CarrierModel, ambiguities, carrier_arcs
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
 from approachsim.sensors.gnss.gbas import CARRIER_NOISE_M, SMOOTHING_TAU_S, GbasModel, station_geometry
@@ -145,6 +157,24 @@ class GnssErrorBudget:
         (stand-alone: clock/ephemeris, iono, tropo; GBAS: ground, iono, tropo residuals)."""
         first = self.clock_ephemeris_tau_s if self.gbas is None else self.gbas.ground_tau_s
         return min(first, self.iono_tau_s, self.tropo_tau_s)
+
+    @property
+    def slow_tau_no_iono_s(self) -> float:
+        """Correlation time (s) of the slow channel state when the ionosphere has its own (carrier phase): the
+        shorter of clock/ephemeris (GBAS: ground) and tropo."""
+        first = self.clock_ephemeris_tau_s if self.gbas is None else self.gbas.ground_tau_s
+        return min(first, self.tropo_tau_s)
+
+    def carrier_channel_sigmas_m(self, el_rad: Array, x_air_m: Array | None = None, dh_m: Array | None = None,
+                                 v_air_mps: Array | None = None) -> tuple[Array, Array, Array | float]:
+        """channel_sigmas_m with the ionosphere split off (the navigation filter's states under carrier phase): the
+        slow range error without it, the ionospheric error, the fast one, m. Stand-alone sqrt(ce^2 + (T_z M)^2),
+        I_z F; GBAS sqrt(gnd^2 + tropo^2), iono (gbas.GbasModel.carrier_channel_sigmas_m)."""
+        if self.gbas is not None:
+            return self.gbas.carrier_channel_sigmas_m(el_rad, x_air_m, dh_m, v_air_mps)
+        slow = np.sqrt(self.clock_ephemeris_m**2 + (self.tropo_zenith_m * tropo_mapping(el_rad)) ** 2)
+        gmp = self.multipath_sigma_m(el_rad) if self.multipath_model == "do253" else self.multipath_m
+        return slow, self.iono_zenith_m * iono_obliquity(el_rad), gmp
 
     def channel_sigmas_m(self, el_rad: Array, x_air_m: Array | None = None, dh_m: Array | None = None,
                          v_air_mps: Array | None = None) -> tuple[Array, Array | float]:
@@ -268,11 +298,14 @@ class GnssReceiver:
     fixed_hold_s: float = 1800.0
     station_ecef: tuple[float, float, float] | None = None
     """The GBAS reference point, ECEF m (needed with a GBAS budget: gbas.GbasModel.station_ecef)."""
+    carrier: CarrierModel | None = None
+    """Carrier phase with float ambiguities (carrier.py); None: code only."""
     name: str = "gnss"
 
     fault_targets: ClassVar[tuple[tuple[str, str, str], ...]] = (
         ("pseudorange", "pseudorange_m", "noise"),
         ("pseudorange_rate", "pseudorange_rate_mps", "rate_noise"),
+        ("carrier_phase", "carrier_phase_m", "carrier_noise"),
     )
 
     def __post_init__(self) -> None:
@@ -301,13 +334,25 @@ class GnssReceiver:
         multipath is unit-sigma under the do253 model (apply scales it by sigma_mp at the channel's elevation).
         GBAS budget: ground, iono, tropo, multipath, noise, all unit-sigma Gauss-Markov (apply scales them; module
         docstring), from the same standard normals as the stand-alone series in the same place, and white (m), the
-        carrier-phase noise, from normals drawn after those."""
+        carrier-phase noise, from normals drawn after those. With carrier phase (carrier.py): carrier_multipath (m),
+        carrier_noise (m) and ambiguity (m, the pool of arc ambiguities) from the child stream "carrier" of the
+        receiver's generator (seeding.substream): its own draws stay as they are, and the carrier's draws for a
+        shorter record are the first samples of a longer record's (the closed loop draws for a longer flight)."""
         b = self.budget
         k = self.constellation.prn.shape[0]
 
         mp_sigma = 1.0 if b.multipath_model == "do253" else b.multipath_m  # do253: scaled by sigma_mp(el) in apply
 
         def one(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
+            out = code(g, m, dt)
+            c = self.carrier
+            if c is not None:  # from a child stream: the receiver's draws untouched, a prefix of a longer record's
+                zc = substream(g, "carrier").standard_normal((m, 3 * k))
+                out |= {"carrier_multipath": base.gauss_markov(zc[:, 0:k], c.multipath_m, c.multipath_tau_s, dt),
+                        "carrier_noise": c.noise_m * zc[:, k : 2 * k], "ambiguity": c.ambiguity_pool(zc[:, 2 * k :])}
+            return out
+
+        def code(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
             z = g.standard_normal((m, (6 if self.doppler else 5) * k))
             extra = {"rate_noise": self.doppler_noise_mps * z[:, 5 * k : 6 * k]} if self.doppler else {}
             if b.gbas is not None:
@@ -405,6 +450,18 @@ class GnssReceiver:
         return (sc["ground"] * series["ground"] + sc["iono"] * series["iono"] + sc["tropo"] * series["tropo"],
                 sc["multipath"] * series["multipath"] + sc["noise"] * series["noise"])
 
+    def carrier_channel_errors(self, series: Mapping[str, Array], el_rad: Array, x_air_m: Array | None = None,
+                               dh_m: Array | None = None, v_air_mps: Array | None = None) -> tuple[Array, Array, Array]:
+        """channel_errors with the ionosphere split off (carrier phase: the filter's gse, gio, gmp), m: stand-alone
+        E + M T, F I and the multipath; GBAS s_gnd g + s_tropo T, s_iono I and s_mp m + s_noise n."""
+        b = self.budget
+        slow, fast = self.channel_errors(series, el_rad, x_air_m, dh_m, v_air_mps)
+        if b.gbas is None:
+            slow = series["clock_ephemeris"] + tropo_mapping(el_rad) * series["tropo_zenith"]
+            return slow, iono_obliquity(el_rad) * series["iono_zenith"], fast
+        sc = b.gbas.scales(el_rad, x_air_m, dh_m, v_air_mps)
+        return sc["ground"] * series["ground"] + sc["tropo"] * series["tropo"], sc["iono"] * series["iono"], fast
+
     def sigma_m(self, el_rad: Array, x_air_m: Array | None = None, dh_m: Array | None = None,
                 v_air_mps: Array | None = None) -> Array:
         """Nominal 1-sigma pseudorange error at elevation el (m): RSS of the budget with its mappings (GBAS: of the
@@ -459,14 +516,18 @@ class GnssReceiver:
         series = _run_axis(errors)
         bias, drift = _clock_arrays(clock, next(iter(series.values())).shape[:2])
         return self.record(truth, errors.rows, errors.t_s, r_sv, v_sv, self.plan(truth, offs), series, bias, drift,
-                           per_run, errors.batched, errors.constants.get("epoch_offset_s"))
+                           per_run, errors.batched, errors.constants.get("epoch_offset_s"),
+                           None if self.carrier is None else (0, None, None, series["ambiguity"]))
 
     def record(self, truth: Truth, rows: Array, t_s: Array, r_sv: Array, v_sv: Array | None, plan: Array,
                series: Mapping[str, Array], bias: Array, drift: Array, per_run: bool, batched: bool,
-               epoch_offset_s: Array | None) -> GnssSamples:
+               epoch_offset_s: Array | None, carrier: tuple | None = None) -> GnssSamples:
         """The record of samples at truth `rows` (times t_s) from the satellites r_sv (and velocities v_sv) (S, m, 24,
         3) of S skies, best4-fixed's plan (S, 24), the error series (R, m, 24) by name and the receiver clock bias
-        and drift (R, m); per_run: the geometry keeps its sky axis; batched: the run axis is kept."""
+        and drift (R, m); per_run: the geometry keeps its sky axis; batched: the run axis is kept. carrier (with
+        carrier phase): (j0, prev_valid, prev_arc, pool): the global index of the first sample, the channels'
+        validity and arc id at the sample before (None at the record's start; carrier.carrier_arcs) and the
+        ambiguity pool of the whole record (R, M, 24)."""
         b = self.budget
         mode = {"all": gk.MODE_ALL, "best4": gk.MODE_BEST4, "best4-fixed": gk.MODE_PLANNED}[self.selection]
         c = np.ascontiguousarray
@@ -479,6 +540,9 @@ class GnssReceiver:
             pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, c(series["clock_ephemeris"]),
                                         c(series["iono_zenith"]), c(series["tropo_zenith"]), c(series["multipath"]),
                                         c(series["noise"]), c(bias))
+            if self.carrier is not None:  # the carrier's slow errors with the code's sign, and its iono term
+                slow, iono = (series["clock_ephemeris"] + m_tropo * series["tropo_zenith"],
+                              f_iono * series["iono_zenith"])
         else:
             s_gnd, s_iono, s_tropo, s_mp, s_noise, sigma = gk.gbas_scales(
                 el, r_rx, c(truth.h_m[rows], dtype=float), c(truth.v_ned[rows], dtype=float),
@@ -486,6 +550,15 @@ class GnssReceiver:
             pr, valid = gk.pseudoranges_gbas(rng, s_gnd, s_iono, s_tropo, s_mp, s_noise, sel, c(series["ground"]),
                                              c(series["iono"]), c(series["tropo"]), c(series["multipath"]),
                                              c(series["noise"]), c(series["white"]), c(bias))
+            if self.carrier is not None:
+                slow, iono = s_gnd * series["ground"] + s_tropo * series["tropo"], s_iono * series["iono"]
+        phi = arc = None
+        if self.carrier is not None:
+            j0, prev_valid, prev_arc, pool = carrier  # type: ignore[misc]
+            arc = carrier_arcs(valid, j0, prev_valid, prev_arc)
+            # phi = range + b_rx + lambda N + S - I + c + w  (carrier.py)
+            phi = (rng + slow - iono + series["carrier_multipath"] + series["carrier_noise"] + bias[..., None]
+                   + ambiguities(arc, pool))
         prr = None
         if self.doppler:
             prr = gk.pseudorange_rates(u, c(v_sv), c(truth.lat_rad[rows], dtype=float),
@@ -498,7 +571,9 @@ class GnssReceiver:
             elevation_rad=sky(el), azimuth_rad=sky(az), visible=sky(vis), valid=run(valid), pdop=sky(pdop),
             clock_bias_m=np.array(run(bias)), clock_drift_mps=np.array(run(drift)),
             fault=np.zeros(run(pr).shape, dtype=np.int8), pseudorange_rate_mps=None if prr is None else run(prr),
-            epoch_offset_s=epoch_offset_s,
+            epoch_offset_s=epoch_offset_s, carrier_phase_m=None if phi is None else run(phi),
+            carrier_arc=None if arc is None else run(arc),
+            carrier_sigma_m=None if self.carrier is None else self.carrier.sigma_m,
         )
 
     def prepare(self, errors: base.SensorErrors, clock: base.SensorErrors | None = None) -> PreparedGnss:
@@ -534,6 +609,20 @@ class GnssReceiver:
             cd = np.broadcast_to(clock.series["drift"], shape_t)
         pr = pr + cb[..., None]
         valid = np.broadcast_to(geo_["sel"], pr.shape).copy()
+        phi = arc = None
+        if self.carrier is not None:  # phi = range + b_rx + lambda N + S - I + c + w (carrier.py)
+            if self.budget.gbas is not None:
+                slow, iono = sc["ground"] * s["ground"] + sc["tropo"] * s["tropo"], sc["iono"] * s["iono"]
+            else:
+                slow = s["clock_ephemeris"] + tropo_mapping(el) * s["tropo_zenith"]
+                iono = iono_obliquity(el) * s["iono_zenith"]
+            run_axis = valid if errors.batched else valid[None]
+            arc = carrier_arcs(run_axis)
+            pool = s["ambiguity"] if errors.batched else s["ambiguity"][None]
+            amb = ambiguities(arc, pool)
+            arc, amb = (arc, amb) if errors.batched else (arc[0], amb[0])
+            phi = np.where(valid, geo_["range"] + slow - iono + s["carrier_multipath"] + s["carrier_noise"]
+                           + cb[..., None] + amb, np.nan)
         prr = None
         if self.doppler:
             r = errors.rows
@@ -547,7 +636,8 @@ class GnssReceiver:
             pseudorange_m=np.where(valid, pr, np.nan), sigma_m=self.sigma_m(el, *geom), elevation_rad=el,
             azimuth_rad=geo_["az"], visible=geo_["visible"], valid=valid, pdop=geo_["pdop"],
             clock_bias_m=np.array(cb), clock_drift_mps=np.array(cd), fault=np.zeros(pr.shape, dtype=np.int8),
-            pseudorange_rate_mps=prr, epoch_offset_s=errors.constants.get("epoch_offset_s"),
+            pseudorange_rate_mps=prr, epoch_offset_s=errors.constants.get("epoch_offset_s"), carrier_phase_m=phi,
+            carrier_arc=arc, carrier_sigma_m=None if self.carrier is None else self.carrier.sigma_m,
         )
 
     def measure(
@@ -596,6 +686,8 @@ class PreparedGnss:
         self.epoch_offset_s = errors.constants.get("epoch_offset_s")
         self._plan_at: tuple[float, bytes] | None = None
         self._plan = np.zeros((self.offsets.shape[0], rx.constellation.prn.shape[0]), dtype=bool)
+        self._carrier: tuple | None = None
+        """(j, valid, arc, state before j) of the last sample given (carrier phase: the arcs continue from it)."""
 
     def plan(self, truth: Truth) -> Array:
         """best4-fixed's plan for this truth's start (kept while row 0 is the same)."""
@@ -607,10 +699,54 @@ class PreparedGnss:
         return self._plan
 
     def at(self, truth: Truth, j: int) -> GnssSamples:
-        """The record of sample j alone (one-sample axes, as apply on errors.sample(j))."""
+        """The record of sample j alone (one-sample axes, as apply on errors.sample(j)). With carrier phase the
+        arcs continue from the previous sample's: samples come in increasing order (the last one may be given
+        again), samples skipped since the last one are run first (their validity decides the arcs), so at(truth, j)
+        equals sample j of apply's record."""
+        if self.rx.carrier is not None:
+            for jj in carrier_gap(self._carrier, j):
+                self._one(truth, jj)
+        return self._one(truth, j)
+
+    def _one(self, truth: Truth, j: int) -> GnssSamples:
         sl = slice(j, j + 1)
         e = self.errors
-        return self.rx.record(
+        carrier = None
+        if self.rx.carrier is not None:
+            carrier = carrier_continuation(self._carrier, j, self.series["ambiguity"])
+        rec = self.rx.record(
             truth, e.rows[sl], e.t_s[sl], self.r_sv[:, sl], None if self.v_sv is None else self.v_sv[:, sl],
             self.plan(truth), {k: v[:, sl] for k, v in self.series.items()}, self.bias[:, sl], self.drift[:, sl],
-            self.per_run, e.batched, self.epoch_offset_s)
+            self.per_run, e.batched, self.epoch_offset_s, carrier)
+        if carrier is not None:
+            self._carrier = carrier_last(j, rec.valid, rec.carrier_arc, carrier)
+        return rec
+
+
+def carrier_gap(last: tuple | None, j: int) -> range:
+    """The samples between the last one given (carrier_continuation's `last`) and j, to be run before j."""
+    return range(0 if last is None else last[0] + 1, j)
+
+
+def carrier_continuation(last: tuple | None, j: int, pool: Array) -> tuple:
+    """record()'s carrier argument (j, valid and arc at j - 1, pool) for sample j after the last sample given, `last`
+    = (j_last, valid, arc, the state before j_last) (None: none yet, j must be 0). The same j again (a repeated
+    epoch) starts from the state before it."""
+    if last is None or j == 0:
+        if j != 0:
+            raise ValueError(f"carrier phase: samples are taken in order from 0; got {j} first")
+        return (0, None, None, pool)
+    j_last, valid, arc, before = last
+    if j == j_last:
+        return (j, *before, pool)
+    if j != j_last + 1:
+        raise ValueError(f"carrier phase: samples are taken in increasing order (skipped ones run first: "
+                         f"carrier_gap); got {j} after {j_last}")
+    return (j, valid, arc, pool)
+
+
+def carrier_last(j: int, valid: Array, arc: Array, carrier: tuple) -> tuple:
+    """The state after sample j of a one-sample record (its valid and arc, sample axis dropped; carrier: the
+    argument it was made with) for carrier_continuation."""
+    _, pv, pa, _ = carrier
+    return (j, np.asarray(valid)[..., -1, :], np.asarray(arc)[..., -1, :], (pv, pa))
