@@ -30,6 +30,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -149,14 +150,18 @@ def runs_to_decide(rms: float, d: float, limit: float, level: float = 0.95, n_ma
         ok = lambda n: rms * rms_lower_factor(n, level) > limit  # noqa: E731
     if not ok(n_max):
         return None
-    lo, hi = 1, n_max  # ok(hi) holds; both factors move monotonically towards 1 with n
+    return max(smallest_n(ok, 1, n_max), MIN_RUNS)  # both factors move monotonically towards 1 with n
+
+
+def smallest_n(ok: Callable[[int], bool], lo: int, hi: int) -> int:
+    """Smallest n in [lo, hi] with ok(n), by bisection: ok monotone in n (false, then true) and ok(hi) true."""
     while lo < hi:
         mid = (lo + hi) // 2
         if ok(mid):
             hi = mid
         else:
             lo = mid + 1
-    return max(lo, MIN_RUNS)
+    return lo
 
 
 def quantile_upper_rank(n: int, p: float = 0.95, level: float = 0.95) -> int | None:

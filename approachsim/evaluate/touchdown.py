@@ -59,7 +59,7 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from approachsim import units
-from approachsim.evaluate.stats import MIN_RUNS
+from approachsim.evaluate.stats import MIN_RUNS, smallest_n
 from approachsim.evaluate.verdict import clopper_pearson
 from approachsim.records import Truth
 
@@ -379,14 +379,7 @@ def runs_to_decide(crit: Criterion, mean: float, sd: float, level: float, n_max:
         ok = lambda n: bounds(n)[1] > crit.probability  # noqa: E731
     if not ok(n_max):
         return None
-    lo, hi = 3, n_max
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if ok(mid):
-            hi = mid
-        else:
-            lo = mid + 1
-    return max(lo, MIN_RUNS)
+    return max(smallest_n(ok, 3, n_max), MIN_RUNS)
 
 
 def clean_runs_needed(probability: float, level: float) -> int:
