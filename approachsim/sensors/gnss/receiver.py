@@ -334,10 +334,12 @@ class GnssReceiver:
         multipath is unit-sigma under the do253 model (apply scales it by sigma_mp at the channel's elevation).
         GBAS budget: ground, iono, tropo, multipath, noise, all unit-sigma Gauss-Markov (apply scales them; module
         docstring), from the same standard normals as the stand-alone series in the same place, and white (m), the
-        carrier-phase noise, from normals drawn after those. With carrier phase (carrier.py): carrier_multipath (m),
-        carrier_noise (m) and ambiguity (m, the pool of arc ambiguities) from the child stream "carrier" of the
-        receiver's generator (seeding.substream): its own draws stay as they are, and the carrier's draws for a
-        shorter record are the first samples of a longer record's (the closed loop draws for a longer flight)."""
+        carrier-phase noise, from the child stream "gbas_white" (seeding.substream: the closed loop, which draws for a
+        longer flight, sees the same white noise as the open loop at every sample). With carrier phase (carrier.py):
+        carrier_multipath (m), carrier_noise (m) and ambiguity (m, the pool of arc ambiguities) from the child stream
+        "carrier" of the receiver's generator (seeding.substream): its own draws stay as they are, and the carrier's
+        draws for a shorter record are the first samples of a longer record's (the closed loop draws for a longer
+        flight)."""
         b = self.budget
         k = self.constellation.prn.shape[0]
 
@@ -357,7 +359,8 @@ class GnssReceiver:
             extra = {"rate_noise": self.doppler_noise_mps * z[:, 5 * k : 6 * k]} if self.doppler else {}
             if b.gbas is not None:
                 return extra | {
-                    "white": b.code_noise_m * g.standard_normal((m, k)),  # after the others: theirs stay the same
+                    # a child stream: the others' draws stay the same, and a shorter record's are a prefix of a longer's
+                    "white": b.code_noise_m * substream(g, "gbas_white").standard_normal((m, k)),
                     "ground": base.gauss_markov(z[:, 0:k], 1.0, b.gbas.ground_tau_s, dt),
                     "iono": base.gauss_markov(z[:, k : 2 * k], 1.0, b.iono_tau_s, dt),
                     "tropo": base.gauss_markov(z[:, 2 * k : 3 * k], 1.0, b.tropo_tau_s, dt),
