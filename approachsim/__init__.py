@@ -5,4 +5,41 @@ a baro damping loop and an error-state EKF estimates the state; the autopilot fl
 evaluator scores navigation error at the decision heights against the FAA/ICAO limits over Monte Carlo runs.
 """
 
+import hashlib as _hashlib
+import os as _os
+import time as _time
+from pathlib import Path as _Path
+
 __version__ = "0.1.0"
+
+
+def _numba_cache_dir() -> None:
+    """Point numba's file cache (the kernels' cache=True) at a directory named by a hash of every module of this
+    package that uses numba, unless NUMBA_CACHE_DIR is set already. Numba invalidates a cached kernel only when its
+    own file changes, not when a kernel it calls from another module does (flight/kernels.py calls
+    nav/kernels/inloop.py): a stale cache would run the old callee. Keyed by all their sources, any change starts a
+    fresh cache (about 9 MB, a minute to build); caches of other versions unused for 14 days are removed."""
+    if "NUMBA_CACHE_DIR" in _os.environ:
+        return
+    h = _hashlib.sha256()
+    pkg = _Path(__file__).resolve().parent
+    for f in sorted(pkg.rglob("*.py")):
+        b = f.read_bytes()
+        if b"numba" in b:
+            h.update(f.relative_to(pkg).as_posix().encode() + b"\0" + b + b"\0")
+    root = _Path(_os.environ.get("XDG_CACHE_HOME") or _Path.home() / ".cache") / "approachsim" / "numba"
+    here = root / h.hexdigest()[:16]
+    try:
+        here.mkdir(parents=True, exist_ok=True)
+        _os.utime(here)
+        for old in root.iterdir():
+            if old != here and _time.time() - old.stat().st_mtime > 14 * 86400:
+                import shutil
+
+                shutil.rmtree(old, ignore_errors=True)
+    except OSError:
+        return  # no writable cache: numba's default (next to the sources)
+    _os.environ["NUMBA_CACHE_DIR"] = str(here)
+
+
+_numba_cache_dir()

@@ -222,7 +222,8 @@ class NavInTheLoop:
                 baro = self.suite.sensors["baro"]
                 if type(baro) is Baro:  # a plain altimeter: its samples made in the kernel (a faulted one: Python)
                     nw[ik.W_BARO_KERNEL] = 1.0
-                    nw[ik.W_BSET], nw[ik.W_BT0L], nw[ik.W_BEXP] = baro.kernel_constants()
+                    (nw[ik.W_BSET], nw[ik.W_BT0L], nw[ik.W_BEXP], nw[ik.W_BFLD],
+                     nw[ik.W_BCM1]) = baro.kernel_constants()
                     nw[ik.W_BSF] = float(np.ravel(e.constants["scale_factor"])[0])
                     baro_e = np.ascontiguousarray(np.column_stack([e.series["bias"], e.series["noise"]]))
                     lag_w = np.ascontiguousarray(baro.lag_weights(self.dt), dtype=float)

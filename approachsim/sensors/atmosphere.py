@@ -16,6 +16,12 @@ temperature error then grows with the height above the field (cold-is-low), zero
 On a standard day (dT = 0, p_set = p_sl) the indication is exactly H. In a cold atmosphere the indication is
 H T0 / (T0 + dT): the cold-is-low error that the PANS-OPS 4 %-per-10-C rule approximates. A setting error
 dp gives dh = R T / (g0 p) dp = 8.32 m (27.3 ft) per hPa at sea level.
+
+Temperature correction with the aerodrome temperature (the air data's or the FMS's compensation of the indication,
+the exact form of the ICAO Doc 8168 cold-temperature correction for this troposphere): in ISA+dT the indicated height
+above the field and the true one are in the ratio of the field's ISA temperature to its real one,
+H - H_f = (h_ind - H_f) T_f / (T0 - L H_f), T_f = T0 + dT - L H_f (both lapse at L, so the ratio is exact here; a
+real day's lapse rate differs). T_f is the reported aerodrome temperature, a METAR's whole degree Celsius.
 """
 
 from __future__ import annotations
@@ -67,3 +73,14 @@ def indicated_altitude_m(p_static_pa: ArrayLike, setting_pa: float = P0_PA) -> n
     """Altimeter indication (m) for static pressure p (Pa) and altimeter setting (QNH, Pa): the ISA inverse."""
     p = np.asarray(p_static_pa, dtype=float)
     return T0_K / LAPSE_K_PER_M * (1.0 - (p / setting_pa) ** (1.0 / EXPONENT))
+
+
+def reported_aerodrome_temperature_k(field_geopot_m: float, isa_dev_k: float = 0.0) -> float:
+    """The aerodrome temperature a METAR reports (K): T0 + dT - L H_f rounded to a whole degree Celsius."""
+    t_c = T0_K + isa_dev_k - LAPSE_K_PER_M * field_geopot_m - 273.15
+    return float(np.round(t_c)) + 273.15
+
+
+def temperature_correction_ratio(field_geopot_m: float, aerodrome_temperature_k: float) -> float:
+    """T_f / (T0 - L H_f): true height above the field per indicated height above it (module docstring)."""
+    return float(aerodrome_temperature_k / (T0_K - LAPSE_K_PER_M * field_geopot_m))

@@ -1,11 +1,15 @@
 """Barometric altimeter: indicated altitude from the truth's static pressure, plus seed 001/003 errors.
 
     h_ind = indicated_altitude(p_static, QNH setting)          (ISA inverse, sensors/atmosphere.py)
-    h_B   = h_ind (1 + S) + B_k + v_k                          (seed 003 eq. 1; seed 001 eq. 1-2 has S = 0)
+    h_c   = h_ind + (h_ind - H_f) (c - 1)                      (temperature correction, c = 1 without one)
+    h_B   = h_c (1 + S) + B_k + v_k                            (seed 003 eq. 1; seed 001 eq. 1-2 has S = 0)
 
 The deterministic part is physics: with the profile's ISA deviation and true sea-level pressure in the
 truth's p_static and the profile's QNH setting here, a cold day or a wrong setting gives the real altimeter
-error (cold-is-low, 8.3 m per hPa at sea level). S is a random-constant scale factor, B a first-order
+error (cold-is-low, 8.3 m per hPa at sea level). With temperature_correction = "aerodrome" the air data correct the
+indication above the field (geopotential elevation H_f) by c = T_f / (T0 - L H_f), T_f the reported aerodrome
+temperature (sensors/atmosphere.py: the exact form of the ICAO Doc 8168 correction for the ISA+dT troposphere, left
+with the METAR's rounding to a whole degree). S is a random-constant scale factor, B a first-order
 Gauss-Markov bias (sigma, tau; exact discretization of seed 001 eq. 2), v white noise. Defaults are seed 001
 Table 1 (sigma_B = 1 m, beta = 0.01 1/s so tau = 100 s) and seed 003 Table 1 (noise 1 m). No static-source
 (position) error.
@@ -43,7 +47,8 @@ _NO_LAG = np.zeros(0)
 @dataclass(frozen=True)
 class Baro:
     """Barometric altimeter. setting_pa: the setting on the instrument, Pa (profile environment.setting_pa:
-    QNH + the setting error)."""
+    QNH + the setting error); field_m, temperature_ratio: the temperature correction's field geopotential elevation (m)
+    and c = T_f / (T0 - L H_f) (1: no correction)."""
 
     setting_pa: float = atmosphere.P0_PA
     rate_hz: float = 10.0
@@ -52,6 +57,8 @@ class Baro:
     scale_factor_sigma: float = 0.0
     noise_sigma_m: float = 1.0
     lag_s: float = 0.0
+    field_m: float = 0.0
+    temperature_ratio: float = 1.0
     name: str = "baro"
 
     fault_targets: ClassVar[tuple[tuple[str, str, str], ...]] = (("h", "h_baro_m", "noise"),)
@@ -70,10 +77,11 @@ class Baro:
 
         return base.make_errors(t_s, self.rate_hz, rng, one)
 
-    def kernel_constants(self) -> tuple[float, float, float]:
-        """(setting Pa, ISA T0 / L m, exponent R L / g0): the indicated-altitude constants of the compiled sample
-        (sensors/kernels/baro.py; nav/kernels/inloop.py makes a closed loop's samples with them)."""
-        return float(self.setting_pa), _T0_OVER_LAPSE_M, _EXPONENT_INV
+    def kernel_constants(self) -> tuple[float, float, float, float, float]:
+        """(setting Pa, ISA T0 / L m, exponent R L / g0, field H_f m, c - 1): the indicated-altitude constants of the
+        compiled sample (sensors/kernels/baro.py; nav/kernels/inloop.py makes a closed loop's samples with them)."""
+        return (float(self.setting_pa), _T0_OVER_LAPSE_M, _EXPONENT_INV, float(self.field_m),
+                float(self.temperature_ratio) - 1.0)
 
     def lag_weights(self, dt_s: float) -> Array:
         """The lag's impulse-response weights (M + 1,) on a truth step dt_s (s), renormalized to sum 1 (module
@@ -108,8 +116,8 @@ class Baro:
             p = truth.p_static_pa[rows[:, None]]
         c = np.ascontiguousarray
         out = np.empty(np.shape(bias))
-        bk.baro_apply(c(p, dtype=float), float(self.setting_pa), _T0_OVER_LAPSE_M, _EXPONENT_INV, w,
-                      c(sf, dtype=float), c(bias, dtype=float), c(noise, dtype=float), out)
+        bk.baro_apply(c(p, dtype=float), *self.kernel_constants(), w, c(sf, dtype=float), c(bias, dtype=float),
+                      c(noise, dtype=float), out)
         h = out if batched else out[0]
         return BaroSamples(
             t_s=t_s, h_baro_m=h, sigma_m=np.full(np.shape(t_s), self.noise_sigma_m),
@@ -129,6 +137,7 @@ class Baro:
             h_ind = np.sum(atmosphere.indicated_altitude_m(truth.p_static_pa[idx], self.setting_pa) * w, axis=-1)
         else:
             h_ind = atmosphere.indicated_altitude_m(truth.p_static_pa[errors.rows], self.setting_pa)
+        h_ind = h_ind + (h_ind - self.field_m) * (self.temperature_ratio - 1.0)
         sf = errors.constants["scale_factor"]
         sf = sf[:, None] if errors.batched else sf
         h = h_ind * (1.0 + sf) + errors.series["bias"] + errors.series["noise"]

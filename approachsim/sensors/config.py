@@ -55,6 +55,8 @@ class BaroConfig:
     scale_factor_sigma: float = 0.0
     noise_sigma_m: float = 1.0
     lag_s: float = 0.0
+    temperature_correction: str = "none"
+    """none | aerodrome: the indication corrected with the reported aerodrome temperature (sensors/atmosphere.py)."""
 
 
 @dataclass(frozen=True)
@@ -180,6 +182,7 @@ def parse_sensors(s: Section) -> SensorsConfig:
             scale_factor_sigma=b.number("scale_factor_sigma", 0.0, lo=0.0, hi=0.5),
             noise_sigma_m=b.number("noise_sigma_m", 1.0, lo=0.0, unit="m"),
             lag_s=b.number("lag_s", 0.0, lo=0.0, hi=10.0, unit="s"),
+            temperature_correction=b.string("temperature_correction", "none", choices=("none", "aerodrome")),
         )
     b.done()
 

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from approachsim.seeding import stream
-from approachsim.sensors import base
+from approachsim.sensors import atmosphere, base
 from approachsim.sensors.baro import Baro
 from approachsim.sensors.config import SENSOR_NAMES, SensorsConfig
 from approachsim.sensors.faults import Faulted, FaultSpec
@@ -53,16 +53,23 @@ RANGING = ("gnss", "pseudolite")
 """Sensors whose measurements carry the receiver clock."""
 
 
-def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = ()) -> dict[str, Any]:
-    """Sensor objects by name from a SensorsConfig (runway frame for pseudolites, QNH setting in Pa)."""
+def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = (),
+                  isa_dev_k: float = 0.0) -> dict[str, Any]:
+    """Sensor objects by name from a SensorsConfig (runway frame for pseudolites and the field elevation, QNH setting
+    in Pa, the day's ISA deviation in K for the baro's reported aerodrome temperature)."""
     grade = replace(PRESETS[cfg.imu.grade], gyro_quant_rad=cfg.imu.gyro_quant_rad,
                     accel_quant_mps=cfg.imu.accel_quant_mps)
     out: dict[str, Any] = {"imu": Imu(grade)}
     if cfg.baro is not None:
         b = cfg.baro
+        field_m, ratio = 0.0, 1.0
+        if b.temperature_correction == "aerodrome":
+            field_m = float(atmosphere.geopotential_m(runway.threshold_h_m))
+            ratio = atmosphere.temperature_correction_ratio(
+                field_m, atmosphere.reported_aerodrome_temperature_k(field_m, isa_dev_k))
         out["baro"] = Baro(setting_pa=qnh_pa, rate_hz=b.rate_hz, bias_sigma_m=b.bias_sigma_m,
                            bias_tau_s=b.bias_tau_s, scale_factor_sigma=b.scale_factor_sigma,
-                           noise_sigma_m=b.noise_sigma_m, lag_s=b.lag_s)
+                           noise_sigma_m=b.noise_sigma_m, lag_s=b.lag_s, field_m=field_m, temperature_ratio=ratio)
     if cfg.radalt is not None:
         r = cfg.radalt
         out["radalt"] = RadarAltimeter(rate_hz=r.rate_hz, max_range_m=r.max_range_m, percent_sigma=r.percent_sigma,
@@ -114,10 +121,10 @@ class SensorSuite:
 
     @classmethod
     def from_config(
-        cls, cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = ()
+        cls, cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = (), isa_dev_k: float = 0.0
     ) -> SensorSuite:
-        """Build from a SensorsConfig."""
-        sensors = build_sensors(cfg, runway, qnh_pa, faults)
+        """Build from a SensorsConfig (build_sensors' arguments)."""
+        sensors = build_sensors(cfg, runway, qnh_pa, faults, isa_dev_k)
         clock = None
         rate = 1.0
         if cfg.gnss is not None:
@@ -130,8 +137,9 @@ class SensorSuite:
 
     @classmethod
     def from_profile(cls, profile: Any) -> SensorSuite:
-        """The suite of a Profile (its sensors, faults, runway and QNH setting)."""
-        return cls.from_config(profile.sensors, profile.runway.frame, profile.environment.setting_pa, profile.faults)
+        """The suite of a Profile (its sensors, faults, runway, QNH setting and ISA deviation)."""
+        env = profile.environment
+        return cls.from_config(profile.sensors, profile.runway.frame, env.setting_pa, profile.faults, env.isa_dev_k)
 
     def without(self, *names: str) -> SensorSuite:
         """The same suite with sensors removed (the clock stays while a ranging sensor remains)."""

@@ -54,7 +54,9 @@ W_BARO_EXCL = 75
 """1 when the online FDE has excluded the baro (the loop holds)."""
 W_BSET, W_BT0L, W_BEXP, W_BSF = 76, 77, 78, 79
 """The baro's setting (Pa), ISA T0 / L (m), exponent R L / g0 and this run's scale factor (sensors/baro.py)."""
-NW = 80
+W_BFLD, W_BCM1 = 80, 81
+"""The baro's temperature correction: field geopotential elevation H_f (m) and c - 1 (sensors/baro.py)."""
+NW = 82
 
 NAV_START, NAV_BARO, NAV_EPOCH = 1, 2, 4
 """Bits of nav_row's code: the rows at which Python must act."""
@@ -64,7 +66,8 @@ NAV_START, NAV_BARO, NAV_EPOCH = 1, 2, 4
 def baro_sample(k: int, buf: np.ndarray, nw: np.ndarray, lag_w: np.ndarray, bias: float, noise: float) -> float:
     """The barometric altimeter's sample at truth row k (sensors/kernels/baro.baro_apply for one run, the same
     operations in order): h_ind = (T0 / L)(1 - (p / p_set)^(R L / g0)) of the static pressure at the IMU (buf column
-    23; with a lag, the weights lag_w over rows k, k - 1, ..., clipped at 0), h = h_ind (1 + S) + bias + noise."""
+    23; with a lag, the weights lag_w over rows k, k - 1, ..., clipped at 0), h_c = h_ind + (h_ind - H_f)(c - 1),
+    h = h_c (1 + S) + bias + noise."""
     t0l, p_set, ex = nw[W_BT0L], nw[W_BSET], nw[W_BEXP]
     if lag_w.shape[0] > 0:
         h = 0.0
@@ -72,6 +75,7 @@ def baro_sample(k: int, buf: np.ndarray, nw: np.ndarray, lag_w: np.ndarray, bias
             h += t0l * (1.0 - (buf[max(k - q, 0), 23] / p_set) ** ex) * lag_w[q]
     else:
         h = t0l * (1.0 - (buf[k, 23] / p_set) ** ex)
+    h = h + (h - nw[W_BFLD]) * nw[W_BCM1]
     return h * (1.0 + nw[W_BSF]) + bias + noise
 
 

@@ -10,16 +10,19 @@ from numba import njit
 
 
 @njit(cache=True)
-def baro_apply(p_static: np.ndarray, setting_pa: float, t0_over_lapse_m: float, exponent: float,
-               weights: np.ndarray, sf: np.ndarray, bias: np.ndarray, noise: np.ndarray, out: np.ndarray) -> None:
+def baro_apply(p_static: np.ndarray, setting_pa: float, t0_over_lapse_m: float, exponent: float, field_m: float,
+               ratio_m1: float, weights: np.ndarray, sf: np.ndarray, bias: np.ndarray, noise: np.ndarray,
+               out: np.ndarray) -> None:
     """Baro heights of R runs at m samples, in place into out (R, m), m:
 
         h_ind = (T0 / L) (1 - (p / p_set)^(R L / g0))        (ISA inverse, sensors/atmosphere.py)
-        h     = h_ind (1 + S_r) + B_ri + v_ri                  (sensors/baro.py)
+        h_c   = h_ind + (h_ind - H_f) (c - 1)                  (temperature correction; c - 1 = 0: none)
+        h     = h_c (1 + S_r) + B_ri + v_ri                    (sensors/baro.py)
 
     p_static (m, n) the static pressure (Pa) of each sample's truth row (column 0) and, with a lag, of the n - 1 rows
     before it; weights (n,) the lag's impulse response (h_ind = sum_l w_l h_ind(p_il), in l order), empty without a
-    lag; t0_over_lapse_m = T0 / L (m), exponent = R L / g0; scale factor sf (R,), bias and noise (R, m) m."""
+    lag; t0_over_lapse_m = T0 / L (m), exponent = R L / g0; field_m = H_f (m), ratio_m1 = c - 1; scale factor sf
+    (R,), bias and noise (R, m) m."""
     m = p_static.shape[0]
     lagged = weights.shape[0] > 0
     for i in range(m):
@@ -29,5 +32,6 @@ def baro_apply(p_static: np.ndarray, setting_pa: float, t0_over_lapse_m: float, 
                 h += t0_over_lapse_m * (1.0 - (p_static[i, q] / setting_pa) ** exponent) * weights[q]
         else:
             h = t0_over_lapse_m * (1.0 - (p_static[i, 0] / setting_pa) ** exponent)
+        h = h + (h - field_m) * ratio_m1
         for r in range(sf.shape[0]):
             out[r, i] = h * (1.0 + sf[r]) + bias[r, i] + noise[r, i]

@@ -113,11 +113,13 @@ def test_geodesy_kernels_equal_geo():
         _close(gk.gravity_nd(lat, h), (g[0], g[2]), "gravity")
 
 
-@pytest.mark.parametrize("feedback", [False, True])
-def test_closed_loop_steps_equal_the_open_loop_pass_to_rounding(feedback):
+@pytest.mark.parametrize(("feedback", "cold"), [(False, False), (True, False), (False, True)])
+def test_closed_loop_steps_equal_the_open_loop_pass_to_rounding(feedback, cold):
     """The closed loop (kernels.strapdown.inloop_step, increments made in the loop from truth sample k-1) and the
     open-loop pass (IMU record from sensors/imu.py, `propagate`) share one kernel: the same navigation to
-    rounding (nanometres), not merely to the 1e-6 m of two different increment definitions."""
+    rounding (nanometres), not merely to the 1e-6 m of two different increment definitions. cold: an ISA -25 day
+    at a 5434 ft field with the baro's aerodrome-temperature correction and the damping loop on, whose baro samples
+    the closed loop makes in its own kernel (inloop.baro_sample) and the open loop in sensors/baro.py."""
     import tomllib
     from pathlib import Path
 
@@ -132,7 +134,15 @@ def test_closed_loop_steps_equal_the_open_loop_pass_to_rounding(feedback):
     path = Path("profiles/gray-maybeck.toml")
     data = tomllib.loads(path.read_text(encoding="utf-8"))
     data.setdefault("nav", {})["feedback"] = feedback
+    if cold:
+        data["nav"]["baro_loop"] = "constant"
+        data["nav"]["initial_error"]["start"] = "converged"  # as the default profile (the loop's start is its own)
+        data["runway"]["elevation_ft"] = 5434.0
+        data["environment"]["isa_dev_C"] = -25.0
+        data["sensors"]["baro"]["temperature_correction"] = "aerodrome"
     prof = parse_profile(data, source=path.resolve())
+    if cold:
+        assert SensorSuite.from_profile(prof).sensors["baro"].temperature_ratio < 0.92
     truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=prof.rates.imu_hz, start_distance_m=300.0,
                                         ground_speed_mps=70.0)
     src = NavInTheLoop(prof, seed=4, run=2, max_time_s=30.0)

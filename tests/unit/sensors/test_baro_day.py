@@ -107,3 +107,41 @@ def test_true_qnh_key_is_refused_with_guidance():
         parse_profile({"runway": {"threshold_lat_deg": 0.0, "threshold_lon_deg": 0.0, "elevation_ft": 0.0,
                                   "heading_true_deg": 0.0}, "environment": {"true_qnh_hPa": 1000.0}})
     assert math.isfinite(_profile(0.0, 0.0).environment.sea_level_pa)
+
+
+
+def _baro_error_ft(elevation_ft: float, isa_dev_c: float, correction: str) -> tuple[np.ndarray, np.ndarray]:
+    """(noise-free baro minus the true geopotential height, true geopotential height above the field), ft, along a
+    synthetic descent to the field in the day's ISA+dT static pressure, read through the profile's sensor suite."""
+    from approachsim import synthetic
+    from approachsim.sensors.suite import SensorSuite
+
+    prof = parse_profile({
+        "runway": {"threshold_lat_deg": 45.0, "threshold_lon_deg": 7.0, "elevation_ft": elevation_ft,
+                   "heading_true_deg": 90.0},
+        "environment": {"isa_dev_C": isa_dev_c},
+        "sensors": {"baro": {"temperature_correction": correction}},
+    })
+    truth = synthetic.profile_descent(prof, rate_hz=10.0)
+    baro = SensorSuite.from_profile(prof).sensors["baro"]
+    s = baro.measure(truth, np.random.default_rng(0), noise=False)
+    h = atm.geopotential_m(truth.h_m[baro.draw(truth.t_s, np.random.default_rng(0)).rows])
+    h_f = float(atm.geopotential_m(prof.runway.elevation_m))
+    return (s.h_baro_m - h) / units.FT, (h - h_f) / units.FT
+
+
+@pytest.mark.parametrize("elevation_ft", [0.0, 5434.0, 8000.0])
+@pytest.mark.parametrize("isa_dev_c", [-30.0, -12.0, 0.0, 17.0, 30.0])
+def test_aerodrome_temperature_correction_leaves_only_the_metar_rounding(elevation_ft, isa_dev_c):
+    """Corrected with the reported aerodrome temperature, the indication is the true height up to the METAR's
+    rounding: at most 0.5 K / T_std(field) of the height above the field (a 10 nmi final starts about 3200 ft above
+    it: under 6 ft there, 0.1 ft at 50 ft); uncorrected the error is dT / T_field of the height (ISA -30: 330 ft)."""
+    err, above = _baro_error_ft(elevation_ft, isa_dev_c, "aerodrome")
+    raw, _ = _baro_error_ft(elevation_ft, isa_dev_c, "none")
+    t_std = atm.T0_K - atm.LAPSE_K_PER_M * float(atm.geopotential_m(elevation_ft * units.FT))
+    assert above.max() > 3000.0 and above.min() < 60.0
+    assert np.all(np.abs(err) <= 0.5 / t_std * above + 1e-6)
+    # the uncorrected error: -dT / (T_std + dT) of the height above the field (exact in this troposphere)
+    np.testing.assert_allclose(raw, -isa_dev_c / (t_std + isa_dev_c) * above, rtol=1e-6, atol=1e-6)
+    if isa_dev_c != 0.0:
+        assert np.max(np.abs(raw)) > 30.0 * np.max(np.abs(err))

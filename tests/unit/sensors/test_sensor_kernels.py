@@ -88,10 +88,13 @@ def test_radalt_kernel_equals_numpy_reference_bit_for_bit(descent):
 
 
 @pytest.mark.parametrize("lag_s", [0.0, 0.4])
-def test_baro_kernel_equals_numpy_reference(descent, lag_s):
+@pytest.mark.parametrize("correction", [(0.0, 1.0), (1650.0, 0.9)])
+def test_baro_kernel_equals_numpy_reference(descent, lag_s, correction):
     """|h - h_ref| <= 1e-12 T0 / L (the indication's own scale; near sea level it cancels to a few metres, so one
-    rounding of the power differs by ~1e-11 m between libm and numpy); a run's bits independent of its batch."""
-    baro = Baro(setting_pa=101000.0, scale_factor_sigma=1e-3, lag_s=lag_s)
+    rounding of the power differs by ~1e-11 m between libm and numpy); a run's bits independent of its batch; with
+    and without a temperature correction (field H_f m, ratio c)."""
+    baro = Baro(setting_pa=101000.0, scale_factor_sigma=1e-3, lag_s=lag_s, field_m=correction[0],
+                temperature_ratio=correction[1])
     one = baro.draw(descent.t_s, np.random.default_rng(3))
     batch = baro.draw(descent.t_s, [np.random.default_rng(s) for s in (3, 4, 5)])
     tol_m = 1e-12 * atmosphere.T0_K / atmosphere.LAPSE_K_PER_M
