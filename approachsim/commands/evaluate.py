@@ -129,9 +129,13 @@ def run(args: argparse.Namespace) -> int:
     from approachsim.campaign.outputs import verdict_table
     from approachsim.campaign.pipeline import PipelineUnavailable, spec_for
     from approachsim.profile import load_profile
+    from approachsim.sensors.baro import temperature_note
 
     profile = load_profile(args.profile)
     runs, seed, mode, out = check_options(args, profile)
+    if (b := profile.sensors.baro) is not None and (note := temperature_note(
+            profile.environment.isa_dev_k, profile.runway.elevation_m, b.bias_sigma_m, b.temperature_correction)):
+        sys.stderr.write(f"approachsim evaluate: note: {note}\n")
     require = parse_require(getattr(args, "require", None))
     try:
         spec = spec_for(profile, mode, land=getattr(args, "land", False))

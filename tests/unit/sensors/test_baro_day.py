@@ -145,3 +145,20 @@ def test_aerodrome_temperature_correction_leaves_only_the_metar_rounding(elevati
     np.testing.assert_allclose(raw, -isa_dev_c / (t_std + isa_dev_c) * above, rtol=1e-6, atol=1e-6)
     if isa_dev_c != 0.0:
         assert np.max(np.abs(raw)) > 30.0 * np.max(np.abs(err))
+
+
+def test_temperature_note_warns_when_the_baro_budget_cannot_cover_the_day():
+    """evaluate's note: the uncorrected error at 1000 ft above the field, dT / T_field of it (116 ft at ISA -30 at sea
+    level), against 3 sigma of the declared bias: the default 1 m budget is warned at +-30 C and not at +-0.5 C; Gray
+    & Maybeck's 100 ft (30.48 m) budget and a corrected indication are not warned."""
+    from approachsim.sensors.baro import temperature_note
+
+    note = temperature_note(-30.0, 0.0, 1.0, "none")
+    assert note is not None and "116 ft" in note and "temperature_correction" in note
+    assert "94 ft" in temperature_note(30.0, 0.0, 1.0, "none")
+    h_f = 1656.0  # a 5434 ft field: T_field = 288.15 + 30 - 10.8 = 307.4 K
+    assert f"{30.0 / (atm.T0_K + 30.0 - atm.LAPSE_K_PER_M * h_f) * 1000.0:.0f} ft" in temperature_note(30.0, h_f, 1.0,
+                                                                                                       "none")
+    assert temperature_note(-0.5, 0.0, 1.0, "none") is None
+    assert temperature_note(-30.0, 0.0, 30.48, "none") is None
+    assert temperature_note(-30.0, 0.0, 1.0, "aerodrome") is None
