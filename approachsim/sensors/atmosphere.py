@@ -77,8 +77,7 @@ def indicated_altitude_m(p_static_pa: ArrayLike, setting_pa: float = P0_PA) -> n
 
 def reported_aerodrome_temperature_k(field_geopot_m: float, isa_dev_k: float = 0.0) -> float:
     """The aerodrome temperature a METAR reports (K): T0 + dT - L H_f rounded to a whole degree Celsius."""
-    t_c = T0_K + isa_dev_k - LAPSE_K_PER_M * field_geopot_m - 273.15
-    return float(np.round(t_c)) + 273.15
+    return float(np.round(air_temperature_k(field_geopot_m, isa_dev_k) - 273.15)) + 273.15
 
 
 def temperature_correction_ratio(field_geopot_m: float, aerodrome_temperature_k: float) -> float:

@@ -32,6 +32,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from approachsim import units
 from approachsim.records import BaroSamples, Truth
 from approachsim.sensors import atmosphere, base
 from approachsim.sensors.kernels import baro as bk
@@ -155,16 +156,17 @@ class Baro:
 
 def temperature_note(isa_dev_k: float, field_m: float, bias_sigma_m: float, correction: str) -> str | None:
     """A warning for a profile whose uncorrected baro's temperature error, dT / (T0 + dT - L H_f) of the height above
-    the field (sensors/atmosphere.py), exceeds 3 sigma of its declared bias at 1000 ft above the field: the filter
-    then trusts a wrong height (docs/cat3.md); None when the budget covers it or the indication is corrected."""
+    the field (field_m: its geometric elevation, m; sensors/atmosphere.py), exceeds 3 sigma of its declared bias at
+    1000 ft above the field: the filter then trusts a wrong height (docs/cat3.md); None when the budget covers it or
+    the indication is corrected."""
     if correction != "none":
         return None
-    t_f = atmosphere.T0_K + isa_dev_k - atmosphere.LAPSE_K_PER_M * field_m
-    err_m = abs(isa_dev_k) / t_f * 304.8
+    t_f = float(atmosphere.air_temperature_k(atmosphere.geopotential_m(field_m), isa_dev_k))
+    err_m = abs(isa_dev_k) / t_f * 1000.0 * units.FT
     if err_m <= 3.0 * bias_sigma_m:
         return None
     ratio = err_m / max(bias_sigma_m, 1e-9)
-    return (f"ISA {isa_dev_k:+.0f} C with an uncorrected baro: its temperature error, {err_m / 0.3048:.0f} ft at "
+    return (f"ISA {isa_dev_k:+.0f} C with an uncorrected baro: its temperature error, {err_m / units.FT:.0f} ft at "
             f"1000 ft above the field, is {ratio:.0f} times the baro's declared {bias_sigma_m:g} m bias; the "
             "navigation will follow it (set [sensors.baro] temperature_correction = \"aerodrome\", or a bias_sigma_m "
             "that covers it)")
