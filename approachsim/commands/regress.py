@@ -97,12 +97,14 @@ def run(args: argparse.Namespace) -> int:
     from approachsim.campaign.outputs import write_json
     from approachsim.campaign.pipeline import PipelineUnavailable, require_stages
     from approachsim.campaign.regress import (
+        CPU_FLOOR_REL,
         SCHEMA,
         baseline_doc,
         compare,
         compare_paired,
         per_run_errors,
         read_baseline,
+        within_cpu_floor,
     )
     from approachsim.profile import load_profile
 
@@ -160,7 +162,14 @@ def run(args: argparse.Namespace) -> int:
             bad = [d for d in diffs if d.regression]
             failed += bool(bad)
             changed = [d for d in diffs if d.old != d.new]
-            state = "REGRESSION" if bad else ("ok, changed within tolerance" if changed else "ok, identical")
+            if bad:
+                state = "REGRESSION"
+            elif not changed:
+                state = "ok, identical"
+            elif doc["schema"] == SCHEMA and within_cpu_floor(doc, per_run):
+                state = f"ok, equal within the cross-machine floor (every run within {CPU_FLOOR_REL:g} of its 1-sigma)"
+            else:
+                state = "ok, changed within tolerance"
             print(f"{path.stem}: {state} ({runs} runs, seed {seed}, {mode} loop)")
             for d in diffs if bad else changed:
                 print("  " + d.line())

@@ -23,6 +23,8 @@ from approachsim.sensors.gnss.gbas import GbasModel
 from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
+pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
+
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 DEFAULT = load_profile(PROFILES / "default.toml")
 

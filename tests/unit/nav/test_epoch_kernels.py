@@ -28,6 +28,8 @@ from approachsim.nav.kernels import measurements as mk
 from approachsim.nav.robust import AdaptivePolicy
 from approachsim.profile import load_profile
 
+pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
+
 PROFILE = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
 RTOL = 1e-12
 """Kernel vs numpy oracle on the same inputs, relative: 4500 eps. An error-model entry is a sum of at most three

@@ -26,6 +26,8 @@ def test_nse_is_minus_the_navigation_error_in_path_terms():
     err = approach_errors(truth, estimate, rw)
     tan_gp = math.tan(rw.glidepath_rad)
     e_path = np.stack([e[:, 1], e[:, 2] + e[:, 0] * tan_gp], axis=1)  # e in path terms: e_d = e_up + e_x tan(gp)
+    # runway-frame numbers of <= 3000 m: floor 8 eps 3000 = 5e-12 m, so 1e-9 m holds on any CPU (and 1e-12 for the
+    # identity TSE = FTE + NSE, sums of path deviations of tens of m)
     np.testing.assert_allclose(err.nse_m, -e_path, atol=1e-9)
     np.testing.assert_allclose(err.tse_m, err.fte_m + err.nse_m, atol=1e-12)
     # the evaluator's identity FTE = TSE + e (evaluate/score.py) on the same numbers

@@ -163,7 +163,7 @@ def test_prior_start_keeps_todays_draws():
     s, fl = nav.start(truth, [stream(2, 0, "nav")], 0)
     sd = np.sqrt(np.diag(nav.initial_covariance())[:9])
     e = sd * stream(2, 0, "nav").standard_normal(9)
-    assert s.h_m[0] == pytest.approx(truth.h_m[0] - e[2], abs=1e-9)
+    assert s.h_m[0] == pytest.approx(truth.h_m[0] - e[2], abs=1e-9)  # geodetic heights < 1000 m: floor 1e-13 m
     assert np.all(fl[0].fs.x == 0.0)
     with pytest.raises(ValueError, match="converged start"):
         NavSystem.from_profile(PROFILE).start(truth, [stream(2, 0, "nav")], 0)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from floors import floor
 
 from approachsim import geo
 from approachsim.nav import errormodel as em
@@ -46,7 +47,10 @@ def test_pseudorange_row_is_the_jacobian_and_innovation_exact(tx):
     z = _pr_exact(x_true, r_tx, **kw)  # the measured difference (noise-free)
     rho = np.linalg.norm(R_INS - r_tx) - z
     m = meas.pseudorange(LAY, x_hat, R_INS, C_EN, r_tx, rho, 1.0, 0.0, "r", **kw)
-    assert m.z - m.h @ x_hat == pytest.approx(z - _pr_exact(x_hat, r_tx, **kw), abs=1e-7)
+    # both sides are differences of ~2.2e7 m ranges built from 6.4e6 / 2.6e7 m ECEF vectors: their floor
+    # (tests/floors.py) 8 eps (|rho| + range + |r_ins| + |r_tx|) = 1.4e-7 m for the satellite, 1e-8 m for the pseudolite
+    ops = (rho, np.linalg.norm(R_INS - r_tx), np.linalg.norm(R_INS), np.linalg.norm(r_tx))
+    assert m.z - m.h @ x_hat == pytest.approx(z - _pr_exact(x_hat, r_tx, **kw), abs=float(floor(8, *ops)))
     eps = 1e-3
     num = np.array([(_pr_exact(x_hat + eps * e, r_tx, **kw) - _pr_exact(x_hat - eps * e, r_tx, **kw)) / (2 * eps)
                     for e in np.eye(LAY.n)])

@@ -12,6 +12,8 @@ from approachsim.nav import ins
 from approachsim.nav import vertical_loop as vl
 from approachsim.nav.kernels import geodesy as gk
 
+pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
+
 RTOL = 1e-12
 """Kernel vs numpy oracle, relative: 4500 eps. A strapdown step is ~100 operations on its own state (k ~ 2 x 100 =
 4.4e-14), 300 steps of a marginally stable integration add up to ~300 x that = 1.3e-11 if every rounding survived;

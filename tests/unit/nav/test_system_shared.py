@@ -20,6 +20,8 @@ from approachsim.seeding import stream
 from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
+pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
+
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 
 PROFILE = load_profile(PROFILES / "default.toml")
@@ -57,7 +59,7 @@ def test_shared_runs_bit_identical_in_any_batch_also_with_a_departing_schedule(e
     for k in range(3):
         rk, sk = _records(truth, [k], prof)
         alone = nav.run(truth, rk, [stream(7, k, "nav")], shared_covariance=True, states=sk)[0]
-        np.testing.assert_array_equal(batch[k].x, alone.x)
+        np.testing.assert_array_equal(batch[k].x, alone.x)  # bit-identical: same code path, same machine, any batch
         np.testing.assert_array_equal(batch[k].P_diag, alone.P_diag)
         np.testing.assert_array_equal(batch[k].solution.r_ecef, alone.solution.r_ecef)
     # the departing run lost its baro updates; the others kept them, and its covariance departed from theirs
