@@ -67,6 +67,8 @@ def _gad_c(theta_deg, m):
 @pytest.mark.parametrize("m", [2, 3, 4])
 def test_ground_curve_is_table_b74_over_the_reference_receivers(theta_deg, m):
     model = gb.GbasModel(gad="C", reference_receivers=m)
+    # the model against the table's formula written here (deg -> rad -> deg, exp of <= 6.3, a sqrt): ~15 eps
+    # relative; rel 1e-13 (450 eps) is 30x that, here and in the formula tests below
     assert float(model.ground_sigma_m(np.radians(theta_deg))) == pytest.approx(_gad_c(theta_deg, m), rel=1e-13)
     a = gb.GbasModel(gad="A", reference_receivers=m).ground_sigma_m(np.radians(theta_deg))
     expect_a = math.sqrt((0.5 + 1.65 * math.exp(-theta_deg / 14.3)) ** 2 / m + 0.08**2)
@@ -243,6 +245,7 @@ def test_total_error_is_the_sum_of_the_terms_with_the_records_sigma(drawn):
     _, out = drawn
     for d in out.values():
         total = sum(d["alone"][t] for t in TERMS)
+        # errors are differences of 2e7 m pseudoranges: floor(4, 2.7e7, 2.7e7) = 4.8e-8 m; 1e-6 m is 20x that
         np.testing.assert_allclose(d["total"], total, rtol=0, atol=1e-6, equal_nan=True)
         i = 0
         for j in np.flatnonzero(np.isfinite(d["total"][0, i])):
@@ -384,7 +387,7 @@ def test_profile_keys_parse_into_the_model():
     m = g.gbas
     assert (m.gad, m.aad, m.reference_receivers, m.refractivity_sigma, m.scale_height_m, m.ground_tau_s) == (
         "A", "A", 3, 10.0, 8000.0, 120.0)
-    assert m.sigma_vig_per_m == pytest.approx(6e-6, rel=1e-12)
+    assert m.sigma_vig_per_m == pytest.approx(6e-6, rel=1e-12)  # unit conversions, 2-3 roundings: 4500 eps is ample
     assert m.station_rwy_m == pytest.approx((914.4, -121.92, 3.048), rel=1e-12)
     assert g.budget().gbas is g.gbas and g.budget().slow_tau_s == 120.0
     st = np.asarray(SensorSuite.from_profile(p).sensors["gnss"].station_ecef)

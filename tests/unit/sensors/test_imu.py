@@ -17,8 +17,9 @@ def test_noise_false_is_the_held_truth_sample(descent):
     rec = Imu(PRESETS["mems"]).measure(descent, np.random.default_rng(0), noise=False)
     dt = descent.t_s[1] - descent.t_s[0]
     assert rec.dt_s == dt
-    assert np.array_equal(rec.t_s, descent.t_s[1:])
-    # exact by construction: zeroed errors add exact zeros to the same product dt * w (x + 0 = x in any rounding)
+    assert np.array_equal(rec.t_s, descent.t_s[1:])  # bit-identical: the truth's times sliced
+    # exact by construction: zeroed errors add exact zeros to the same products dt * w, dt * f (x + 0 = x in any
+    # rounding)
     assert np.array_equal(rec.dtheta_body, dt * descent.w_ib_body[:-1])
     assert np.array_equal(rec.dv_body, dt * descent.f_body[:-1])
     assert rec.valid.all() and not rec.fault.any()
