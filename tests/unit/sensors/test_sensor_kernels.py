@@ -29,8 +29,8 @@ from approachsim.sensors.radalt import RadarAltimeter
 
 def _imu_floor(descent, e):
     """The floor of the kernel against the oracle, (runs, m, 3) or (m, 3): out_r = d_r + sum_j M_rj d_j + (b0_r +
-    b_r) dt + n_r is ~6 roundings in each (a 3-term dot product, 4 sums, a product; the kernel may fuse some, numpy's
-    einsum may sum in another order), so they differ by up to floor(12, the terms' sizes)."""
+    b_r) dt + n_r is ~10 roundings on its longest path (a 3-term dot product, four sums, a product; the kernel may
+    fuse some, numpy's einsum may sum in another order): floor(12, the terms' sizes)."""
     dth, dv, dt = true_increments(descent, e.rows)
     s, k = e.series, e.constants
     lead = (slice(None), None) if e.batched else (None,)
