@@ -41,7 +41,7 @@ def test_per_run_epoch_offsets_are_uniform_over_the_sidereal_day():
     off = draw_epoch_offsets(SIDEREAL_DAY_S, [stream(11, r, EPOCH_STREAM) for r in runs])
     assert off.shape == (2000,) and np.all((off >= 0.0) & (off < SIDEREAL_DAY_S))
     assert sps.kstest(off / SIDEREAL_DAY_S, "uniform").pvalue > 0.01
-    assert off[7] == stream(11, 7, EPOCH_STREAM).uniform(0.0, SIDEREAL_DAY_S)
+    assert off[7] == stream(11, 7, EPOCH_STREAM).uniform(0.0, SIDEREAL_DAY_S)  # bit-identical: the same seeded draw
 
 
 def test_per_run_sky_is_bit_identical_whatever_the_batch(descent, runway):
@@ -64,7 +64,7 @@ def test_per_run_sky_is_bit_identical_whatever_the_batch(descent, runway):
         np.testing.assert_array_equal(v, e_run.series[k], err_msg=k)
     assert "epoch_offset_s" not in e_fixed.constants
     off = e_run.constants["epoch_offset_s"]
-    assert off[0] == stream(5, 3, EPOCH_STREAM).uniform(0.0, SIDEREAL_DAY_S)
+    assert off[0] == stream(5, 3, EPOCH_STREAM).uniform(0.0, SIDEREAL_DAY_S)  # bit-identical: the same seeded draw
     # noise=False keeps the run's sky (the epoch is not an error)
     exact = suite.measure(descent, seed=5, runs=[3], noise=False)["gnss"]
     np.testing.assert_array_equal(exact.elevation_rad, alone.elevation_rad)  # bit-identical: same code path
