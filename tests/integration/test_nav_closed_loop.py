@@ -45,12 +45,16 @@ def test_guidance_flew_on_the_navigation_solution_and_tse_is_fte_plus_nse(flown)
     lat, lon, h = geo.ecef_to_geodetic(nav.solution.r_ecef)
     r_nav = rwy.frame.from_ecef(nav.solution.r_ecef)
     r_nav[:, 2] = h - rwy.elevation_m
+    # runway coordinates from 6.4e6 m ECEF positions in the loop and here: floor(4, 6.4e6, 6.4e6) = 1.1e-8 m;
+    # 1e-6 m is 90x that
     np.testing.assert_allclose(res.guidance_r_rwy, r_nav, atol=1e-6)
     err = approach_errors(res.truth, res.guidance_r_rwy, rwy)
+    # deviations from runway coordinates <= 2e4 m (heights against x tan(gamma) <= 1000 m): floor(4, 2e4) = 1.8e-11 m;
+    # 1e-9 m is 55x that
     np.testing.assert_allclose(err.tse_m, err.fte_m + err.nse_m, atol=1e-9)
     # NSE is the navigation error in path terms: d(truth) - d(navigation solution)
     np.testing.assert_allclose(err.nse_m, path_deviation(res.truth.r_rwy, rwy) - path_deviation(r_nav, rwy),
-                               atol=1e-6)
+                               atol=1e-6)  # as guidance_r_rwy above: 90x the ECEF floor
     # and it is as small as the filter claims: at 200 ft, |vertical NSE| < 4 sigma of the vertical position
     k = int(np.argmin(np.abs(res.truth.r_rwy[:, 2] - 200.0 * units.FT)))
     sigma_v = np.sqrt(nav.solution.P_pos_ned[k, 2, 2])

@@ -23,6 +23,8 @@ def truth():
 def test_height_profile_climbs_descends_and_levels_off(truth):
     legs = manoeuvre.SEED003_LEGS
     h, v_up, a_up = manoeuvre.vertical_profile(truth.t_s, 600.0, legs)
+    # the truth's height and climb rate are vertical_profile's (same code path: bit-identical in fact); the bounds are
+    # 900x floor(5, 1000 m) = 1.1e-12 m and 200x floor(5, 4 m/s) = 4.4e-15 m/s
     np.testing.assert_allclose(truth.h_m, h, atol=1e-9)
     np.testing.assert_allclose(-truth.v_ned[:, 2], v_up, atol=1e-12)
     # level at the start, after every leg the height has changed by exactly that leg's dh, and level again
@@ -31,6 +33,8 @@ def test_height_profile_climbs_descends_and_levels_off(truth):
         before = 600.0 + sum(lg.dh_m for lg in legs[:k])
         assert truth.h_m[i0] == pytest.approx(before, abs=1e-9)
         assert truth.h_m[i1] == pytest.approx(before + leg.dh_m, abs=1e-9)
+        # 1 - cos(2 pi s) at s = 0 and 1 is an exact 0 (cos(0) = cos(fl(2 pi)) = 1.0): the bounds only allow for s a
+        # few ulp off an end, (2 pi k eps)^2 / 2 ~ 1e-30
         assert v_up[i0] == pytest.approx(0.0, abs=1e-12) and v_up[i1] == pytest.approx(0.0, abs=1e-9)
         mid = (i0 + i1) // 2
         assert v_up[mid] == pytest.approx(leg.peak_climb_mps, rel=1e-3)
@@ -45,6 +49,8 @@ def test_height_profile_climbs_descends_and_levels_off(truth):
     g = synthetic.gravity_ned(truth.lat_rad, truth.h_m)
     mean = lambda a: 0.5 * (a[:-1] + a[1:])  # noqa: E731 - the interval mean (trapezoid)
     expected = np.diff(truth.v_ned, axis=0) * 10.0 + mean(cor) - mean(g)
+    # velocity differences of ~70 m/s over 0.1 s (floor(2, 70, 70) / 0.1 = 3e-13 m/s^2) and ~10 roundings of g and
+    # the rotation (floor(10, 9.8) = 2e-14): 1e-7 m/s^2 is far above them (the truth integrates these interval means)
     np.testing.assert_allclose(f_ned[:-1], expected, atol=1e-7)
     assert np.abs(cor[:, 2]).max() > 1e-3  # the check above would see a missing Coriolis term
     assert np.abs(np.diff(truth.v_ned[:, 2])).max() * 10.0 > 0.5  # and the manoeuvre's own acceleration

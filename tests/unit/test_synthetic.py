@@ -28,7 +28,9 @@ def _check_ecef_consistency(truth, tol_acc, tol_rate):
     t = truth.t_s
     dt = t[1] - t[0]
     r = truth.r_ecef
-    # central differences at interior samples
+    # central differences at interior samples: of 6.4e6 m ECEF positions, so the second difference carries
+    # floor(1, |r|, 2|r|, |r|) / dt^2 ~ 4 eps |r| / dt^2 = 5.7e-9 m/s^2 per rounding, ~4 of them: 2.3e-8 m/s^2 at dt =
+    # 1 s (tol_acc 1e-7 and 2e-7 are 4x and 9x that); the velocity floor(2, |r|, |r|) / 2 dt = 2.8e-9 m/s (1e-6: 350x)
     v_e = (r[2:] - r[:-2]) / (2 * dt)
     a_e = (r[2:] - 2 * r[1:-1] + r[:-2]) / dt**2
     lat, lon, h = truth.lat_rad[1:-1], truth.lon_rad[1:-1], truth.h_m[1:-1]
@@ -50,6 +52,8 @@ def _check_ecef_consistency(truth, tol_acc, tol_rate):
         cen = _c_en(truth.lat_rad[k], truth.lon_rad[k])
         return rz @ cen @ synthetic.euler_to_c_nb(truth.euler_rad[k])
 
+    # the rotation vector of C'C from differences of entries of size 1, ~20 roundings: floor(20, 1) / 2 dt = 2.2e-15
+    # rad/s at dt = 1 s (tol_rate 1e-12 and 1e-11 are >= 450x that, the descent's covering the truncation too)
     for k in (1, len(t) // 2, len(t) - 2):
         dc = c_ib(k - 1).T @ c_ib(k + 1)
         w_fd = _log_so3(dc) / (2 * dt)
@@ -60,14 +64,16 @@ def test_stationary_reads_one_g_up_and_earth_rate():
     tr = synthetic.stationary(RWY.threshold_lat_rad, RWY.threshold_lon_rad, 4.0, 10.0, 10.0,
                               euler_rad=(0.1, -0.05, 1.0))
     g = np.linalg.norm(geo.gravity_ned(RWY.threshold_lat_rad, 4.0))
+    # g rotated into the body and normed, ~10 roundings of 9.8 m/s^2: floor(10, 9.8) = 2.2e-14; 1e-12 is 45x that
     assert np.allclose(np.linalg.norm(tr.f_body, axis=1), g, rtol=0, atol=1e-12)
-    assert np.allclose(np.linalg.norm(tr.w_ib_body, axis=1), geo.OMEGA_E, rtol=1e-12)
+    assert np.allclose(np.linalg.norm(tr.w_ib_body, axis=1), geo.OMEGA_E, rtol=1e-12)  # 4500 eps of a ~10-op chain
     # level attitude: f_body = (0, 0, -g), gyros see Earth rate north and up components
     lv = synthetic.stationary(RWY.threshold_lat_rad, 0.0, 0.0, 1.0, 10.0)
-    assert np.allclose(lv.f_body[0], -geo.gravity_ned(RWY.threshold_lat_rad, 0.0), atol=1e-12)
+    assert np.allclose(lv.f_body[0], -geo.gravity_ned(RWY.threshold_lat_rad, 0.0), atol=1e-12)  # 45x, as above
     lat = RWY.threshold_lat_rad
+    # ~10 roundings of the 7.3e-5 rad/s Earth rate: floor(10, 7.3e-5) = 1.6e-19 rad/s; 1e-18 is 6x that
     assert np.allclose(lv.w_ib_body[0], geo.OMEGA_E * np.array([math.cos(lat), 0, -math.sin(lat)]), atol=1e-18)
-    assert np.all(tr.v_ned == 0.0)
+    assert np.all(tr.v_ned == 0.0)  # exact by construction: a stationary truth writes zeros
 
 
 def test_stationary_is_consistent_in_ecef():
@@ -83,6 +89,7 @@ def test_descent_is_consistent_in_ecef():
 
 def test_descent_follows_glidepath_and_reaches_threshold():
     tr = synthetic.glidepath_descent(RWY, rate_hz=10.0, start_distance_m=18520.0, tch_m=15.24)
+    # runway coordinates from 6.4e6 m ECEF positions: floor(2, 6.4e6, 6.4e6) = 2.8e-9 m; 1e-6 m is 350x that
     assert tr.r_rwy[-1, :2] == pytest.approx([0.0, 0.0], abs=1e-6)
     assert tr.r_rwy[-1, 2] == pytest.approx(15.24, abs=1e-6)
     assert tr.r_rwy[0, 0] == pytest.approx(-18520.0, abs=10.0)  # rhumb line at altitude vs tangent-plane chord

@@ -27,6 +27,8 @@ ROOT = HERE.parents[2]
 
 
 def _same(a: list[RunResult], b: list[RunResult]) -> bool:
+    """Bit-identical: same code path (a run's result does not depend on the executor, the pool, the chunking, the
+    store's round trip or a resume: the campaign's reproducibility contract, RunResult.same_as)."""
     return len(a) == len(b) and all(x.same_as(y) for x, y in zip(a, b, strict=True))
 
 
@@ -46,6 +48,7 @@ def test_local_pool_matches_in_process_and_disk(tmp_path):
     # runs differ from one another (the seed reaches each run)
     assert len({r.scalars["mean_m"] for r in a.results}) == 24
     table = pq.read_table(tmp_path / "runs.parquet").to_pydict()
+    # bit-identical: parquet stores float64 as it is
     assert table["run"] == list(range(24)) and table["mean_m"][3] == a.results[3].scalars["mean_m"]
     heights = pq.read_table(tmp_path / "heights.parquet").to_pydict()
     assert len(heights["first_m"]) == 24 * 7
@@ -105,6 +108,7 @@ def test_a_real_profile_travels_to_worker_processes():
 
     prof = load_profile(ROOT / "profiles" / "default.toml")
     res = run_campaign(prof, seed=1, runs=4, run_fn=profile_run, workers=2, per_task=1, progress=False)
+    # exact: the profile's decision height passed through (a parsed 200.0)
     assert not res.failed and all(r.scalars["dh_cat1_ft"] == 200.0 for r in res.results)
 
 

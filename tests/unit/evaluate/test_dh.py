@@ -21,11 +21,14 @@ def test_crossing_exact_on_a_straight_line():
         cr = dh_crossing(hat, dh)
         assert cr is not None
         t_star = (hat0 - dh) / sink
+        # w = (h_k - dh) / (h_k - h_k+1) divides a difference of 700 m heights by 0.47 m: relative floor(4, 700) /
+        # 0.47 = 1.3e-12, times the 0.14 s step, plus floor(4, 250 s): 2.4e-13 s; 1e-9 s is 4000x that
         assert at_crossing(t, cr) == pytest.approx(t_star, abs=1e-9)
-        # an error linear in time is interpolated exactly
+        # an error linear in time is interpolated exactly: w's floor times the 1.9e-3 step of err, plus floor(4, 1.7):
+        # 4e-15; 1e-12 is 250x that
         err = 1.7 - 0.013 * t
         assert at_crossing(err, cr) == pytest.approx(1.7 - 0.013 * t_star, abs=1e-12)
-        assert at_crossing(hat, cr) == pytest.approx(dh, abs=1e-9)
+        assert at_crossing(hat, cr) == pytest.approx(dh, abs=1e-9)  # floor(4, 700) = 6e-13 m; 1600x
 
 
 def test_first_downward_crossing_and_none():
@@ -42,6 +45,8 @@ def test_interp_on_height_uses_first_pass_and_is_exact_on_a_line():
     grid = np.array([250.0, 100.0, 12.25, -50.0, 400.0])
     out = interp_on_height(hat, 5.0 + 0.1 * t, grid)
     expect = 5.0 + 0.1 * (300.0 - grid[:3]) / 2.5
+    # weights from 300 m heights 1.25 m apart (relative floor(4, 300) / 1.25 = 2e-13) times the 0.05 step of the
+    # values, plus floor(4, 18): 2.6e-14; 1e-12 is 40x that
     np.testing.assert_allclose(out[:3], expect, rtol=0, atol=1e-12)
     assert np.isnan(out[3])  # below the lowest point flown
     assert np.isnan(out[4])  # above the start: never descended through it
@@ -59,7 +64,7 @@ def test_runway_errors_map_ned_error_to_lateral_and_vertical():
     np.testing.assert_allclose(err.lateral_m, 3.0, atol=3e-3)
     np.testing.assert_allclose(err.vertical_m, 2.0, atol=3e-3)
     np.testing.assert_allclose(err.along_m, 0.0, atol=3e-3)
-    np.testing.assert_allclose(err.hat_m, truth.h_m - RWY.threshold_h_m)
+    np.testing.assert_allclose(err.hat_m, truth.h_m - RWY.threshold_h_m)  # rtol 1e-7: far above floor(2, |h|)
 
 
 def test_along_track_error_is_not_lateral():

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from floors import assert_within, floor
 from scipy import stats as sps
 from scipy.spatial.transform import Rotation
 
@@ -48,7 +49,9 @@ LEVER = np.array([[-10.11, -2.54, 0.356], [-10.11, 2.54, 0.356]])
 def test_c_nb_is_the_zyx_rotation(euler_deg):
     e = np.radians(euler_deg)
     oracle = Rotation.from_euler("ZYX", [e[2], e[1], e[0]]).as_matrix()
-    np.testing.assert_allclose(c_nb_from_euler(e), oracle, atol=1e-15)
+    # two formulas of a rotation: direction cosines in ~5 roundings of sin/cos products (entries <= 1), scipy's Euler
+    # -> quaternion -> matrix in ~10: floor(16, 1) = 3.6e-15 (the 1e-15 it had was 4.5 eps)
+    assert_within(c_nb_from_euler(e), oracle, floor(16, 1.0), "C_nb")
 
 
 def test_level_gear_positions_are_the_lever_arms_in_runway_axes():
@@ -57,9 +60,11 @@ def test_level_gear_positions_are_the_lever_arms_in_runway_axes():
     heading = math.radians(298.0)
     r = np.array([500.0, 1.0, 5.0])
     pos, vel = gear_state(r, np.zeros(3), np.array([0.0, 0.0, heading]), np.zeros(3), heading, LEVER)
-    np.testing.assert_allclose(pos[1], r + np.array([-10.11, 2.54, -0.356]), atol=1e-12)
-    np.testing.assert_allclose(pos[0], r + np.array([-10.11, -2.54, -0.356]), atol=1e-12)
-    np.testing.assert_allclose(vel, 0.0, atol=1e-15)
+    # r + C l: a 3-term rotation of the 10.4 m lever arm added to a 500 m position: floor(4, |r|, |l|) = 4.5e-13 m
+    fl = floor(4, np.linalg.norm(r), np.linalg.norm(LEVER[0]))
+    assert_within(pos[1], r + np.array([-10.11, 2.54, -0.356]), fl, "right gear")
+    assert_within(pos[0], r + np.array([-10.11, -2.54, -0.356]), fl, "left gear")
+    np.testing.assert_allclose(vel, 0.0, atol=1e-15)  # exact by construction: zero velocity and rate give exact zeros
 
 
 def test_pitched_up_gear_sits_lower_by_the_lever_arm_times_sin_pitch():
@@ -67,6 +72,7 @@ def test_pitched_up_gear_sits_lower_by_the_lever_arm_times_sin_pitch():
     theta = math.radians(4.0)
     pos, _ = gear_state(np.zeros(3), np.zeros(3), np.array([0.0, theta, heading]), np.zeros(3), heading, LEVER)
     # nose up: the aft gear goes down by 10.11 sin(theta), and its 0.356 m below the IMU shrinks to cos(theta)
+    # (~5 roundings of the 10.11 m and 0.356 m terms: floor(5, 10.11, 0.356) = 1.2e-14 m; 1e-12 is 85x that)
     assert pos[0, 2] == pytest.approx(-10.11 * math.sin(theta) - 0.356 * math.cos(theta), abs=1e-12)
     assert pos[0, 0] == pytest.approx(-10.11 * math.cos(theta) + 0.356 * math.sin(theta), abs=1e-12)
 
@@ -92,6 +98,8 @@ def test_gear_velocity_is_the_derivative_of_its_position(w_body):
     h = 1e-4
     fd = (at(h) - at(-h)) / (2 * h)
     _, vel = gear_state(r0, v_ned, e0, w, heading, LEVER)
+    # central difference of ~450 m positions over 2e-4 s: floor(4, 450, 450) / 2e-4 = 4e-9 m/s, truncation h^2
+    # |d3x/dt3| / 6 ~ 1e-11 m/s: 1e-7 m/s is 25x the floor
     np.testing.assert_allclose(vel, fd, atol=1e-7)
 
 
@@ -108,6 +116,8 @@ def test_the_scalars_list_is_what_touchdown_scalars_returns():
 @pytest.mark.parametrize(("t", "df", "delta"), [(33.6, 49, 30.0), (5.0, 4, 3.0), (-21.0, 49, -20.0), (2.0, 2, 0.5),
                                                 (150.0, 999, 140.0)])
 def test_nct_sf_agrees_with_scipy_where_scipy_converges(t, df, delta):
+    # two algorithms (our series against scipy's Boost): their truncation, not rounding (floor(50, p) ~ 1e-14 p), sets
+    # the agreement; rel 1e-9 / abs 1e-13 are what both converge to
     assert nct_sf(t, df, delta) == pytest.approx(float(sps.nct.sf(t, df, delta)), rel=1e-9, abs=1e-13)
 
 
@@ -247,7 +257,7 @@ def test_below_and_two_sided_criteria_use_their_own_tails():
     lat = Criterion("lat", "td_y_m", "abs_above", 15.0, "ft", 1e-6, "V", "t", "t")
     y = _sample(100, 2.0, 2.0)
     p = criterion_result(lat, y, 0, 0.95)["normal"]["probability"]
-    assert p == pytest.approx(sps.norm.sf(6.5) + sps.norm.sf(8.5), rel=1e-12)
+    assert p == pytest.approx(sps.norm.sf(6.5) + sps.norm.sf(8.5), rel=1e-12)  # the same two calls summed: 4500 eps
 
 
 def test_the_outboard_gear_is_two_normal_tails_not_one_bimodal_fit():

@@ -52,6 +52,7 @@ def test_bound_factors():
     assert rms_upper_factor(20, 0.0) == pytest.approx(np.sqrt(20 / sps.chi2.ppf(0.05, 20)))
     assert rms_lower_factor(20) == pytest.approx(np.sqrt(20 / sps.chi2.ppf(0.95, 20)))
     assert rms_upper_factor(20, 1e12) == pytest.approx(1.0, abs=1e-4)  # all bias: nothing random to bound
+    # exact by construction: a constant's variance is an exact 0 (15 / 5 = 3), a non-positive estimate returns 0.0
     assert bias_ratio(np.full(5, 3.0)) > 1e9 and bias_ratio(np.array([1.0, -1.0])) == 0.0
 
 

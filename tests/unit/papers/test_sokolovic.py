@@ -101,7 +101,8 @@ def _reference_gap_mean_square(p: sk.SokolovicParams) -> float:
     P = np.diag([0.0, 0.0, 0.0, p.baro_bias_m**2, p.accel_bias_mps2**2])
     var = []
     a, b = p.gps_gaps_s[0]
-    assert all(g[1] - g[0] == b - a for g in p.gps_gaps_s)  # every gap the same length: one reference
+    # every gap the same length: one reference (exact: differences of whole seconds < 2^53 are exact)
+    assert all(g[1] - g[0] == b - a for g in p.gps_gaps_s)
     for _ in range(int(round((b - a) / dt))):
         P = phi @ P @ phi.T + Q
         var.append(P[0, 0])

@@ -19,6 +19,8 @@ LAT, LON = math.radians(37.6117), math.radians(-122.3581)
 def test_standard_day_reads_geopotential_height_exactly():
     tr = synthetic.stationary(LAT, LON, 1000.0, 2.0, 10.0)
     rec = Baro().measure(tr, np.random.default_rng(0), noise=False)
+    # the ISA pressure and its inverse, ~16 roundings of T0 / L = 44.3 km: floor(16, 44330) = 1.6e-10 m; 1e-6 m (here
+    # and below) is 6e3x that
     assert rec.h_baro_m == pytest.approx(atmosphere.geopotential_m(1000.0), abs=1e-6)
     # geopotential vs geometric: 0.157 m at 1000 m (r0 z^2 / (r0 + z)^2)
     assert 1000.0 - rec.h_baro_m[0] == pytest.approx(0.157, abs=0.001)
@@ -38,7 +40,9 @@ def test_isa_minus_15_cold_error_matches_the_pans_ops_rule():
     tr = synthetic.stationary(LAT, LON, z, 1.0, 10.0, isa_dev_k=-15.0)
     rec = Baro().measure(tr, np.random.default_rng(0), noise=False)
     err_frac = (rec.h_baro_m[0] - h_true) / h_true
-    assert err_frac == pytest.approx(15.0 / (288.15 - 15.0), rel=1e-9)  # the exact ISA+dT result
+    # the exact ISA+dT result; a difference of two ~1000 m heights over 1000 m: floor(16, 44330) / 1000 / 0.055 =
+    # 2.9e-12 relative; rel 1e-9 is 350x that
+    assert err_frac == pytest.approx(15.0 / (288.15 - 15.0), rel=1e-9)
     rule = 0.04 * 15.0 / 10.0
     assert err_frac == pytest.approx(rule, rel=0.10)
 
@@ -66,7 +70,7 @@ def test_bias_scale_factor_noise_statistics():
     exact = b.measure(tr, np.random.default_rng(0), noise=False).h_baro_m
     err = rec.h_baro_m - exact
     expect = e.constants["scale_factor"][:, None] * exact + e.series["bias"] + e.series["noise"]
-    assert np.allclose(err, expect, atol=1e-9)
+    assert np.allclose(err, expect, atol=1e-9)  # heights <= 1000 m, ~8 roundings: floor(8, 1000) = 1.8e-12 m; 550x
 
 
 @settings(derandomize=True, max_examples=200, deadline=None)
@@ -87,8 +91,10 @@ def test_first_order_lag_reads_high_by_rate_times_lag_and_is_stateless(descent):
     v_down = descent.v_ned[0, 2]
     settled = rec.t_s > 10 * lag
     assert np.allclose(rec.h_baro_m[settled] - plain.h_baro_m[settled], v_down * lag, rtol=2e-3)  # geopotential rate
-    assert rec.h_baro_m[0] == pytest.approx(plain.h_baro_m[0], abs=1e-9)  # starts in steady state
+    # starts in steady state: sum_l w_l h over 301 taps of h ~ 990 m against h: floor(301, 990) = 6.6e-11 m;
+    # 1e-9 m is 15x that
+    assert rec.h_baro_m[0] == pytest.approx(plain.h_baro_m[0], abs=1e-9)
     e = b.draw(descent.t_s, np.random.default_rng(4))
     batch = b.apply(descent, e)
-    for j in (0, 3, 500):
+    for j in (0, 3, 500):  # bit-identical: same code path (the kernel on a one-sample slice)
         assert b.apply(descent, e.take(slice(j, j + 1))).h_baro_m[0] == batch.h_baro_m[j]

@@ -37,6 +37,7 @@ def _indicated_ft(prof, true_height_above_field_ft: float) -> float:
 def test_qnh_reads_field_elevation_at_the_field_on_any_day(elevation_ft, isa_dev_c, qnh_hpa):
     prof = _profile(elevation_ft, isa_dev_c, qnh_hpa)
     field_geopot_ft = float(atm.geopotential_m(prof.runway.elevation_m)) / units.FT
+    # the ISA pressure and its inverse: floor(16, T0 / L = 44330 m) = 1.6e-10 m = 5e-10 ft; 1e-6 ft is 2000x
     assert _indicated_ft(prof, 0.0) == pytest.approx(field_geopot_ft, abs=1e-6)
 
 
@@ -80,7 +81,7 @@ def test_cold_error_grows_with_height_and_vanishes_at_the_field():
     prof = _profile(5000.0, -25.0)
     errs = [_indicated_ft(prof, h) - h for h in (0.0, 250.0, 1000.0)]
     base = float(atm.geopotential_m(prof.runway.elevation_m)) / units.FT
-    assert errs[0] - base == pytest.approx(0.0, abs=1e-6)
+    assert errs[0] - base == pytest.approx(0.0, abs=1e-6)  # as above: 2000x floor(16, T0 / L)
     assert 0.0 < errs[1] - base < errs[2] - base
 
 
@@ -140,9 +141,10 @@ def test_aerodrome_temperature_correction_leaves_only_the_metar_rounding(elevati
     raw, _ = _baro_error_ft(elevation_ft, isa_dev_c, "none")
     t_std = atm.T0_K - atm.LAPSE_K_PER_M * float(atm.geopotential_m(elevation_ft * units.FT))
     assert above.max() > 3000.0 and above.min() < 60.0
+    # 1e-6 ft slack: 2000x the heights' floor(16, T0 / L) = 5e-10 ft
     assert np.all(np.abs(err) <= 0.5 / t_std * above + 1e-6)
     # the uncorrected error: -dT / (T_std + dT) of the height above the field (exact in this troposphere)
-    np.testing.assert_allclose(raw, -isa_dev_c / (t_std + isa_dev_c) * above, rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(raw, -isa_dev_c / (t_std + isa_dev_c) * above, rtol=1e-6, atol=1e-6)  # as above
     if isa_dev_c != 0.0:
         assert np.max(np.abs(raw)) > 30.0 * np.max(np.abs(err))
 

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from floors import assert_within
+from gnss_floors import record_floors
 
 from approachsim import synthetic
 from approachsim.config import ProfileError
@@ -84,8 +86,11 @@ def test_carrier_is_range_clock_slow_minus_iono_plus_the_arcs_ambiguity(drawn):
     arcs = rec.carrier_arc
     r, j, k = np.nonzero(v)
     start = e.series["ambiguity"][r, arcs[r, j, k], k]
-    np.testing.assert_allclose(amb[r, j, k], start, rtol=0, atol=1e-6)  # the arc's ambiguity, to the range's rounding
+    # the arc's ambiguity, to the range's rounding: amb is carrier - range - ... of 2e7 m values, ~4 roundings each
+    # (floor(4, 2.7e7, 2.7e7) = 4.8e-8 m); 1e-6 m is 20x that
+    np.testing.assert_allclose(amb[r, j, k], start, rtol=0, atol=1e-6)
     cycles = start / L1_WAVELENGTH_M
+    # the pool is whole cycles times lambda: cycles ~ 300 carry ~2 roundings, floor(2, 300) = 1.3e-13; 1e-9 is 7e3x
     np.testing.assert_allclose(cycles, np.round(cycles), atol=1e-9)
     a0 = e.series["ambiguity"][:, 0]  # one draw per run and channel
     assert np.std(a0) == pytest.approx(c.ambiguity_sigma_m, rel=5.0 / math.sqrt(2.0 * a0.size))
@@ -108,6 +113,7 @@ def test_code_minus_carrier_is_twice_the_iono_less_the_ambiguity(drawn):
     amb = resid - e.series["carrier_multipath"] - e.series["carrier_noise"]
     cmc = rec.pseudorange_m - rec.carrier_phase_m
     expect = 2.0 * iono + code_err - amb - e.series["carrier_multipath"] - e.series["carrier_noise"]
+    # differences of 2e7 m pseudoranges, carriers and ranges, ~8 of them: floor(8, 2.7e7, 2.7e7) = 9.6e-8 m; 1e-6 is 10x
     np.testing.assert_allclose(cmc[v], expect[v], rtol=0, atol=1e-6)
     assert np.std(iono[v]) > 1e-3  # the iono term is not negligible (the check above can fail on its sign)
 
@@ -146,9 +152,11 @@ def test_an_outage_ends_the_arcs_and_reacquisition_draws_a_new_ambiguity():
     assert np.mean(np.abs(jump)) > 1.0  # a new ambiguity of the 10 m spread, not the old one
     clean = SensorSuite.from_config(p.sensors, p.runway.frame, p.environment.setting_pa).sensors["gnss"].apply(truth, e)
     dphi = rec.carrier_phase_m[:, after] - clean.carrier_phase_m[:, after]
+    # a difference of two 2e7 m carriers against a difference of two ~10 m pool entries: floor(2, 2.7e7, 2.7e7) =
+    # 2.4e-8 m; 1e-6 m is 40x that
     np.testing.assert_allclose(dphi[both], jump, rtol=0, atol=1e-6)
     assert np.all(np.isnan(rec.carrier_phase_m[:, (t >= 40.0) & (t < 60.0)]))
-    prepared = rx.prepare(e)
+    prepared = rx.prepare(e)  # bit-identical: same code path (the record's kernels on one sample's slice)
     for j in range(len(t)):
         one = prepared.at(truth, j)
         np.testing.assert_array_equal(one.carrier_phase_m[:, 0], rec.carrier_phase_m[:, j])
@@ -175,9 +183,9 @@ def test_without_carrier_phase_draws_and_records_are_unchanged(gnss):
     eo = off.draw(truth.t_s, [stream(8, r, "gnss") for r in range(3)])
     en = on.draw(truth.t_s, [stream(8, r, "gnss") for r in range(3)])
     assert set(en.series) - set(eo.series) == {"carrier_multipath", "carrier_noise", "ambiguity"}
-    for k in eo.series:
+    for k in eo.series:  # bit-identical: same code path (the same draws; the carrier's come from a child stream)
         np.testing.assert_array_equal(eo.series[k], en.series[k], err_msg=k)
-    a, b = off.apply(truth, eo), on.apply(truth, en)
+    a, b = off.apply(truth, eo), on.apply(truth, en)  # bit-identical: the code path does not touch the carrier
     np.testing.assert_array_equal(a.pseudorange_m, b.pseudorange_m)
     assert a.carrier_phase_m is None and a.carrier_arc is None and a.carrier_sigma_m is None
     assert b.carrier_sigma_m == pytest.approx(math.hypot(0.01, 0.002))
@@ -190,7 +198,10 @@ def test_apply_equals_the_numpy_reference_with_carrier():
     e = rx.draw(truth.t_s, [stream(4, r, "gnss") for r in range(3)])
     a, b = rx.apply(truth, e), rx.apply_reference(truth, e)
     np.testing.assert_array_equal(a.carrier_arc, b.carrier_arc)
-    np.testing.assert_allclose(a.carrier_phase_m, b.carrier_phase_m, rtol=1e-13, atol=1e-6)
+    # two computations of a 2e7 m carrier: the floor of the range it is built on (orbit phases and ECEF operands,
+    # ~5e-7 m, gnss_floors.py) plus the sums onto it
+    assert_within(a.carrier_phase_m, b.carrier_phase_m, record_floors(rx, truth, e.rows, b)["carrier_phase_m"],
+                  "carrier phase")
 
 
 def test_profile_keys_and_their_errors():

@@ -45,8 +45,9 @@ def test_cbm_step_ramp_iam_on_baro(descent):
     w = np.isin(t, [200.0, 210.0, 220.0, 230.0])  # every 10th sample of [200, 240)
     expect[w] += 50.0
     lab[w] = FAULT_CODES["iam"]
-    assert np.allclose(d, expect, atol=1e-9)
-    assert np.array_equal(d != 0, expect != 0)  # exactly the intended samples
+    assert np.allclose(d, expect, atol=1e-9)  # a difference of ~1000 m heights: floor(2, 1000, 1000) = 8.9e-13 m
+    # bit-identical: same code path (an unfaulted sample adds an exact 0 to the same noise): exactly the intended
+    assert np.array_equal(d != 0, expect != 0)
     assert np.array_equal(faulty.fault, lab)
     assert faulty.valid.all()
 
@@ -59,6 +60,8 @@ def test_seed_000_spikes_and_mni(descent):
     truth_h = b.measure(descent, np.random.default_rng(4), noise=False).h_baro_m
     n_clean = clean.h_baro_m - truth_h
     n_faulty = faulty.h_baro_m - truth_h
+    # unchanged samples are bit-identical (same code path); 1e-12 m (above floor(2, 1000) = 4.4e-13 m of the
+    # heights) only separates them from the changes (>= 1e-3 m)
     changed = np.flatnonzero(~np.isclose(n_clean, n_faulty, rtol=0, atol=1e-12))
     mni = np.flatnonzero((clean.t_s >= 10) & (clean.t_s < 20))
     assert np.array_equal(changed, np.sort(np.concatenate([mni, [101, 201]])))
@@ -89,9 +92,9 @@ def test_gnss_outage_and_single_prn_bias(descent):
     ch[ic] = True
     expect_changed = w[:, None] & ch[None, :] & clean.valid
     assert expect_changed.any()
-    assert np.allclose(d[expect_changed], 100.0)
+    assert np.allclose(d[expect_changed], 100.0)  # of 2e7 m ranges: floor(2, 2.7e7, 2.7e7) = 1.2e-8; 1e-3 (rtol)
     both = clean.valid & faulty.valid & ~expect_changed
-    assert np.all(d[both] == 0.0)
+    assert np.all(d[both] == 0.0)  # bit-identical: same code path (an exact 0 added)
     lab = np.where(out[:, None], FAULT_CODES["outage"], 0) + np.where(w[:, None] & ch[None, :], FAULT_CODES["cbm"], 0)
     assert np.array_equal(faulty.fault, lab.astype(np.int8))
 
@@ -104,6 +107,7 @@ def test_imu_axis_fault_and_batched_runs(descent):
     faulty = Faulted(imu, (spec,)).measure(descent, rngs)
     w = clean.t_s >= 5.0
     d = faulty.dtheta_body - clean.dtheta_body
+    # the step: allclose's 1e-8 rad is far above floor(2, 2e-4) = 9e-20; elsewhere bit-identical (same code path)
     assert np.allclose(d[:, w, 2], 1e-4) and np.all(d[:, ~w, :] == 0) and np.all(d[:, :, :2] == 0)
     assert np.array_equal(faulty.dv_body, clean.dv_body)
     assert faulty.fault.shape == (2, len(clean.t_s))

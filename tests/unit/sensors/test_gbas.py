@@ -11,11 +11,13 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
-from dataclasses import fields, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+from floors import assert_within, floor
+from gnss_floors import assert_fields_within, record_floors
 
 from approachsim import synthetic
 from approachsim.config import ProfileError
@@ -65,6 +67,8 @@ def _gad_c(theta_deg, m):
 @pytest.mark.parametrize("m", [2, 3, 4])
 def test_ground_curve_is_table_b74_over_the_reference_receivers(theta_deg, m):
     model = gb.GbasModel(gad="C", reference_receivers=m)
+    # the model against the table's formula written here (deg -> rad -> deg, exp of <= 6.3, a sqrt): ~15 eps
+    # relative; rel 1e-13 (450 eps) is 30x that, here and in the formula tests below
     assert float(model.ground_sigma_m(np.radians(theta_deg))) == pytest.approx(_gad_c(theta_deg, m), rel=1e-13)
     a = gb.GbasModel(gad="A", reference_receivers=m).ground_sigma_m(np.radians(theta_deg))
     expect_a = math.sqrt((0.5 + 1.65 * math.exp(-theta_deg / 14.3)) ** 2 / m + 0.08**2)
@@ -241,6 +245,7 @@ def test_total_error_is_the_sum_of_the_terms_with_the_records_sigma(drawn):
     _, out = drawn
     for d in out.values():
         total = sum(d["alone"][t] for t in TERMS)
+        # errors are differences of 2e7 m pseudoranges: floor(4, 2.7e7, 2.7e7) = 4.8e-8 m; 1e-6 m is 20x that
         np.testing.assert_allclose(d["total"], total, rtol=0, atol=1e-6, equal_nan=True)
         i = 0
         for j in np.flatnonzero(np.isfinite(d["total"][0, i])):
@@ -252,7 +257,8 @@ def test_total_error_is_the_sum_of_the_terms_with_the_records_sigma(drawn):
 def test_gbas_scales_kernel_equals_numpy():
     """gbas_scales against gbas.station_geometry and GbasModel.scales on random elevations (-10..90 deg) and aircraft
     positions around the runway (heights below and above the reference point), every designator, M = 2..4: to 1e-12
-    relative."""
+    relative of the elevation functions, plus the floors of the geometry they are scaled by: x_air = |r - station|
+    a difference of two 6.4e6 m ECEF positions, dh = h - station_h a difference of heights."""
     p = load_profile(DEFAULT)
     rng = np.random.default_rng(3)
     el = np.radians(rng.uniform(-10.0, 90.0, (2, 30, 24)))
@@ -272,27 +278,27 @@ def test_gbas_scales_kernel_equals_numpy():
                                      model.scale_height_m, 350e3, gb.CARRIER_NOISE_M**2)
                 x, dh, v = gb.station_geometry(r_rx, h, v_ned, st, st_h)
                 ref = model.scales(el, x[:, None], dh[:, None], v[:, None])
+                # the elevation functions (exp of up to 25, a division by M, a sqrt): ~(25 + 10) eps; 1e-12 relative
+                # is 130x that. iono scales x_air + 2 tau v, tropo |expm1(-dh / h0)|: the relative floors of their
+                # operands (1e-12 of a 500 m x_air, 5e-10 m, was below one ulp of the positions it is formed from)
+                rel = {"iono": floor(1, np.linalg.norm(r_rx, axis=-1), np.linalg.norm(st))
+                       / (x + 2.0 * gb.SMOOTHING_TAU_S * v),
+                       "tropo": floor(1, h, st_h) / np.abs(dh)}
+                tol = {k: 1e-12 * np.abs(ref[k]) + np.abs(ref[k]) * rel.get(k, 0.0)[:, None] if k in rel
+                       else 1e-12 * np.abs(ref[k]) for k in SCALED}
+                tol["sigma"] = sum(np.abs(ref[k]) * tol[k] for k in SCALED) / ref["sigma"] + 1e-12 * ref["sigma"]
                 for name, a in zip((*SCALED, "sigma"), got, strict=True):
-                    np.testing.assert_allclose(a, ref[name], rtol=1e-12, atol=0, err_msg=f"{gad} {aad} {m} {name}")
-
-
-def _close(a, b, what, rel=1e-12):
-    """|a - b| <= rel max(|b|, 1e-3 max|b|) where b is finite (test_gnss_kernels.py's measure); non-finite where b
-    is."""
-    a, b = np.asarray(a), np.asarray(b)
-    assert a.shape == b.shape, what
-    fin = np.isfinite(b)
-    assert np.array_equal(np.isfinite(a), fin), what
-    if fin.any():
-        x, y = a[fin], b[fin]
-        scale = np.maximum(np.abs(y), np.max(np.abs(y)) * 1e-3 + 1e-300)
-        assert np.max(np.abs(x - y) / scale) <= rel, what
+                    assert_within(a, ref[name], tol[name], f"{gad} {aad} {m} {name}")
 
 
 @pytest.mark.parametrize("selection", ["best4", "best4-fixed", "all"])
 def test_apply_equals_the_numpy_reference(selection):
-    """Records of 6 runs on their own skies, 3 runs on one sky and one run: the pseudorange errors (pseudorange minus
-    range) and sigma to 1e-12 relative, every other float field to 1e-12, masks identical."""
+    """Records of 6 runs on their own skies, 3 runs on one sky and one run: every float field to its floor
+    (gnss_floors.py), the pseudorange errors (pseudorange minus range) to the pseudoranges' floor, masks identical.
+
+    The errors are a difference of two 2e7 m values: they are known to the ranges' floor (~5e-7 m, gnss_floors.py),
+    not to 1e-12 of their own metre (the tolerance they had, 1e5x below it); the error model's own precision is
+    checked where it is formed (test_gbas_scales_kernel_equals_numpy, 1e-12 relative)."""
     p, rx = _receiver(selection=selection)
     rx = replace(rx, doppler=True)
     truth = synthetic.profile_descent(p, rate_hz=10.0)
@@ -308,13 +314,9 @@ def test_apply_equals_the_numpy_reference(selection):
         rng_m = np.linalg.norm(b.r_sv_ecef - truth.r_ecef[errs.rows][..., :, None, :], axis=-1)
         clk_b = 0.0 if clk is None else b.clock_bias_m[..., None]
         ea, eb = a.pseudorange_m - rng_m - clk_b, b.pseudorange_m - rng_m - clk_b
-        _close(ea, eb, "pseudorange error")
-        for f in fields(a):
-            x, y = getattr(a, f.name), getattr(b, f.name)
-            if isinstance(y, np.ndarray) and y.dtype.kind == "f":
-                _close(x, y, f.name)
-            elif isinstance(y, np.ndarray):
-                np.testing.assert_array_equal(x, y, err_msg=f.name)
+        fl = record_floors(rx, truth, errs.rows, b)
+        assert_within(ea, eb, fl["pseudorange_m"] + floor(2, b.pseudorange_m, rng_m), "pseudorange error")
+        assert_fields_within(a, b, fl)
         assert a.valid.any()
 
 
@@ -330,7 +332,7 @@ def test_none_is_the_stand_alone_receiver_and_gbas_draws_the_same_normals():
     truth = synthetic.profile_descent(base, rate_hz=10.0)
     e0 = rx0.draw(truth.t_s, [stream(8, r, "gnss") for r in range(3)])
     e1 = rx1.draw(truth.t_s, [stream(8, r, "gnss") for r in range(3)])
-    for k in e0.series:
+    for k in e0.series:  # bit-identical: same code path (the same receiver built twice, the same seeds)
         np.testing.assert_array_equal(e0.series[k], e1.series[k])
     np.testing.assert_array_equal(rx0.apply(truth, e0).pseudorange_m, rx1.apply(truth, e1).pseudorange_m)
     _, rx_g = _receiver()
@@ -338,10 +340,16 @@ def test_none_is_the_stand_alone_receiver_and_gbas_draws_the_same_normals():
     b = rx0.budget
     for sa, gname, sig in (("iono_zenith", "iono", b.iono_zenith_m), ("tropo_zenith", "tropo", b.tropo_zenith_m),
                            ("multipath", "multipath", 1.0)):
-        np.testing.assert_allclose(sig * eg.series[gname], e0.series[sa], rtol=1e-12, atol=1e-15)
+        # sigma GM(z; 1) against GM(z; sigma): the recursion x_k = a x_(k-1) + d_k rounds once a step relative to
+        # the series' size and carries the error on with a < 1: over m steps floor(2 m, max |x|) per column (the
+        # 1e-15 absolute it had was below one rounding of a value near a zero crossing)
+        y = e0.series[sa]
+        assert_within(sig * eg.series[gname], y, floor(2 * y.shape[1], np.max(np.abs(y), axis=1, keepdims=True)),
+                      gname)
     # the ground series is the clock/ephemeris normals at the ground's correlation time: the first samples agree
-    np.testing.assert_allclose(b.clock_ephemeris_m * eg.series["ground"][:, 0], e0.series["clock_ephemeris"][:, 0],
-                               rtol=1e-12)
+    # (x_0 = sigma z_0 against sigma (1 z_0): one rounding each)
+    y0 = e0.series["clock_ephemeris"][:, 0]
+    assert_within(b.clock_ephemeris_m * eg.series["ground"][:, 0], y0, floor(1, y0), "ground x_0")
 
 
 def test_realized_channel_states_add_up_to_the_pseudorange_error():
@@ -360,6 +368,8 @@ def test_realized_channel_states_add_up_to_the_pseudorange_error():
     err = rec.pseudorange_m[:, 0] - exact.pseudorange_m[:, 0]
     white = errors.sensors["gnss"].series["white"][:, 0]
     assert np.std(white[ok]) < 0.005
+    # err is a difference of two 2e7 m pseudoranges (floor(2, 2.7e7) = 1.2e-8 m), the states a sum of terms of a few m:
+    # 1e-6 m is 80x the floor
     np.testing.assert_allclose(err[ok], (st.gse + st.gmp + st.clk[:, :1] + white)[ok], atol=1e-6)
     assert np.all(np.abs(st.gse[ok]) < 3.0) and np.all(np.abs(st.gmp[ok]) < 3.0)
 
@@ -377,7 +387,7 @@ def test_profile_keys_parse_into_the_model():
     m = g.gbas
     assert (m.gad, m.aad, m.reference_receivers, m.refractivity_sigma, m.scale_height_m, m.ground_tau_s) == (
         "A", "A", 3, 10.0, 8000.0, 120.0)
-    assert m.sigma_vig_per_m == pytest.approx(6e-6, rel=1e-12)
+    assert m.sigma_vig_per_m == pytest.approx(6e-6, rel=1e-12)  # unit conversions, 2-3 roundings: 4500 eps is ample
     assert m.station_rwy_m == pytest.approx((914.4, -121.92, 3.048), rel=1e-12)
     assert g.budget().gbas is g.gbas and g.budget().slow_tau_s == 120.0
     st = np.asarray(SensorSuite.from_profile(p).sensors["gnss"].station_ecef)

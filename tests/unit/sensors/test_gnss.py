@@ -20,11 +20,12 @@ def test_orbits_are_circular_kepler_with_the_right_period():
     period = 2 * math.pi * math.sqrt(c.a_m**3 / MU_GPS)
     assert period == pytest.approx(43077.0, abs=5.0)  # standards.md 2.1: 11.966 h
     r = c.positions_ecef(np.array([0.0, period]))
+    # 1e-3 m: 2000x the orbit's floor(6, 4 pi a) + floor(5, a) = 4.7e-7 m (gnss_floors.py)
     assert np.allclose(np.linalg.norm(r, axis=-1), 26559800.0, atol=1e-3)
     # after one period the inertial position repeats: ECEF rotates by OMEGA_E * period about z
     a = geo.OMEGA_E * period
     rz = np.array([[math.cos(a), math.sin(a), 0], [-math.sin(a), math.cos(a), 0], [0, 0, 1]])
-    assert np.allclose(r[1], r[0] @ rz.T, atol=1e-3)
+    assert np.allclose(r[1], r[0] @ rz.T, atol=1e-3)  # as above, the angle w_E T ~ 3 rad adding floor(3, 3 a)
     # inclination 55 deg: maximum |z| / a = sin 55
     t = np.linspace(0, period, 400)
     z = c.positions_ecef(t)[..., 2]
@@ -42,8 +43,7 @@ def test_geometry_at_the_default_airport_over_a_day(runway):
     _, pdop, hdop, vdop = dops(u, vis, geo.c_ecef_to_ned(lat, lon))
     assert vis.sum(axis=1).min() >= 5
     assert pdop.max() < 6.0
-    assert np.allclose(pdop**2, hdop**2 + vdop**2)
-
+    assert np.allclose(pdop**2, hdop**2 + vdop**2)  # rtol 1e-5: far above the traces' floor(16, pdop^2)
 
 def _pdop_from_angles(el: np.ndarray, az: np.ndarray) -> float:
     """PDOP of SVs at elevations el and azimuths az (rad): G rows [-u_NED, 1], PDOP^2 = trace of the position
@@ -68,6 +68,7 @@ def test_best_four_is_the_minimum_pdop_combination(runway):
              for combo in itertools.combinations(np.flatnonzero(vis[0]), 4)}
     best = min(pdops, key=pdops.get)
     assert sel.sum() == 4 and set(np.flatnonzero(sel[0])) == set(best)
+    # two formulas of a pdop ~ 2: relative floor 96 pdop^2 16 eps = 1.4e-12 (gnss_floors.py); rel 1e-9 is 700x
     assert p_sel[0] == pytest.approx(pdops[best], rel=1e-9)
 
 
@@ -78,7 +79,7 @@ def test_noise_false_pseudorange_is_geometric_range(descent):
     rng = np.linalg.norm(rec.r_sv_ecef - descent.r_ecef[rows][:, None, :], axis=-1)
     ok = rec.valid
     assert ok.sum(axis=1).min() >= 5
-    assert np.max(np.abs(rec.pseudorange_m[ok] - rng[ok])) < 1e-3
+    assert np.max(np.abs(rec.pseudorange_m[ok] - rng[ok])) < 1e-3  # 2000x the range floor ~5e-7 m (gnss_floors)
     assert np.all(np.isnan(rec.pseudorange_m[~ok]))
 
 
@@ -91,8 +92,7 @@ def test_pseudorange_minus_clock_bias_is_geometric_range(descent):
     rng = np.linalg.norm(rec.r_sv_ecef - descent.r_ecef[rows][:, None, :], axis=-1)
     assert np.ptp(rec.clock_bias_m) > 1000.0  # a real, drifting clock
     resid = rec.pseudorange_m - rec.clock_bias_m[:, None] - rng
-    assert np.nanmax(np.abs(resid)) < 1e-3
-
+    assert np.nanmax(np.abs(resid)) < 1e-3  # 2000x the range floor ~5e-7 m (gnss_floors.py)
 
 def test_pseudorange_error_matches_the_budget(runway):
     """Per-SV errors at 1 Hz over 2000 runs: RSS matches sigma(el) within 5 % (P(Y) and C/A)."""
@@ -121,6 +121,7 @@ def test_pseudorange_rate_is_the_range_derivative_plus_clock_drift(descent):
     r_m = np.linalg.norm(c.positions_ecef(descent.t_s[mid - 1]) - descent.r_ecef[mid - 1][:, None], axis=-1)
     fd = (r_p - r_m) / (2 * dt)
     ok = exact.valid[1:-1]
+    # the central difference of 2e7 m ranges over 0.1 s: floor(6, 2.7e7, 6.4e6) / 0.1 s = 4.5e-7 m/s; 2000x
     assert np.max(np.abs(exact.pseudorange_rate_mps[1:-1][ok] - fd[ok])) < 1e-3
     noisy = rx.measure(descent, [np.random.default_rng(i) for i in range(200)],
                        clock_rng=[np.random.default_rng(1000 + i) for i in range(200)])
@@ -148,10 +149,11 @@ def test_best4_fixed_keeps_the_start_set_and_is_stateless(descent):
     assert set(np.flatnonzero(rec.valid[0])) == set(best)
     for j in (0, len(e) // 2, len(e) - 1):
         m = rec.valid[j]
+        # two formulas of pdop (the los vs the angles): 700x the relative floor 96 pdop^2 16 eps, as above
         assert rec.pdop[j] == pytest.approx(_pdop_from_angles(rec.elevation_rad[j][m], rec.azimuth_rad[j][m]),
                                             rel=1e-9)
     switched = ~np.all(every.valid == rec.valid, axis=1)
-    assert np.all(rec.pdop[switched] > every.pdop[switched] - 1e-9)
-    for j in (0, 100, len(e) - 1):
+    assert np.all(rec.pdop[switched] > every.pdop[switched] - 1e-9)  # 1e-9: 100x the pdops' floor ~1e-11
+    for j in (0, 100, len(e) - 1):  # bit-identical: same code path (the kernels on a one-sample slice)
         one = fixed.apply(descent, e.take(slice(j, j + 1)))
         assert np.array_equal(one.pseudorange_m[0], rec.pseudorange_m[j], equal_nan=True)

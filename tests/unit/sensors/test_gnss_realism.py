@@ -41,7 +41,7 @@ def test_per_run_epoch_offsets_are_uniform_over_the_sidereal_day():
     off = draw_epoch_offsets(SIDEREAL_DAY_S, [stream(11, r, EPOCH_STREAM) for r in runs])
     assert off.shape == (2000,) and np.all((off >= 0.0) & (off < SIDEREAL_DAY_S))
     assert sps.kstest(off / SIDEREAL_DAY_S, "uniform").pvalue > 0.01
-    assert off[7] == stream(11, 7, EPOCH_STREAM).uniform(0.0, SIDEREAL_DAY_S)
+    assert off[7] == stream(11, 7, EPOCH_STREAM).uniform(0.0, SIDEREAL_DAY_S)  # bit-identical: the same seeded draw
 
 
 def test_per_run_sky_is_bit_identical_whatever_the_batch(descent, runway):
@@ -53,21 +53,21 @@ def test_per_run_sky_is_bit_identical_whatever_the_batch(descent, runway):
     alone = suite.measure(descent, seed=5, runs=[3])["gnss"]
     assert batch.per_run_sky and alone.per_run_sky
     a, b = alone.run(0), batch.run(3)
-    for f in ("r_sv_ecef", "elevation_rad", "pseudorange_m", "valid", "pdop", "sigma_m"):
+    for f in ("r_sv_ecef", "elevation_rad", "pseudorange_m", "valid", "pdop", "sigma_m"):  # bit-identical: same path
         np.testing.assert_array_equal(getattr(a, f), getattr(b, f), err_msg=f)
     assert not np.array_equal(batch.run(0).visible, b.visible)  # a different sky (14 h apart for this seed)
     fixed = _suite(runway, 'epoch = "fixed"')
     assert fixed.epoch_window_s == 0.0
     e_fixed = fixed.draw(descent.t_s, 5, [3]).sensors["gnss"]
     e_run = suite.draw(descent.t_s, 5, [3]).sensors["gnss"]
-    for k, v in e_fixed.series.items():
+    for k, v in e_fixed.series.items():  # bit-identical: the same draws
         np.testing.assert_array_equal(v, e_run.series[k], err_msg=k)
     assert "epoch_offset_s" not in e_fixed.constants
     off = e_run.constants["epoch_offset_s"]
-    assert off[0] == stream(5, 3, EPOCH_STREAM).uniform(0.0, SIDEREAL_DAY_S)
+    assert off[0] == stream(5, 3, EPOCH_STREAM).uniform(0.0, SIDEREAL_DAY_S)  # bit-identical: the same seeded draw
     # noise=False keeps the run's sky (the epoch is not an error)
     exact = suite.measure(descent, seed=5, runs=[3], noise=False)["gnss"]
-    np.testing.assert_array_equal(exact.elevation_rad, alone.elevation_rad)
+    np.testing.assert_array_equal(exact.elevation_rad, alone.elevation_rad)  # bit-identical: same code path
 
 
 def test_do253_multipath_sigma_measured_against_elevation(descent):
@@ -113,6 +113,7 @@ def test_budget_selection_and_the_filter_uses_the_same_sigmas(runway):
     el = np.radians(np.linspace(5.0, 85.0, 24))
     for cfg, gmp, ce in ((d, do253_multipath_sigma_m(el), 2.4), (old, np.full(24, 1.8), 3.6)):
         nz = NavSystem.build(sensors=SensorsConfig(gnss=cfg), runway=runway).noise(el)
+        # the DO-253 curve 0.13 + 0.53 exp(-el / 10 deg), ~6 roundings (exp of <= 8.5): rtol 1e-12 is 300x that
         np.testing.assert_allclose(np.broadcast_to(nz.gmp_sigma_m, (24,)), gmp, rtol=1e-12)
         assert nz.gmp_tau_s == cfg.budget().multipath_tau_s
         assert np.all(np.asarray(nz.gse_sigma_m) > ce) and np.min(nz.gse_sigma_m) < ce + 0.5

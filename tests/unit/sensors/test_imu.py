@@ -17,7 +17,9 @@ def test_noise_false_is_the_held_truth_sample(descent):
     rec = Imu(PRESETS["mems"]).measure(descent, np.random.default_rng(0), noise=False)
     dt = descent.t_s[1] - descent.t_s[0]
     assert rec.dt_s == dt
-    assert np.array_equal(rec.t_s, descent.t_s[1:])
+    assert np.array_equal(rec.t_s, descent.t_s[1:])  # bit-identical: the truth's times sliced
+    # exact by construction: zeroed errors add exact zeros to the same products dt * w, dt * f (x + 0 = x in any
+    # rounding)
     assert np.array_equal(rec.dtheta_body, dt * descent.w_ib_body[:-1])
     assert np.array_equal(rec.dv_body, dt * descent.f_body[:-1])
     assert rec.valid.all() and not rec.fault.any()
@@ -27,7 +29,7 @@ def test_stepwise_apply_equals_batch_bit_for_bit(descent):
     imu = Imu(PRESETS["tactical"])
     e = imu.draw(descent.t_s, np.random.default_rng(7))
     batch = imu.apply(descent, e)
-    for j in (0, 1, 100, len(e) - 1):
+    for j in (0, 1, 100, len(e) - 1):  # bit-identical: same code path (the kernel on a one-sample slice)
         one = imu.apply(descent, e.take(slice(j, j + 1)))
         assert np.array_equal(one.dtheta_body[0], batch.dtheta_body[j])
         assert np.array_equal(one.dv_body[0], batch.dv_body[j])
@@ -39,6 +41,7 @@ def test_prefix_property_and_run_axis(descent):
     short = descent.slice(slice(0, 500))
     a = imu.measure(short, np.random.default_rng(3))
     b = imu.measure(descent, np.random.default_rng(3))
+    # bit-identical: same code path (a record's prefix, a run of a batch)
     assert np.array_equal(a.dv_body, b.dv_body[:499])
     assert np.array_equal(a.dtheta_body, b.dtheta_body[:499])
     many = imu.measure(short, [np.random.default_rng(s) for s in (9, 3)])
@@ -123,7 +126,10 @@ def test_quantization_rounds_each_increment(descent):
     imu = Imu(replace(PRESETS["mems"], gyro_quant_rad=q_th, accel_quant_mps=q_v))
     rec = imu.measure(descent, np.random.default_rng(2))
     raw = Imu(PRESETS["mems"]).measure(descent, np.random.default_rng(2))
+    # q n / q for |n| ~ 1e2..1e4: floor(2, 1e4) = 4.4e-12; 1e-6 is 2e5x that
     assert np.allclose(rec.dtheta_body / q_th, np.round(rec.dtheta_body / q_th), rtol=0, atol=1e-6)
+    # |q rint(v / q) - v| <= q / 2 plus the floor of the two roundings, floor(2, |v| <= 1 m/s) = 4.4e-16 m/s; the
+    # slack 1e-9 q / 2 = 5e-14 m/s is 100x that
     assert np.max(np.abs(rec.dv_body - raw.dv_body)) <= 0.5 * q_v * (1 + 1e-9)
-    exact = imu.measure(descent, np.random.default_rng(2), noise=False)
+    exact = imu.measure(descent, np.random.default_rng(2), noise=False)  # exact by construction, as in the first test
     assert np.array_equal(exact.dv_body, (descent.t_s[1] - descent.t_s[0]) * descent.f_body[:-1])

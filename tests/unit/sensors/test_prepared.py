@@ -45,6 +45,7 @@ def truth():
 
 
 def _identical(a, b, what):
+    """Bit-identical: same code path (prepare().at runs the record's kernels on one sample's values)."""
     assert type(a) is type(b), what
     for f in fields(b):
         x, y = getattr(a, f.name), getattr(b, f.name)

@@ -35,6 +35,8 @@ def test_reads_a_100_ft_terrain_step(runway):
     height_above_ellipsoid = tr.h_m
     jump = np.diff(height_above_ellipsoid - rec.h_agl_m)  # = terrain height under the aircraft, differenced
     k = int(np.argmax(np.abs(jump)))
+    # h - h_agl differenced: heights <= 400 m, ~4 roundings each: floor(4, 400, 400) = 7e-13 m; 1e-9 m (and 1e-6 ft
+    # on the step) are >= 1400x that
     assert -jump[k] / units.FT == pytest.approx(step_ft, abs=1e-6)
     assert tr.r_rwy[k, 0] < -3000.0 <= tr.r_rwy[k + 1, 0]
     assert np.max(np.abs(np.delete(jump, k))) < 1e-9
@@ -105,6 +107,7 @@ def test_default_bias_and_markov_statistics(runway):
     rho = np.sum(x[:, 1:] * x[:, :-1]) / np.sum(x[:, :-1] ** 2)
     assert -1.0 / np.log(rho) == pytest.approx(ra.markov_tau_s, rel=0.05)
     # the bias is constant within a run: the sample-to-sample differences carry no bias
+    # allclose's 1e-8 m + 1e-5 rel against floor(4, 30) = 2.7e-14 m: a constant bias cancels, far above rounding
     assert np.allclose(np.diff(rec.h_agl_m - 30.0, axis=1), np.diff(x, axis=1))
 
 
@@ -115,7 +118,7 @@ def test_correlated_parts_do_not_move_the_white_noise_draws(runway):
                               100.0, 1.0, terrain_h_m=runway.threshold_h_m)
     new = RadarAltimeter().draw(tr.t_s, _gens(3))
     old = RadarAltimeter(markov_sigma_m=0.0, bias_sigma_m=0.0).draw(tr.t_s, _gens(3))
-    assert np.array_equal(new.series["noise"], old.series["noise"])
+    assert np.array_equal(new.series["noise"], old.series["noise"])  # bit-identical: the same draws
     assert np.all(old.series["markov"] == 0.0) and np.all(old.constants["bias"] == 0.0)
     assert np.all(new.constants["bias"] != 0.0)
     # today's draw: z = (m, 2) normals from the stream, column 1 the white noise

@@ -29,6 +29,7 @@ def _full_suite():
 
 
 def _same(a, b):
+    """Bit-identical: same code path (a sensor left out or a run drawn alone does not move the others' values)."""
     for f in fields(a):
         x, y = getattr(a, f.name), getattr(b, f.name)
         if isinstance(x, np.ndarray):
@@ -67,7 +68,7 @@ def test_removing_a_sensor_leaves_the_others_bit_identical(setup, removed):
 def test_run_is_reproducible_alone(setup):
     suite, truth = setup
     many = suite.measure(truth, seed=5, runs=[0, 3])
-    one = suite.measure(truth, seed=5, runs=3)
+    one = suite.measure(truth, seed=5, runs=3)  # bit-identical: same code path (a run alone and in a batch)
     for name in one:
         assert np.array_equal(one[name].t_s, many[name].t_s)
     assert np.array_equal(one["imu"].dv_body, many["imu"].dv_body[1])
@@ -83,7 +84,7 @@ def test_stepwise_apply_equals_batch_for_every_sensor(setup):
     batch = suite.measure(truth, seed=9, runs=2)
     for name, e in errs.sensors.items():
         m = len(batch[name].t_s)
-        for j in (0, m // 3, m - 1):
+        for j in (0, m // 3, m - 1):  # bit-identical: same code path (the kernels on a one-sample slice)
             rec = suite.apply(truth, SensorSuite.take(errs, name, slice(j, j + 1)), names=[name])[name]
             for f in fields(rec):
                 x = getattr(rec, f.name)

@@ -45,18 +45,25 @@ def test_mapped_states_reproduce_the_realized_measurement_errors():
     assert ok.sum() >= 12  # four channels in each of the three runs
     pr_err = g.pseudorange_m[:, 0] - exact["gnss"].pseudorange_m[:, 0]  # exact: geometric range, zero clock
     model = st.gse + st.gmp + st.clk[:, :1] + ge.series["noise"][:, 0]
+    # a difference of two 2e7 m pseudoranges: floor(4, 2.7e7, 2.7e7) = 4.8e-8 m; 1e-6 m is 20x that
     np.testing.assert_allclose(pr_err[ok], model[ok], atol=1e-6)
-    # the clock state is the receiver clock of the record (bias, m) and its drift (m/s)
+    # the clock state is the receiver clock of the record (bias, m) and its drift (m/s): the same draws read two
+    # ways, ~4 roundings of a bias <= 1e4 m (floor(4, 1e4) = 8.9e-12 m) and of a drift <= 10 m/s (8.9e-15 m/s):
+    # 1e-9 and 1e-12 are ~100x those
     np.testing.assert_allclose(st.clk[:, 0], g.clock_bias_m[:, 0], atol=1e-9)
     np.testing.assert_allclose(st.clk[:, 1], g.clock_drift_mps[:, 0], atol=1e-12)
     # baro: h_B - h_ind = B + S h_ind + v
     b = errors.sensors["baro"]
     h_ind = exact["baro"].h_baro_m[:, 0]
+    # heights ~ 100 m from the ISA inverse (~8 roundings of T0 / L = 44.3 km: floor(8, 44330) = 7.9e-11 m); 1e-9 m
+    # is 13x that
     np.testing.assert_allclose(rec["baro"].h_baro_m[:, 0] - h_ind, st.bb + st.sb * h_ind + b.series["noise"][:, 0],
                                atol=1e-9)
     assert np.all(np.abs(st.sb) > 0.0)
     # IMU, zero noise: the first increment's error is the body-axis bias the filter's bg / ba states mean
     dth_t, dv_t, dt = true_increments(truth, np.array([1]))
+    # increment minus the true increment, over dt: floor(8, |w| ~ 1e-4 rad/s) = 1.8e-19 rad/s and floor(8, |f| ~ 9.8
+    # m/s^2) = 1.7e-14 m/s^2 (the increments' ~8 roundings, kernel imu.py); atol 1e-15 and 1e-12 are >= 60x those
     np.testing.assert_allclose((rec["imu"].dtheta_body[:, 0] - dth_t[0]) / dt, st.bg, rtol=1e-9, atol=1e-15)
     np.testing.assert_allclose((rec["imu"].dv_body[:, 0] - dv_t[0]) / dt, st.ba, rtol=1e-9, atol=1e-12)
     # pseudolites: rho - |r_pl,true - r| - clk - noise = T |r_pl,true - r| + m + b_PL
@@ -65,6 +72,7 @@ def test_mapped_states_reproduce_the_realized_measurement_errors():
     true_pl = suite.sensors["pseudolite"].r_published_ecef[None] + pe.constants["survey"]
     rng = np.linalg.norm(true_pl - r, axis=-1)
     lhs = p.pseudorange_m[:, 0] - rng - st.clk[:, :1] - pe.series["noise"][:, 0]
+    # ranges from 6.4e6 m ECEF positions: floor(4, 6.4e6, 6.4e6) = 1.1e-8 m; 1e-6 m is 90x that
     np.testing.assert_allclose(lhs, st.ptr * rng + st.pmp + st.pclk[:, 0::2], atol=1e-6)
     assert np.all(np.abs(st.pclk[:, 1::2]) > 0.0)  # unsynchronized: their drift is realized too
 
@@ -74,6 +82,7 @@ def test_one_run_drawn_alone_gets_the_run_axis_and_the_same_values():
     one = suite.draw(truth.t_s, 4, 1)
     alone = start_states(suite, truth, one)
     assert alone.runs == 1
+    # bit-identical: same code path (run 1 drawn alone and in a batch)
     np.testing.assert_array_equal(alone.gse, st.gse[1:2])
     np.testing.assert_array_equal(alone.clk, st.clk[1:2])
     np.testing.assert_array_equal(alone.bb, st.bb[1:2])
