@@ -30,6 +30,8 @@ from approachsim.sensors.gnss.receiver import (
 from approachsim.sensors.kernels import gnss as gk
 from approachsim.sensors.suite import SensorSuite
 
+pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
+
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 
 

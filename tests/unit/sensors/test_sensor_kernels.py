@@ -26,6 +26,8 @@ from approachsim.sensors.presets import PRESETS
 from approachsim.sensors.pseudolite import Pseudolite
 from approachsim.sensors.radalt import RadarAltimeter
 
+pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
+
 
 def _imu_floor(descent, e):
     """The floor of the kernel against the oracle, (runs, m, 3) or (m, 3): out_r = d_r + sum_j M_rj d_j + (b0_r +
