@@ -114,7 +114,7 @@ def measure(approach: Approach, seed: int, run: int = 0) -> dict:
     out = {"termination": res.termination, "ok": res.ok}
     if not np.any(sel):
         return out
-    d = z - rw.glidepath_height_m(x)  # true glidepath deviation from the runway geometry
+    d = tr.gs_dev_m  # true glidepath deviation from the straight cone (approachsim.glidepath)
     target = approach.aircraft.approach_speed_mps
     cas_err = tr.airspeed_mps[sel] - target
     # speed through the mean air mass (ground velocity - steady wind) as EAS (= CAS within 0.3 kt at M 0.25),

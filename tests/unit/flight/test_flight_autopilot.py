@@ -11,6 +11,7 @@ import pytest
 from approachsim import units
 from approachsim.flight.aircraft import load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
+from approachsim.glidepath import GlidePath
 from approachsim.profile import load_profile
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
@@ -26,22 +27,31 @@ def ap():
     return Autopilot(ac.gains, Trim(theta_rad=0.02, throttle=0.47, cas_mps=72.0), geom, 1.0 / 120.0)
 
 
+CONE = GlidePath(GP, TCH, 0.0, 0.0)
+
+
 def _on_path(x):
-    return TCH - x * math.tan(GP)
+    """Height of the straight glide path cone (approachsim.glidepath) in the runway frame's z at x."""
+    return float(CONE.height_m(x))
+
+
+def _sink_on_path(x, v):
+    """Sink rate (m/s) that follows the cone at ground speed v along the runway: v times its slope at x."""
+    return v * (_on_path(x - 0.5) - _on_path(x + 0.5))
 
 
 def test_on_the_glidepath_flying_down_it_has_zero_deviation(ap):
     x = -5000.0
     v = 70.0
-    d, d_dot, y, y_dot = ap.deviations(x, 0.0, _on_path(x), v, 0.0, v * math.tan(GP))
+    d, d_dot, y, y_dot = ap.deviations(x, 0.0, _on_path(x), v, 0.0, _sink_on_path(x, v))
     assert d == pytest.approx(0.0, abs=1e-9)
-    assert d_dot == pytest.approx(0.0, abs=1e-9)
+    assert d_dot == pytest.approx(0.0, abs=1e-6)  # the slope by a 1 m central difference: O(1e-7) m/s
     assert y == 0.0 and y_dot == pytest.approx(0.0, abs=1e-12)
 
 
 def test_deviation_signs(ap):
     x = -3000.0
-    d, _, y, y_dot = ap.deviations(x, 12.0, _on_path(x) + 7.0, 70.0, 1.5, 3.67)
+    d, _, y, y_dot = ap.deviations(x, 12.0, float(CONE.height_m(x, 12.0)) + 7.0, 70.0, 1.5, 3.67)
     assert d == pytest.approx(7.0)
     assert y == 12.0
     assert y_dot == pytest.approx(1.5)  # heading north: east velocity drifts right
