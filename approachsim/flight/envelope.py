@@ -4,7 +4,7 @@ stabilized-approach criterion (checked every step below the stabilization height
 Limits come from the aircraft file's [envelope] table (aircraft/737.toml says where each figure comes from);
 a profile outside them is refused with one line naming the field and the limit (ProfileError, exit 2):
 
-    environment.wind_speed_kt: tailwind component 15 kt exceeds the 737's 10 kt limit
+    environment.wind_speed_kt: tailwind component 20 kt exceeds the 737's 15 kt limit
 
 Wind components are taken against the runway heading: headwind = W cos(from - heading), crosswind =
 W |sin(from - heading)|. The descent the glidepath needs must also be a stabilized one: FSF's 1000 ft/min

@@ -3,7 +3,7 @@ elevation, glidepath) and the flight technical error of each combination.
 
 Used by the envelope acceptance test (tests/integration/test_flight_envelope.py) and by
 tools/envelope_table.py, which writes docs/envelope.md and its figure. The design is fixed, not drawn: 28
-cases, the 7 wind cases (headwind 0/10/20/25 kt, crosswind 15/25 kt from the left/right, tailwind 10 kt) x
+cases, the 7 wind cases (headwind 0/10/20/25 kt, crosswind 15/25 kt from the left/right, tailwind 15 kt) x
 the 2 turbulence levels, twice, with ISA deviation, field elevation and glidepath cycling through their
 levels so that every level of every factor appears; a case whose planned sink rate exceeds the
 stabilized-approach limit (flight.envelope) takes the next shallower glidepath and says so.
@@ -34,7 +34,7 @@ WIND_CASES = (
     ("headwind 25 kt", 25.0, 0.0),
     ("crosswind 15 kt", 15.0, -90.0),
     ("crosswind 25 kt", 25.0, 90.0),
-    ("tailwind 10 kt", 10.0, 180.0),
+    ("tailwind 15 kt", 15.0, 180.0),
 )
 """(label, speed kt, wind direction relative to the runway heading, deg: 0 head, 180 tail, -90 from the left)."""
 TURBULENCE = ("light", "moderate")
