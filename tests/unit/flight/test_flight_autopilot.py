@@ -80,3 +80,36 @@ def test_meridian_convergence_rotates_the_runway_axes():
     # 10 km east of a north-pointing runway: the local north differs by 10e3 tan(60 deg)/R ~ 0.156 deg
     _, _, _, y_dot = ap.deviations(0.0, 10e3, 0.0, 70.0, 0.0, 0.0)
     assert y_dot == pytest.approx(-70.0 * 10e3 * math.tan(lat) / 6.394e6, rel=0.01)
+
+
+def test_the_flare_command_starts_at_the_entry_sink_and_ends_at_the_touchdown_sink(ap):
+    """Exponential flare h'_c = -(h - h_off) / tau with tau, h_off from continuity at entry (autopilot.py): at
+    entry the sink-rate error is zero (no step in the pitch command), at h = 0 the command is the touchdown sink."""
+    g = ap.g
+    h0, sink0 = g.flare_height_m - 0.01, 3.8
+    x = -300.0
+    ap.step(x, 0.0, _on_path(x), 70.0, 0.0, sink0, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, h0)
+    assert ap.flaring
+    tau = ap._flare_tau
+    assert tau == pytest.approx(h0 / (sink0 - g.touchdown_sink_mps))
+    assert ap._int_flare == pytest.approx(0.0, abs=1e-12)  # zero sink-rate error at entry
+    assert ap._flare_h_off == pytest.approx(-tau * g.touchdown_sink_mps)
+    # the command at the runway: h'_c(0) = h_off / tau = -touchdown sink
+    assert -(0.0 - ap._flare_h_off) / tau == pytest.approx(-g.touchdown_sink_mps)
+
+
+def test_the_decrab_yaws_towards_the_runway_and_holds_the_sideslip(ap):
+    """Below the align height, crabbed 8 deg right of the runway (heading 0) with the wind from the right (beta > 0
+    once aligned): rudder nose left (+) from the heading error; the sideslip terms add rudder, bank and aileron
+    into the wind (right)."""
+    x = -200.0
+    g = ap.g
+    h = 0.5 * g.align_height_m
+    de, da, dr, thr = ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, h,
+                              psi=math.radians(8.0), r=0.0)
+    assert ap.aligning
+    assert dr == pytest.approx(g.k_r_align * math.radians(8.0) / g.align_tau_s)
+    _, da_b, dr_b, _ = ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.1, 72.0, h,
+                               psi=0.0, r=0.0)
+    assert dr_b == pytest.approx(g.k_beta_align * 0.1, rel=1e-9)  # aligned: the rudder that holds beta = 0.1
+    assert da_b > 0.0  # right wing down into the wind
