@@ -128,7 +128,10 @@ def measure(approach: Approach, seed: int, run: int = 0) -> dict:
     mean3 = np.convolve(eas, np.ones(n) / n, mode="full")[: eas.size]
     mean3[: n - 1] = np.nan
     air_err = mean3[sel] - target
-    slope = np.polyfit(x[sel], z[sel], 1)[0]  # dz/dx = -tan(flight-path angle)
+    _, x_gpi, ca, cb, cc = rw.glidepath.constants()
+    dx = x - x_gpi
+    z_plane = z - (ca * dx * dx + cb * dx * y + cc * y * y)  # height above the GPI's horizontal plane
+    slope = np.polyfit(x[sel], z_plane[sel], 1)[0]  # dz/dx = -tan(flight-path angle)
     out.update(
         vertical_rms_ft=float(np.sqrt(np.mean(d[sel] ** 2)) / units.FT),
         lateral_rms_ft=float(np.sqrt(np.mean(y[sel] ** 2)) / units.FT),
