@@ -34,9 +34,10 @@ Array = NDArray[np.float64]
 
 
 def glidepath_height_m(along_m: ArrayLike, tch_m: float, tan_gp: float) -> Array:
-    """Height above the threshold (m) of the ideal glidepath at runway-frame x = along_m (m, negative before the
-    threshold): TCH - x tan(glidepath). The one source of the glidepath geometry; the compiled flight kernels
-    (flight/kernels.py) write the same expression inline and are tested against it."""
+    """Height above the threshold (m) of a path parallel to the ellipsoid at runway-frame x = along_m (m, negative
+    before the threshold): TCH - x tan(glidepath). It follows the Earth's curvature; the synthetic trajectories
+    (approachsim/synthetic.py, manoeuvre.py) fly it. The glide path the aircraft flies and is scored against is
+    the straight cone of approachsim.glidepath, (x - x_gpi)^2 / (2 R) above this."""
     return tch_m - np.asarray(along_m) * tan_gp
 
 

@@ -18,10 +18,11 @@ from pathlib import Path
 
 import numpy as np
 
-from approachsim import geo, units
+from approachsim import units
 from approachsim.config import ProfileError, Section
 from approachsim.evaluate.config import EvaluationConfig, parse_evaluation
 from approachsim.geo import RunwayFrame
+from approachsim.glidepath import GlidePath
 from approachsim.nav.config import NavConfig, parse_nav
 from approachsim.sensors import atmosphere
 from approachsim.sensors.config import SensorsConfig, parse_faults, parse_sensors
@@ -49,9 +50,16 @@ class Runway:
         """The runway frame (origin at the threshold, x along the landing direction, y right, z up)."""
         return RunwayFrame(self.threshold_lat_rad, self.threshold_lon_rad, self.elevation_m, self.heading_rad)
 
-    def glidepath_height_m(self, along_m: np.ndarray | float) -> np.ndarray | float:
-        """Height above the threshold of the ideal glidepath at runway-frame x = along_m (negative before)."""
-        return geo.glidepath_height_m(along_m, self.tch_m, math.tan(self.glidepath_rad))
+    def glidepath_height_m(self, along_m: np.ndarray | float, cross_m: np.ndarray | float = 0.0
+                           ) -> np.ndarray | float:
+        """Height above the threshold (the runway frame's z) of the straight glide path cone at runway-frame
+        x = along_m (negative before), y = cross_m (approachsim.glidepath: the one geometric reference)."""
+        return GlidePath.of(self).height_m(along_m, cross_m)
+
+    @property
+    def glidepath(self) -> GlidePath:
+        """The straight ILS glide path cone of this runway (GPI, TCH, angle)."""
+        return GlidePath.of(self)
 
 
 @dataclass(frozen=True)
@@ -62,6 +70,8 @@ class AircraftChoice:
     approach_speed_mps: float | None
     flaps_norm: float | None
     gear_down: bool
+    autopilot_law: str | None = None
+    """Speed and path law flown ("classic" | "tecs"; None: the aircraft file's)."""
 
 
 @dataclass(frozen=True)
@@ -179,8 +189,11 @@ def _aircraft(s: Section) -> AircraftChoice:
     if flaps is not None:
         flaps = s.number("flaps_norm", lo=0.0, hi=1.0)
     gear = s.boolean("gear_down", True)
+    law = s.raw("autopilot_law", None)
+    if law is not None:
+        law = s.string("autopilot_law", choices=("classic", "tecs"))
     s.done()
-    return AircraftChoice(name=name, approach_speed_mps=speed, flaps_norm=flaps, gear_down=gear)
+    return AircraftChoice(name=name, approach_speed_mps=speed, flaps_norm=flaps, gear_down=gear, autopilot_law=law)
 
 
 def _environment(s: Section, runway: Runway) -> Environment:

@@ -110,7 +110,7 @@ def _score(
     fte = {}
     if flight is not None:  # closed loop: FTE is the deviation of the position guidance flew on
         g = flight.guidance_r_rwy
-        fte = {"fte_lat_m": g[:, 1], "fte_vert_m": g[:, 2] - profile.runway.glidepath_height_m(g[:, 0])}
+        fte = {"fte_lat_m": g[:, 1], "fte_vert_m": profile.runway.glidepath.deviation_rwy_m(g)}
     scalars, arrays, series = score_run(
         truth, nav, cfg, clock_bias_true_m=clock_true, keep_series=run < cfg.series_runs, **fte
     )

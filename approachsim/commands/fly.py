@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 
 from approachsim.commands._single_run import add_single_run_arguments, load_single_run
@@ -62,6 +63,9 @@ def run(args: argparse.Namespace) -> int:
         "lowest_height_ft": result.lowest_height_ft,
         "touchdown_past_threshold_ft": result.touchdown_x_m / 0.3048 if args.land else None,
         "touchdown_sink_fps": result.touchdown_sink_mps / 0.3048 if args.land else None,
+        "touchdown_right_of_centreline_ft": result.touchdown_y_m / 0.3048 if args.land else None,
+        "touchdown_drift_deg": math.degrees(result.touchdown_drift_rad) if args.land else None,
+        "touchdown_crab_deg": math.degrees(result.touchdown_crab_rad) if args.land else None,
         **stats,
     }
     (args.out / "flight.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
@@ -78,8 +82,8 @@ def run(args: argparse.Namespace) -> int:
         f"CAS {stats['cas_min_kt']:.1f}-{stats['cas_max_kt']:.1f} kt"
     )
     if args.land:
-        print(f"  touchdown {summary['touchdown_past_threshold_ft']:.0f} ft past the threshold, "
-              f"sink {summary['touchdown_sink_fps']:.1f} ft/s")
+        print(f"  touchdown (main gear) {summary['touchdown_past_threshold_ft']:.0f} ft past the threshold, "
+              f"sink {summary['touchdown_sink_fps']:.1f} ft/s, drift {summary['touchdown_drift_deg']:.1f} deg")
     extra = "" if args.no_figures else ", figures"
     print(f"  wrote {args.out / 'truth.npz'} (+ truth.json schema, flight.json{extra})")
     if not result.ok:

@@ -7,6 +7,7 @@ then $APPROACHSIM_AIRCRAFT_PATH, then the installed package's data. Errors name 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from dataclasses import dataclass
@@ -14,7 +15,7 @@ from pathlib import Path
 
 from approachsim import resources, units
 from approachsim.config import ProfileError, Section
-from approachsim.flight.design import AutopilotGains
+from approachsim.flight.design import LAWS, AutopilotGains
 from approachsim.flight.envelope import TURBULENCE_ORDER, ApproachLimits
 from approachsim.profile import Profile
 
@@ -56,6 +57,9 @@ def _gains(s: Section) -> AutopilotGains:
     def pos(key: str) -> float:
         return s.number(key, lo=0.0)
 
+    def pos_default(key: str) -> float:
+        return s.number(key, 0.0, lo=0.0)
+
     g = AutopilotGains(
         k_theta=pos("k_theta"),
         k_q=pos("k_q"),
@@ -75,11 +79,32 @@ def _gains(s: Section) -> AutopilotGains:
         bank_limit_rad=math.radians(s.number("bank_limit_deg", lo=0.0, hi=35.0, lo_open=True, unit="deg")),
         pitch_limit_rad=math.radians(s.number("pitch_limit_deg", lo=0.0, hi=20.0, lo_open=True, unit="deg")),
         flare_height_m=s.number("flare_height_ft", lo=10.0, hi=200.0, unit="ft") * units.FT,
-        flare_tau_s=s.number("flare_tau_s", lo=0.5, hi=20.0, unit="s"),
         touchdown_sink_mps=s.number("touchdown_sink_fps", lo=0.0, hi=10.0, unit="ft/s") * units.FPS,
         k_flare=pos("k_flare"),
         k_flare_i=pos("k_flare_i"),
         retard_height_m=s.number("retard_height_ft", lo=0.0, hi=200.0, unit="ft") * units.FT,
+        tecs=s.string("law", "classic", choices=LAWS) == "tecs",
+        tecs_t_h_s=s.number("tecs_t_h_s", 5.0, lo=0.0, hi=60.0, lo_open=True, unit="s"),
+        tecs_t_v_s=s.number("tecs_t_v_s", 5.0, lo=0.0, hi=60.0, lo_open=True, unit="s"),
+        tecs_thr_per_rad=s.number("tecs_thr_per_rad", 3.44, lo=0.0, hi=100.0, lo_open=True),
+        tecs_k_thr_damp=s.number("tecs_k_thr_damp", 0.05, lo=0.0),
+        tecs_k_thr_i=s.number("tecs_k_thr_i", 0.05, lo=0.0),
+        tecs_k_pitch_damp=s.number("tecs_k_pitch_damp", 0.1, lo=0.0),
+        tecs_k_pitch_i=s.number("tecs_k_pitch_i", 0.1, lo=0.0),
+        tecs_seb_ff=s.number("tecs_seb_ff", 1.0, lo=0.0),
+        tecs_spd_weight=s.number("tecs_spd_weight", 1.0, lo=0.0, hi=2.0),
+        tecs_rate_tau_s=s.number("tecs_rate_tau_s", 0.4, lo=0.0, hi=10.0, lo_open=True, unit="s"),
+        tecs_sink_max_mps=s.number("tecs_sink_max_fpm", 1000.0, lo=0.0, hi=3000.0, lo_open=True, unit="ft/min")
+        * units.FT / 60.0,
+        tecs_climb_max_mps=s.number("tecs_climb_max_fpm", 600.0, lo=0.0, hi=6000.0, lo_open=True, unit="ft/min")
+        * units.FT / 60.0,
+        tecs_vert_acc_mps2=s.number("tecs_vert_acc_mps2", 7.0, lo=0.0, hi=50.0, lo_open=True, unit="m/s^2"),
+        align_height_m=s.number("align_height_ft", 0.0, lo=0.0, hi=500.0, unit="ft") * units.FT,
+        align_tau_s=s.number("align_tau_s", 1.5, lo=0.0, hi=20.0, lo_open=True, unit="s"),
+        k_r_align=pos_default("k_r_align"),
+        k_beta_align=pos_default("k_beta_align"),
+        k_phi_align=pos_default("k_phi_align"),
+        k_da_align=pos_default("k_da_align"),
     )
     s.done()
     return g
@@ -159,7 +184,8 @@ def load_aircraft(profile: Profile) -> Aircraft:
         gear_down=choice.gear_down,
         engine_lag_s=ac.engine_lag_s,
         imu_location_struct_m=ac.imu_location_struct_m,
-        gains=ac.gains,
+        gains=ac.gains if choice.autopilot_law is None else dataclasses.replace(
+            ac.gains, tecs=choice.autopilot_law == "tecs"),
         source=ac.source,
         limits=ac.limits,
     )

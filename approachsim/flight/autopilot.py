@@ -1,23 +1,57 @@
-"""Approach autopilot: glideslope and localizer guidance, pitch and roll inner loops, autothrottle.
+"""Approach autopilot: glide path and localizer guidance, pitch and roll inner loops, speed; flare and decrab.
 
 Guidance flies on the navigation source's position (runway frame) and NED velocity; the inner loops use the
-aircraft's own attitude, body rates, sideslip and calibrated airspeed (AHRS and air data). The laws, whose
-linearization approachsim.flight.design checks loop at a time (gains from the aircraft file):
+aircraft's own attitude, body rates, sideslip and calibrated airspeed (AHRS and air data). The glide path is the
+straight ILS cone of approachsim.glidepath (d, d' its deviation and rate). Two laws for speed and path, chosen by
+the aircraft file's `law` (approachsim.flight.design checks either's linearization loop at a time):
 
-    d   = h - h_gp(x),  d' = -v_down + x' tan(gp)                  glidepath deviation (m, + above) and rate
-    theta_c = theta_0 - (k_gs_p d + k_gs_d d' + k_gs_i int d)      limited to theta_0 +- pitch_limit
-    de  = -k_theta (theta_c - theta) + k_q q                       elevator, added to the trimmed pitch trim
+Common to both:
+
     w   <- w + dt/tau_w (V_tas - |v_ground| - w)                   wind along the path (complementary filter)
     V   = V_cas (|v_ground| + w) / V_tas                           inertially smoothed CAS (= V_cas in still air)
-    e_f <- e_f + dt/tau_v (V_c - V - e_f)                          filtered speed error (turbulence)
-    thr = thr_0 + k_v_p e_f + k_v_i int e_f                        autothrottle (integral frozen at saturation)
-    y, y' = cross-track deviation (m, + right) and its rate
+    de  = -k_theta (theta_c - theta) + k_q q                       elevator, added to the trimmed pitch trim
     phi_c = -(k_loc_p y + k_loc_d y' + k_loc_i int y)              limited to +- bank_limit
     da  = k_phi (phi_c - phi) - k_p p                              aileron
     dr  = -k_beta beta                                             rudder (crab into the wind; FCS adds a yaw damper)
 
-Landing runs add a flare below flare_height (main-gear height h_g): theta_c = theta_entry + k_flare e +
-k_flare_i int e, e = -(h_g / tau_flare + sink_td) - h', and the throttle to idle below retard_height.
+law = "classic" (glidepath to pitch, speed to throttle, each loop alone):
+
+    theta_c = theta_0 - (k_gs_p d + k_gs_d d' + k_gs_i int d)      limited to theta_0 +- pitch_limit
+    e_f <- e_f + dt/tau_v (V_c - V - e_f)                          filtered speed error (turbulence)
+    thr = thr_0 + k_v_p e_f + k_v_i int e_f                        autothrottle (integral frozen at saturation)
+
+law = "tecs" (total energy control, Lambregts 1983; the structure and default gains of PX4's TECS by
+P. Riseborough, normalised by g V so that every energy rate is a flight-path angle, rad):
+
+    V' = (V - V_l) / tau_r,  V_l <- V_l + dt V'                    acceleration of the smoothed speed (washout)
+    h'_c = clip(h'_gp - d / T_h, -sink_max, climb_max)             height-rate setpoint, h'_gp = h' - d'
+    V'_c = clip((V_c - V) / T_V, +- 0.5 / K_thr)                   acceleration setpoint
+    e_h = (h'_c - h') / V,  e_v = (V'_c - V') / g                  path and speed errors as angles
+    E_T = e_h + e_v,  E_B = w_p e_h - w_k e_v                      total-energy and energy-balance rate errors
+    T_sp = (h'_c - h'_gp) / V + V'_c / g,  B_sp = w_p (h'_c - h'_gp) / V - w_k V'_c / g   setpoints (feed-forward)
+    thr = thr_0 + K_thr (T_sp + k_td E_T + k_ti int E_T)           thrust from the total energy rate
+    theta_c = theta_0 + k_bff B_sp + k_pd E_B + k_pi int E_B       pitch from the energy distribution, limited to
+                                                                   theta_0 +- pitch_limit and to a change of
+                                                                   dt a_vert / V per step (integrals frozen there)
+
+K_thr (throttle per rad of energy-rate) is g / (dV'/d thr) of the aircraft's linearization: PX4 scales its
+throttle terms by the throttle range over the total-energy-rate range, which is the same number when thrust is
+linear in throttle; the other gains are PX4's defaults (aircraft file). w_k = clip(spd_weight, 0, 1),
+w_p = clip(2 - spd_weight, 0, 1).
+
+Landing runs (h_gear: main-gear height above the terrain, the radio altitude) add:
+
+* an exponential flare from flare_height (Stevens & Lewis style, approachsim's reference notes sec. 5): the sink-rate
+  command h'_c = -(h_gear - h_off) / tau with tau and h_off set at flare entry from the sink rate h'_0 there, so that
+  the command starts at the aircraft's sink rate (continuity: h_f - h_off = tau h'_0) and ends at the touchdown
+  sink (h_off = -tau sink_td):  tau = h_f / (h'_0 - sink_td);  theta_c = theta_entry + k_flare e + k_flare_i int e,
+  e = h'_c - h' (> 0: sinking too fast); the throttle to idle below retard_height.
+* a decrab (runway alignment) below align_height: the rudder turns the heading onto the runway's and holds the
+  sideslip that the crosswind then needs (the 737 FCTM's sideslip technique: "prior to the flare the airplane
+  centerline is aligned on or parallel to the runway centerline", upwind wing low; the localizer loop banks into
+  the wind): r_c = -crab / tau_align,  dr = k_r_align (r - r_c) + k_beta_align beta, crab = psi - runway heading.
+  k_beta_align = -N_beta / N_dr holds the sideslip (yaw moment balance), k_r_align = (1/tau_r + N_r) / -N_dr puts the
+  yaw-rate loop's pole at -1/tau_r, tau_r = tau_align / 3 (linearization derivatives; the aircraft file has them).
 
 Sign conventions of the 737 FCS: + elevator = nose down, + aileron = roll right, + rudder = nose left.
 This class is the readable oracle; the flight loop runs its compiled twin (flight/kernels.py autopilot_step, equal
@@ -31,6 +65,8 @@ from dataclasses import dataclass
 
 from approachsim.flight.design import AutopilotGains
 from approachsim.geo import radii
+from approachsim.glidepath import GlidePath, deviation_and_rate
+from approachsim.units import G0
 
 
 @dataclass(frozen=True)
@@ -63,10 +99,15 @@ class Autopilot:
         self.g = gains
         self.trim = trim
         self.dt = dt_s
+        self.heading_rad = geometry.heading_rad
         self.ch = math.cos(geometry.heading_rad)
         self.sh = math.sin(geometry.heading_rad)
         self.tan_gp = math.tan(geometry.glidepath_rad)
         self.tch_m = geometry.tch_m
+        self.cone = GlidePath(geometry.glidepath_rad, geometry.tch_m, geometry.heading_rad,
+                              geometry.threshold_lat_rad)
+        """The straight glide path cone guidance flies (approachsim.glidepath)."""
+        _, self.x_gpi_m, self.cone_a, self.cone_b, self.cone_c = self.cone.constants()
         lat0 = geometry.threshold_lat_rad
         r_e = float(radii(lat0)[1])
         self.conv_per_east_m = math.sin(lat0) / (r_e * math.cos(lat0))
@@ -80,29 +121,37 @@ class Autopilot:
         self._theta_flare0 = 0.0
         self._int_flare = 0.0
         self._theta_c = trim.theta_rad
+        self._v_lag = math.nan  # TECS: washout state of the smoothed speed, m/s
+        self.int_t = 0.0  # TECS: integral of the total-energy rate error, rad s
+        self.int_b = 0.0  # TECS: integral of the energy-balance rate error, rad s
+        self._flare_tau = 0.0
+        self._flare_h_off = 0.0
+        self.aligning = False
 
     def deviations(self, x: float, y: float, z: float, vn: float, ve: float, vd: float) -> tuple[float, ...]:
-        """Glidepath deviation d (m, + above), its rate (m/s), cross-track y (m, + right) and its rate (m/s)."""
+        """Glidepath deviation d (m, + above the cone), its rate (m/s), cross-track y (m, + right) and its rate
+        (m/s)."""
         ch, sh = self.ch, self.sh
         conv = (x * sh + y * ch) * self.conv_per_east_m  # runway heading in the local NED minus at the threshold
         x0 = vn * ch + ve * sh
         y0 = -vn * sh + ve * ch
         x_dot = x0 + conv * y0  # small-angle rotation by the convergence (|conv| < 0.01 rad)
         y_dot = y0 - conv * x0
-        d = z - (self.tch_m - x * self.tan_gp)
-        d_dot = -vd + x_dot * self.tan_gp
+        d, d_dot = deviation_and_rate(x, y, z, x_dot, y_dot, -vd, self.tan_gp, self.x_gpi_m, self.cone_a, self.cone_b,
+                                   self.cone_c)
         return d, d_dot, y, y_dot
 
     def step(
         self,
         x: float, y: float, z: float, vn: float, ve: float, vd: float,
         phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float | None = None,
-        tas: float | None = None,
+        tas: float | None = None, psi: float | None = None, r: float = 0.0,
     ) -> tuple[float, float, float, float]:
         """One control step: guidance position (runway frame, m) and NED velocity (m/s), attitude (rad),
         body rates (rad/s), sideslip (rad), calibrated airspeed (m/s) -> elevator, aileron, rudder, throttle.
         h_gear: main-gear height above the terrain (m) on landing runs (the radio altitude; None: no flare).
-        tas: true airspeed (m/s) for the speed complement (None: the autothrottle holds the raw CAS)."""
+        tas: true airspeed (m/s) for the speed complement (None: the autothrottle holds the raw CAS).
+        psi, r: true heading (rad) and yaw rate (rad/s) for the decrab (psi None: no decrab)."""
         g = self.g
         dt = self.dt
         if tas is not None and tas > 1.0:  # inertially smoothed speed (module docstring)
@@ -116,32 +165,32 @@ class Autopilot:
         conv = (x * sh + y * ch) * self.conv_per_east_m
         x0 = vn * ch + ve * sh
         y0 = -vn * sh + ve * ch
-        d = z - (self.tch_m - x * self.tan_gp)
-        d_dot = -vd + (x0 + conv * y0) * self.tan_gp
         y_dot = y0 - conv * x0
-        # glidepath -> pitch command (integral frozen while the command is limited)
-        th_off = -(g.k_gs_p * d + g.k_gs_d * d_dot + g.k_gs_i * self.int_d)
+        d, d_dot = deviation_and_rate(x, y, z, x0 + conv * y0, y_dot, -vd, self.tan_gp, self.x_gpi_m, self.cone_a,
+                                   self.cone_b, self.cone_c)
         lim = g.pitch_limit_rad
-        if -lim < th_off < lim:
-            self.int_d += d * dt
+        if g.tecs:
+            theta_c, thr = self._tecs(d, d_dot, -vd, cas)
         else:
-            th_off = lim if th_off > 0.0 else -lim
-        theta_c = self.trim.theta_rad + th_off
+            # glidepath -> pitch command (integral frozen while the command is limited)
+            th_off = -(g.k_gs_p * d + g.k_gs_d * d_dot + g.k_gs_i * self.int_d)
+            if -lim < th_off < lim:
+                self.int_d += d * dt
+            else:
+                th_off = lim if th_off > 0.0 else -lim
+            theta_c = self.trim.theta_rad + th_off
+            # autothrottle on the filtered speed error
+            self.e_f += dt / g.tau_v_s * (self.trim.cas_mps - cas - self.e_f)
+            thr = self.trim.throttle + g.k_v_p * self.e_f + g.k_v_i * self.int_e
+            if 0.0 < thr < 1.0:
+                self.int_e += self.e_f * dt
+            else:
+                thr = 1.0 if thr >= 1.0 else 0.0
         if h_gear is not None and (self.flaring or h_gear <= g.flare_height_m):
-            theta_c, thr_flare = self._flare(h_gear, -vd, theta_c)
-        else:
-            thr_flare = None
+            theta_c, thr_flare = self._flare(h_gear, -vd)
+            thr = min(thr, thr_flare)
         self._theta_c = theta_c
         de = -g.k_theta * (theta_c - theta) + g.k_q * q
-        # autothrottle on the filtered speed error
-        self.e_f += dt / g.tau_v_s * (self.trim.cas_mps - cas - self.e_f)
-        thr = self.trim.throttle + g.k_v_p * self.e_f + g.k_v_i * self.int_e
-        if 0.0 < thr < 1.0:
-            self.int_e += self.e_f * dt
-        else:
-            thr = 1.0 if thr >= 1.0 else 0.0
-        if thr_flare is not None:
-            thr = min(thr, thr_flare)
         # localizer -> bank command
         phi_c = -(g.k_loc_p * y + g.k_loc_d * y_dot + g.k_loc_i * self.int_y)
         blim = g.bank_limit_rad
@@ -149,28 +198,85 @@ class Autopilot:
             self.int_y += y * dt
         else:
             phi_c = blim if phi_c > 0.0 else -blim
-        da = g.k_phi * (phi_c - phi) - g.k_p * p
-        dr = -g.k_beta * beta
+        if h_gear is not None and psi is not None and (self.aligning or h_gear <= g.align_height_m):
+            self.aligning = True
+            crab = _wrap(psi - (self.heading_rad + conv))
+            dr = g.k_r_align * (r + crab / g.align_tau_s) + g.k_beta_align * beta
+            da = g.k_phi * (phi_c + g.k_phi_align * beta - phi) - g.k_p * p + g.k_da_align * beta
+        else:
+            dr = -g.k_beta * beta
+            da = g.k_phi * (phi_c - phi) - g.k_p * p
         return _clip1(de), _clip1(da), _clip1(dr), thr
+
+    def _tecs(self, d: float, d_dot: float, h_dot: float, v: float) -> tuple[float, float]:
+        """Total energy control (module docstring): pitch command and throttle from the glide path deviation d
+        (m) and its rate (m/s), the height rate h' (m/s) and the smoothed speed v (m/s)."""
+        g = self.g
+        dt = self.dt
+        if self._v_lag != self._v_lag:
+            self._v_lag = v
+        v_dot = (v - self._v_lag) / g.tecs_rate_tau_s
+        self._v_lag += dt * v_dot
+        v0 = max(v, 1.0)
+        hd_gp = h_dot - d_dot
+        hd_c = min(max(hd_gp - d / g.tecs_t_h_s, -g.tecs_sink_max_mps), g.tecs_climb_max_mps)
+        a_lim = 0.5 * G0 / g.tecs_thr_per_rad
+        vd_c = min(max((self.trim.cas_mps - v) / g.tecs_t_v_s, -a_lim), a_lim)
+        wk = min(max(g.tecs_spd_weight, 0.0), 1.0)
+        wp = min(max(2.0 - g.tecs_spd_weight, 0.0), 1.0)
+        e_h = (hd_c - h_dot) / v0
+        e_v = (vd_c - v_dot) / G0
+        e_t = e_h + e_v
+        e_b = wp * e_h - wk * e_v
+        sp_h = (hd_c - hd_gp) / v0
+        t_sp = sp_h + vd_c / G0
+        b_sp = wp * sp_h - wk * vd_c / G0
+        thr = self.trim.throttle + g.tecs_thr_per_rad * (t_sp + g.tecs_k_thr_damp * e_t + g.tecs_k_thr_i * self.int_t)
+        if 0.0 < thr < 1.0:
+            self.int_t += e_t * dt
+        else:
+            thr = 1.0 if thr >= 1.0 else 0.0
+        th_off = g.tecs_seb_ff * b_sp + g.tecs_k_pitch_damp * e_b + g.tecs_k_pitch_i * self.int_b
+        lim = g.pitch_limit_rad
+        step_max = dt * g.tecs_vert_acc_mps2 / v0
+        prev = self._theta_c - self.trim.theta_rad
+        lo, hi = max(-lim, prev - step_max), min(lim, prev + step_max)
+        if lo < th_off < hi:
+            self.int_b += e_b * dt
+        else:
+            th_off = hi if th_off >= hi else lo
+        return self.trim.theta_rad + th_off, thr
 
     def state(self) -> tuple[float, ...]:
         """The integrators and filters (int d, int y, e_f, wind along the path, int e_f, flaring, flare-entry pitch
-        command, flare integral, last pitch command): the compiled autopilot's APS_* state vector."""
+        command, flare integral, last pitch command, TECS speed washout, int E_T, int E_B, flare tau, flare h_off,
+        aligning): the compiled autopilot's APS_* state vector."""
         return (self.int_d, self.int_y, self.e_f, self._w, self.int_e, float(self.flaring), self._theta_flare0,
-                self._int_flare, self._theta_c)
+                self._int_flare, self._theta_c, self._v_lag, self.int_t, self.int_b, self._flare_tau,
+                self._flare_h_off, float(self.aligning))
 
-    def _flare(self, h_gear: float, h_dot: float, theta_c_path: float) -> tuple[float, float]:
-        """Flare: pitch command from the sink-rate error to h'_c = -(h_gear / tau + sink_td), starting from
-        the pitch command at flare entry; throttle limit (1 above the retard height, then idle)."""
+    def _flare(self, h_gear: float, h_dot: float) -> tuple[float, float]:
+        """Exponential flare (module docstring): pitch command from the sink-rate error to
+        h'_c = -(h_gear - h_off) / tau, tau and h_off from the sink rate at entry; throttle limit (1 above the
+        retard height, then idle)."""
         g = self.g
         if not self.flaring:
             self.flaring = True
             self._theta_flare0 = self._theta_c
-        e = -(max(h_gear, 0.0) / g.flare_tau_s + g.touchdown_sink_mps) - h_dot  # > 0: sinking too fast
+            sink0 = max(-h_dot, g.touchdown_sink_mps + 0.1)  # an entry sink below the touchdown sink: 0.1 m/s above
+            self._flare_tau = max(h_gear, 0.0) / (sink0 - g.touchdown_sink_mps) if h_gear > 0.0 else 1.0
+            self._flare_h_off = -self._flare_tau * g.touchdown_sink_mps
+        e = -(max(h_gear, 0.0) - self._flare_h_off) / self._flare_tau - h_dot  # > 0: sinking too fast
         self._int_flare += e * self.dt
         theta_c = self._theta_flare0 + g.k_flare * e + g.k_flare_i * self._int_flare
         thr_limit = 1.0 if h_gear > g.retard_height_m else 0.0
         return theta_c, thr_limit
+
+
+def _wrap(a: float) -> float:
+    """a wrapped to [-pi, pi) (written as the compiled twin computes it)."""
+    a = a + math.pi
+    return a - 2.0 * math.pi * math.floor(a / (2.0 * math.pi)) - math.pi
 
 
 def _clip1(u: float) -> float:

@@ -8,7 +8,7 @@ integral, the filtered airspeed perturbation and its integral, and a first-order
 throttle command and the thrust the linearization sees (the linearization has no engine state; the lag is the
 aircraft file's `engine_lag_s`, measured from a throttle step).
 
-The control laws are the same as autopilot.py's, linearized (no limits):
+The control laws are the same as autopilot.py's, linearized (no limits); the classic law:
 
     theta_c = theta_0 - (k_gs_p d + k_gs_d d' + k_gs_i int d)              glidepath  -> pitch command
     de      = -k_theta (theta_c - theta) + k_q q                           pitch      -> elevator (+ = nose down)
@@ -16,6 +16,9 @@ The control laws are the same as autopilot.py's, linearized (no limits):
     phi_c   = -(k_loc_p y + k_loc_d y' + k_loc_i int y)                    localizer  -> bank command
     da      = k_phi (phi_c - phi) - k_p p                                  roll       -> aileron (+ = roll right)
     dr      = -k_beta beta                                                 sideslip   -> rudder (+ = nose left)
+
+or, with gains.tecs, the total energy control law of autopilot.py (thrust from the total-energy rate error,
+pitch from the energy-distribution rate error, the speed derivative by a washout), in the same states.
 
 Each loop is broken at one point with every other loop closed (the classical loop-at-a-time check):
 "elevator", "throttle", "aileron", "rudder" at the actuator commands, "glidepath" at theta_c and "localizer"
@@ -34,6 +37,9 @@ import numpy as np
 from approachsim import units
 
 Array = np.ndarray
+
+LAWS = ("classic", "tecs")
+"""The speed and path laws the autopilot can fly (aircraft file `[autopilot] law`, profile `aircraft.autopilot_law`)."""
 
 LOOPS = ("elevator", "throttle", "aileron", "rudder", "glidepath", "localizer")
 """The break points of the loop-at-a-time margin check."""
@@ -85,8 +91,6 @@ class AutopilotGains:
     (inertially smoothed speed, as transport autothrottles use). In still air it equals the airspeed."""
     flare_height_m: float = 50.0 * units.FT
     """Main-gear height above the terrain where the flare starts (landing runs only), m."""
-    flare_tau_s: float = 5.0
-    """Flare time constant: sink-rate command h' = -(h_gear / tau + touchdown sink), s."""
     touchdown_sink_mps: float = 2.0 * units.FPS
     """Sink rate the flare aims to touch down with, m/s."""
     k_flare: float = 0.05
@@ -95,6 +99,46 @@ class AutopilotGains:
     """Pitch command per integrated sink-rate error in the flare, rad/m."""
     retard_height_m: float = 25.0 * units.FT
     """Main-gear height where the throttle goes to idle in the flare, m."""
+    tecs: bool = False
+    """Speed and path law: True the total energy control law (TECS), False the classic one (autopilot.py)."""
+    tecs_t_h_s: float = 5.0
+    """TECS height time constant T_h: height-rate setpoint h'_gp - d / T_h, s (PX4 FW_T_ALT_TC)."""
+    tecs_t_v_s: float = 5.0
+    """TECS speed time constant T_V: acceleration setpoint (V_c - V) / T_V, s (PX4 FW_T_TAS_TC)."""
+    tecs_thr_per_rad: float = 3.44
+    """TECS K_thr: throttle per rad of total-energy rate (g / (dV'/d throttle) of the linearization)."""
+    tecs_k_thr_damp: float = 0.05
+    """TECS throttle damping on the total-energy rate error, in units of K_thr (PX4 FW_T_THR_DAMPING)."""
+    tecs_k_thr_i: float = 0.05
+    """TECS throttle integral of the total-energy rate error, 1/s in units of K_thr (PX4 FW_T_I_GAIN_THR)."""
+    tecs_k_pitch_damp: float = 0.1
+    """TECS pitch damping: rad of pitch per rad of energy-balance rate error (PX4 FW_T_PTCH_DAMP)."""
+    tecs_k_pitch_i: float = 0.1
+    """TECS pitch integral of the energy-balance rate error, 1/s (PX4 FW_T_I_GAIN_PIT)."""
+    tecs_seb_ff: float = 1.0
+    """TECS pitch feed-forward of the energy-balance rate setpoint (PX4 FW_T_SEB_R_FF)."""
+    tecs_spd_weight: float = 1.0
+    """TECS speed weighting: 1 balances height and speed (PX4 FW_T_SPDWEIGHT)."""
+    tecs_rate_tau_s: float = 0.4
+    """TECS washout time constant of the speed derivative, s (PX4 FW_T_STE_R_TC)."""
+    tecs_sink_max_mps: float = 1000.0 * units.FT / 60.0
+    """TECS height-rate setpoint floor (maximum sink), m/s."""
+    tecs_climb_max_mps: float = 3.0
+    """TECS height-rate setpoint ceiling (maximum climb), m/s (PX4 FW_T_CLMB_R_SP)."""
+    tecs_vert_acc_mps2: float = 7.0
+    """TECS pitch-command rate limit as a vertical acceleration: dt a / V per step, m/s^2 (PX4 FW_T_VERT_ACC)."""
+    align_height_m: float = 0.0
+    """Main-gear height below which the decrab aligns the heading with the runway (landing runs), m; 0: none."""
+    align_tau_s: float = 1.5
+    """Decrab time constant: yaw-rate command -crab / tau, s."""
+    k_r_align: float = 0.0
+    """Decrab rudder per yaw-rate error, s/rad."""
+    k_beta_align: float = 0.0
+    """Decrab rudder per sideslip (the rudder that holds it), 1/rad."""
+    k_phi_align: float = 0.0
+    """Decrab bank command per sideslip (the bank whose side force balances it), rad/rad."""
+    k_da_align: float = 0.0
+    """Decrab aileron per sideslip (the aileron that holds the dihedral roll moment), 1/rad."""
 
 
 @dataclass(frozen=True)
@@ -163,9 +207,36 @@ def closed_loop(lin: Linearization, g: AutopilotGains, glidepath_rad: float, eng
     y_dot[ix[_BETA]] = v0
 
     theta_c = row()  # perturbation of the pitch command
-    theta_c[iD] = -g.k_gs_p
-    theta_c -= g.k_gs_d * d_dot
-    theta_c[iZD] = -g.k_gs_i
+    thr = row()
+    if g.tecs:
+        # TECS (autopilot.py), linearized without its limits. States reused: iZD int E_B, iVF the speed washout
+        # V_l, iZV int E_T. V' = (Vt - V_l) / tau_r; h' = the altitude row; h'_gp = h' - d'.
+        g0 = units.G0
+        v_dot = row()
+        v_dot[ix[_VT]] = 1.0 / g.tecs_rate_tau_s
+        v_dot[iVF] = -1.0 / g.tecs_rate_tau_s
+        vd_c = row()
+        vd_c[ix[_VT]] = -1.0 / g.tecs_t_v_s
+        sp_h = row()  # (h'_c - h'_gp) / V = -d / (T_h V)
+        sp_h[iD] = -1.0 / (g.tecs_t_h_s * v0)
+        e_h = sp_h - d_dot / v0  # (h'_c - h') / V
+        e_v = (vd_c - v_dot) / g0
+        wk = min(max(g.tecs_spd_weight, 0.0), 1.0)
+        wp = min(max(2.0 - g.tecs_spd_weight, 0.0), 1.0)
+        e_t = e_h + e_v
+        e_b = wp * e_h - wk * e_v
+        t_sp = sp_h + vd_c / g0
+        b_sp = wp * sp_h - wk * vd_c / g0
+        theta_c = g.tecs_seb_ff * b_sp + g.tecs_k_pitch_damp * e_b
+        theta_c[iZD] += g.tecs_k_pitch_i
+        thr = g.tecs_thr_per_rad * (t_sp + g.tecs_k_thr_damp * e_t)
+        thr[iZV] += g.tecs_thr_per_rad * g.tecs_k_thr_i
+    else:
+        theta_c[iD] = -g.k_gs_p
+        theta_c -= g.k_gs_d * d_dot
+        theta_c[iZD] = -g.k_gs_i
+        thr[iVF] = -g.k_v_p  # e_f = -v_f (speed error = command - speed)
+        thr[iZV] = g.k_v_i
     phi_c = row()
     phi_c[iY] = -g.k_loc_p
     phi_c -= g.k_loc_d * y_dot
@@ -185,9 +256,6 @@ def closed_loop(lin: Linearization, g: AutopilotGains, glidepath_rad: float, eng
     da[ix[_P]] -= g.k_p
     dr = row()
     dr[ix[_BETA]] = -g.k_beta
-    thr = row()
-    thr[iVF] = -g.k_v_p  # e_f = -v_f (speed error = command - speed)
-    thr[iZV] = g.k_v_i
 
     ctrl = {"elevator": de, "throttle": thr, "aileron": da, "rudder": dr}
     A = np.zeros((n, n))
@@ -206,12 +274,17 @@ def closed_loop(lin: Linearization, g: AutopilotGains, glidepath_rad: float, eng
     if w_phi:
         Bw[:n_r, 0] += b_da * g.k_phi
     A[iD, :] = d_dot
-    A[iZD, iD] = 1.0
     A[iY, :] = y_dot
     A[iZY, iY] = 1.0
-    A[iVF, ix[_VT]] = 1.0 / g.tau_v_s
-    A[iVF, iVF] = -1.0 / g.tau_v_s
-    A[iZV, iVF] = -1.0
+    if g.tecs:
+        A[iZD, :] = e_b
+        A[iVF, :] = v_dot
+        A[iZV, :] = e_t
+    else:
+        A[iZD, iD] = 1.0
+        A[iVF, ix[_VT]] = 1.0 / g.tau_v_s
+        A[iVF, iVF] = -1.0 / g.tau_v_s
+        A[iZV, iVF] = -1.0
     A[iENG, iENG] = -1.0 / engine_lag_s
     if break_at == "throttle":
         Bw[iENG, 0] = 1.0 / engine_lag_s

@@ -4,7 +4,7 @@ stabilized-approach criterion (checked every step below the stabilization height
 Limits come from the aircraft file's [envelope] table (aircraft/737.toml says where each figure comes from);
 a profile outside them is refused with one line naming the field and the limit (ProfileError, exit 2):
 
-    environment.wind_speed_kt: tailwind component 15 kt exceeds the 737's 10 kt limit
+    environment.wind_speed_kt: tailwind component 20 kt exceeds the 737's 15 kt limit
 
 Wind components are taken against the runway heading: headwind = W cos(from - heading), crosswind =
 W |sin(from - heading)|. The descent the glidepath needs must also be a stabilized one: FSF's 1000 ft/min
@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 from approachsim import units
 from approachsim.config import ProfileError
+from approachsim.glidepath import deviation_and_rate
 
 GS_DOT_PER_GLIDEPATH = 0.12
 """ILS glide path: 1 dot (0.0875 DDM, half of full scale) is 0.12 x the glidepath angle (ICAO Annex 10 Vol I
@@ -163,8 +164,11 @@ class StabilityMonitor:
     deviation 1.3 dots". Re-create per run. The readable oracle of the compiled monitor (flight/kernels.py
     monitor_step); check() is its step with the result as (MON_* code, figures)."""
 
-    def __init__(self, glidepath_rad: float, tch_m: float, target_cas_mps: float, dt_s: float) -> None:
+    def __init__(self, glidepath_rad: float, tch_m: float, target_cas_mps: float, dt_s: float,
+                 curvature: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None:
         self.tan_gp = math.tan(glidepath_rad)
+        self.curvature = curvature
+        """The glide path cone's Earth-curvature coefficients (glidepath.GlidePath.curvature; zeros: flat Earth)."""
         self.gs_dot_rad = GS_DOT_PER_GLIDEPATH * glidepath_rad
         self.x_gp_m = tch_m / self.tan_gp  # glide-path origin past the threshold (runway frame x)
         self.x_floor_m = self.x_gp_m - GS_DOT_FLOOR_HEIGHT_M / self.tan_gp
@@ -187,7 +191,7 @@ class StabilityMonitor:
 
     def dots(self, x_m: float, y_m: float, z_m: float) -> tuple[float, float]:
         """Glidepath and localizer deviation in dots (+ above / + right) at runway-frame position (m)."""
-        d = z_m - (self.tch_m - x_m * self.tan_gp)
+        d = deviation_and_rate(x_m, y_m, z_m, 0.0, 0.0, 0.0, self.tan_gp, self.x_gp_m, *self.curvature)[0]
         r_gp = max(self.x_gp_m - min(x_m, self.x_floor_m), 1.0)
         gs_dots = d / (r_gp * math.tan(self.gs_dot_rad))
         r_loc = LOC_ANTENNA_PAST_THRESHOLD_M - x_m

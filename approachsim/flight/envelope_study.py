@@ -3,7 +3,7 @@ elevation, glidepath) and the flight technical error of each combination.
 
 Used by the envelope acceptance test (tests/integration/test_flight_envelope.py) and by
 tools/envelope_table.py, which writes docs/envelope.md and its figure. The design is fixed, not drawn: 28
-cases, the 7 wind cases (headwind 0/10/20/25 kt, crosswind 15/25 kt from the left/right, tailwind 10 kt) x
+cases, the 7 wind cases (headwind 0/10/20/25 kt, crosswind 15/25 kt from the left/right, tailwind 15 kt) x
 the 2 turbulence levels, twice, with ISA deviation, field elevation and glidepath cycling through their
 levels so that every level of every factor appears; a case whose planned sink rate exceeds the
 stabilized-approach limit (flight.envelope) takes the next shallower glidepath and says so.
@@ -34,7 +34,7 @@ WIND_CASES = (
     ("headwind 25 kt", 25.0, 0.0),
     ("crosswind 15 kt", 15.0, -90.0),
     ("crosswind 25 kt", 25.0, 90.0),
-    ("tailwind 10 kt", 10.0, 180.0),
+    ("tailwind 15 kt", 15.0, 180.0),
 )
 """(label, speed kt, wind direction relative to the runway heading, deg: 0 head, 180 tail, -90 from the left)."""
 TURBULENCE = ("light", "moderate")
@@ -114,7 +114,7 @@ def measure(approach: Approach, seed: int, run: int = 0) -> dict:
     out = {"termination": res.termination, "ok": res.ok}
     if not np.any(sel):
         return out
-    d = z - rw.glidepath_height_m(x)  # true glidepath deviation from the runway geometry
+    d = tr.gs_dev_m  # true glidepath deviation from the straight cone (approachsim.glidepath)
     target = approach.aircraft.approach_speed_mps
     cas_err = tr.airspeed_mps[sel] - target
     # speed through the mean air mass (ground velocity - steady wind) as EAS (= CAS within 0.3 kt at M 0.25),
@@ -128,7 +128,10 @@ def measure(approach: Approach, seed: int, run: int = 0) -> dict:
     mean3 = np.convolve(eas, np.ones(n) / n, mode="full")[: eas.size]
     mean3[: n - 1] = np.nan
     air_err = mean3[sel] - target
-    slope = np.polyfit(x[sel], z[sel], 1)[0]  # dz/dx = -tan(flight-path angle)
+    _, x_gpi, ca, cb, cc = rw.glidepath.constants()
+    dx = x - x_gpi
+    z_plane = z - (ca * dx * dx + cb * dx * y + cc * y * y)  # height above the GPI's horizontal plane
+    slope = np.polyfit(x[sel], z_plane[sel], 1)[0]  # dz/dx = -tan(flight-path angle)
     out.update(
         vertical_rms_ft=float(np.sqrt(np.mean(d[sel] ** 2)) / units.FT),
         lateral_rms_ft=float(np.sqrt(np.mean(y[sel] ** 2)) / units.FT),

@@ -54,6 +54,7 @@ from approachsim.flight.envelope import (
     WATCH_HEIGHT_M,
 )
 from approachsim.flight.turbulence import COEFF_EVERY, POE_ALT_FT, POE_SIGMA_FPS
+from approachsim.glidepath import GlidePath, cone_height
 from approachsim.nav.kernels import geodesy as gk
 from approachsim.nav.kernels import inloop as nav
 
@@ -77,30 +78,53 @@ R_AIR = 287.05287
 
 _FT, _FPS, _KT, _PSF = units.FT, units.FPS, units.KT, units.PSF
 _LBF_PER_SLUG = units.LBF / units.SLUG
+_G0 = units.G0
 _G0_OVER_R = units.G0 / R_AIR
 _GM = geo.GM_JSBSIM
 _OMEGA = geo.OMEGA_JSBSIM
 _RANKINE = 1.8
 _TWO_PI = 2.0 * math.pi
 
-N_CONST = 18
+N_CONST = 22
 
 # positions in RAW_FIELDS of the reads the loop uses besides the truth row
 _R_H_FT, _R_VN, _R_PHI, _R_VC, _R_BETA, _R_VT = 2, 3, 6, 21, 22, 23
 
 
 def imu_point_constants(lever_arm_m: Array, lat0_rad: float, runway: Any, dt_s: float) -> Array:
-    """The kernel's constants (18,): lever arm l (body axes, m; CG to IMU), the radii R_N, R_E (m) at lat0_rad
+    """The kernel's constants (22,): lever arm l (body axes, m; CG to IMU), the radii R_N, R_E (m) at lat0_rad
     (held over the approach, as flight/run.py does), the runway frame's ECEF origin (m) and the first two rows
-    of its ECEF-to-runway matrix, threshold height (m), tan(glidepath), TCH (m) and the step dt_s (s).
+    of its ECEF-to-runway matrix, threshold height (m), tan(glidepath), TCH (m), the glide path cone's GPI (m)
+    and curvature coefficients a, b, c (1/m; approachsim.glidepath.GlidePath.constants) and the step dt_s (s).
 
-    runway: the profile's runway (profile.Runway: .frame, .elevation_m, .glidepath_rad, .tch_m)."""
+    runway: the profile's runway (profile.Runway: .frame, .elevation_m, .glidepath_rad, .tch_m, .heading_rad,
+    .threshold_lat_rad)."""
     r_n, r_e = geo.radii(lat0_rad)
     frame = runway.frame
     c = frame.c_ecef_to_rwy
+    _, x_gpi, ca, cb, cc = GlidePath.of(runway).constants()
     return np.array([*np.asarray(lever_arm_m, dtype=float), float(r_n), float(r_e), *frame.origin_ecef,
-                     *c[0], *c[1], runway.elevation_m, math.tan(runway.glidepath_rad), runway.tch_m, dt_s],
-                    dtype=float)
+                     *c[0], *c[1], runway.elevation_m, math.tan(runway.glidepath_rad), runway.tch_m,
+                     x_gpi, ca, cb, cc, dt_s], dtype=float)
+
+
+@njit(cache=True)
+def cone_deviation(x: float, y: float, z: float, x_dot: float, y_dot: float, z_dot: float, tan_gp: float,
+                   x_gpi: float, a: float, b: float, c: float) -> tuple[float, float]:
+    """Glidepath deviation from the straight cone (m, + above) and its rate (m/s) of a runway-frame point (x, y,
+    z) moving at (x', y', z'): approachsim.glidepath's z - z_cone(x, y), z_cone = tan(gp) r + a dx^2 + b dx y +
+    c y^2, dx = x - x_gpi, r = sqrt(dx^2 + y^2) before the GPI (-r past it); its oracle is
+    glidepath.GlidePath.deviation_m (tests/unit/flight/test_flight_kernels.py)."""
+    dx = x - x_gpi
+    r = math.sqrt(dx * dx + y * y)
+    s = 1.0 if dx <= 0.0 else -1.0
+    d = z - (s * tan_gp * r + a * dx * dx + b * dx * y + c * y * y)
+    if r > 0.0:
+        drx, dry = s * tan_gp * dx / r, s * tan_gp * y / r
+    else:
+        drx, dry = -tan_gp, 0.0
+    d_dot = z_dot - (drx + 2.0 * a * dx + b * y) * x_dot - (dry + b * dx + 2.0 * c * y) * y_dot
+    return d, d_dot
 
 
 @njit(cache=True)
@@ -113,8 +137,8 @@ def imu_point_row(raw: Array, const: Array, along_m: Array, height_m: Array, t_s
 
 @njit(cache=True)
 def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: float,
-               out: Array) -> tuple[float, float, float]:
-    """imu_point_row, returning (terrain height (m), the CG's Earth-relative body rates p, q (rad/s))."""
+               out: Array) -> tuple[float, float, float, float]:
+    """imu_point_row, returning (terrain height (m), the CG's Earth-relative body rates p, q, r (rad/s))."""
     lat, lon, h_ft = raw[0], raw[1], raw[2]
     vn_f, ve_f, vd_f = raw[3], raw[4], raw[5]
     phi, th, psi = raw[6], raw[7], raw[8]
@@ -125,7 +149,7 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     lx, ly, lz, r_n, r_e = const[0], const[1], const[2], const[3], const[4]
     ox, oy, oz = const[5], const[6], const[7]
     c00, c01, c02, c10, c11, c12 = const[8], const[9], const[10], const[11], const[12], const[13]
-    h_thr, tan_gp, tch, dt = const[14], const[15], const[16], const[17]
+    h_thr, tan_gp, dt = const[14], const[15], const[21]
     hdt = 0.5 * dt
     h = h_ft * _FT
     # body -> NED direction cosines from the Euler angles
@@ -212,9 +236,10 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     out[20], out[21], out[22] = fbx, fby, fbz
     out[23], out[24], out[25] = p_imu, t_r / _RANKINE, h_i - terr
     out[26], out[27], out[28] = xr, yr, zr
-    out[29], out[30] = zr - (tch - xr * tan_gp), yr
+    out[29] = cone_deviation(xr, yr, zr, 0.0, 0.0, 0.0, tan_gp, const[17], const[18], const[19], const[20])[0]
+    out[30] = yr
     out[35] = vc_kt * _KT
-    return terr, p, q
+    return terr, p, q, r
 
 
 def _cross(a: Array, b: Array) -> Array:
@@ -250,7 +275,7 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
     r_n, r_e = const[3], const[4]
     origin = const[5:8]
     c_rwy2 = np.stack([const[8:11], const[11:14]])
-    h_thr, tan_gp, tch, dt = const[14], const[15], const[16], const[17]
+    h_thr, dt = const[14], const[21]
     lat, lon, h = raw[:, 0], raw[:, 1], raw[:, 2] * _FT
     v_cg = raw[:, 3:6] * _FPS
     eul = raw[:, 6:9]
@@ -307,7 +332,8 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
     out[:, 17:20], out[:, 20:23] = w_ib, f
     out[:, 23], out[:, 24], out[:, 25] = p_imu, raw[:, 20] / _RANKINE, h_i - terr
     out[:, 26], out[:, 27], out[:, 28] = xy[:, 0], xy[:, 1], zr
-    out[:, 29], out[:, 30] = zr - (tch - xy[:, 0] * tan_gp), xy[:, 1]
+    out[:, 29] = zr - cone_height(xy[:, 0], xy[:, 1], const[15], *const[17:21])
+    out[:, 30] = xy[:, 1]
     out[:, 35] = raw[:, 21] * _KT
     return out
 
@@ -335,16 +361,22 @@ there whenever the IMU is below LOW_READ_HEIGHT_M (at any vertical speed below m
 # autopilot: parameters (the gains in AP_GAINS order, then trim, geometry, step) and state
 AP_GAINS = ("k_theta", "k_q", "k_gs_p", "k_gs_d", "k_gs_i", "k_v_p", "k_v_i", "tau_v_s", "k_phi", "k_p", "k_beta",
             "k_loc_p", "k_loc_d", "k_loc_i", "bank_limit_rad", "pitch_limit_rad", "tau_wind_s", "flare_height_m",
-            "flare_tau_s", "touchdown_sink_mps", "k_flare", "k_flare_i", "retard_height_m")
+            "touchdown_sink_mps", "k_flare", "k_flare_i", "retard_height_m", "tecs", "tecs_t_h_s", "tecs_t_v_s",
+            "tecs_thr_per_rad", "tecs_k_thr_damp", "tecs_k_thr_i", "tecs_k_pitch_damp", "tecs_k_pitch_i",
+            "tecs_seb_ff", "tecs_spd_weight", "tecs_rate_tau_s", "tecs_sink_max_mps", "tecs_climb_max_mps",
+            "tecs_vert_acc_mps2", "align_height_m", "align_tau_s", "k_r_align", "k_beta_align", "k_phi_align",
+            "k_da_align")
 """flight.design.AutopilotGains fields, in the order of the autopilot parameter vector."""
 (AP_K_THETA, AP_K_Q, AP_K_GS_P, AP_K_GS_D, AP_K_GS_I, AP_K_V_P, AP_K_V_I, AP_TAU_V, AP_K_PHI, AP_K_P, AP_K_BETA,
- AP_K_LOC_P, AP_K_LOC_D, AP_K_LOC_I, AP_BANK_LIMIT, AP_PITCH_LIMIT, AP_TAU_WIND, AP_FLARE_H, AP_FLARE_TAU, AP_TD_SINK,
- AP_K_FLARE, AP_K_FLARE_I, AP_RETARD_H, AP_THETA0, AP_THR0, AP_CAS0, AP_CH, AP_SH, AP_TAN_GP, AP_TCH, AP_CONV,
- AP_DT) = range(32)
-N_AP_PAR = 32
+ AP_K_LOC_P, AP_K_LOC_D, AP_K_LOC_I, AP_BANK_LIMIT, AP_PITCH_LIMIT, AP_TAU_WIND, AP_FLARE_H, AP_TD_SINK,
+ AP_K_FLARE, AP_K_FLARE_I, AP_RETARD_H, AP_TECS, AP_T_H, AP_T_V, AP_K_THR, AP_K_TD, AP_K_TI, AP_K_PD, AP_K_PI,
+ AP_SEB_FF, AP_SPD_W, AP_RATE_TAU, AP_SINK_MAX, AP_CLIMB_MAX, AP_VERT_ACC, AP_ALIGN_H, AP_ALIGN_TAU, AP_K_R_ALIGN,
+ AP_K_BETA_ALIGN, AP_K_PHI_ALIGN, AP_K_DA_ALIGN, AP_THETA0, AP_THR0, AP_CAS0, AP_CH, AP_SH, AP_HEADING, AP_TAN_GP,
+ AP_X_GPI, AP_CONE_A, AP_CONE_B, AP_CONE_C, AP_CONV, AP_DT) = range(55)
+N_AP_PAR = 55
 (APS_INT_D, APS_INT_Y, APS_E_F, APS_WIND, APS_INT_E, APS_FLARING, APS_THETA_FLARE0, APS_INT_FLARE,
- APS_THETA_C) = range(9)
-N_AP_STATE = 9
+ APS_THETA_C, APS_V_LAG, APS_INT_T, APS_INT_B, APS_FLARE_TAU, APS_FLARE_H_OFF, APS_ALIGNING) = range(15)
+N_AP_STATE = 15
 
 # Dryden turbulence: parameters (W20, dt, wind-axes rotation, the intensity table's altitudes and the level's row)
 (TB_W20, TB_DT, TB_COS, TB_SIN) = range(4)
@@ -356,14 +388,15 @@ N_TB_PAR = TB_SIGMA + N_POE
 N_TB_STATE = 10
 
 # stabilized-approach monitor: parameters, state; its ring buffer is [speed (n) | sink (m) | sink excess (m)]
-(MN_TAN_GP, MN_GS_DOT_TAN, MN_X_GP, MN_X_FLOOR, MN_LOC_DOT_TAN, MN_TCH, MN_TARGET, MN_N, MN_M) = range(9)
-N_MN_PAR = 9
+(MN_TAN_GP, MN_GS_DOT_TAN, MN_X_GP, MN_X_FLOOR, MN_LOC_DOT_TAN, MN_TCH, MN_TARGET, MN_N, MN_M, MN_CA, MN_CB,
+ MN_CC) = range(12)
+N_MN_PAR = 12
 (MNS_I, MNS_J, MNS_COUNT, MNS_SUM_CAS, MNS_SUM_SINK, MNS_SUM_EXCESS) = range(6)
 N_MN_STATE = 6
 # the step: its own parameters and state, then the components' at these offsets
 (F_PITCH_TRIM, F_STOP_H, F_LAND, F_TAN_GP, F_TCH, F_MON_FLOOR, F_WIND_N, F_WIND_E, F_TURBULENT,
- F_N_TERRAIN) = range(10)
-N_F_PAR = 10
+ F_N_TERRAIN, F_X_GPI, F_CA, F_CB, F_CC) = range(14)
+N_F_PAR = 14
 P_IMU = 0
 P_STEP = P_IMU + N_CONST
 P_AP = P_STEP + N_F_PAR
@@ -372,8 +405,8 @@ P_MN = P_TB + N_TB_PAR
 P_TERRAIN = P_MN + N_MN_PAR
 """The terrain profile ends the parameter vector: F_N_TERRAIN along-track distances, then as many heights (m)."""
 (FS_DE, FS_DA, FS_DR, FS_THR, FS_LOWEST, FS_TD_X, FS_TD_SINK, FS_MON, FS_MON_Z, FS_MON_A, FS_MON_B,
- FS_PHI, FS_THETA, FS_P, FS_Q, FS_BETA, FS_CAS, FS_H_GEAR, FS_TAS) = range(19)
-N_F_STATE = 19
+ FS_PHI, FS_THETA, FS_P, FS_Q, FS_BETA, FS_CAS, FS_H_GEAR, FS_TAS, FS_PSI, FS_R) = range(21)
+N_F_STATE = 21
 S_STEP = 0
 S_AP = S_STEP + N_F_STATE
 S_TB = S_AP + N_AP_STATE
@@ -397,13 +430,53 @@ def _clip1(u: float) -> float:
 
 
 @njit(cache=True)
+def _tecs(par: Array, st: Array, d: float, d_dot: float, h_dot: float, v: float) -> tuple[float, float]:
+    """Total energy control (flight/autopilot.Autopilot._tecs, the oracle): pitch command and throttle."""
+    dt = par[AP_DT]
+    if st[APS_V_LAG] != st[APS_V_LAG]:
+        st[APS_V_LAG] = v
+    v_dot = (v - st[APS_V_LAG]) / par[AP_RATE_TAU]
+    st[APS_V_LAG] += dt * v_dot
+    v0 = max(v, 1.0)
+    hd_gp = h_dot - d_dot
+    hd_c = min(max(hd_gp - d / par[AP_T_H], -par[AP_SINK_MAX]), par[AP_CLIMB_MAX])
+    a_lim = 0.5 * _G0 / par[AP_K_THR]
+    vd_c = min(max((par[AP_CAS0] - v) / par[AP_T_V], -a_lim), a_lim)
+    wk = min(max(par[AP_SPD_W], 0.0), 1.0)
+    wp = min(max(2.0 - par[AP_SPD_W], 0.0), 1.0)
+    e_h = (hd_c - h_dot) / v0
+    e_v = (vd_c - v_dot) / _G0
+    e_t = e_h + e_v
+    e_b = wp * e_h - wk * e_v
+    sp_h = (hd_c - hd_gp) / v0
+    t_sp = sp_h + vd_c / _G0
+    b_sp = wp * sp_h - wk * vd_c / _G0
+    thr = par[AP_THR0] + par[AP_K_THR] * (t_sp + par[AP_K_TD] * e_t + par[AP_K_TI] * st[APS_INT_T])
+    if 0.0 < thr < 1.0:
+        st[APS_INT_T] += e_t * dt
+    else:
+        thr = 1.0 if thr >= 1.0 else 0.0
+    th_off = par[AP_SEB_FF] * b_sp + par[AP_K_PD] * e_b + par[AP_K_PI] * st[APS_INT_B]
+    lim = par[AP_PITCH_LIMIT]
+    step_max = dt * par[AP_VERT_ACC] / v0
+    prev = st[APS_THETA_C] - par[AP_THETA0]
+    lo, hi = max(-lim, prev - step_max), min(lim, prev + step_max)
+    if lo < th_off < hi:
+        st[APS_INT_B] += e_b * dt
+    else:
+        th_off = hi if th_off >= hi else lo
+    return par[AP_THETA0] + th_off, thr
+
+
+@njit(cache=True)
 def autopilot_step(par: Array, st: Array, x: float, y: float, z: float, vn: float, ve: float, vd: float,
                    phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float,
-                   tas: float) -> tuple[float, float, float, float]:
+                   tas: float, psi: float, r: float) -> tuple[float, float, float, float]:
     """One autopilot step (flight/autopilot.Autopilot.step, the oracle, whose module docstring has the laws):
     guidance position (runway frame, m), NED velocity (m/s), attitude (rad), body rates (rad/s), sideslip (rad),
-    CAS (m/s), main-gear height (m; nan: no flare), TAS (m/s; nan: no speed complement) -> elevator, aileron,
-    rudder, throttle. par: AP_* parameters, st: APS_* state (updated)."""
+    CAS (m/s), main-gear height (m; nan: no flare), TAS (m/s; nan: no speed complement), true heading (rad; nan:
+    no decrab) and yaw rate (rad/s) -> elevator, aileron, rudder, throttle. par: AP_* parameters, st: APS_* state
+    (updated)."""
     dt = par[AP_DT]
     if tas > 1.0:  # inertially smoothed speed
         gs = math.sqrt(vn * vn + ve * ve + vd * vd)
@@ -411,44 +484,48 @@ def autopilot_step(par: Array, st: Array, x: float, y: float, z: float, vn: floa
             st[APS_WIND] = tas - gs
         st[APS_WIND] += dt / par[AP_TAU_WIND] * (tas - gs - st[APS_WIND])
         cas = cas * (gs + st[APS_WIND]) / tas
-    # glidepath and cross-track deviations, the runway axes turned by the meridian convergence
-    ch, sh, tan_gp = par[AP_CH], par[AP_SH], par[AP_TAN_GP]
+    # glidepath (cone) and cross-track deviations, the runway axes turned by the meridian convergence
+    ch, sh = par[AP_CH], par[AP_SH]
     conv = (x * sh + y * ch) * par[AP_CONV]
     x0 = vn * ch + ve * sh
     y0 = -vn * sh + ve * ch
-    d = z - (par[AP_TCH] - x * tan_gp)
-    d_dot = -vd + (x0 + conv * y0) * tan_gp
     y_dot = y0 - conv * x0
-    # glidepath -> pitch command (integral frozen while the command is limited)
-    th_off = -(par[AP_K_GS_P] * d + par[AP_K_GS_D] * d_dot + par[AP_K_GS_I] * st[APS_INT_D])
+    d, d_dot = cone_deviation(x, y, z, x0 + conv * y0, y_dot, -vd, par[AP_TAN_GP], par[AP_X_GPI], par[AP_CONE_A],
+                              par[AP_CONE_B], par[AP_CONE_C])
     lim = par[AP_PITCH_LIMIT]
-    if -lim < th_off < lim:
-        st[APS_INT_D] += d * dt
+    if par[AP_TECS] != 0.0:
+        theta_c, thr = _tecs(par, st, d, d_dot, -vd, cas)
     else:
-        th_off = lim if th_off > 0.0 else -lim
-    theta_c = par[AP_THETA0] + th_off
-    flare = h_gear == h_gear and (st[APS_FLARING] != 0.0 or h_gear <= par[AP_FLARE_H])
-    thr_flare = 1.0
-    if flare:  # sink-rate command -(h_gear / tau + sink_td) from the pitch command at flare entry
+        # glidepath -> pitch command (integral frozen while the command is limited)
+        th_off = -(par[AP_K_GS_P] * d + par[AP_K_GS_D] * d_dot + par[AP_K_GS_I] * st[APS_INT_D])
+        if -lim < th_off < lim:
+            st[APS_INT_D] += d * dt
+        else:
+            th_off = lim if th_off > 0.0 else -lim
+        theta_c = par[AP_THETA0] + th_off
+        # autothrottle on the filtered speed error (integral frozen at saturation)
+        st[APS_E_F] += dt / par[AP_TAU_V] * (par[AP_CAS0] - cas - st[APS_E_F])
+        thr = par[AP_THR0] + par[AP_K_V_P] * st[APS_E_F] + par[AP_K_V_I] * st[APS_INT_E]
+        if 0.0 < thr < 1.0:
+            st[APS_INT_E] += st[APS_E_F] * dt
+        else:
+            thr = 1.0 if thr >= 1.0 else 0.0
+    landing = h_gear == h_gear
+    if landing and (st[APS_FLARING] != 0.0 or h_gear <= par[AP_FLARE_H]):
+        # exponential flare: h'_c = -(h_gear - h_off) / tau, tau and h_off from the entry sink (continuity)
+        td = par[AP_TD_SINK]
         if st[APS_FLARING] == 0.0:
             st[APS_FLARING] = 1.0
             st[APS_THETA_FLARE0] = st[APS_THETA_C]
-        h_dot = -vd
-        e = -(max(h_gear, 0.0) / par[AP_FLARE_TAU] + par[AP_TD_SINK]) - h_dot
+            sink0 = max(vd, td + 0.1)
+            st[APS_FLARE_TAU] = max(h_gear, 0.0) / (sink0 - td) if h_gear > 0.0 else 1.0
+            st[APS_FLARE_H_OFF] = -st[APS_FLARE_TAU] * td
+        e = -(max(h_gear, 0.0) - st[APS_FLARE_H_OFF]) / st[APS_FLARE_TAU] + vd
         st[APS_INT_FLARE] += e * dt
         theta_c = st[APS_THETA_FLARE0] + par[AP_K_FLARE] * e + par[AP_K_FLARE_I] * st[APS_INT_FLARE]
-        thr_flare = 1.0 if h_gear > par[AP_RETARD_H] else 0.0
+        thr = min(thr, 1.0 if h_gear > par[AP_RETARD_H] else 0.0)
     st[APS_THETA_C] = theta_c
     de = -par[AP_K_THETA] * (theta_c - theta) + par[AP_K_Q] * q
-    # autothrottle on the filtered speed error (integral frozen at saturation)
-    st[APS_E_F] += dt / par[AP_TAU_V] * (par[AP_CAS0] - cas - st[APS_E_F])
-    thr = par[AP_THR0] + par[AP_K_V_P] * st[APS_E_F] + par[AP_K_V_I] * st[APS_INT_E]
-    if 0.0 < thr < 1.0:
-        st[APS_INT_E] += st[APS_E_F] * dt
-    else:
-        thr = 1.0 if thr >= 1.0 else 0.0
-    if flare:
-        thr = min(thr, thr_flare)
     # localizer -> bank command
     phi_c = -(par[AP_K_LOC_P] * y + par[AP_K_LOC_D] * y_dot + par[AP_K_LOC_I] * st[APS_INT_Y])
     blim = par[AP_BANK_LIMIT]
@@ -456,8 +533,17 @@ def autopilot_step(par: Array, st: Array, x: float, y: float, z: float, vn: floa
         st[APS_INT_Y] += y * dt
     else:
         phi_c = blim if phi_c > 0.0 else -blim
-    da = par[AP_K_PHI] * (phi_c - phi) - par[AP_K_P] * p
-    dr = -par[AP_K_BETA] * beta
+    if landing and psi == psi and (st[APS_ALIGNING] != 0.0 or h_gear <= par[AP_ALIGN_H]):
+        # decrab: yaw-rate command -crab / tau_align; the rudder, bank and aileron that hold the sideslip
+        st[APS_ALIGNING] = 1.0
+        crab = psi - (par[AP_HEADING] + conv) + math.pi
+        crab = crab - _TWO_PI * math.floor(crab / _TWO_PI) - math.pi
+        dr = par[AP_K_R_ALIGN] * (r + crab / par[AP_ALIGN_TAU]) + par[AP_K_BETA_ALIGN] * beta
+        da = (par[AP_K_PHI] * (phi_c + par[AP_K_PHI_ALIGN] * beta - phi) - par[AP_K_P] * p
+              + par[AP_K_DA_ALIGN] * beta)
+    else:
+        dr = -par[AP_K_BETA] * beta
+        da = par[AP_K_PHI] * (phi_c - phi) - par[AP_K_P] * p
     return _clip1(de), _clip1(da), _clip1(dr), thr
 
 
@@ -540,7 +626,8 @@ def monitor_step(par: Array, st: Array, ring: Array, x_m: float, y_m: float, z_m
     if z_m > STABILIZATION_HEIGHT_M:
         return MON_OK, 0.0, 0.0
     # deviations in dots: the glide path's angular dot held at its 200 ft size below, the localizer's angular
-    d = z_m - (par[MN_TCH] - x_m * par[MN_TAN_GP])
+    d = cone_deviation(x_m, y_m, z_m, 0.0, 0.0, 0.0, par[MN_TAN_GP], par[MN_X_GP], par[MN_CA], par[MN_CB],
+                       par[MN_CC])[0]
     r_gp = max(par[MN_X_GP] - min(x_m, par[MN_X_FLOOR]), 1.0)
     gs_dots = d / (r_gp * par[MN_GS_DOT_TAN])
     loc_dots = y_m / ((LOC_ANTENNA_PAST_THRESHOLD_M - x_m) * par[MN_LOC_DOT_TAN])
@@ -580,7 +667,8 @@ def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, x
         return TERM_TOUCHDOWN if x >= 0.0 else TERM_SHORT
     if wow_nose > 0.0 or wow_left > 0.0 or wow_right > 0.0 or h_agl <= 0.0:
         return TERM_GROUND
-    if (abs(phi) > DIVERGED_BANK_RAD or abs(z - (fpar[F_TCH] - x * fpar[F_TAN_GP])) > DIVERGED_VERTICAL_M
+    dev = cone_deviation(x, y, z, 0.0, 0.0, 0.0, fpar[F_TAN_GP], fpar[F_X_GPI], fpar[F_CA], fpar[F_CB], fpar[F_CC])[0]
+    if (abs(phi) > DIVERGED_BANK_RAD or abs(dev) > DIVERGED_VERTICAL_M
             or abs(y) > DIVERGED_LATERAL_M):
         return TERM_DIVERGED
     if fpar[F_MON_FLOOR] < z < WATCH_HEIGHT_M:
@@ -596,10 +684,10 @@ def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, x
 @njit(cache=True)
 def _control(par: Array, st: Array, row: Array, x: float, y: float, z: float, vn: float, ve: float, vd: float,
              phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float,
-             tas: float) -> tuple[float, float, float, float]:
+             tas: float, psi: float, r: float) -> tuple[float, float, float, float]:
     """The autopilot on guidance (x, y, z, vn, ve, vd); the commands go into the row and the step's state."""
     de, da, dr, thr = autopilot_step(par[P_AP:P_AP + N_AP_PAR], st[S_AP:S_AP + N_AP_STATE], x, y, z, vn, ve, vd,
-                                     phi, theta, p, q, beta, cas, h_gear, tas)
+                                     phi, theta, p, q, beta, cas, h_gear, tas, psi, r)
     row[CONTROLS_COL] = de + par[P_STEP + F_PITCH_TRIM]
     row[CONTROLS_COL + 1], row[CONTROLS_COL + 2], row[CONTROLS_COL + 3] = da, dr, thr
     st[S_STEP + FS_DE], st[S_STEP + FS_DA], st[S_STEP + FS_DR], st[S_STEP + FS_THR] = de, da, dr, thr
@@ -625,7 +713,7 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
     row = buf[k]
     fpar, fst = par[P_STEP:P_STEP + N_F_PAR], st[S_STEP:S_STEP + N_F_STATE]
     nt = int(fpar[F_N_TERRAIN])
-    terr, p, q = _imu_point(raw, par[P_IMU:P_IMU + N_CONST], par[P_TERRAIN:P_TERRAIN + nt],
+    terr, p, q, r = _imu_point(raw, par[P_IMU:P_IMU + N_CONST], par[P_TERRAIN:P_TERRAIN + nt],
                             par[P_TERRAIN + nt:P_TERRAIN + 2 * nt], k * par[P_IMU + N_CONST - 1], row)
     vn_f, ve_f, vd_f, phi, theta = raw[_R_VN], raw[_R_VN + 1], raw[_R_VN + 2], raw[_R_PHI], raw[_R_PHI + 1]
     cas, beta, tas = raw[_R_VC] * _KT, raw[_R_BETA], raw[_R_VT] * _FPS
@@ -652,8 +740,11 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
     # the inner loops' inputs of this step (fly_control's, when a navigation source guides)
     fst[FS_PHI], fst[FS_THETA], fst[FS_P], fst[FS_Q], fst[FS_BETA] = phi, theta, p, q, beta
     fst[FS_CAS], fst[FS_H_GEAR], fst[FS_TAS] = cas, h_gear, tas
+    psi = raw[_R_PHI + 2] if fpar[F_LAND] != 0.0 else math.nan
+    fst[FS_PSI], fst[FS_R] = psi, r
     if guided and code == TERM_NONE:
-        de, da, dr, thr = _control(par, st, row, xr, yr, zr, vn, ve, vd, phi, theta, p, q, beta, cas, h_gear, tas)
+        de, da, dr, thr = _control(par, st, row, xr, yr, zr, vn, ve, vd, phi, theta, p, q, beta, cas, h_gear, tas,
+                                   psi, r)
     else:
         de, da, dr, thr = fst[FS_DE], fst[FS_DA], fst[FS_DR], fst[FS_THR]
     return code, de, da, dr, thr, gn, ge, gd, terr / _FT, near
@@ -666,14 +757,14 @@ def fly_control(k: int, guidance: Array, buf: Array, par: Array, st: Array) -> t
     g = guidance[k]
     s = st[S_STEP:S_STEP + N_F_STATE]
     return _control(par, st, buf[k], g[0], g[1], g[2], g[3], g[4], g[5], s[FS_PHI], s[FS_THETA], s[FS_P], s[FS_Q],
-                    s[FS_BETA], s[FS_CAS], s[FS_H_GEAR], s[FS_TAS])
+                    s[FS_BETA], s[FS_CAS], s[FS_H_GEAR], s[FS_TAS], s[FS_PSI], s[FS_R])
 
 
 def autopilot_arrays(ap: Any) -> tuple[Array, Array]:
     """(parameters, state) of the compiled autopilot (AP_*, APS_*) from its oracle (flight/autopilot.Autopilot)."""
     par = [getattr(ap.g, name) for name in AP_GAINS]
-    par += [ap.trim.theta_rad, ap.trim.throttle, ap.trim.cas_mps, ap.ch, ap.sh, ap.tan_gp, ap.tch_m,
-            ap.conv_per_east_m, ap.dt]
+    par += [ap.trim.theta_rad, ap.trim.throttle, ap.trim.cas_mps, ap.ch, ap.sh, ap.heading_rad, ap.tan_gp,
+            ap.x_gpi_m, ap.cone_a, ap.cone_b, ap.cone_c, ap.conv_per_east_m, ap.dt]
     return np.array(par, dtype=float), np.array(ap.state(), dtype=float)
 
 
@@ -688,7 +779,7 @@ def monitor_arrays(mon: Any) -> tuple[Array, Array, Array]:
     """(parameters, state, windows) of the compiled stabilized-approach monitor (MN_*, MNS_*, the ring buffer)
     from its oracle (flight/envelope.StabilityMonitor)."""
     par = [mon.tan_gp, math.tan(mon.gs_dot_rad), mon.x_gp_m, mon.x_floor_m, math.tan(mon.loc_dot_rad), mon.tch_m,
-           mon.target_mps, float(mon.n), float(mon.m)]
+           mon.target_mps, float(mon.n), float(mon.m), *mon.curvature]
     return np.array(par, dtype=float), np.array(mon.state(), dtype=float), np.array(mon.windows(), dtype=float)
 
 
@@ -709,6 +800,7 @@ def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, terrain_al
     fpar = np.zeros(N_F_PAR)
     fpar[F_PITCH_TRIM], fpar[F_STOP_H], fpar[F_LAND] = pitch_trim, stop_height_m, float(land)
     fpar[F_TAN_GP], fpar[F_TCH] = ap.tan_gp, ap.tch_m
+    fpar[F_X_GPI], fpar[F_CA], fpar[F_CB], fpar[F_CC] = ap.x_gpi_m, ap.cone_a, ap.cone_b, ap.cone_c
     fpar[F_MON_FLOOR], fpar[F_WIND_N], fpar[F_WIND_E] = monitor_floor_m, wind_ned_mps[0], wind_ned_mps[1]
     fpar[F_TURBULENT] = float(turb is not None)
     fpar[F_N_TERRAIN] = len(terrain_along_m)

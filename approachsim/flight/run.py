@@ -50,6 +50,7 @@ import numpy as np
 
 from approachsim import units
 from approachsim.config import ProfileError
+from approachsim.evaluate.touchdown import touchdown_scalars
 from approachsim.flight import kernels as fk
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
@@ -139,9 +140,17 @@ class FlightResult:
     """The simulation/randomseed JSBSim used (the turbulence itself comes from the run's "turbulence" stream)."""
 
     touchdown_x_m: float = math.nan
-    """Landing runs: IMU runway-frame x when the main gear touched down, m past the threshold (nan: none)."""
+    """Landing runs: the main gears' mean runway-frame x when a main gear touched down, m past the threshold
+    (evaluate.touchdown.touchdown_scalars td_x_m; nan: none)."""
     touchdown_sink_mps: float = math.nan
-    """Landing runs: sink rate at touchdown (IMU, positive down), m/s (nan: none)."""
+    """Landing runs: sink rate of the main gear that touched (positive down), m/s (nan: none)."""
+    touchdown_y_m: float = math.nan
+    """Landing runs: the main-gear centre's runway-frame y at touchdown, m right of the centreline (nan: none)."""
+    touchdown_drift_rad: float = math.nan
+    """Landing runs: drift (wheel-slip) angle at touchdown, the touching main gear's ground track minus the
+    heading, rad (+: the gear moves to the right of where the nose points; nan: none)."""
+    touchdown_crab_rad: float = math.nan
+    """Landing runs: heading minus the runway heading at touchdown, rad (nan: none)."""
 
     @property
     def ok(self) -> bool:
@@ -333,14 +342,21 @@ class Approach:
         else:
             g_r, g_v = np.ascontiguousarray(guidance[:n, 0:3]), np.ascontiguousarray(guidance[:n, 3:6])
         fs = st[fk.S_STEP:fk.S_STEP + fk.N_F_STATE]
+        td = {}
+        if code in (fk.TERM_TOUCHDOWN, fk.TERM_SHORT):  # scored at the main gear, not the IMU point
+            sc = touchdown_scalars(final, self.main_gear_lever_arms_m)
+            td = {"touchdown_x_m": sc["td_x_m"], "touchdown_sink_mps": sc["td_sink_mps"],
+                  "touchdown_y_m": sc["td_y_m"], "touchdown_drift_rad": sc["td_gear_slip_rad"],
+                  "touchdown_crab_rad": sc["td_crab_rad"]}
+            fs[fk.FS_TD_X] = sc["td_x_m"]
+            code = fk.TERM_TOUCHDOWN if sc["td_x_m"] >= 0.0 else fk.TERM_SHORT
         return FlightResult(
             truth=final,
             guidance_r_rwy=g_r,
             guidance_v_ned=g_v,
             termination=termination_reason(code, fs),
             lowest_height_ft=float(fs[fk.FS_LOWEST]) / units.FT,
-            touchdown_x_m=float(fs[fk.FS_TD_X]),
-            touchdown_sink_mps=float(fs[fk.FS_TD_SINK]),
+            **td,
             seed=seed,
             run=run,
             turbulence_seed=turb_seed,
@@ -362,7 +378,8 @@ class Approach:
         trim = Trim(theta_rad=fdm["attitude/theta-rad"], throttle=fdm["fcs/throttle-cmd-norm[0]"],
                     cas_mps=ac.approach_speed_mps)
         ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m, rw.threshold_lat_rad), dt)
-        monitor = StabilityMonitor(rw.glidepath_rad, rw.tch_m, ac.approach_speed_mps, dt)
+        monitor = StabilityMonitor(rw.glidepath_rad, rw.tch_m, ac.approach_speed_mps, dt,
+                                   curvature=ap.cone.curvature)
         turb = None
         nu = np.zeros((1, 3))
         if env.turbulence != "none":

@@ -64,7 +64,7 @@ def test_the_design_covers_every_level():
     cs = [admissible(BASE, c, DEFAULT) for c in cases()]
     assert len(cs) >= 24
     assert {c.wind for c in cs} >= {"headwind 10 kt", "headwind 20 kt", "headwind 25 kt", "crosswind 15 kt",
-                                     "crosswind 25 kt", "tailwind 10 kt", "calm"}
+                                     "crosswind 25 kt", "tailwind 15 kt", "calm"}
     assert {c.turbulence for c in cs} == {"light", "moderate"}
     assert {c.isa_dev_c for c in cs} == {-30.0, 0.0, 30.0}
     assert {c.elevation_ft for c in cs} == {0.0, 5000.0, 8000.0}
@@ -79,7 +79,7 @@ def _prof(**env):
 
 
 @pytest.mark.parametrize(("edit", "field", "words"), [
-    ({"wind_speed_kt": 15.0, "wind_from_deg": 118.0}, "environment.wind_speed_kt", "tailwind component 15 kt"),
+    ({"wind_speed_kt": 20.0, "wind_from_deg": 118.0}, "environment.wind_speed_kt", "tailwind component 20 kt"),
     ({"wind_speed_kt": 35.0, "wind_from_deg": 28.0}, "environment.wind_speed_kt", "crosswind component 35 kt"),
     ({"wind_speed_kt": 30.0, "wind_from_deg": 298.0}, "environment.wind_speed_kt", "headwind component 30 kt"),
     ({"runway": {"glidepath_deg": 7.0}}, "runway.glidepath_deg", "7 deg"),
@@ -99,7 +99,7 @@ def test_outside_the_envelope_is_refused_naming_the_limit(edit, field, words):
 @pytest.mark.parametrize("command", ["fly", "evaluate"])
 def test_outside_the_envelope_exits_2_through_the_cli(tmp_path, command):
     """fly refuses it; evaluate refuses it before any run (not as one failed run per worker, exit 3)."""
-    text = DEFAULT.read_text(encoding="utf-8").replace("wind_speed_kt = 5.0", "wind_speed_kt = 15.0").replace(
+    text = DEFAULT.read_text(encoding="utf-8").replace("wind_speed_kt = 5.0", "wind_speed_kt = 20.0").replace(
         "wind_from_deg = 300.0", "wind_from_deg = 118.0")
     prof = tmp_path / "profiles" / "tail15.toml"
     prof.parent.mkdir()
@@ -111,7 +111,7 @@ def test_outside_the_envelope_exits_2_through_the_cli(tmp_path, command):
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
-    assert len(lines) == 1 and "tailwind component 15 kt exceeds the 737's 10 kt limit" in lines[0]
+    assert len(lines) == 1 and "tailwind component 20 kt exceeds the 737's 15 kt limit" in lines[0]
 
 
 def test_a_flight_made_to_fail_ends_with_its_reason_and_exit_3(tmp_path):

@@ -64,9 +64,13 @@ def test_gray_maybeck_speed_and_glideslope():
 def test_glidepath_geometry():
     p = load_profile(ROOT / "profiles" / "default.toml")
     rw = p.runway
-    assert rw.glidepath_height_m(0.0) == pytest.approx(rw.tch_m)
-    # 1 nmi before the threshold on a 3 deg path: TCH + 1852 tan 3 = 15.24 + 97.06 m
-    assert rw.glidepath_height_m(-1852.0) == pytest.approx(15.24 + 1852 * math.tan(math.radians(3)), abs=1e-6)
+    # the straight cone from the GPI (approachsim.glidepath), in the height above the threshold's ellipsoid
+    # height: TCH - x tan 3 plus the Earth's drop below the GPI's horizontal plane, (x - x_gpi)^2 / (2 R)
+    x_gpi = rw.tch_m / math.tan(math.radians(3))
+    assert rw.glidepath_height_m(0.0) == pytest.approx(rw.tch_m + x_gpi**2 / (2 * 6.371e6), abs=1e-4)
+    # 1 nmi before the threshold on a 3 deg path: TCH + 1852 tan 3 = 15.24 + 97.06 m, + 0.36 m of drop
+    want = 15.24 + 1852 * math.tan(math.radians(3)) + (1852 + x_gpi) ** 2 / (2 * 6.371e6)
+    assert rw.glidepath_height_m(-1852.0) == pytest.approx(want, abs=2e-3)  # R: 6371 km against the radii here
 
 
 def test_terrain_default_flat_and_table():

@@ -11,6 +11,7 @@ import pytest
 from approachsim import units
 from approachsim.flight.aircraft import load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
+from approachsim.glidepath import GlidePath
 from approachsim.profile import load_profile
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
@@ -26,22 +27,31 @@ def ap():
     return Autopilot(ac.gains, Trim(theta_rad=0.02, throttle=0.47, cas_mps=72.0), geom, 1.0 / 120.0)
 
 
+CONE = GlidePath(GP, TCH, 0.0, 0.0)
+
+
 def _on_path(x):
-    return TCH - x * math.tan(GP)
+    """Height of the straight glide path cone (approachsim.glidepath) in the runway frame's z at x."""
+    return float(CONE.height_m(x))
+
+
+def _sink_on_path(x, v):
+    """Sink rate (m/s) that follows the cone at ground speed v along the runway: v times its slope at x."""
+    return v * (_on_path(x - 0.5) - _on_path(x + 0.5))
 
 
 def test_on_the_glidepath_flying_down_it_has_zero_deviation(ap):
     x = -5000.0
     v = 70.0
-    d, d_dot, y, y_dot = ap.deviations(x, 0.0, _on_path(x), v, 0.0, v * math.tan(GP))
+    d, d_dot, y, y_dot = ap.deviations(x, 0.0, _on_path(x), v, 0.0, _sink_on_path(x, v))
     assert d == pytest.approx(0.0, abs=1e-9)
-    assert d_dot == pytest.approx(0.0, abs=1e-9)
+    assert d_dot == pytest.approx(0.0, abs=1e-6)  # the slope by a 1 m central difference: O(1e-7) m/s
     assert y == 0.0 and y_dot == pytest.approx(0.0, abs=1e-12)
 
 
 def test_deviation_signs(ap):
     x = -3000.0
-    d, _, y, y_dot = ap.deviations(x, 12.0, _on_path(x) + 7.0, 70.0, 1.5, 3.67)
+    d, _, y, y_dot = ap.deviations(x, 12.0, float(CONE.height_m(x, 12.0)) + 7.0, 70.0, 1.5, 3.67)
     assert d == pytest.approx(7.0)
     assert y == 12.0
     assert y_dot == pytest.approx(1.5)  # heading north: east velocity drifts right
@@ -70,3 +80,36 @@ def test_meridian_convergence_rotates_the_runway_axes():
     # 10 km east of a north-pointing runway: the local north differs by 10e3 tan(60 deg)/R ~ 0.156 deg
     _, _, _, y_dot = ap.deviations(0.0, 10e3, 0.0, 70.0, 0.0, 0.0)
     assert y_dot == pytest.approx(-70.0 * 10e3 * math.tan(lat) / 6.394e6, rel=0.01)
+
+
+def test_the_flare_command_starts_at_the_entry_sink_and_ends_at_the_touchdown_sink(ap):
+    """Exponential flare h'_c = -(h - h_off) / tau with tau, h_off from continuity at entry (autopilot.py): at
+    entry the sink-rate error is zero (no step in the pitch command), at h = 0 the command is the touchdown sink."""
+    g = ap.g
+    h0, sink0 = g.flare_height_m - 0.01, 3.8
+    x = -300.0
+    ap.step(x, 0.0, _on_path(x), 70.0, 0.0, sink0, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, h0)
+    assert ap.flaring
+    tau = ap._flare_tau
+    assert tau == pytest.approx(h0 / (sink0 - g.touchdown_sink_mps))
+    assert ap._int_flare == pytest.approx(0.0, abs=1e-12)  # zero sink-rate error at entry
+    assert ap._flare_h_off == pytest.approx(-tau * g.touchdown_sink_mps)
+    # the command at the runway: h'_c(0) = h_off / tau = -touchdown sink
+    assert -(0.0 - ap._flare_h_off) / tau == pytest.approx(-g.touchdown_sink_mps)
+
+
+def test_the_decrab_yaws_towards_the_runway_and_holds_the_sideslip(ap):
+    """Below the align height, crabbed 8 deg right of the runway (heading 0) with the wind from the right (beta > 0
+    once aligned): rudder nose left (+) from the heading error; the sideslip terms add rudder, bank and aileron
+    into the wind (right)."""
+    x = -200.0
+    g = ap.g
+    h = 0.5 * g.align_height_m
+    de, da, dr, thr = ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, h,
+                              psi=math.radians(8.0), r=0.0)
+    assert ap.aligning
+    assert dr == pytest.approx(g.k_r_align * math.radians(8.0) / g.align_tau_s)
+    _, da_b, dr_b, _ = ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.1, 72.0, h,
+                               psi=0.0, r=0.0)
+    assert dr_b == pytest.approx(g.k_beta_align * 0.1, rel=1e-9)  # aligned: the rudder that holds beta = 0.1
+    assert da_b > 0.0  # right wing down into the wind

@@ -83,3 +83,39 @@ def test_loop_transfer_of_a_known_system():
     assert pm_deg == pytest.approx(38.67, abs=0.05)
     assert wc == pytest.approx(1.249, abs=0.005)
     assert gm_db == float("inf")
+
+
+def test_tecs_loops_have_their_margins(setup):
+    """The total energy control law (aircraft file's TECS gains, PX4/ArduPilot defaults) on the same
+    linearization: every loop GM >= 6 dB, PM >= 45 deg, closed loop stable."""
+    lin, ac, gp = setup
+    g = dataclasses.replace(ac.gains, tecs=True)
+    assert np.max(design.closed_loop_poles(lin, g, gp, ac.engine_lag_s).real) < 0.0
+    for m in design.loop_margins(lin, g, gp, ac.engine_lag_s):
+        print(f"TECS {m.loop:10s} GM {m.gm_db:6.1f} dB  PM {m.pm_deg:6.1f} deg  wc {m.wc_rad_s:.3f} rad/s")
+        assert m.gm_db >= GM_MIN_DB, m
+        assert m.pm_deg >= PM_MIN_DEG, m
+
+
+def test_tecs_thrust_gain_and_decrab_gains_are_the_linearizations(setup):
+    """K_thr = g / (dV'/d throttle) and the decrab's sideslip-holding rudder, bank and aileron come from the
+    landing linearization's derivatives (aircraft file comments); the file holds the default profile's (140 KCAS,
+    sea level), within 15 % of every shipped profile's (gray-maybeck flies 133 kt: its yaw-rate gain is 6.5, 13 %
+    above; the gains are not scheduled with speed)."""
+    lin, ac, gp = setup
+    from approachsim import units
+
+    a, b = lin.A, lin.B
+    beta, phi, p, r = 4, 5, 6, 8
+    k_thr = units.G0 / (b[0, 0] * units.FT)
+    n_dr, n_r, n_b = b[r, 3], a[r, r], a[r, beta]
+    k_beta = -n_b / n_dr
+    k_phi = -(a[beta, beta] + b[beta, 3] * k_beta) / a[beta, phi]
+    k_da = -(a[p, beta] + b[p, 3] * k_beta) / b[p, 1]
+    k_r = (1.0 / (ac.gains.align_tau_s / 3.0) + n_r) / -n_dr  # pole of r' = N_r r + N_dr k (r - r_c) at -1/tau_r
+    g = ac.gains
+    print(f"K_thr {k_thr:.3f} k_beta_align {k_beta:.3f} k_phi_align {k_phi:.3f} k_da_align {k_da:.3f} "
+          f"k_r_align {k_r:.3f}")
+    for want, got in ((k_thr, g.tecs_thr_per_rad), (k_beta, g.k_beta_align), (k_phi, g.k_phi_align),
+                      (k_da, g.k_da_align), (k_r, g.k_r_align)):
+        assert got == pytest.approx(want, rel=0.15)

@@ -17,7 +17,8 @@ from approachsim.nav import ins
 
 FRAME = geo.RunwayFrame(math.radians(37.6117), math.radians(-122.3581), 4.0, math.radians(298.0))
 RWY = SimpleNamespace(frame=FRAME, elevation_m=4.0, glidepath_rad=math.radians(3.0), tch_m=15.0,
-                      threshold_lat_rad=FRAME.threshold_lat_rad, threshold_lon_rad=FRAME.threshold_lon_rad)
+                      threshold_lat_rad=FRAME.threshold_lat_rad, threshold_lon_rad=FRAME.threshold_lon_rad,
+                      heading_rad=FRAME.heading_rad)
 DT = 1.0 / 120.0
 
 
@@ -160,27 +161,31 @@ def test_kernel_reproduces_the_flight_loop_rows(monkeypatch):
         _close(got[:, c:c + w], ref, name)
 
 
-def test_every_glidepath_formula_is_geo_glidepath_deviation():
+def test_every_glidepath_formula_is_the_cone():
     """The compiled truth row (gs_dev), the autopilot's per-step deviation and the stability monitor's write the
-    glidepath d = h - (TCH - x tan gp) inline for speed; each equals geo.glidepath_deviation_m, the one source."""
+    glide path cone's deviation inline in scalars; each equals glidepath.GlidePath.deviation_m, the one source.
+    Tolerance: the scalar and numpy forms round differently (math.sqrt of dx^2 + y^2 against np.hypot, the terms
+    summed in another order): a few ulp of the largest operand, tan(gp) r + z <= 2 km here, so 16 eps x 2000 m."""
     from approachsim.flight.aircraft import load_aircraft
     from approachsim.flight.autopilot import Autopilot, Geometry, Trim
     from approachsim.flight.envelope import StabilityMonitor
+    from approachsim.glidepath import GlidePath
     from approachsim.profile import load_profile
 
+    tol = 16 * np.finfo(float).eps * 2000.0
     rng = np.random.default_rng(21)
     raw = _raw(50, rng)
     const = fk.imu_point_constants([10.0, 0.4, -1.2], RWY.threshold_lat_rad, RWY, DT)
     got, _ = _kernel_rows(raw, const, np.array([0.0]), np.array([4.0]), np.arange(50) * DT)
-    tan_gp = math.tan(RWY.glidepath_rad)
-    np.testing.assert_array_equal(got[:, 29], geo.glidepath_deviation_m(got[:, 26], got[:, 28], RWY.tch_m, tan_gp))
+    cone = GlidePath.of(RWY)
+    np.testing.assert_allclose(got[:, 29], cone.deviation_m(got[:, 26], got[:, 27], got[:, 28]), rtol=0, atol=tol)
     prof = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
     ap = Autopilot(load_aircraft(prof).gains, Trim(0.02, 0.47, 72.0),
-                   Geometry(0.3, RWY.glidepath_rad, RWY.tch_m, RWY.threshold_lat_rad), DT)
-    mon = StabilityMonitor(RWY.glidepath_rad, RWY.tch_m, 72.0, DT)
+                   Geometry(RWY.heading_rad, RWY.glidepath_rad, RWY.tch_m, RWY.threshold_lat_rad), DT)
+    mon = StabilityMonitor(RWY.glidepath_rad, RWY.tch_m, 72.0, DT, curvature=cone.curvature)
     for x, z in zip(rng.uniform(-18000.0, 0.0, 20), rng.uniform(0.0, 1000.0, 20), strict=True):
-        ref = float(geo.glidepath_deviation_m(x, z, RWY.tch_m, tan_gp))
-        assert ap.deviations(x, 3.0, z, 70.0, 1.0, 3.0)[0] == ref
+        ref = float(cone.deviation_m(x, 3.0, z))
+        assert ap.deviations(x, 3.0, z, 70.0, 1.0, 3.0)[0] == pytest.approx(ref, rel=0, abs=tol)
         d_dots = mon.dots(x, 3.0, z)[0]
         r_gp = max(mon.x_gp_m - min(x, mon.x_floor_m), 1.0)
-        assert d_dots == pytest.approx(ref / (r_gp * math.tan(mon.gs_dot_rad)), rel=1e-15)
+        assert d_dots == pytest.approx(ref / (r_gp * math.tan(mon.gs_dot_rad)), rel=1e-12, abs=1e-12)

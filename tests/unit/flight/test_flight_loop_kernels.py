@@ -31,6 +31,7 @@ from approachsim.flight.envelope import (
 )
 from approachsim.flight.run import _entry, termination_reason
 from approachsim.flight.turbulence import DrydenTurbulence, scales
+from approachsim.glidepath import GlidePath
 from approachsim.profile import load_profile
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
@@ -56,7 +57,7 @@ def test_the_autopilot_gain_layout_is_the_gains_dataclass():
     import dataclasses
 
     assert fk.AP_GAINS == tuple(f.name for f in dataclasses.fields(AutopilotGains))
-    assert fk.N_AP_PAR == len(fk.AP_GAINS) + 9
+    assert fk.N_AP_PAR == len(fk.AP_GAINS) + 13
 
 
 def _autopilot_inputs(rng, n, *, flare):
@@ -74,37 +75,52 @@ def _autopilot_inputs(rng, n, *, flare):
     cas[n // 2:n // 2 + 150] -= 30.0  # far too slow (CAS only: no TAS change): throttle at 1, integral frozen
     cas[2 * n // 3:2 * n // 3 + 150] += 30.0  # far too fast: throttle at 0
     tas[::7] = np.nan  # no speed complement at these steps
-    att = rng.normal(0.0, 0.05, (n, 6))  # phi, theta, p, q, beta, spare
+    att = rng.normal(0.0, 0.05, (n, 6))  # phi, theta, p, q, beta, yaw rate r
+    psi = 0.4 + rng.normal(0.0, 0.1, n)  # heading about the runway's (_autopilot: 0.4 rad), crabbed
+    psi[::5] += 2.0 * math.pi  # the crab is wrapped
     h_gear = np.full(n, np.nan)
     if flare:
         h_gear = np.linspace(40.0, -1.0, n)
-    return x, y, z, v, att, cas, h_gear, tas
+    return x, y, z, v, att, cas, h_gear, tas, psi
 
 
+@pytest.mark.parametrize("law", ["classic", "tecs"])
 @pytest.mark.parametrize("flare", [False, True])
-def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare):
+def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
+    import dataclasses
+
+    gains = dataclasses.replace(gains, tecs=law == "tecs")
     rng = np.random.default_rng(5 + flare)
     n = 600
-    x, y, z, v, att, cas, h_gear, tas = _autopilot_inputs(rng, n, flare=flare)
+    x, y, z, v, att, cas, h_gear, tas, psi = _autopilot_inputs(rng, n, flare=flare)
     ap = _autopilot(gains)
     par, st = fk.autopilot_arrays(ap)
-    seen = {"pitch limited": 0, "bank limited": 0, "throttle 1": 0, "throttle 0": 0, "flaring": 0, "idle": 0}
+    seen = {"pitch limited": 0, "bank limited": 0, "throttle 1": 0, "throttle 0": 0, "flaring": 0, "idle": 0,
+            "aligning": 0}
     for k in range(n):
         args = (x[k], y[k], z[k], *v[k], att[k, 0], att[k, 1], att[k, 2], att[k, 3], att[k, 4], cas[k])
-        int_d, int_y = ap.int_d, ap.int_y
-        want = ap.step(*args, None if math.isnan(h_gear[k]) else h_gear[k], None if math.isnan(tas[k]) else tas[k])
-        got = fk.autopilot_step(par, st, *args, h_gear[k], tas[k])
+        int_p = ap.int_b if gains.tecs else ap.int_d
+        int_y = ap.int_y
+        hg = None if math.isnan(h_gear[k]) else h_gear[k]
+        want = ap.step(*args, hg, None if math.isnan(tas[k]) else tas[k], psi=None if hg is None else psi[k],
+                       r=att[k, 5])
+        got = fk.autopilot_step(par, st, *args, h_gear[k], tas[k], psi[k] if hg is not None else math.nan,
+                                att[k, 5])
         assert got == want, f"step {k}"
         np.testing.assert_array_equal(st, np.array(ap.state()), err_msg=f"state at step {k}")
-        seen["pitch limited"] += ap.int_d == int_d
+        seen["pitch limited"] += (ap.int_b if gains.tecs else ap.int_d) == int_p and not ap.flaring
         seen["bank limited"] += ap.int_y == int_y
         seen["throttle 1"] += want[3] == 1.0
         seen["throttle 0"] += want[3] == 0.0
         seen["flaring"] += ap.flaring
         seen["idle"] += ap.flaring and h_gear[k] <= gains.retard_height_m
+        seen["aligning"] += ap.aligning
     assert seen["pitch limited"] > 0 and seen["bank limited"] > 0, seen
     assert seen["throttle 1"] > 0 and seen["throttle 0"] > 0, seen
-    assert (seen["flaring"] > 100 and seen["idle"] > 0) if flare else seen["flaring"] == 0, seen
+    if flare:
+        assert seen["flaring"] > 100 and seen["idle"] > 0 and seen["aligning"] > 100, seen
+    else:
+        assert seen["flaring"] == 0 and seen["aligning"] == 0, seen
 
 
 def test_dryden_scales_equal_the_oracle_across_the_regimes():
@@ -185,7 +201,8 @@ def _step_vectors(gains, *, land=False, turbulent=True, stop_h=-math.inf, n_step
     mon = StabilityMonitor(GP, TCH, 72.0, DT)
     turb = DrydenTurbulence("light", np.random.default_rng(4), n_steps, DT, 1.0) if turbulent else None
     frame = geo.RunwayFrame(math.radians(39.8), math.radians(-104.7), 1600.0, 0.4)
-    rw = SimpleNamespace(frame=frame, elevation_m=1600.0, glidepath_rad=GP, tch_m=TCH)
+    rw = SimpleNamespace(frame=frame, elevation_m=1600.0, glidepath_rad=GP, tch_m=TCH, heading_rad=0.4,
+                         threshold_lat_rad=frame.threshold_lat_rad)
     const = fk.imu_point_constants(np.array([9.0, 0.3, -1.1]), frame.threshold_lat_rad, rw, DT)
     par, st = fk.flight_vectors(const, ap, mon, turb, np.array([-20000.0, 0.0]), np.array([1650.0, 1600.0]),
                                 pitch_trim=-0.1, stop_height_m=stop_h, land=land,
@@ -220,7 +237,9 @@ def test_termination_codes_in_order_and_their_words(gains):
     assert term(400.0, 0.0, 11.0, wow_left=1.0, wow_nose=1.0) == fk.TERM_GROUND  # nose gear first
     assert term(x_high, 0.0, high, h_agl=0.0) == fk.TERM_GROUND
     assert term(x_high, 0.0, high, phi=1.01) == fk.TERM_DIVERGED
-    assert term(x_high, 0.0, high + 301.0) == fk.TERM_DIVERGED
+    on_cone = float(GlidePath(GP, TCH, 0.4, LAT).height_m(x_high))  # _autopilot's geometry
+    assert term(x_high, 0.0, on_cone + 299.0) == fk.TERM_NONE
+    assert term(x_high, 0.0, on_cone + 301.0) == fk.TERM_DIVERGED
     assert term(x_high, -1501.0, high) == fk.TERM_DIVERGED
     low = 600.0 * units.FT
     assert term((TCH - low) / math.tan(GP), 0.0, low + 30.0) == fk.TERM_UNSTABLE  # 1 dot is ~22 m here

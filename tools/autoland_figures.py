@@ -1,0 +1,237 @@
+"""The autoland figures of docs/autoland-before-after.md (issue 25): stabilization across the envelope, touchdown in
+a 20 kt crosswind, flight technical error against the straight glide path cone.
+
+    python tools/autoland_figures.py envelope --seeds 20 --out envelope.json   # 28 cases x 20 seeds, moderate
+    python tools/autoland_figures.py crosswind --runs 1000 --out xwind.json    # landings, 20 kt from the right
+    python tools/autoland_figures.py fte --runs 20 --out fte.json              # calm and moderate, 1000-200 ft
+    [--law classic|tecs] [--workers N]
+
+Every flight flies on the true state (no navigation in the loop), seeded: envelope case i, seed 1000 + i, runs
+0..seeds-1 (the envelope test's seed is run 0); crosswind and FTE: seed 1, runs 0..N-1 of the default profile.
+The glidepath deviation is taken against the straight cone (approachsim.glidepath) from the recorded ECEF
+position, whatever the autopilot flew on, so the before and after figures are measured the same way.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import math
+import os
+import sys
+import time
+import tomllib
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from approachsim import units  # noqa: E402
+from approachsim.evaluate.touchdown import touchdown_scalars  # noqa: E402
+from approachsim.flight.envelope_study import admissible, cases, measure, profile_dict  # noqa: E402
+from approachsim.flight.run import Approach  # noqa: E402
+from approachsim.glidepath import GlidePath  # noqa: E402
+from approachsim.profile import parse_profile  # noqa: E402
+
+DEFAULT = ROOT / "profiles" / "default.toml"
+BASE = tomllib.loads(DEFAULT.read_text(encoding="utf-8"))
+
+
+def _with_law(d: dict, law: str | None) -> dict:
+    if law is not None:
+        d = copy.deepcopy(d)
+        d.setdefault("aircraft", {})["autopilot_law"] = law
+    return d
+
+
+def clopper_pearson_upper(k: int, n: int, level: float = 0.95) -> float:
+    """One-sided Clopper-Pearson upper bound of a binomial proportion (k of n) at `level`."""
+    return 1.0 if k >= n else float(stats.beta.ppf(level, k + 1, n - k))
+
+
+def _cone_fte(res, approach: Approach) -> dict:
+    rw = approach.profile.runway
+    gp = GlidePath.of(rw)
+    tr = res.truth
+    x, y, z = tr.r_rwy[:, 0], tr.r_rwy[:, 1], tr.r_rwy[:, 2]
+    sel = (z <= 1000.0 * units.FT) & (z >= 200.0 * units.FT)
+    if not np.any(sel):
+        return {}
+    d_cone = gp.deviation_m(x, y, z)[sel] / units.FT
+    d_old = (z - (rw.tch_m - x * math.tan(rw.glidepath_rad)))[sel] / units.FT
+    return {"cone_rms_ft": float(np.sqrt(np.mean(d_cone**2))), "cone_max_ft": float(np.max(np.abs(d_cone))),
+            "cone_mean_ft": float(np.mean(d_cone)),
+            "ellipsoid_path_rms_ft": float(np.sqrt(np.mean(d_old**2))),
+            "lat_rms_ft": float(np.sqrt(np.mean(y[sel] ** 2)) / units.FT)}
+
+
+def _envelope_job(args: tuple) -> list[dict]:
+    idx, seeds, turb, law = args
+    c = cases()[idx]
+    if turb != "design":
+        c = type(c)(**{**c.__dict__, "turbulence": turb})
+    c = admissible(BASE, c, DEFAULT)
+    approach = Approach(parse_profile(_with_law(profile_dict(BASE, c), law), source=DEFAULT))
+    out = []
+    for r in range(seeds):
+        m = measure(approach, seed=1000 + c.index, run=r)
+        m.update(case=idx, run=r, wind=c.wind, glidepath_deg=c.glidepath_deg, turbulence=c.turbulence)
+        out.append(m)
+    return out
+
+
+def envelope(seeds: int, turb: str, law: str | None, workers: int) -> dict:
+    jobs = [(i, seeds, turb, law) for i in range(28)]
+    with ProcessPoolExecutor(workers) as ex:
+        rows = [r for rs in ex.map(_envelope_job, jobs) for r in rs]
+    n = len(rows)
+    unstab = [r for r in rows if r["termination"].startswith("unstabilized")]
+    failed = [r for r in rows if not r["ok"]]
+    by_reason: dict[str, int] = {}
+    for r in unstab:
+        what = r["termination"].split(": ", 1)[1].split(" ")[0:2]
+        key = " ".join(what)
+        by_reason[key] = by_reason.get(key, 0) + 1
+    lim = {"light": (5.0, 10.0), "moderate": (10.0, 20.0)}
+    outside = 0
+    for r in rows:
+        if not r["ok"]:
+            continue
+        v, lat = lim[r["turbulence"]]
+        if not (r["vertical_rms_ft"] <= v and r["lateral_rms_ft"] <= lat and -5 <= r["airmass_err_min_kt"]
+                and r["airmass_err_max_kt"] <= 5 and abs(r["path_err_deg"]) <= 0.1 and abs(r["x50_err_ft"]) <= 300):
+            outside += 1
+    ok = [r for r in rows if r["ok"]]
+    return {
+        "flights": n, "turbulence": turb, "law": law or "aircraft default",
+        "unstabilized": len(unstab), "unstabilized_fraction": len(unstab) / n,
+        "unstabilized_cp95_upper": clopper_pearson_upper(len(unstab), n),
+        "failed": len(failed), "failed_cp95_upper": clopper_pearson_upper(len(failed), n),
+        "unstabilized_by_reason": by_reason,
+        "completed_outside_a_test_limit": outside,
+        "vertical_rms_ft_mean": float(np.mean([r["vertical_rms_ft"] for r in ok])),
+        "vertical_rms_ft_max": float(np.max([r["vertical_rms_ft"] for r in ok])),
+        "airmass_err_kt_range": [float(np.min([r["airmass_err_min_kt"] for r in ok])),
+                                 float(np.max([r["airmass_err_max_kt"] for r in ok]))],
+        "x50_err_ft_absmax": float(np.max([abs(r["x50_err_ft"]) for r in ok])),
+        "rows": rows,
+    }
+
+
+def _xwind_profile(law: str | None, speed_kt: float, turb: str) -> dict:
+    d = copy.deepcopy(BASE)
+    hdg = float(d["runway"]["heading_true_deg"])
+    d["environment"].update(wind_speed_kt=speed_kt, wind_from_deg=(hdg + 90.0) % 360.0, turbulence=turb)
+    return _with_law(d, law)
+
+
+def _xwind_job(args: tuple) -> list[dict]:
+    runs, law, speed_kt, turb = args
+    approach = Approach(parse_profile(_xwind_profile(law, speed_kt, turb), source=DEFAULT), land=True)
+    arms = approach.main_gear_lever_arms_m
+    out = []
+    for r in runs:
+        res = approach.fly(seed=1, run=r)
+        row = {"run": r, "termination": res.termination, "ok": res.ok}
+        if res.termination == "touchdown":
+            row.update(touchdown_scalars(res.truth, arms))
+            row["flight_td_x_m"], row["flight_td_sink_mps"] = res.touchdown_x_m, res.touchdown_sink_mps
+        out.append(row)
+    return out
+
+
+def crosswind(runs: int, law: str | None, workers: int, speed_kt: float, turb: str) -> dict:
+    chunks = [list(range(i, runs, workers * 4)) for i in range(workers * 4)]
+    with ProcessPoolExecutor(workers) as ex:
+        rows = sorted((r for rs in ex.map(_xwind_job, [(c, law, speed_kt, turb) for c in chunks]) for r in rs),
+                      key=lambda r: r["run"])
+    td = [r for r in rows if r["termination"] == "touchdown"]
+
+    def st(key: str, f: float) -> dict:
+        v = np.array([r[key] for r in td]) * f
+        return {"mean": float(v.mean()), "sd": float(v.std(ddof=1)), "min": float(v.min()), "max": float(v.max()),
+                "p99_abs": float(np.percentile(np.abs(v), 99))}
+
+    deg, ft, fps = 180.0 / math.pi, 1.0 / units.FT, 1.0 / units.FPS
+    return {
+        "landings": runs, "completed": len(td), "failed": runs - len(td), "law": law or "aircraft default",
+        "wind": f"{speed_kt:g} kt from the right", "turbulence": turb,
+        "failures": sorted({r["termination"] for r in rows if r["termination"] != "touchdown"}),
+        "gear_x_ft": st("td_x_m", ft), "gear_y_ft": st("td_y_m", ft),
+        "outboard_gear_y_ft": st("td_outboard_gear_y_m", ft),
+        "drift_deg": st("td_gear_slip_rad", deg), "crab_deg": st("td_crab_rad", deg),
+        "bank_deg": st("td_bank_rad", deg), "sink_fps": st("td_sink_mps", fps),
+        "imu_x_ft": st("td_imu_x_m", ft), "imu_sink_fps": st("td_imu_sink_mps", fps),
+        "flight_field_x_ft": st("flight_td_x_m", ft), "flight_field_sink_fps": st("flight_td_sink_mps", fps),
+        "drift_over_5deg": int(sum(abs(r["td_gear_slip_rad"]) * deg > 5.0 for r in td)),
+    }
+
+
+def _fte_job(args: tuple) -> list[dict]:
+    runs, law, turb = args
+    d = copy.deepcopy(BASE)
+    d["environment"].update(turbulence=turb)
+    approach = Approach(parse_profile(_with_law(d, law), source=DEFAULT))
+    out = []
+    for r in runs:
+        res = approach.fly(seed=1, run=r)
+        out.append({"run": r, "termination": res.termination, **_cone_fte(res, approach)})
+    return out
+
+
+def _pooled(rows: list[dict], key: str) -> float:
+    return float(np.sqrt(np.mean([r[key] ** 2 for r in rows])))
+
+
+def fte(runs: int, law: str | None, workers: int) -> dict:
+    res = {}
+    for turb in ("none", "moderate"):
+        n = 1 if turb == "none" else runs
+        chunks = [list(range(i, n, workers)) for i in range(min(workers, n))]
+        with ProcessPoolExecutor(workers) as ex:
+            rows = [r for rs in ex.map(_fte_job, [(c, law, turb) for c in chunks]) for r in rs]
+        ok = [r for r in rows if "cone_rms_ft" in r]
+        res["calm" if turb == "none" else turb] = {
+            "flights": n, "failed": sum(r["termination"] != "reached stop height" for r in rows),
+            "cone_rms_ft_pooled": _pooled(ok, "cone_rms_ft"), "cone_max_ft": float(max(r["cone_max_ft"] for r in ok)),
+            "cone_mean_ft": float(np.mean([r["cone_mean_ft"] for r in ok])),
+            "ellipsoid_path_rms_ft_pooled": _pooled(ok, "ellipsoid_path_rms_ft"),
+            "lat_rms_ft_pooled": _pooled(ok, "lat_rms_ft"), "rows": rows}
+    res["law"] = law or "aircraft default"
+    return res
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("what", choices=["envelope", "crosswind", "fte"])
+    p.add_argument("--seeds", type=int, default=20)
+    p.add_argument("--runs", type=int, default=1000)
+    p.add_argument("--turbulence", default="moderate", help="envelope: moderate | design; crosswind: light ...")
+    p.add_argument("--wind-kt", type=float, default=20.0)
+    p.add_argument("--law", default=None)
+    p.add_argument("--workers", type=int, default=max(1, min(2, os.cpu_count() or 1)))
+    p.add_argument("--out", type=Path, required=True)
+    a = p.parse_args()
+    t0 = time.time()
+    if a.what == "envelope":
+        res = envelope(a.seeds, a.turbulence, a.law, a.workers)
+    elif a.what == "crosswind":
+        res = crosswind(a.runs, a.law, a.workers, a.wind_kt, "light" if a.turbulence == "moderate" else a.turbulence)
+    else:
+        res = fte(a.runs, a.law, a.workers)
+    res["wall_s"] = time.time() - t0
+    a.out.write_text(json.dumps(res, indent=1, default=float), encoding="utf-8")
+    print(json.dumps(_brief(res), indent=1, default=float))
+
+
+def _brief(d: dict) -> dict:
+    return {k: (_brief(v) if isinstance(v, dict) else v) for k, v in d.items() if k != "rows"}
+
+
+if __name__ == "__main__":
+    main()
