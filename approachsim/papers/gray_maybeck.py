@@ -1,11 +1,19 @@
-"""Gray & Maybeck (seed 002): the 16-case study (Table 2) on the closed-loop simulator, Tables 3-8 beside ours.
+"""Gray & Maybeck (seed 002): the 16-case study (Table 2), Tables 3-8 beside ours, in two variants.
 
 Gray & Maybeck, *An integrated GPS/INS/Baro and radar altimeter system for aircraft precision approach
 landings*. Table 2: three INS grades (0.4 / 2.0 / 4.0 nmi/h CEP), baro always, 4-SV P-code GPS, radar
 altimeter below 3000 ft AGL, one pseudolite near the runway, single and double GPS outages. Each case is the
 shipped profile `gray-maybeck` with the paper's own values pinned (PINNED: every key of the era budgets and
 of the models other defaults may move) and the case's own settings (`case_settings`). 15-run Monte Carlo per
-case (assumption 10), closed loop.
+case (assumption 10). Two variants (VARIANTS):
+
+- "faithful", the reproduction's headline (`approachsim reproduce gray-maybeck`): open loop on one flown truth,
+  the paper's 4 m / 5 m GPS, R tuned by one stated rule, the initial errors of 8 min alignment + 60 min flight
+  per grade, short outages (papers/gray_maybeck_faithful.py states every value and its formula); its gap fills
+  are measured by the sensitivity table (papers/gray_maybeck_sensitivity.py, `--sensitivity N`);
+- "closed", our closed-loop study (`--closed`; the regress baselines' case profiles, `case_profile(case)`).
+
+The note is written by papers/gray_maybeck_note.py, with the rule "reproduces" (magnitude and direction).
 
 Figures of merit (sec. 7): the time-averaged RMS of the latitude, longitude, altitude and clock-bias error
 (evaluate/timeavg.py: sqrt of the mean over runs of each run's time-averaged squared error, from

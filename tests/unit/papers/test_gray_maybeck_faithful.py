@@ -133,7 +133,7 @@ def _sens_data(n: int, lat_pl: float, cat2: float) -> dict[int, dict[str, np.nda
     out = {}
     for c in gs.ALL_CASES:
         lat = lat_pl if c in gs.PL_CASES else 10.0
-        alt = 3.0 if c in (2, 4, 6, 10, 11, 12) else 6.0 if c == 16 else 20.0
+        alt = 3.0 if c in (4, 6, 11) else 6.0 if c == 16 else 20.0
         out[c] = {"ta_latitude_ft2": (lat * w) ** 2, "ta_longitude_ft2": (10.0 * w) ** 2,
                   "ta_altitude_ft2": (alt * w) ** 2, "ta_clock_bias_ft2": (5.0 * w) ** 2,
                   "cat2_lat_ft2": (cat2 * w) ** 2, "cat2_vert_ft2": (0.5 * w) ** 2}
@@ -152,9 +152,9 @@ def test_sensitivity_metrics_and_pairing() -> None:
     assert tab["better"]["diff"]["cat2_lat_ft"] == pytest.approx(-4.0)
     lo, hi = tab["better"]["diff_ci"]["t3_lat_pct"]
     assert lo < 40.0 < hi  # 50 % - 10 %, paired: the common run weights cancel
-    sens = {"runs": 200, "common_runs": 200, "rows": [{"key": "same", "label": "s", "cases": ["X"]},
-                                                        {"key": "better", "label": "b", "cases": ["X"]}],
-            "table": tab, "verdicts": {"faithful": {"X": "fails"}}, "faithful_uere_m": 3.2, "nrc_uere_m": 4.1}
+    sens = {"runs": 200, "common_runs": 200, "rows": [{"key": "same", "label": "s", "cases": ["XI"]},
+                                                        {"key": "better", "label": "b", "cases": ["XI"]}],
+            "table": tab, "verdicts": {"faithful": {"XI": "fails"}}, "faithful_uere_m": 3.2, "nrc_uere_m": 4.1}
     words = gn.sensitivity_findings(sens)
     assert "rows under the limit: better" in words[0]
 
