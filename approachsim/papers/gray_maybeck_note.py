@@ -395,6 +395,12 @@ def sensitivity_findings(sens: dict) -> list[str]:
                f"({r['diff']['t3_hvar_pct']:+.1f} points {_ci(r['diff_ci']['t3_hvar_pct'], '+.1f')}); latitude / "
                f"longitude cuts there {r['value']['t3_lat_pct']:.1f} / {r['value']['t3_lon_pct']:.1f} % (the paper "
                "48.3 / 57.6 %).")
+    single = {k: r for k, r in rows.items() if k.startswith("pl-") and "two" not in k}
+    if single:
+        sb = max(single, key=lambda k: single[k]["value"]["t3_hvar_pct"])
+        out.append(f"With one pseudolite (the paper's number), the largest cut of the horizontal error variance over "
+                   f"the sites tried is {sb} at {single[sb]['value']['t3_hvar_pct']:.1f} % (the paper "
+                   f"{paper_cut:.1f} %).")
     for m in ("t4_alt_ft", "t6_alt_pct"):
         moved = [(k, rows[k]["diff"][m], rows[k]["diff_ci"][m]) for k in rows if _significant(rows[k]["diff_ci"][m])]
         lab = METRICS[m]["label"]

@@ -104,6 +104,9 @@ ROWS: tuple[Row, ...] = (
         "(150-170 s, 238-258 s)", _outages(((150.0, 170.0), (238.0, 258.0))), OUTAGE_CASES),
     Row("untuned", "filter R untuned: the full variance of the range errors (nav.gps_sigma_scale = 1)",
         (("nav.gps_sigma_scale", 1.0),), ALL_CASES),
+    Row("channel-states", "filter with per-channel range-error states (nav.channel_states = true, R = the white "
+        "code noise): not the paper's 13-state filter; what carrying the correlated GPS errors as states gives",
+        (("nav.channel_states", True), ("nav.gps_sigma_scale", 1.0)), ALL_CASES),
     Row("prior-start", "initial errors: the closed study's independent prior draw (5 m, 0.05 m/s, 0.05 / 0.5 mrad) "
         "instead of the converged start after the free-inertial prior",
         (("nav.initial_error.start", "prior"), ("nav.initial_error.position_m", 5.0),
