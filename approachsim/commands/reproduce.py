@@ -44,10 +44,13 @@ def _figure_writer(name: str) -> Callable[[Any, Path], list[str]]:
     return lambda d, out: rep.write_figures(d, out)
 
 
-def reproduce(name: str, out_dir: Path, *, seed: int, runs: int, cases: list[str] | None = None) -> dict:
+def reproduce(name: str, out_dir: Path, *, seed: int, runs: int, cases: list[str] | None = None,
+              closed: bool = False, sensitivity_runs: int | None = None) -> dict:
     """Compute paper `name`'s reproduction, draw its figures, write DIR/<name>.json and DIR/<name>.md; return
     the JSON content (with the figure names under "figures"). A paper whose compute() takes out_dir (its
-    campaigns' run stores) and cases (a subset of its cases) gets them."""
+    campaigns' run stores) and cases (a subset of its cases) gets them; closed and sensitivity_runs go to a
+    paper that has them (gray-maybeck: our closed-loop study instead of the faithful variant, and the
+    sensitivity table's runs)."""
     paper = importlib.import_module(PAPERS[name][0])
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -64,6 +67,11 @@ def reproduce(name: str, out_dir: Path, *, seed: int, runs: int, cases: list[str
         if "cases" not in params:
             raise ProfileError(f"--cases: {name} has no cases to choose from (gray-maybeck has)")
         extra["cases"] = cases
+    for key, val, flag in (("closed", closed, "--closed"), ("sensitivity_runs", sensitivity_runs, "--sensitivity")):
+        if val:
+            if key not in params:
+                raise ProfileError(f"{flag}: {name} has no such option (gray-maybeck has)")
+            extra[key] = val
     result, data = paper.compute(seed=seed, runs=runs, **extra)
     figures = _figure_writer(name)(data, out_dir)
     result["figures"] = figures
@@ -84,10 +92,14 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "(Hajiyev & Saltoglu), manero-hajiyev (Manero Contreras & Hajiyev), sokolovic (Sokolovic, "
                     "Dikic & Stancic), chernodarov (Chernodarov), gray-maybeck (Gray & Maybeck, An integrated "
                     "GPS/INS/Baro and radar altimeter system for aircraft precision approach landings: the 16 cases "
-                    "of its Table 2, closed loop, 15 runs each by default).",
+                    "of its Table 2, 15 runs each by default; by default the faithful variant, open loop on a "
+                    "flown truth with the paper's own GPS budget, tuning and initial errors; --closed: our "
+                    "closed-loop study; --sensitivity N: the sensitivity table of the gap fills at N runs).",
         examples=["approachsim reproduce sokolovic --out out/sokolovic",
                   "approachsim reproduce hajiyev-saltoglu --out out/hs --runs 200 --seed 3",
-                  "approachsim reproduce gray-maybeck --out out/gm --cases II,X --runs 5"],
+                  "approachsim reproduce gray-maybeck --out out/gm --cases II,X --runs 5",
+                  "approachsim reproduce gray-maybeck --out out/gm-closed --closed",
+                  "approachsim reproduce gray-maybeck --out out/gm --runs 1000 --sensitivity 200"],
     )
     p.add_argument("paper", help=f"one of: {', '.join(PAPERS)}")
     p.add_argument("--out", required=True, type=Path, help="output directory")
@@ -96,6 +108,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help=f"Monte Carlo runs (default: the paper's, gray-maybeck 15 per case; else {DEFAULT_RUNS})")
     p.add_argument("--cases", default=None,
                    help="gray-maybeck only: comma-separated subset of Table 2's cases, e.g. II,X (default all 16)")
+    p.add_argument("--closed", action="store_true",
+                   help="gray-maybeck only: our closed-loop study (the regress baselines' cases) instead of the "
+                        "faithful variant")
+    p.add_argument("--sensitivity", type=int, default=None, metavar="N",
+                   help="gray-maybeck only: also the sensitivity table of the faithful variant's gap fills, N runs "
+                        "per row and case (paired: the same seed and runs)")
     p.set_defaults(func=run)
 
 
@@ -110,7 +128,10 @@ def run(args: argparse.Namespace) -> int:
     if args.seed < 0:
         raise ProfileError(f"--seed: must be >= 0, got {args.seed}")
     cases = [c for c in args.cases.split(",") if c.strip()] if args.cases else None
-    result = reproduce(args.paper, args.out, seed=args.seed, runs=runs, cases=cases)
+    if args.sensitivity is not None and args.sensitivity < 2:
+        raise ProfileError(f"--sensitivity: must be >= 2 runs, got {args.sensitivity}")
+    result = reproduce(args.paper, args.out, seed=args.seed, runs=runs, cases=cases, closed=args.closed,
+                       sensitivity_runs=args.sensitivity)
     print(f"{args.paper}: {runs} runs, seed {args.seed}")
     for line in paper.headline(result):
         print(f"  {line}")

@@ -25,7 +25,7 @@ from approachsim.nav.kernels import inloop as ik
 from approachsim.nav.kernels import strapdown as sk
 from approachsim.nav.navigator import Navigator, NavRun
 from approachsim.nav.observations import Observations
-from approachsim.nav.system import NavSystem
+from approachsim.nav.system import NavSystem, tuned_records
 from approachsim.records import ApproachErrors, Truth
 from approachsim.seeding import stream
 from approachsim.sensors.baro import Baro
@@ -141,6 +141,7 @@ class NavInTheLoop:
         """The aiding sensors' samples at truth row k (their pre-drawn errors applied to the row)."""
         recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite") if (r := self._apply(name, k, truth))
                 is not None}
+        recs = dict(tuned_records(recs, self.nav.nav.gps_sigma_scale))  # [nav] gps_sigma_scale (R tuning)
         return Observations.at(recs, float(truth.t_s[k]), 0.25 * self.dt, False), recs
 
     def step(self, k: int, truth: Truth) -> tuple[Array, Array]:

@@ -292,6 +292,7 @@ class NavSystem:
         the integrity bank's sub-filters, which differ only in the measurements they use): the INS is integrated
         once for all of them (feed-forward only; checked).
         """
+        records = tuned_records(records, self.nav.gps_sigma_scale)
         if shared_covariance and not self.shares_covariance():
             raise ValueError("shared_covariance needs the optimal 'ekf' filter (robust filters gate per run), "
                              "tight GPS coupling and a constant-gain or no baro loop")
@@ -359,3 +360,12 @@ class NavSystem:
             j0 = j1
         results = nav.results(truth, solutions={0} if copies else True)  # copies: the main filter's solution only
         return results if batched else results[0]
+
+
+def tuned_records(records: Mapping[str, Any], gps_sigma_scale: float) -> Mapping[str, Any]:
+    """The records as the filter weighs them: the GNSS record's nominal pseudorange 1-sigma times gps_sigma_scale
+    ([nav] gps_sigma_scale, R tuning without channel states); the same mapping when the scale is 1."""
+    g = records.get("gnss")
+    if g is None or gps_sigma_scale == 1.0:
+        return records
+    return {**records, "gnss": replace(g, sigma_m=np.asarray(g.sigma_m) * gps_sigma_scale)}

@@ -1,11 +1,19 @@
-"""Gray & Maybeck (seed 002): the 16-case study (Table 2) on the closed-loop simulator, Tables 3-8 beside ours.
+"""Gray & Maybeck (seed 002): the 16-case study (Table 2), Tables 3-8 beside ours, in two variants.
 
 Gray & Maybeck, *An integrated GPS/INS/Baro and radar altimeter system for aircraft precision approach
 landings*. Table 2: three INS grades (0.4 / 2.0 / 4.0 nmi/h CEP), baro always, 4-SV P-code GPS, radar
 altimeter below 3000 ft AGL, one pseudolite near the runway, single and double GPS outages. Each case is the
 shipped profile `gray-maybeck` with the paper's own values pinned (PINNED: every key of the era budgets and
 of the models other defaults may move) and the case's own settings (`case_settings`). 15-run Monte Carlo per
-case (assumption 10), closed loop.
+case (assumption 10). Two variants (VARIANTS):
+
+- "faithful", the reproduction's headline (`approachsim reproduce gray-maybeck`): open loop on one flown truth,
+  the paper's 4 m / 5 m GPS, R tuned by one stated rule, the initial errors of 8 min alignment + 60 min flight
+  per grade, short outages (papers/gray_maybeck_faithful.py states every value and its formula); its gap fills
+  are measured by the sensitivity table (papers/gray_maybeck_sensitivity.py, `--sensitivity N`);
+- "closed", our closed-loop study (`--closed`; the regress baselines' case profiles, `case_profile(case)`).
+
+The note is written by papers/gray_maybeck_note.py, with the rule "reproduces" (magnitude and direction).
 
 Figures of merit (sec. 7): the time-averaged RMS of the latitude, longitude, altitude and clock-bias error
 (evaluate/timeavg.py: sqrt of the mean over runs of each run's time-averaged squared error, from
@@ -32,7 +40,6 @@ import numpy as np
 
 from approachsim import seeding, units
 from approachsim.config import ProfileError
-from approachsim.papers.claims import reproduces
 
 PAPER = "gray-maybeck"
 TITLE = ("Gray & Maybeck, *An integrated GPS/INS/Baro and radar altimeter system for aircraft precision approach "
@@ -215,21 +222,78 @@ ASSUMPTIONS = (
     "GPS outages: 60-120 s (single) and 60-120 s + 160-220 s (double) after the run start (gap fill).",
 )
 
+FAITHFUL_ASSUMPTIONS = (
+    "Open loop (the paper's PROFGEN -> MSOFE chain): the bundled JSBSim 737 flies the approach once on true "
+    "navigation at 133 kt on a 3 deg glideslope in calm air, from 10 nmi out (the paper's PROFGEN tanker sortie "
+    "starts earlier: only the final segment is scored); every run navigates over that flown truth with its own "
+    "sensor and filter noise, so no run is lost to an approach flown on the navigation solution.",
+    "GPS: the NRC 1995 P(Y) pseudorange budget scaled by one factor to the paper's 4 m horizontal / 5 m vertical "
+    "(sensors.gnss.budget_scale = sqrt((4^2 + 5^2) / (HDOP^2 + VDOP^2)) / UERE_budget at the pinned sky's four); "
+    "the horizontal and vertical figures it gives are in the note.",
+    "Filter: our error-state EKF, tightly coupled, feed-forward, without per-channel range-error states (the "
+    "paper's 2-state clock); R tuned by one rule for every case: each range-error component of 1-sigma s and "
+    "correlation time tau counts s^2 max(1, min(2 tau, T) / dt) (T the approach's duration, dt the aiding "
+    "interval), nav.gps_sigma_scale = the square root of that over the untuned sum of variances.",
+    "Initial errors: per INS grade, our free-inertial propagation of 8 min alignment + 60 min flight (the grade's "
+    "turn-on biases and random walks, Schuler dynamics on a stationary earth) as the prior of the converged start "
+    "(the filter has aided the INS before the final).",
+    "Baro: the paper's 50-150 ft 1 sigma read as a first-order Gauss-Markov bias of 100 ft with a 3600 s "
+    "correlation time (gap fill), plus 1 m white noise.",
+    "Radar altimeter: R = (0.01 h)^2 + 0.25 with the 0.25 read as m^2 (0.5 m floor), white noise only, below "
+    "3000 ft AGL, flat terrain at the runway elevation (assumption 11).",
+    "Pseudolite: one, synchronized to GPS time, 1000 ft past the threshold and 500 ft left of the centreline, "
+    "30 ft high (gap fill: the paper's site is not given), code noise 0.3 m, all other errors zero (assumption 4).",
+    "GPS outages: short, 20 s each: 100-120 s (single) and 100-120 s + 200-220 s (double) after the run start "
+    "(gap fill; the paper gives their number only).",
+)
+
 
 # --- the cases as profiles --------------------------------------------------------------------------------------
 
-def case_settings(case: Case) -> list[tuple[str, Any]]:
-    """Every profile field one case sets on the shipped gray-maybeck profile: PINNED, then the case's own."""
+VARIANTS = ("faithful", "closed")
+"""faithful: the paper's own setup (papers/gray_maybeck_faithful.py), the reproduction's headline; closed: our
+closed-loop study (today's PINNED values, the regress baselines)."""
+
+
+def case_settings(case: Case, variant: str = "closed") -> list[tuple[str, Any]]:
+    """Every profile field one case sets on the shipped gray-maybeck profile: PINNED, then the case's own; the
+    faithful variant then overrides the values papers/gray_maybeck_faithful.py computes for the case (later
+    settings win). variant "closed" is exactly the closed-loop study the regress baselines were made with."""
+    if variant not in VARIANTS:
+        raise ProfileError(f"gray-maybeck variant: must be one of {', '.join(VARIANTS)}; got {variant!r}")
+    windows = OUTAGE_WINDOWS_S if variant == "closed" else _faithful().OUTAGE_WINDOWS_S
     faults = [{"sensor": "gnss", "kind": "outage", "start_s": a, "end_s": b}
-              for a, b in OUTAGE_WINDOWS_S[case.gps_outages]]
+              for a, b in windows[case.gps_outages]]
     own = [
         ("sensors.imu.grade", case.grade),
         ("sensors.radalt.enabled", case.radalt),
         ("sensors.pseudolite.enabled", case.pseudolite),
         ("faults", faults),
     ]
-    return (list(PINNED) + (list(PINNED_RADALT) if case.radalt else [])
-            + (list(PINNED_PSEUDOLITE) if case.pseudolite else []) + own)
+    out = (list(PINNED) + (list(PINNED_RADALT) if case.radalt else [])
+           + (list(PINNED_PSEUDOLITE) if case.pseudolite else []) + own)
+    if variant == "faithful":
+        out += list(faithful_overrides(case).items())
+    return out
+
+
+def _faithful() -> Any:
+    from approachsim.papers import gray_maybeck_faithful
+
+    return gray_maybeck_faithful
+
+
+def faithful_overrides(case: Case) -> dict[str, Any]:
+    """The faithful variant's own values for a case (gray_maybeck_faithful.faithful_settings on the case's
+    closed-loop profile and IMU grade)."""
+    from approachsim.sensors.presets import PRESETS
+
+    return _faithful().faithful_settings(case_profile(case, "closed"), PRESETS[case.grade])
+
+
+def settings_dict(case: Case, variant: str = "closed", extra: Sequence[tuple[str, Any]] = ()) -> dict[str, Any]:
+    """case_settings (and extra settings after them) as one dict, later keys winning."""
+    return dict(list(case_settings(case, variant)) + list(extra))
 
 
 def _set(data: dict, dotted: str, value: Any) -> None:
@@ -254,15 +318,19 @@ def base_profile_path() -> Path:
     return {s.name: s.path for s in shipped_profiles()}["gray-maybeck"]
 
 
-def case_profile(case: Case) -> Any:
-    """The validated Profile of one case (ProfileError names the field if a pinned value is rejected)."""
+def case_profile(case: Case, variant: str = "closed", extra: Sequence[tuple[str, Any]] = (),
+                 label: str = "") -> Any:
+    """The validated Profile of one case in a variant ("closed": the regress baselines' profile, unchanged;
+    "faithful"), with extra settings after the variant's (a sensitivity row); ProfileError names the field if a
+    value is rejected."""
     from approachsim.profile import parse_profile
 
     path = base_profile_path()
     data = tomllib.loads(path.read_text(encoding="utf-8"))
-    for dotted, value in case_settings(case):
+    for dotted, value in settings_dict(case, variant, extra).items():
         _set(data, dotted, value)
-    data["name"] = f"gray-maybeck[case {case.roman}]"
+    tag = "" if variant == "closed" else f", {variant}"
+    data["name"] = f"gray-maybeck[case {case.roman}{tag}{', ' + label if label else ''}]"
     try:
         return parse_profile(data, source=path)
     except ProfileError as e:
@@ -336,10 +404,18 @@ def _group_rms(ms: dict[int, dict[str, np.ndarray]], cases: Sequence[int], idx: 
     return np.mean(np.array(vals), axis=0)
 
 
-def compare_groups(ms: dict[int, dict[str, np.ndarray]], a: Sequence[int], b: Sequence[int], *, seed: int) -> dict:
-    """Group a vs group b per state: averaged RMS (ft) of each, % change (a - b) / a x 100, and their 95 %
-    paired bootstrap intervals (resampling the run index, common to every case). ms[case][state]: per-run
-    time-averaged squared errors (ft^2) over the runs every case completed, in the same run order."""
+PAPER_RUNS = 15
+"""The paper's Monte Carlo size (assumption 10): the magnitude rule's subsample size."""
+
+
+def compare_groups(ms: dict[int, dict[str, np.ndarray]], a: Sequence[int], b: Sequence[int], *, seed: int,
+                   paper_runs: int = PAPER_RUNS) -> dict:
+    """Group a vs group b per state: averaged RMS (ft) of each, % change (a - b) / a x 100, their 95 % paired
+    bootstrap intervals (resampling the run index, common to every case), and the magnitude rule's ranges:
+    the central 95 % of the same three statistics computed from `paper_runs` runs drawn (with replacement, the
+    same run indices in every case) from ours, the spread a Monte Carlo of the paper's size would show if our
+    model were the truth. ms[case][state]: per-run time-averaged squared errors (ft^2) over the runs every case
+    completed, in the same run order."""
     n = len(next(iter(ms.values()))[STATES[0]])
     full = np.arange(n)
     ga, gb = _group_rms(ms, a, full), _group_rms(ms, b, full)
@@ -347,18 +423,40 @@ def compare_groups(ms: dict[int, dict[str, np.ndarray]], a: Sequence[int], b: Se
     out: dict[str, Any] = {"runs": int(n), "a_ft": ga.tolist(), "b_ft": gb.tolist(), "pct": pct.tolist()}
     if n >= 2:
         rng = seeding.stream(seed, 0, "gray-maybeck-bootstrap")
-        boot = np.empty((BOOTSTRAP, 3, len(STATES)))
-        for k in range(BOOTSTRAP):
-            idx = rng.integers(0, n, n)
-            xa, xb = _group_rms(ms, a, idx), _group_rms(ms, b, idx)
-            boot[k] = (xa, xb, (xa - xb) / xa * 100.0)
-        lo, hi = np.percentile(boot, [50 * (1 - LEVEL), 100 - 50 * (1 - LEVEL)], axis=0)
-        out["a_ci_ft"] = np.stack([lo[0], hi[0]], axis=1).tolist()
-        out["b_ci_ft"] = np.stack([lo[1], hi[1]], axis=1).tolist()
-        out["pct_ci"] = np.stack([lo[2], hi[2]], axis=1).tolist()
+        q = [50 * (1 - LEVEL), 100 - 50 * (1 - LEVEL)]
+        for key, size in (("", n), ("_paper_runs", paper_runs)):
+            boot = np.empty((BOOTSTRAP, 3, len(STATES)))
+            for k in range(BOOTSTRAP):
+                idx = rng.integers(0, n, size)
+                xa, xb = _group_rms(ms, a, idx), _group_rms(ms, b, idx)
+                boot[k] = (xa, xb, (xa - xb) / xa * 100.0)
+            lo, hi = np.percentile(boot, q, axis=0)
+            suffix = "_ci" if not key else "_range" + key
+            out["a" + suffix + "_ft"] = np.stack([lo[0], hi[0]], axis=1).tolist()
+            out["b" + suffix + "_ft"] = np.stack([lo[1], hi[1]], axis=1).tolist()
+            out["pct" + suffix] = np.stack([lo[2], hi[2]], axis=1).tolist()
+        out["paper_runs"] = int(paper_runs)
     else:
         out["a_ci_ft"] = out["b_ci_ft"] = out["pct_ci"] = None
+        out["a_range_paper_runs_ft"] = out["b_range_paper_runs_ft"] = out["pct_range_paper_runs"] = None
     return out
+
+
+def _inside(x: float, r: Sequence[float] | None) -> bool:
+    return r is not None and r[0] <= x <= r[1]
+
+
+def row_verdict(direction_ok: bool, magnitude_ok: bool) -> str:
+    """The rule's verdict of one row of Tables 3-6 (section 'reproduces' of the note): 'reproduces' (the paper's
+    % change inside our paper-size range and the same direction), 'direction only', 'magnitude only' (the
+    paper's % inside our range while our direction is undecided or opposite) or 'does not reproduce'."""
+    if direction_ok and magnitude_ok:
+        return "reproduces"
+    if direction_ok:
+        return "direction only"
+    if magnitude_ok:
+        return "magnitude only"
+    return "does not reproduce"
 
 
 def direction(pct_ci: Sequence[float] | None) -> str:
@@ -380,9 +478,31 @@ def table_claims(ours: dict, paper: dict) -> list[dict]:
         ci = ours["pct_ci"][j] if ours["pct_ci"] is not None else None
         o_dir = direction(ci)
         inside = ci is not None and ci[0] <= p_signed <= ci[1]
+
+        def rng_of(key: str, j: int = j) -> Sequence[float] | None:
+            r = ours.get(key)
+            return None if r is None else r[j]
+        mag = {"a": _inside(p_a, rng_of("a_range_paper_runs_ft")), "b": _inside(p_b, rng_of("b_range_paper_runs_ft")),
+               "pct": _inside(p_signed, rng_of("pct_range_paper_runs"))}
         out.append({"state": s, "paper_pct_signed": p_signed, "paper_direction": p_dir, "our_direction": o_dir,
-                    "direction_reproduces": o_dir == p_dir, "paper_pct_inside_our_interval": bool(inside)})
+                    "direction_reproduces": o_dir == p_dir, "paper_pct_inside_our_interval": bool(inside),
+                    "magnitude": mag, "verdict": row_verdict(o_dir == p_dir, mag["pct"])})
     return out
+
+
+def cell_counts(tables: dict) -> dict:
+    """Over Tables 3-6: numeric cells (two levels and the % change per row) whose paper value lies inside our
+    paper-size range, rows whose direction reproduces, and rows by verdict."""
+    cells = mag = dirs = 0
+    verdicts: dict[str, int] = {}
+    for t in tables.values():
+        for cl in t["claims"]:
+            cells += 3
+            mag += sum(bool(v) for v in cl["magnitude"].values())
+            dirs += bool(cl["direction_reproduces"])
+            verdicts[cl["verdict"]] = verdicts.get(cl["verdict"], 0) + 1
+    rows = sum(verdicts.values())
+    return {"cells": cells, "magnitude_cells": mag, "rows": rows, "direction_rows": dirs, "verdicts": verdicts}
 
 
 def case_verdicts(summary: dict) -> dict:
@@ -468,9 +588,13 @@ def pseudolite_geometry(profile: Any, heights_ft: Sequence[float] = (1000.0, 200
 
 def compute(*, seed: int, runs: int, out_dir: Path | None = None,
             cases: Sequence[str] | None = None, workers: int | None = None,
-            evaluate: Any = None, columns: Any = None) -> tuple[dict, dict]:
-    """Run every selected case (runs each, closed loop, seed common to all) into out_dir/cases/<case>, then build
-    Tables 3-8; returns (the JSON result, the per-case data for the figures).
+            evaluate: Any = None, columns: Any = None, closed: bool = False,
+            sensitivity_runs: int | None = None) -> tuple[dict, dict]:
+    """Run every selected case (runs each, seed common to all) into out_dir/faithful/<case> (the faithful variant,
+    open loop) or, closed=True, out_dir/cases/<case> (our closed-loop study), then build Tables 3-8; with
+    sensitivity_runs, also the sensitivity table of the faithful variant's gap fills
+    (papers/gray_maybeck_sensitivity.py) at that many runs per row and case. Returns (the JSON result, the
+    per-case data for the figures).
 
     evaluate, columns: the campaign stage's campaign.evaluation.evaluate_profile and campaign.outputs.columns,
     passed in by the command that composes the stages (a paper module never imports the flight stage)."""
@@ -481,14 +605,18 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
     evaluate_profile = evaluate
 
     chosen = select_cases(cases)
+    variant = "closed" if closed else "faithful"
+    mode = "closed" if closed else "open"
+    windows = OUTAGE_WINDOWS_S if closed else _faithful().OUTAGE_WINDOWS_S
     root = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="gray-maybeck-"))
     per_case: dict[int, dict] = {}
     ms_by_run: dict[int, dict[int, dict[str, float]]] = {}
     for case in chosen:
-        prof = case_profile(case)
+        prof = case_profile(case, variant)
         # resume: a rerun into the same DIR reuses the finished runs of an identical campaign (the store checks
         # profile digest, seed and mode, and refuses a different one)
-        ev = evaluate_profile(prof, runs=runs, seed=seed, mode="closed", out_dir=root / "cases" / case.roman,
+        ev = evaluate_profile(prof, runs=runs, seed=seed, mode=mode,
+                              out_dir=root / ("cases" if closed else "faithful") / case.roman,
                               workers=workers, resume=True, progress=True)
         cols = columns(ev.results)
         ok_runs = [r.run for r in ev.results if r.ok]
@@ -498,7 +626,7 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
         geom = ev.details.get("gnss_geometry")
         per_case[case.number] = {
             "case": case.roman, "grade": case.grade, "radalt": case.radalt, "pseudolite": case.pseudolite,
-            "gps_outages": [list(w) for w in OUTAGE_WINDOWS_S[case.gps_outages]],
+            "gps_outages": [list(w) for w in windows[case.gps_outages]],
             "runs": runs, "failed_runs": ev.summary["failed_runs"],
             "time_averaged_rms_ft": ta,
             "tables_7_8": case_verdicts(ev.summary),
@@ -508,8 +636,15 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
             "pseudolite_geometry": pseudolite_geometry(prof),
             "runway_heading_rad": prof.runway.heading_rad,
             "clock_q60_bias_sigma_ft": _clock_q_sigma_ft(prof, 60.0),
+            "outage_s": (windows[case.gps_outages][0][1] - windows[case.gps_outages][0][0]
+                         if case.gps_outages else 0.0),
+            "clock_q_outage_sigma_ft": (_clock_q_sigma_ft(prof, windows[case.gps_outages][0][1]
+                                                          - windows[case.gps_outages][0][0])
+                                        if case.gps_outages else 0.0),
+            "oscillator": prof.sensors.gnss.oscillator,
             "failure_reasons": failure_reasons(ev.details.get("failures", {})),
             "wall_s": ev.wall_s,
+            "overrides": faithful_overrides(case) if not closed else {},
         }
         per_case[case.number]["claim"] = category_claim(case.number, per_case[case.number]["tables_7_8"])
     tables = {}
@@ -517,24 +652,45 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
         need = tuple(t["a"]) + tuple(t["b"])
         if not all(c in ms_by_run for c in need):
             continue
-        common = sorted(set.intersection(*(set(ms_by_run[c]) for c in need)))
-        ms = {c: {s: np.array([ms_by_run[c][r][s] for r in common]) for s in STATES} for c in need}
+        common = common_runs(ms_by_run, need)
         if not common:
             continue
+        ms = {c: {s: np.array([ms_by_run[c][r][s] for r in common]) for s in STATES} for c in need}
         ours = compare_groups(ms, t["a"], t["b"], seed=seed)
         tables[tid] = {"title": t["title"], "a_cases": [ROMAN[c - 1] for c in t["a"]],
                        "b_cases": [ROMAN[c - 1] for c in t["b"]],
+                       "failed_per_case": {ROMAN[c - 1]: per_case[c]["failed_runs"] for c in need},
                        "paper": {k: list(t[k]) for k in ("a_ft", "b_ft", "pct")},
                        "ours": ours, "claims": table_claims(ours, t)}
+    pinned = {k: v for k, v in PINNED + PINNED_RADALT + PINNED_PSEUDOLITE}
+    if not closed:
+        for key in ("run.mode", "nav.initial_error.start"):
+            pinned.pop(key, None)
+        for key in ("nav.initial_error.position_m", "nav.initial_error.velocity_mps", "nav.initial_error.tilt_mrad",
+                    "nav.initial_error.heading_mrad"):
+            pinned.pop(key, None)
     result = {
-        "paper": TITLE, "seed": seed, "runs_per_case": runs, "mode": "closed",
+        "paper": TITLE, "seed": seed, "runs_per_case": runs, "mode": mode, "variant": variant,
         "cases": {ROMAN[n - 1]: v for n, v in per_case.items()},
         "tables": tables,
-        "pinned": {k: v for k, v in PINNED + PINNED_RADALT + PINNED_PSEUDOLITE},
-        "assumptions": list(ASSUMPTIONS),
+        "cell_counts": cell_counts(tables),
+        "pinned": pinned,
+        "assumptions": list(ASSUMPTIONS if closed else FAITHFUL_ASSUMPTIONS),
         "pattern": _pattern(per_case),
+        "wall_s": float(sum(v["wall_s"] for v in per_case.values())),
     }
+    if sensitivity_runs:
+        from approachsim.papers import gray_maybeck_sensitivity as sens
+
+        result["sensitivity"] = sens.run_table(seed=seed, runs=sensitivity_runs, root=root / "sensitivity",
+                                               evaluate=evaluate_profile, columns=columns, workers=workers)
     return result, {"per_case": per_case, "ms_by_run": ms_by_run}
+
+
+def common_runs(by_run: dict[int, dict[int, Any]], cases: Sequence[int]) -> list[int]:
+    """The run indices every one of `cases` completed (by_run[case]: run -> its numbers), sorted: the run set of
+    every comparison of groups (no survivorship: a run lost in one case is left out of all)."""
+    return sorted(set.intersection(*(set(by_run[c]) for c in cases))) if cases else []
 
 
 def failure_reasons(failures: dict[str, str]) -> dict[str, int]:
@@ -554,243 +710,17 @@ def _pattern(per_case: dict[int, dict]) -> dict:
             "indeterminate": st.count("indeterminate"),
             "differing_cases": [v["case"] for v in per_case.values() if v["claim"]["status"] == "differs"]}
 
-
-# --- the note ---------------------------------------------------------------------------------------------------
-
-def _ci(ci: Sequence[float] | None, fmt: str = ".1f") -> str:
-    return "" if ci is None else f" [{ci[0]:{fmt}}, {ci[1]:{fmt}}]"
-
-
-def _state_word(s: str) -> str:
-    return s.replace("_", " ").capitalize()
-
-
-def _difference_reason(state: str, group: Sequence[str], result: dict) -> str:
-    """Why our averaged error of `state` over the cases `group` differs from the paper's, with our numbers."""
-    c0 = result["cases"][group[0]]
-    g = c0["gps_implied"]
-    if "hdop" not in g:
-        return ""
-    has_ra, has_pl = c0["radalt"], c0["pseudolite"]
-    if state in ("latitude", "longitude"):
-        if has_pl:
-            geo_pl = c0.get("pseudolite_geometry") or []
-            shares = ", ".join(f"{x['cross_share']:.2f} at {x['height_ft']:g} ft" for x in geo_pl)
-            return (f"the pseudolite (gap-fill site 1000 ft past the threshold, 500 ft left) is seen almost along "
-                    f"the approach path: the cross-track share of its line of sight is {shares}, so its range "
-                    f"measures along-track and height, hardly the lateral position; our GPS alone gives "
-                    f"{g['per_axis_horizontal_ft']:.1f} ft per axis (UERE {g['uere_zenith_m']:.2f} m x HDOP "
-                    f"{g['hdop']:.2f} / sqrt 2); the runway heads {math.degrees(c0.get('runway_heading_rad', 0)):.0f}"
-                    " deg, so latitude and longitude each mix along- and cross-track")
-        return (f"GPS-limited: our UERE {g['uere_zenith_m']:.2f} m x HDOP {g['hdop']:.2f} / sqrt 2 = "
-                f"{g['per_axis_horizontal_ft']:.1f} ft per axis against the paper's 4 m / sqrt 2 = "
-                f"{g['paper_per_axis_horizontal_ft']:.1f} ft; the clock/ephemeris error (2 h correlation) is "
-                f"nearly constant over the 4.5 min approach, so the filter cannot average it")
-    if state == "altitude":
-        if has_ra:
-            h = 200.0 * units.FT
-            sig = math.sqrt((0.01 * h) ** 2 + 0.25) / units.FT
-            dh = [result["cases"][k]["tables_7_8"]["categories"]["CAT I"]["vertical_1sigma_ft"] for k in group]
-            dh_s = ", ".join("--" if v is None else f"{v:.2f}" for v in dh)
-            return (f"R = (0.01 h)^2 + 0.25 gives {sig:.2f} ft at 200 ft but "
-                    f"{math.sqrt((0.01 * 1000 * units.FT) ** 2 + 0.25) / units.FT:.1f} ft at 1000 ft and "
-                    f"{math.sqrt((0.01 * 3000 * units.FT) ** 2 + 0.25) / units.FT:.1f} ft at 3000 ft AGL; our "
-                    f"vertical RMS at the CAT I decision height is {dh_s} ft, so the time average is made high on "
-                    f"the approach, where the GPS vertical ({g['vertical_ft']:.1f} ft, a near-constant bias per run: "
-                    "clock/ephemeris correlated over 2 h) competes with a 10-30 ft radar altimeter and our filter, "
-                    "without channel states, weighs that GPS bias as white noise (R = its full variance, no tuning)"
-                    + _outage_altitude_evidence(result))
-        failed = [result["cases"][k]["failed_runs"] for k in group]
-        lost = ""
-        if any(failed):
-            lost = (f"; {', '.join(str(n) for n in failed)} of {c0['runs']} runs of these cases failed (unstabilized "
-                    "approach: closed loop, the autopilot flies the vertical error) and are not in the average, "
-                    "which leaves out the largest vertical errors")
-        return (f"GPS-limited: UERE {g['uere_zenith_m']:.2f} m x VDOP {g['vdop']:.2f} = {g['vertical_ft']:.1f} ft "
-                f"against the paper's 5 m = {g['paper_vertical_ft']:.1f} ft (the baro, with its 100 ft bias, cannot "
-                f"correct it){lost}")
-    out_s = [result["cases"][k]["gps_outages"] for k in group]
-    if any(out_s):
-        q = c0.get("clock_q60_bias_sigma_ft")
-        return ("the receiver clock free-runs through each 60 s GPS outage (no range measures it): our TCXO's "
-                f"clock-bias process noise over 60 s is {q:.0f} ft 1-sigma, so the error grows until GPS returns; "
-                "the paper's clock error does not move in its Table 6, its oscillator model is in the thesis, "
-                "not the paper")
-    return ("the receiver clock estimate absorbs the part of the satellites' range errors common to the used "
-            f"channels (UERE {g['uere_zenith_m']:.2f} m); the paper's clock error is of the same order")
-
-
-def _outage_altitude_evidence(result: dict) -> str:
-    """Case VI vs XVI altitude (same INS and radar altimeter; XVI loses GPS for 120 s): the measured effect of
-    taking the GPS out of the vertical, when both cases ran."""
-    cs = result["cases"]
-    if "VI" not in cs or "XVI" not in cs:
-        return ""
-    a, b = cs["VI"]["time_averaged_rms_ft"]["altitude"], cs["XVI"]["time_averaged_rms_ft"]["altitude"]
-    if a is None or b is None:
-        return ""
-    return (f"; measured: case XVI, which loses GPS for 120 s, has altitude {b:.2f} ft against case VI's {a:.2f} ft "
-            f"({compare_words(b, a)})")
-
-
-def compare_words(x: float, y: float) -> str:
-    """'lower' / 'higher' / 'equal' for x against y."""
-    return "lower" if x < y else "higher" if x > y else "equal"
-
+# --- the note (papers/gray_maybeck_note.py) ------------------------------------------------------------------
 
 def note(result: dict, figures: Sequence[str]) -> str:
-    """The reproduction note (markdown): the cases, Tables 3-8 ours beside the paper's, findings from numbers."""
-    runs = result["runs_per_case"]
-    lines = [f"# Reproduction: {TITLE}", "",
-             f"Closed loop on the JSBSim simulator, {runs} runs per case (the paper: 15), campaign seed "
-             f"{result['seed']} common to every case (common random numbers). Time-averaged RMS: sqrt of the mean "
-             "over runs of each run's time average of the squared true error (estimate - truth), from 10 s after "
-             "the run start; a group of cases is the mean of their RMS, as the paper averages its three INS "
-             "grades; % change = (a - b) / a x 100 as the paper computes it (Table 6 prints |.|). Brackets: 95 % "
-             "paired bootstrap over the run index.", ""]
-    lines += ["## Assumptions and gap fills", ""] + [f"- {a}" for a in result["assumptions"]] + [""]
-    # truth / filter split
-    lines += ["## The cases (Table 2) and the truth / filter split", "",
-              "The paper: a 69-state truth (39 INS, 30 GPS) against a 13-state filter (11 INS, 2 GPS clock). Ours: "
-              "the sensor models' time-correlated error processes (counted below; white noises are not states) "
-              "against our error-state EKF's states.", "",
-              "| case | INS | radar alt. | pseudolite | GPS outages (s) | truth states | filter states | failed runs |",
-              "|---|---|---|---|---|---|---|---|"]
-    for c in result["cases"].values():
-        ts, fs = c["truth_states"], c["filter_states"]
-        tdet = ", ".join(f"{k} {v}" for k, v in ts.items() if k != "total" and v)
-        fdet = ", ".join(f"{k} {v}" for k, v in fs.items() if k != "total")
-        outs = "; ".join(f"{a:g}-{b:g}" for a, b in c["gps_outages"]) or "none"
-        lines.append(f"| {c['case']} | {c['grade']} | {'yes' if c['radalt'] else 'no'} | "
-                     f"{'yes' if c['pseudolite'] else 'no'} | {outs} | {ts['total']} ({tdet}) | {fs['total']} "
-                     f"({fdet}) | {c['failed_runs']} |")
-    g = next(iter(result["cases"].values()))["gps_implied"]
-    if "hdop" in g:
-        lines += ["", f"GPS mapping: the paper's receiver is 4 m horizontal / 5 m vertical 1 sigma. Our P(Y) 1995 "
-                  f"budget has a zenith UERE of {g['uere_zenith_m']:.2f} m; the four used have PDOP {g['pdop']:.2f}, "
-                  f"HDOP {g['hdop']:.2f}, VDOP {g['vdop']:.2f} at the CAT I decision height, so ours is "
-                  f"{g['horizontal_m']:.1f} m horizontal / {g['vertical_m']:.1f} m vertical "
-                  f"({g['horizontal_m'] / 4.0:.2f} and {g['vertical_m'] / 5.0:.2f} x the paper's)."]
-    lines += ["", "Per case, time-averaged RMS (ft) over the runs that completed (a failed run, e.g. an approach "
-              "the autopilot flew outside the stabilized-approach window on its navigation solution, has no time "
-              "series to average; failed runs count against every category in Tables 7-8):", "",
-              "| case | latitude | longitude | altitude | clock bias |", "|---|---|---|---|---|"]
-    for c in result["cases"].values():
-        ta = c["time_averaged_rms_ft"]
-        lines.append(f"| {c['case']} | " + " | ".join("--" if ta[s] is None else f"{ta[s]:.2f}" for s in STATES)
-                     + " |")
-    # Tables 3-6
-    for tid, t in result["tables"].items():
-        o, p = t["ours"], t["paper"]
-        a, b = "-".join(t["a_cases"]), "-".join(t["b_cases"])
-        lines += ["", f"## Table {tid}: {t['title']}", "",
-                  f"Ours over the {o['runs']} runs that completed in every case of the table (common random "
-                  "numbers: the same run index in each case), so a group can differ from the per-case figures "
-                  "above when some cases lost runs.", "",
-                  f"| error state | paper {a} (ft) | ours {a} (ft) | paper {b} (ft) | ours {b} (ft) | paper % change "
-                  "| ours % change | direction | paper's % inside our bounds |",
-                  "|---|---|---|---|---|---|---|---|---|"]
-        for j, s in enumerate(STATES):
-            cl = t["claims"][j]
-            aci = o["a_ci_ft"][j] if o["a_ci_ft"] else None
-            bci = o["b_ci_ft"][j] if o["b_ci_ft"] else None
-            pci = o["pct_ci"][j] if o["pct_ci"] else None
-            lines.append(
-                f"| {_state_word(s)} | {p['a_ft'][j]:.1f} | {o['a_ft'][j]:.2f}{_ci(aci)} | {p['b_ft'][j]:.1f} | "
-                f"{o['b_ft'][j]:.2f}{_ci(bci)} | {cl['paper_pct_signed']:+.1f} % | {o['pct'][j]:+.1f} %{_ci(pci)} | "
-                f"paper {cl['paper_direction']}, ours {cl['our_direction']}: "
-                f"{reproduces(cl['direction_reproduces'])} | "
-                f"{'yes' if cl['paper_pct_inside_our_interval'] else 'no'} |")
-        lines += ["", "Differences (Table " + tid + ", row by row):", ""]
-        for j, s in enumerate(STATES):
-            for grp, pv, ov in ((t["a_cases"], p["a_ft"][j], o["a_ft"][j]),
-                                (t["b_cases"], p["b_ft"][j], o["b_ft"][j])):
-                why = _difference_reason(s, grp, result)
-                lines.append(f"- {_state_word(s)}, cases {'-'.join(grp)}: ours {ov:.2f} ft vs paper {pv:.1f} ft "
-                             f"(ratio {ov / pv:.2f}); {why}.")
-    # Tables 7-8
-    lines += ["", "## Tables 7-8: precision approach categories met (FAA Table 1, 1 sigma at decision height)", "",
-              "Verdicts on the one-sided 95 % bounds of the RMS over runs (meets: upper bound inside the limit; "
-              "fails: lower bound outside; else indeterminate).", "",
-              "| case | paper (Table 7/8) | ours: best met | CAT I lat / vert (upper) ft, verdict | "
-              "CAT II lat / vert (upper), verdict | CAT III lat / vert (upper), verdict | Tables 7-8 |",
-              "|---|---|---|---|---|---|---|"]
-    for c in result["cases"].values():
-        v = c["tables_7_8"]
-        cells = []
-        for cat in ("CAT I", "CAT II", "CAT III"):
-            e = v["categories"][cat]
+    """The reproduction note (markdown): gray_maybeck_note.note."""
+    from approachsim.papers import gray_maybeck_note
 
-            def f(x: float | None) -> str:
-                return "--" if x is None else f"{x:.2f}"
-            cells.append(f"{f(e['lateral_1sigma_ft'])} / {f(e['vertical_1sigma_ft'])} "
-                         f"({f(e['lateral_1sigma_upper_ft'])} / {f(e['vertical_1sigma_upper_ft'])}), {e['verdict']}")
-        cl = c["claim"]
-        lines.append(f"| {c['case']} | {cl['paper_best'] or 'none'} | {v['best'] or 'none'} | "
-                     + " | ".join(cells) + f" | {cl['status']} |")
-    pat = result["pattern"]
-    lines += ["", f"Verdict pattern: {pat['reproduces']} of {pat['cases']} cases reproduce Tables 7-8, "
-              f"{pat['differs']} differ ({', '.join(pat['differing_cases']) or 'none'}), {pat['indeterminate']} are "
-              f"indeterminate at {runs} runs."]
-    diff = [c for c in result["cases"].values() if c["claim"]["status"] != "reproduces"]
-    if diff:
-        lines += ["", "Why each case that does not reproduce differs:", ""]
-        for c in diff:
-            lines.append("- " + _category_reason(c))
-    if figures:
-        lines += ["", "## Figures", ""] + [f"![{f}]({f})" for f in figures]
-    lines += ["", "Pinned profile values (every case; `approachsim reproduce gray-maybeck` sets them on the shipped "
-              "gray-maybeck profile):", ""]
-    lines += [f"- `{k}` = {v!r}" for k, v in result["pinned"].items()]
-    return "\n".join(lines) + "\n"
-
-
-def _category_reason(c: dict) -> str:
-    """One sentence with numbers on why a case's verdicts differ from (or do not yet decide) Tables 7-8."""
-    cl, v = c["claim"], c["tables_7_8"]["categories"]
-    parts = []
-    for cat in ("CAT I", "CAT II", "CAT III"):
-        e = v[cat]
-        lat, ver = e["lateral_1sigma_ft"], e["vertical_1sigma_ft"]
-        if lat is None or ver is None:
-            parts.append(f"{cat}: no scored runs")
-            continue
-        lat_up = e["lateral_1sigma_upper_ft"] or float("nan")
-        ver_up = e["vertical_1sigma_upper_ft"] or float("nan")
-        parts.append(f"{cat} {e['verdict']} (lateral {lat:.2f} ft, upper {lat_up:.2f}, "
-                     f"limit {e['limit_lateral_1sigma_ft']:g}; vertical {ver:.2f} ft, upper "
-                     f"{ver_up:.2f}, limit {e['limit_vertical_1sigma_ft']:g}"
-                     + (f"; ~{e['runs_needed']} runs to decide" if e["runs_needed"] else "") + ")")
-    aid = ("radar altimeter" if c["radalt"] else "GPS/baro") + (" + pseudolite" if c["pseudolite"] else "")
-    fails = ""
-    if c["failed_runs"]:
-        why = ", ".join(f"{n} {k}" for k, n in c.get("failure_reasons", {}).items())
-        fails = (f"; {c['failed_runs']} of {c['runs']} runs failed ({why}): closed loop, the autopilot flies the "
-                 "navigation error, and a failed run blocks `meets` (evaluation.max_failure_fraction = 0)")
-    g = c["gps_implied"]
-    lateral = ""
-    if "hdop" in g:
-        lateral = (f"; lateral set by GPS: our budget gives {g['per_axis_horizontal_ft']:.1f} ft per horizontal axis "
-                   f"(the paper's 4 m horizontal would give {g['paper_per_axis_horizontal_ft']:.1f} ft, itself above "
-                   "the CAT II 8.6 ft)")
-        geo_pl = c.get("pseudolite_geometry")
-        if geo_pl:
-            shares = ", ".join(f"{x['cross_share']:.2f} at {x['height_ft']:g} ft" for x in geo_pl)
-            lateral += (f", and the pseudolite's line of sight is nearly along the approach (cross-track share "
-                        f"{shares}), so it does not bring the lateral error under 8.6 ft")
-    return (f"case {c['case']} (paper: {cl['paper_best'] or 'none'}; ours: {cl['our_best'] or 'none'}, "
-            f"{cl['status']}): vertical set by the {aid}; " + "; ".join(parts) + fails + lateral + ".")
+    return gray_maybeck_note.note(result, figures)
 
 
 def headline(result: dict) -> list[str]:
-    """Short printed findings, chosen from the numbers."""
-    pat = result["pattern"]
-    out = [f"Tables 7-8: {pat['reproduces']}/{pat['cases']} cases reproduce, {pat['differs']} differ "
-           f"({', '.join(pat['differing_cases']) or 'none'}), {pat['indeterminate']} indeterminate"]
-    for tid, t in result["tables"].items():
-        o = t["ours"]
-        cells = ", ".join(
-            f"{_state_word(s).lower()} {o['pct'][j]:+.0f} % (paper {t['claims'][j]['paper_pct_signed']:+.0f})"
-            for j, s in enumerate(STATES))
-        out.append(f"Table {tid} % change: {cells}")
-    return out
+    """Short printed findings, chosen from the numbers: gray_maybeck_note.headline."""
+    from approachsim.papers import gray_maybeck_note
+
+    return gray_maybeck_note.headline(result)

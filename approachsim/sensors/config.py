@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
 from approachsim import units
@@ -101,11 +101,21 @@ class GnssConfig:
     """[sensors.gnss.gbas]: the ground station and airborne equipment (set exactly when corrections = "gbas")."""
     carrier: CarrierModel | None = None
     """carrier_phase = true: L1 carrier phase with float ambiguities (sensors/gnss/carrier.py); None: code only."""
+    budget_scale: float = 1.0
+    """Factor on every 1-sigma of the stand-alone ranging budget (clock/ephemeris, iono, tropo, multipath, code
+    noise), correlation times unchanged: a study that states its GPS as a position accuracy (Gray & Maybeck's
+    4 m horizontal / 5 m vertical) scales the era budget to it. 1.0: the budget as selected."""
 
     def budget(self) -> GnssErrorBudget:
         """The error budget these settings select (code preset, multipath model, clock/ephemeris budget, GBAS
-        corrections)."""
-        return make_budget(self.code, self.multipath_model, self.clock_ephemeris, self.multipath_tau_s, self.gbas)
+        corrections), its 1-sigma terms times budget_scale."""
+        b = make_budget(self.code, self.multipath_model, self.clock_ephemeris, self.multipath_tau_s, self.gbas)
+        if self.budget_scale == 1.0:
+            return b
+        k = self.budget_scale
+        return replace(b, clock_ephemeris_m=k * b.clock_ephemeris_m, iono_zenith_m=k * b.iono_zenith_m,
+                       tropo_zenith_m=k * b.tropo_zenith_m, multipath_m=k * b.multipath_m,
+                       code_noise_m=k * b.code_noise_m)
 
     def epoch_window(self) -> float:
         """Width (s) of the per-run epoch window; 0 for a fixed epoch."""
@@ -229,7 +239,10 @@ def parse_sensors(s: Section) -> SensorsConfig:
             corrections=(corr := g.string("corrections", "none", choices=CORRECTIONS)),
             gbas=_parse_gbas(g, corr),
             carrier=_parse_carrier(g),
+            budget_scale=g.number("budget_scale", 1.0, lo=0.0, lo_open=True, hi=10.0),
         )
+        if corr == "gbas" and gnss.budget_scale != 1.0:
+            raise ProfileError(f"{g.path}.budget_scale: scales the stand-alone budget only (corrections is \"gbas\")")
         if gnss.epoch == "fixed" and g.has("epoch_window_h"):
             raise ProfileError(f"{g.path}.epoch_window_h: only used with epoch = \"per-run\" (epoch is \"fixed\")")
         if corr == "gbas" and mp != "do253":

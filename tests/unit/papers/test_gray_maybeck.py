@@ -170,7 +170,8 @@ def test_reproduce_gray_maybeck_end_to_end(tmp_path: Path) -> None:
     assert "Gray & Maybeck, *An integrated GPS/INS/Baro and radar altimeter system" in md
     assert "seed 002" not in md and "## Table 6" in md and "Tables 7-8" in md
     assert (tmp_path / "gray-maybeck_cases.png").is_file()
-    assert (tmp_path / "cases" / "XVI" / "summary.json").is_file()
+    assert (tmp_path / "faithful" / "XVI" / "summary.json").is_file()
+    assert doc["variant"] == "faithful" and doc["mode"] == "open"
 
 
 def test_failure_reasons_are_counted_by_kind() -> None:
