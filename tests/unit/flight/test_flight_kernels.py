@@ -15,6 +15,8 @@ from approachsim import geo, units
 from approachsim.flight import kernels as fk
 from approachsim.nav import ins
 
+pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
+
 FRAME = geo.RunwayFrame(math.radians(37.6117), math.radians(-122.3581), 4.0, math.radians(298.0))
 RWY = SimpleNamespace(frame=FRAME, elevation_m=4.0, glidepath_rad=math.radians(3.0), tch_m=15.0,
                       threshold_lat_rad=FRAME.threshold_lat_rad, threshold_lon_rad=FRAME.threshold_lon_rad,

@@ -34,6 +34,8 @@ from approachsim.flight.turbulence import DrydenTurbulence, scales
 from approachsim.glidepath import GlidePath
 from approachsim.profile import load_profile
 
+pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
+
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 DT = 1.0 / 120.0
 GP = math.radians(3.0)
@@ -106,6 +108,8 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
                        r=att[k, 5])
         got = fk.autopilot_step(par, st, *args, h_gear[k], tas[k], psi[k] if hg is not None else math.nan,
                                 att[k, 5])
+        # exact: the kernel and its Python oracle do the same scalar IEEE operations in the same order (numba emits
+        # no FMA without fastmath, both call the same libm), which the generic-CPU pass checks as well
         assert got == want, f"step {k}"
         np.testing.assert_array_equal(st, np.array(ap.state()), err_msg=f"state at step {k}")
         seen["pitch limited"] += (ap.int_b if gains.tecs else ap.int_d) == int_p and not ap.flaring
