@@ -1,7 +1,7 @@
 """`approachsim integrity-risk PROFILE [--modes M,...] [--method nais|ce|mc] [--samples N] [--max-calls N]
-[--fault-free-runs N] [--truths T] [--seed S] [--workers K] [--out DIR] [--require CAT]`: the probability of
-hazardously misleading information per category by rare-event simulation (integrity/risk.py, docs/integrity.md
-"Integrity risk"), against the Annex 10 allocations.
+[--fault-free-runs N] [--truths T] [--seed S] [--workers K] [--sensor-modes] [--out DIR] [--require CAT]`: the
+probability of hazardously misleading information per category by rare-event simulation (integrity/risk.py,
+docs/integrity.md "Integrity risk"), against the Annex 10 allocations.
 
 Writes DIR/integrity_risk.json (docs/contract.md) and prints one line per category. Exit status: 0 the study ran;
 1 the --require'd category's P(HMI) is not shown within its allocation; 2 bad input (one line naming the option);
@@ -48,6 +48,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=None, help="study seed (default: the profile's run.seed)")
     p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
     p.add_argument("--out", type=Path, default=None, help="output directory (default: integrity-risk-<profile>)")
+    p.add_argument("--sensor-modes", action="store_true",
+                   help="the bank also leaves out the baro, the radar altimeter and each pseudolite (default: GPS "
+                        "satellites only, as evaluate's bank)")
     p.add_argument("--require", default=None, metavar="CAT",
                    help="exit 1 unless this category's P(HMI) upper bound is within its allocation")
     p.set_defaults(func=run)
@@ -80,7 +83,8 @@ def check_options(args: argparse.Namespace, profile: object) -> dict:
     if names is not None and not names:
         raise ProfileError(f"--modes: name at least one of {', '.join(MODES)}")
     return {"modes": names, "method": args.method, "samples": args.samples, "max_calls": args.max_calls,
-            "fault_free_runs": args.fault_free_runs, "truths": args.truths, "seed": seed, "workers": args.workers}
+            "fault_free_runs": args.fault_free_runs, "truths": args.truths, "seed": seed, "workers": args.workers,
+            "sensor_modes": bool(getattr(args, "sensor_modes", False))}
 
 
 def _fmt(x: float | None) -> str:

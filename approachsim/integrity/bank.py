@@ -1,7 +1,11 @@
 """The sub-filter bank of solution-separation integrity over one run's records, and its protection levels.
 
 The main filter uses every measurement; sub-filter k is the same navigation system on the same records with
-GNSS channel k never used (every channel the main filter used during the run is a fault mode). The bank runs
+GNSS channel k never used (every channel the main filter used during the run is a fault mode). With
+`sensor_modes` (run_bank) the baro, the radar altimeter and each pseudolite unit are fault modes too: sub-filter k
+then never uses that source (its record invalid throughout, as an outage: the navigation holds the baro damping
+loop without a baro, nav/fde.py). Mode codes (`BankEpochs.channels`): a GNSS channel index >= 0, BARO_MODE,
+RADALT_MODE, PSEUDOLITE_MODE - u for pseudolite unit u. The bank runs
 as K + 1 copies of the run in one batched NavSystem pass (same sensor draws, same initial-error draw: the
 copies differ only in the excluded channel), with the shared covariance where the configuration allows it.
 
@@ -33,23 +37,80 @@ from approachsim.integrity.separation import SeparationResult, identify_statisti
 Array = np.ndarray
 
 
+BARO_MODE = -2
+"""Mode code of the baro (a sub-filter without it)."""
+RADALT_MODE = -3
+"""Mode code of the radar altimeter."""
+PSEUDOLITE_MODE = -10
+"""Mode code of pseudolite unit 0; unit u is PSEUDOLITE_MODE - u."""
+
+
+def mode_name(code: int) -> str:
+    """A mode code's source: "gnss <channel>", "baro", "radalt" or "pseudolite <unit>"."""
+    if code >= 0:
+        return f"gnss {code}"
+    if code == BARO_MODE:
+        return "baro"
+    if code == RADALT_MODE:
+        return "radalt"
+    return f"pseudolite {PSEUDOLITE_MODE - code}"
+
+
+def sensor_modes(records: dict[str, Any]) -> list[int]:
+    """Mode codes of the non-GNSS sources in `records` (one run): baro, radar altimeter, each pseudolite unit with a
+    valid sample."""
+    out = []
+    if "baro" in records:
+        out.append(BARO_MODE)
+    if "radalt" in records:
+        out.append(RADALT_MODE)
+    if "pseudolite" in records:
+        v = np.asarray(records["pseudolite"].valid, bool)
+        v = v.reshape(-1, v.shape[-1])
+        out.extend(PSEUDOLITE_MODE - u for u in np.nonzero(np.any(v, axis=0))[0])
+    return out
+
+
 def used_channels(valid: Array) -> Array:
     """Indices of the GNSS channels valid at any sample (valid (m, channels) of one run)."""
     return np.nonzero(np.any(np.asarray(valid, bool), axis=0))[0]
 
 
 def bank_records(records: dict[str, Any], channels: Array) -> dict[str, Any]:
-    """K + 1 copies of one run's records (run axis first): copy 0 as given, copy k + 1 with GNSS channel
-    channels[k] marked invalid. Records must come from SensorSuite.measure(..., runs=[i] * (K + 1))."""
+    """K + 1 copies of one run's records (run axis first): copy 0 as given, copy k + 1 without mode channels[k]
+    (a GNSS channel index, or a sensor mode code: that source's samples invalid and nan, as an outage). Records
+    must come from SensorSuite.measure(..., runs=[i] * (K + 1))."""
     g = records["gnss"]
     valid = np.array(g.valid, dtype=bool, copy=True)
     if valid.ndim != 3 or valid.shape[0] != len(channels) + 1:
         raise ValueError("bank_records: measure the run K + 1 times (runs=[i] * (K + 1)) first")
-    for k, c in enumerate(channels):
-        valid[k + 1, :, c] = False
     out = dict(records)
+    for k, c in enumerate(channels):
+        c = int(c)
+        if c >= 0:
+            valid[k + 1, :, c] = False
+        else:
+            name = "baro" if c == BARO_MODE else "radalt" if c == RADALT_MODE else "pseudolite"
+            if name not in out:
+                raise ValueError(f"bank_records: mode {mode_name(c)} but no {name} record")
+            out[name] = _without(out[name], k + 1, None if name != "pseudolite" else PSEUDOLITE_MODE - c)
     out["gnss"] = dataclasses.replace(g, valid=valid)
     return out
+
+
+def _without(rec: Any, copy: int, unit: int | None) -> Any:
+    """The record with copy `copy`'s samples (unit `unit` only, when given) invalid and their values nan."""
+    valid = np.array(rec.valid, dtype=bool, copy=True)
+    sl = (copy, slice(None)) if unit is None else (copy, slice(None), unit)
+    valid[sl] = False
+    upd: dict[str, Any] = {"valid": valid}
+    for f in ("h_baro_m", "h_agl_m", "pseudorange_m"):
+        v = getattr(rec, f, None)
+        if v is not None:
+            v = np.array(v, dtype=float, copy=True)
+            v[sl] = np.nan
+            upd[f] = v
+    return dataclasses.replace(rec, **upd)
 
 
 @dataclass(frozen=True)
@@ -127,7 +188,7 @@ class CategoryIntegrity:
     result: SeparationResult
     """The main filter's separation test and protection levels (before any exclusion)."""
     excluded_channel: int
-    """GNSS channel excluded at the first detection (-1: none)."""
+    """Mode excluded at the first detection: a GNSS channel, or a sensor mode code (-1: none)."""
     t_detect_s: float
     """Time of the first detection (nan: none), s."""
     time_to_alert_s: float
@@ -189,9 +250,11 @@ def score_run(ep: BankEpochs, epoch_hz: float, start_height_m: float, dh_m: dict
     return out
 
 
-def run_bank(profile: Any, truth: Any, seed: int, run: int) -> tuple[BankEpochs, Any]:
+def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: bool = False
+             ) -> tuple[BankEpochs, Any]:
     """Measure run `run` of the campaign seeded `seed` on `truth`, navigate it with the main filter and the
     sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun).
+    sensor_modes_on: the baro, radar altimeter and pseudolite units are fault modes too (module docstring).
 
     The copies share the run's IMU record and its INS (NavSystem.run(copies=True), feed-forward): the IMU is
     drawn and applied once; the other sensors are measured for the K + 1 copies (the same draws: the same
@@ -209,12 +272,16 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int) -> tuple[BankEpochs,
     if "gnss" not in one:
         raise ValueError("integrity bank: the profile has no GNSS receiver")
     channels = used_channels(np.asarray(one["gnss"].valid)[0])
+    if sensor_modes_on:
+        channels = np.concatenate([channels, np.asarray(sensor_modes(one), dtype=int)]).astype(int)
     copies = len(channels) + 1
     nav = NavSystem.from_profile(profile)
     states = start_states(suite, truth, errors)
     states = replace(states, **{f.name: np.repeat(getattr(states, f.name), copies, axis=0)
                                 for f in fields(states) if isinstance(getattr(states, f.name), np.ndarray)})
-    share = not nav.nav.feedback and "imu" in one
+    # a sub-filter without the baro has its own INS when the baro damping loop drives the INS vertical channel
+    own_ins = bool(sensor_modes_on and "baro" in one and nav.loop_gains() is not None)
+    share = not nav.nav.feedback and "imu" in one and not own_ins
     rest = suite.without("imu") if share else suite  # feed-forward: one IMU record for every copy
     recs = rest.apply(truth, rest.draw(truth.t_s, seed, [run] * copies))
     if share:

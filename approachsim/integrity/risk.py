@@ -200,7 +200,7 @@ def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float) -> dict[str, f
         win = settled & (ep.height_m >= cfg.dh_m(cat))
         s = score_category(ep, req, epoch_hz, win)
         err = np.abs(ep.e0[win])
-        if s.excluded_channel >= 0:
+        if s.excluded_channel != -1:
             k = int(np.nonzero(ep.channels == s.excluded_channel)[0][0])
             i = int(np.argmax(s.result.detected))
             err[i:] = np.abs(ep.ek[win][i:, k])
@@ -232,10 +232,11 @@ def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float) -> dict[str, f
     return out
 
 
-def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | None, u: Sequence[float]
-               ) -> dict[str, float]:
-    """One sample: the flown truth run % truths, the fault of `mode_name` at u (None: fault-free), the bank, the
-    limit states (and the fault's parameters). A sample that raises is returned with `failed` = 1 and every
+def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | None, u: Sequence[float],
+               sensor_modes: bool = False) -> dict[str, float]:
+    """One sample: the flown truth run % truths, the fault of `mode_name` at u (None: fault-free), the bank (with
+    the baro, radar altimeter and pseudolites as fault modes too when `sensor_modes`), the limit states (and the
+    fault's parameters). A sample that raises is returned with `failed` = 1 and every
     category's hmi_g = +1e3 (a failed navigation counts as the event: conservative)."""
     try:
         from approachsim.integrity.bank import run_bank
@@ -247,7 +248,7 @@ def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | 
         if mode_name is not None:
             spec, params = fault_spec(MODES[mode_name], np.asarray(u), profile, truth, seed, run, (t_lo, t_hi))
             prof = dataclasses.replace(profile, faults=(*tuple(profile.faults or ()), spec))
-        ep, _ = run_bank(bank_profile(prof), truth, seed, run)
+        ep, _ = run_bank(bank_profile(prof), truth, seed, run, sensor_modes_on=sensor_modes)
         out = limit_states(ep, profile.evaluation, profile.nav.aiding_rate_hz, float(truth.t_s[0]))
         return {**out, **{f"fault_{k}": float(v) for k, v in params.items()}, "failed": 0.0}
     except Exception as e:  # noqa: BLE001 - a failed sample is data (counted as the event), never dropped
@@ -256,20 +257,22 @@ def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | 
 
 
 def _task(args: tuple) -> list[dict]:
-    profile, seed, truths, mode_name, items = args
+    profile, seed, truths, mode_name, items, sensor_modes = args
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1):
-        return [run_sample(profile, seed, run, truths, mode_name, u) for run, u in items]
+        return [run_sample(profile, seed, run, truths, mode_name, u, sensor_modes) for run, u in items]
 
 
 class Simulator:
     """Batched evaluation of samples on a local process pool (fork; `workers` processes), in order."""
 
-    def __init__(self, profile: Any, seed: int, truths: int = 4, workers: int = 1) -> None:
+    def __init__(self, profile: Any, seed: int, truths: int = 4, workers: int = 1, sensor_modes: bool = False
+                 ) -> None:
         if truths < 1 or workers < 1:
             raise ValueError("truths and workers must be >= 1")
         self.profile, self.seed, self.truths, self.workers = profile, int(seed), int(truths), int(workers)
+        self.sensor_modes = bool(sensor_modes)
         self._pool: ProcessPoolExecutor | None = None
         self.samples = 0
         self.wall_s = 0.0
@@ -294,12 +297,13 @@ class Simulator:
         t = time.time()
         items = list(zip([int(r) for r in runs], np.asarray(u, float).tolist(), strict=True))
         if self._pool is None or len(items) < 2:
-            out = _task((self.profile, self.seed, self.truths, mode_name, items))
+            out = _task((self.profile, self.seed, self.truths, mode_name, items, self.sensor_modes))
         else:
             n = max(1, math.ceil(len(items) / (4 * self.workers)))
             chunks = [items[i:i + n] for i in range(0, len(items), n)]
             out = [r for part in self._pool.map(
-                _task, [(self.profile, self.seed, self.truths, mode_name, c) for c in chunks]) for r in part]
+                _task, [(self.profile, self.seed, self.truths, mode_name, c, self.sensor_modes) for c in chunks])
+                for r in part]
         self.samples += len(items)
         self.wall_s += time.time() - t
         return out
@@ -439,7 +443,7 @@ def _rms(s2: Array, n: Array) -> float | None:
 
 def integrity_risk(profile: Any, *, modes: Sequence[str] | None = None, method: str = "nais", samples: int = 200,
                    max_calls: int | None = None, seed: int = 1, truths: int = 4, workers: int | None = None,
-                   fault_free_runs: int = 100, level: float | None = None,
+                   fault_free_runs: int = 100, level: float | None = None, sensor_modes: bool = False,
                    log: Callable[[str], None] | None = None) -> dict:
     """The integrity-risk study of a profile (module docstring): the fault-free term, each mode's conditional
     estimate, the totals per category against the allocations. JSON-ready."""
@@ -452,8 +456,8 @@ def integrity_risk(profile: Any, *, modes: Sequence[str] | None = None, method: 
     t0 = time.time()
     out: dict = {"schema": "approachsim.integrity_risk/1", "profile": profile.name, "seed": seed,
                  "method": method, "samples_per_step": samples, "max_calls_per_mode": max_calls, "truths": truths,
-                 "confidence": level, "modes": {}}
-    with Simulator(profile, seed, truths, workers) as sim:
+                 "confidence": level, "bank_sensor_modes": bool(sensor_modes), "modes": {}}
+    with Simulator(profile, seed, truths, workers, sensor_modes) as sim:
         say(f"fault-free: {fault_free_runs} runs")
         out["fault_free"] = fault_free(sim, fault_free_runs, level)
         for i, m in enumerate(ms):
