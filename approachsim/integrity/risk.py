@@ -26,14 +26,17 @@ magnitudes only: the filter and the bank are linear in the measurement errors an
 fault of -m gives the error of +m mirrored and the same probability of an event defined on |e|.
 
 **The fault-free term is analytic.** HMI needs the output's PL inside the AL, and PL >= K_ff sigma, so a
-fault-free HMI is an error beyond AL > K_ff sigma: per epoch and axis P = 2 Q(AL / (s sigma)), with sigma the
-filter's standard deviation and s the upper confidence bound of the RMS of the simulated normalized errors
-e / sigma (the covariance's overbound, measured on `fault_free_runs` runs, the runs counted as the independent
-samples), at most N_es = exposure / TTA independent samples per exposure (rare.gaussian_hmi_bound). Simulating
-this tail directly would need the sensor noise as standard normals (the sensors draw from their named streams);
-the filter is linear in that noise, so its error is Gaussian with the filter's covariance where the models are
-(what is simulated is the check that the covariance bounds it). Same for false alerts: the detection threshold
-K_fa sigma_ss of each separation, with s_ss the measured bound of the RMS of Delta / sigma_ss.
+fault-free HMI is an error beyond AL > K_ff sigma. Per run, N_es = exposure / TTA independent samples times
+2 Q(r_v / s_v) + 2 Q(r_l / s_l), r the smallest AL / sigma over the run's available epochs (sigma the filter's
+standard deviation on that axis) and s the upper confidence bound of the RMS of the simulated normalized errors
+e / sigma on that axis (the covariance's overbound, measured on `fault_free_runs` runs, the runs counted as the
+independent samples; at least 1); the term is the mean over the runs (`hmi_gaussian`), its upper figure the worst
+run's. Simulating this tail directly would need the sensor noise as standard normals (the sensors draw from their
+named streams); the filter is linear in that noise, so its error is Gaussian with the filter's covariance where the
+models are: what is simulated is the check that the covariance bounds the error. The RMS checks the core, not the
+tail: an error distribution with heavier tails than its RMS suggests is not caught (overbounding in the sense of
+DeCleene, *Defining pseudorange integrity - overbounding*, is not tested). Same for false alerts: the allocation
+scaled by Q(K_fa / s_ss) / Q(K_fa), s_ss the measured bound of the RMS of Delta / sigma_ss over the separations.
 
 **Priors** (per approach; marks as in the reference notes: [S] a secondary source, [U] none found, [D] derived):
 satellite fault P_sat = 1e-5 per satellite (ARAIM ISM default, integrity-envelope.md sec. 3a) [S], times the
@@ -504,6 +507,12 @@ def totals(study: Mapping[str, Any], level: float) -> dict:
             complete = complete and c.get("shown", False)
         alloc = req.integrity_risk
         verdict = "shown" if hi <= alloc else ("exceeds" if lo > alloc else "not shown")
+        # a term bounded only by its first step's Monte Carlo: the first-step size that would bound it, with no HMI
+        # sample, by an equal share of the allocation (Clopper-Pearson at 0 hits: 1 - (1 - level)^(1 / n))
+        share = alloc / max(1, len(terms))
+        for name, tm in terms.items():
+            if name != "fault_free" and not tm["shown"] and tm["prior"] > share:
+                tm["first_step_needed"] = math.ceil(math.log(1.0 - level) / math.log1p(-share / tm["prior"]))
         fa = study["fault_free"]["categories"][cat]["false_alert"]
         fa_up = max(fa["rate_per_15s_gaussian"], 0.0)
         out[cat] = {"p_hmi": p, "p_hmi_lower": lo, "p_hmi_upper": hi, "allocation": alloc,
