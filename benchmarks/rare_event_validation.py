@@ -1,5 +1,6 @@
 """Issue 26 acceptance, estimator validation: the same fault mode and the same event by brute force (plain Monte
-Carlo over the fault distribution) and by importance sampling (NAIS, integrity.rare), on the real simulation.
+Carlo over the fault distribution, plain numpy normals) and by importance sampling (NAIS, integrity.rare), on the
+real simulation.
 
     PYTHONPATH=. python benchmarks/rare_event_validation.py [--profile P] [--mode sat-ramp] [--thresholds C1,C2]
         [--brute N] [--samples N] [--seed S] [--workers K] [--truths T] [--pilot N] [--out FILE.json]
@@ -9,9 +10,11 @@ The event: the protected output's largest vertical error over the CAT I window (
 the mode with its parameters drawn from the mode's distribution (integrity.risk: onset uniform, magnitude
 log-uniform, satellite uniform among those in use). The levels C are where brute force can answer (1e-3 .. 1e-4);
 --pilot N runs N plain samples on other run indices first and prints the quantiles to choose them (neither the
-brute-force nor the IS samples see the pilot). Brute force runs once (its per-sample values are compared with every
-C); NAIS runs once per C, each on its own run indices (its own noise) and its own OpenTURNS seed. Prints and writes
-the table: estimate, CoV, one-sided bounds, hits, evaluations, wall time, whether the intervals overlap.
+brute-force nor the IS samples see the pilot). Brute force (plain numpy normals through the same map) runs once and
+its values are compared with every C; they are appended to --vmax-file as chunks finish, so a brute-force-only run
+(--no-nais) and a NAIS-only run (--brute 0 with the same --vmax-file, read at the end) can go side by side. NAIS runs
+once per C, each on its own run indices (its own noise) and its own OpenTURNS seed. Prints and writes the table:
+estimate, CoV, one-sided bounds, hits, evaluations, wall time, whether the intervals overlap.
 """
 
 from __future__ import annotations
@@ -40,6 +43,10 @@ def main() -> None:
     ap.add_argument("--truths", type=int, default=4)
     ap.add_argument("--pilot", type=int, default=0)
     ap.add_argument("--out", type=Path, default=None)
+    ap.add_argument("--vmax-file", type=Path, default=Path("rare_event_validation_vmax.txt"),
+                    help="brute-force values, appended as they finish (and read back: a run can be continued)")
+    ap.add_argument("--brute-wall-s", type=float, default=None, help="wall time of an earlier brute-force run, s")
+    ap.add_argument("--no-nais", action="store_true", help="brute force only")
     a = ap.parse_args()
     profile = load_profile(a.profile)
     mode = MODES[a.mode]
@@ -64,38 +71,52 @@ def main() -> None:
             cols = _columns(sim.run(a.mode, runs, u))
             return np.where(cols["failed"] > 0, 1e3, cols["cat1_vmax_m"])
 
-        t = time.time()
-        store: list[np.ndarray] = []
-
-        def g_mc(u: np.ndarray) -> np.ndarray:
-            v = sample(u, 5_000_000)
-            store.append(v)
-            return v - levels[0]
-
-        rare.estimate(g_mc, mode.dim, method="mc", samples=a.brute, seed=a.seed * 31)
-        vmax = np.concatenate(store)
-        wall_mc = time.time() - t
-        res["brute_force"] = {"samples": int(vmax.size), "wall_s": wall_mc,
-                              "largest_vmax_m": [float(x) for x in np.sort(vmax)[::-1][:20]]}
-        print(f"brute force: {vmax.size} runs, {wall_mc:.0f} s; largest vmax (m)",
-              np.round(np.sort(vmax)[::-1][:10], 2), flush=True)
+        if a.brute:  # plain Monte Carlo over the fault distribution, in chunks appended to --vmax-file as they finish
+            t = time.time()
+            rng = np.random.default_rng(a.seed * 31)
+            done = 0
+            chunk = 50 * a.workers
+            while done < a.brute:
+                n = min(chunk, a.brute - done)
+                u = rng.standard_normal((n, mode.dim))
+                cols = _columns(sim.run(a.mode, 5_000_000 + done + np.arange(n), u))
+                v = np.where(cols["failed"] > 0, 1e3, cols["cat1_vmax_m"])
+                with open(a.vmax_file, "a") as fh:
+                    np.savetxt(fh, v)
+                done += n
+                print(f"brute force {done}/{a.brute} ({time.time() - t:.0f} s); above the levels:",
+                      [int(np.sum(np.loadtxt(a.vmax_file) > c)) for c in levels], flush=True)
+        wall_mc = float(a.brute_wall_s) if a.brute_wall_s else (time.time() - t if a.brute else float("nan"))
+        if a.no_nais:
+            vmax = np.atleast_1d(np.loadtxt(a.vmax_file))
+            for c in levels:
+                k = int(np.sum(vmax > c))
+                print(f"C = {c} m: brute force {k}/{vmax.size} = {k / vmax.size:.3g} "
+                      f"{rare.clopper_pearson(k, vmax.size, 0.95)}")
+            return
+        nais_rows = []
         for j, c in enumerate(levels):
-            k = int(np.sum(vmax > c))
-            lo, hi = rare.clopper_pearson(k, vmax.size, 0.95)
-            mc = {"method": "mc", "probability": k / vmax.size, "lower": lo, "upper": hi, "hits": k,
-                  "calls": int(vmax.size), "wall_s": wall_mc}
             counter[0] = 0
             t = time.time()
             est, _ = rare.estimate(lambda u, c=c, j=j: sample(u, 6_000_000 + 100_000 * j) - c, mode.dim,
                                    method="nais", samples=a.samples, seed=a.seed * 31 + 1 + j,
                                    max_calls=12 * a.samples)
-            nais = {**est.as_dict(), "wall_s": time.time() - t}
-            overlap = bool(lo <= (nais["upper"] or 1.0) and (nais["lower"] or 0.0) <= hi)
-            res["levels"].append({"threshold_m": c, "brute_force": mc, "nais": nais, "overlap": overlap})
-            print(f"C = {c} m: brute force {k}/{vmax.size} = {k / vmax.size:.3g} [{lo:.3g}, {hi:.3g}]; NAIS "
-                  f"{est.probability:.3g} CoV {est.cov:.2g} [{est.lower:.3g}, {est.upper:.3g}] hits {est.hits}/"
-                  f"{est.samples} calls {est.calls} ({est.steps} steps, {nais['wall_s']:.0f} s) {est.note}; "
-                  f"overlap {overlap}", flush=True)
+            nais_rows.append({**est.as_dict(), "wall_s": time.time() - t})
+            print(f"C = {c} m: NAIS {est.probability:.3g} CoV {est.cov:.2g} [{est.lower:.3g}, {est.upper:.3g}] hits "
+                  f"{est.hits}/{est.samples} calls {est.calls} ({est.steps} steps, {nais_rows[-1]['wall_s']:.0f} s) "
+                  f"{est.note}", flush=True)
+    vmax = np.atleast_1d(np.loadtxt(a.vmax_file)) if a.vmax_file.exists() else np.empty(0)
+    res["brute_force"] = {"samples": int(vmax.size), "wall_s": wall_mc,
+                          "largest_vmax_m": [float(x) for x in np.sort(vmax)[::-1][:20]]}
+    for c, nais in zip(levels, nais_rows, strict=True):
+        k = int(np.sum(vmax > c))
+        lo, hi = rare.clopper_pearson(k, vmax.size, 0.95)
+        mc = {"method": "mc", "probability": k / max(vmax.size, 1), "lower": lo, "upper": hi, "hits": k,
+              "calls": int(vmax.size), "wall_s": wall_mc}
+        overlap = bool(lo <= (nais["upper"] or 1.0) and (nais["lower"] or 0.0) <= hi)
+        res["levels"].append({"threshold_m": c, "brute_force": mc, "nais": nais, "overlap": overlap})
+        print(f"C = {c} m: brute force {k}/{vmax.size} = {mc['probability']:.3g} [{lo:.3g}, {hi:.3g}]; NAIS "
+              f"{nais['probability']} [{nais['lower']}, {nais['upper']}]; overlap {overlap}", flush=True)
     res["wall_s"] = time.time() - t_all
     if a.out is not None:
         a.out.write_text(json.dumps(res, indent=1) + "\n")

@@ -1,5 +1,6 @@
 """`approachsim integrity-risk PROFILE [--modes M,...] [--method nais|ce|mc] [--samples N] [--max-calls N]
-[--fault-free-runs N] [--truths T] [--seed S] [--workers K] [--sensor-modes] [--out DIR] [--require CAT]`: the
+[--fault-free-runs N] [--truths T] [--seed S] [--workers K] [--sensor-modes] [--second-level] [--out DIR]
+[--require CAT]`: the
 probability of hazardously misleading information per category by rare-event simulation (integrity/risk.py,
 docs/integrity.md "Integrity risk"), against the Annex 10 allocations.
 
@@ -51,6 +52,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--sensor-modes", action="store_true",
                    help="the bank also leaves out the baro, the radar altimeter and each pseudolite (default: GPS "
                         "satellites only, as evaluate's bank)")
+    p.add_argument("--second-level", action="store_true",
+                   help="the bank confirms an identification before excluding (a second look: docs/integrity.md; "
+                        "default: the first detection's suspect, as evaluate's bank)")
     p.add_argument("--require", default=None, metavar="CAT",
                    help="exit 1 unless this category's P(HMI) upper bound is within its allocation")
     p.set_defaults(func=run)
@@ -84,7 +88,8 @@ def check_options(args: argparse.Namespace, profile: object) -> dict:
         raise ProfileError(f"--modes: name at least one of {', '.join(MODES)}")
     return {"modes": names, "method": args.method, "samples": args.samples, "max_calls": args.max_calls,
             "fault_free_runs": args.fault_free_runs, "truths": args.truths, "seed": seed, "workers": args.workers,
-            "sensor_modes": bool(getattr(args, "sensor_modes", False))}
+            "sensor_modes": bool(getattr(args, "sensor_modes", False)),
+            "second_level": bool(getattr(args, "second_level", False))}
 
 
 def _fmt(x: float | None) -> str:

@@ -196,12 +196,59 @@ class CategoryIntegrity:
     (negative: detected before; nan: the error never exceeded it), s."""
     alert: Array
     """(e,) the output cannot be protected: PL >= AL (unavailable), the flag a crew would see."""
+    err_m: Array | None = None
+    """(e, 2) |error| of the output (the main solution; after an exclusion the excluded sub-solution), m."""
 
 
-def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, window: Array | None = None
-                   ) -> CategoryIntegrity:
+SECOND_LEVEL_RATIO = 2.0
+"""Second-level identification: the candidate's statistic must be at least this multiple of the runner-up's."""
+SECOND_LEVEL_EPOCHS = 3
+"""Second-level identification: ... for this many consecutive detected epochs before its exclusion."""
+
+
+def second_level(detected: Array, stat: Array, ratio: float = SECOND_LEVEL_RATIO,
+                 epochs: int = SECOND_LEVEL_EPOCHS) -> tuple[Array, Array]:
+    """Confirmed identification with a second look (issue 26: the misidentified ramp of run 44).
+
+    From the first detection on, at each detected epoch the candidate is the mode with the largest identification
+    statistic stat (epochs, modes) if it is at least `ratio` times the runner-up, else none (ambiguous). A mode is
+    excluded once it has been the candidate at `epochs` consecutive detected epochs; an excluded mode is replaced
+    when another is confirmed the same way. The output is protected (confirmed) only at epochs where the excluded
+    mode is not contradicted (a later detected epoch whose clear candidate is another mode contradicts it; an
+    ambiguous one does not); elsewhere from the first detection on it is not: the caller raises the alert
+    (PL = inf). Returns (excluded mode per epoch, -1 none; confirmed (epochs,))."""
+    det = np.asarray(detected, bool)
+    st = np.asarray(stat, float)
+    n = det.size
+    mode = np.full(n, -1)
+    ok = np.ones(n, bool)
+    if not det.any():
+        return mode, ok
+    order = np.argsort(st, axis=1)
+    top = order[:, -1]
+    second = st[np.arange(n), order[:, -2]] if st.shape[1] > 1 else np.zeros(n)
+    clear = st[np.arange(n), top] >= ratio * np.maximum(second, 0.0)
+    current, last, run = -1, -2, 0
+    for e in range(int(np.argmax(det)), n):
+        if det[e]:
+            c = int(top[e]) if clear[e] else -1
+            run = run + 1 if (c == last and c >= 0) else (1 if c >= 0 else 0)
+            last = c
+            if c >= 0 and c != current and run >= epochs:
+                current = c
+            ok[e] = current >= 0 and c in (current, -1)  # an ambiguous epoch does not contradict an exclusion
+        else:
+            ok[e] = current >= 0
+        mode[e] = current
+    return mode, ok
+
+
+def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, window: Array | None = None,
+                   confirm: bool = False) -> CategoryIntegrity:
     """Protection levels, detection and the per-epoch counts of one category (Annex 10 alert limits at the
-    aircraft's distance from the threshold and height above it)."""
+    aircraft's distance from the threshold and height above it). confirm: identify with the second look
+    (second_level: the output is not protected until a mode's exclusion is confirmed, and again whenever a later
+    detection names another mode); default: exclude the first detection's suspect for good."""
     sel = np.ones(ep.t_s.shape, bool) if window is None else np.asarray(window, bool)
     n_modes = max(ep.ek.shape[1], 1)
     r = separation(ep.e0[sel], ep.p0[sel], ep.ek[sel], ep.pk[sel], req.k_ff(), req.k_fa(epoch_hz, 2 * n_modes),
@@ -212,7 +259,17 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
     e_main = np.abs(ep.e0[sel])
     err, pl = e_main.copy(), r.pl_m.copy()
     excluded, t_det = -1, float("nan")
-    if r.detected.any():  # exclude the suspect from the first detection on: its sub-solution is the output
+    if r.detected.any() and confirm:
+        stat = ep.wtest[sel] if ep.wtest is not None else np.max(r.test_ratio, axis=2)
+        mode, ok = second_level(r.detected, stat)
+        t_det = float(t[int(np.argmax(r.detected))])
+        on = mode >= 0
+        kk = np.where(on, mode, 0)
+        err = np.where(on[:, None], np.abs(ep.ek[sel][np.arange(kk.size), kk]), err)
+        pl = np.where(on[:, None], req.k_ff() * np.sqrt(ep.pk[sel][np.arange(kk.size), kk]), pl)
+        pl = np.where(ok[:, None], pl, np.inf)
+        excluded = int(ep.channels[mode[-1]]) if mode[-1] >= 0 else -1
+    elif r.detected.any():  # exclude the suspect from the first detection on: its sub-solution is the output
         i = int(np.argmax(r.detected))
         # identification: the full navigation-state statistic (Baarda's w-test squared) where the bank has it,
         # else the largest two-axis normalized separation
@@ -228,7 +285,7 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
     mi = np.any(err > pl, axis=1)
     hmi = np.any(err > al, axis=1) & avail
     return CategoryIntegrity(req.category, int(sel.sum()), avail, mi, hmi, r.detected, pl, al, r, excluded, t_det,
-                             tta, ~avail)
+                             tta, ~avail, err)
 
 
 def _no_modes(ep: BankEpochs, sel: Array, req: IntegrityRequirement) -> SeparationResult:

@@ -189,11 +189,12 @@ def fault_spec(mode: FaultMode, u: Array, profile: Any, truth: Any, seed: int, r
                   "n_channels": n_used}
 
 
-def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float) -> dict[str, float]:
+def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float, confirm: bool = False) -> dict[str, float]:
     """Per category (prefix cat1_ ...): `hmi_g` (module docstring), `mi_g` (max over available epochs of
     max_axis (|e| - PL)), the largest output errors `vmax_m` / `lmax_m`, `hmi` / `mi` epoch counts, `available`
     epochs, `detected` (any detection) and the excluded channel; fault-free diagnostics: the normalized main errors
-    and separations (`z2_v`, `z2_l`, `ss2`: sums of squares, `n_z`, `n_ss`: counts)."""
+    and separations (`z2_v`, `z2_l`, `ss2`: sums of squares, `n_z`, `n_ss`: counts). confirm: the bank identifies
+    with the second look (bank.second_level)."""
     from approachsim.integrity.bank import score_category
 
     out: dict[str, float] = {}
@@ -201,12 +202,8 @@ def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float) -> dict[str, f
     for cat, req in REQUIREMENTS.items():
         key = CATEGORY_KEYS[cat]
         win = settled & (ep.height_m >= cfg.dh_m(cat))
-        s = score_category(ep, req, epoch_hz, win)
-        err = np.abs(ep.e0[win])
-        if s.excluded_channel != -1:
-            k = int(np.nonzero(ep.channels == s.excluded_channel)[0][0])
-            i = int(np.argmax(s.result.detected))
-            err[i:] = np.abs(ep.ek[win][i:, k])
+        s = score_category(ep, req, epoch_hz, win, confirm=confirm)
+        err = s.err_m
         al, pl = s.al_m, s.pl_m
         with np.errstate(invalid="ignore"):
             h = np.minimum(np.max(err - al, axis=1), np.min(al - pl, axis=1))
@@ -236,11 +233,12 @@ def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float) -> dict[str, f
 
 
 def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | None, u: Sequence[float],
-               sensor_modes: bool = False) -> dict[str, float]:
+               sensor_modes: bool = False, confirm: bool = False) -> dict[str, float]:
     """One sample: the flown truth run % truths, the fault of `mode_name` at u (None: fault-free), the bank (with
     the baro, radar altimeter and pseudolites as fault modes too when `sensor_modes`), the limit states (and the
-    fault's parameters). A sample that raises is returned with `failed` = 1 and every
-    category's hmi_g = +1e3 (a failed navigation counts as the event: conservative)."""
+    fault's parameters); confirm: the second-level identification (bank.second_level). A sample that raises is
+    returned with `failed` = 1 and every category's hmi_g = +1e3 (a failed navigation counts as the event:
+    conservative)."""
     try:
         from approachsim.integrity.bank import run_bank
         from approachsim.integrity.campaign import bank_profile
@@ -252,7 +250,7 @@ def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | 
             spec, params = fault_spec(MODES[mode_name], np.asarray(u), profile, truth, seed, run, (t_lo, t_hi))
             prof = dataclasses.replace(profile, faults=(*tuple(profile.faults or ()), spec))
         ep, _ = run_bank(bank_profile(prof), truth, seed, run, sensor_modes_on=sensor_modes)
-        out = limit_states(ep, profile.evaluation, profile.nav.aiding_rate_hz, float(truth.t_s[0]))
+        out = limit_states(ep, profile.evaluation, profile.nav.aiding_rate_hz, float(truth.t_s[0]), confirm)
         return {**out, **{f"fault_{k}": float(v) for k, v in params.items()}, "failed": 0.0}
     except Exception as e:  # noqa: BLE001 - a failed sample is data (counted as the event), never dropped
         out = {f"{k}_hmi_g": 1e3 for k in CATEGORY_KEYS.values()}
@@ -260,22 +258,23 @@ def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | 
 
 
 def _task(args: tuple) -> list[dict]:
-    profile, seed, truths, mode_name, items, sensor_modes = args
+    profile, seed, truths, mode_name, items, sensor_modes, confirm = args
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1):
-        return [run_sample(profile, seed, run, truths, mode_name, u, sensor_modes) for run, u in items]
+        return [run_sample(profile, seed, run, truths, mode_name, u, sensor_modes, confirm) for run, u in items]
 
 
 class Simulator:
     """Batched evaluation of samples on a local process pool (fork; `workers` processes), in order."""
 
-    def __init__(self, profile: Any, seed: int, truths: int = 4, workers: int = 1, sensor_modes: bool = False
-                 ) -> None:
+    def __init__(self, profile: Any, seed: int, truths: int = 4, workers: int = 1, sensor_modes: bool = False,
+                 confirm: bool = False) -> None:
         if truths < 1 or workers < 1:
             raise ValueError("truths and workers must be >= 1")
         self.profile, self.seed, self.truths, self.workers = profile, int(seed), int(truths), int(workers)
         self.sensor_modes = bool(sensor_modes)
+        self.confirm = bool(confirm)
         self._pool: ProcessPoolExecutor | None = None
         self.samples = 0
         self.wall_s = 0.0
@@ -300,12 +299,13 @@ class Simulator:
         t = time.time()
         items = list(zip([int(r) for r in runs], np.asarray(u, float).tolist(), strict=True))
         if self._pool is None or len(items) < 2:
-            out = _task((self.profile, self.seed, self.truths, mode_name, items, self.sensor_modes))
+            out = _task((self.profile, self.seed, self.truths, mode_name, items, self.sensor_modes, self.confirm))
         else:
             n = max(1, math.ceil(len(items) / (4 * self.workers)))
             chunks = [items[i:i + n] for i in range(0, len(items), n)]
             out = [r for part in self._pool.map(
-                _task, [(self.profile, self.seed, self.truths, mode_name, c, self.sensor_modes) for c in chunks])
+                _task, [(self.profile, self.seed, self.truths, mode_name, c, self.sensor_modes, self.confirm)
+                        for c in chunks])
                 for r in part]
         self.samples += len(items)
         self.wall_s += time.time() - t
@@ -447,7 +447,7 @@ def _rms(s2: Array, n: Array) -> float | None:
 def integrity_risk(profile: Any, *, modes: Sequence[str] | None = None, method: str = "nais", samples: int = 200,
                    max_calls: int | None = None, seed: int = 1, truths: int = 4, workers: int | None = None,
                    fault_free_runs: int = 100, level: float | None = None, sensor_modes: bool = False,
-                   log: Callable[[str], None] | None = None) -> dict:
+                   second_level: bool = False, log: Callable[[str], None] | None = None) -> dict:
     """The integrity-risk study of a profile (module docstring): the fault-free term, each mode's conditional
     estimate, the totals per category against the allocations. JSON-ready."""
     level = profile.evaluation.confidence if level is None else level
@@ -459,8 +459,9 @@ def integrity_risk(profile: Any, *, modes: Sequence[str] | None = None, method: 
     t0 = time.time()
     out: dict = {"schema": "approachsim.integrity_risk/1", "profile": profile.name, "seed": seed,
                  "method": method, "samples_per_step": samples, "max_calls_per_mode": max_calls, "truths": truths,
-                 "confidence": level, "bank_sensor_modes": bool(sensor_modes), "modes": {}}
-    with Simulator(profile, seed, truths, workers, sensor_modes) as sim:
+                 "confidence": level, "bank_sensor_modes": bool(sensor_modes),
+                 "bank_second_level": bool(second_level), "modes": {}}
+    with Simulator(profile, seed, truths, workers, sensor_modes, second_level) as sim:
         say(f"fault-free: {fault_free_runs} runs")
         out["fault_free"] = fault_free(sim, fault_free_runs, level)
         for i, m in enumerate(ms):
