@@ -2,6 +2,10 @@
 integrity.risk.totals, so a change of the combination is seen on stored studies).
 
     PYTHONPATH=. python benchmarks/integrity_risk_tables.py DIR/integrity_risk.json [...]
+    PYTHONPATH=. python benchmarks/integrity_risk_tables.py --merge A/integrity_risk.json B/integrity_risk.json
+
+--merge: one study from several runs of the same profile and seed with different --modes (run side by side): the
+first file's fault-free term, every file's modes (a mode in two files: the first), the runs and wall times summed.
 """
 
 from __future__ import annotations
@@ -17,9 +21,25 @@ def g(x: float | None) -> str:
     return "-" if x is None else f"{x:.2g}"
 
 
+def merged(paths: list[str]) -> dict:
+    """One study from several (module docstring)."""
+    studies = [json.loads(Path(p).read_text()) for p in paths]
+    out = dict(studies[0])
+    out["modes"] = {}
+    for st in studies:
+        if (st["profile"], st["seed"]) != (out["profile"], out["seed"]):
+            raise SystemExit("--merge: the files are not of one profile and seed")
+        for k, v in st["modes"].items():
+            out["modes"].setdefault(k, v)
+    out["samples"] = sum(st["samples"] for st in studies)
+    out["wall_s"] = sum(st["wall_s"] for st in studies)
+    return out
+
+
 def main() -> None:
-    for path in sys.argv[1:]:
-        r = json.loads(Path(path).read_text())
+    args = sys.argv[1:]
+    runs = [merged(args[1:])] if args and args[0] == "--merge" else [json.loads(Path(p).read_text()) for p in args]
+    for r in runs:
         cats = totals(r, r["confidence"])
         print(f"\n### {r['profile']} (seed {r['seed']}, {r['method']}, {r['samples_per_step']} per step, "
               f"bank sensor modes {r.get('bank_sensor_modes', False)}): {r['samples']} runs, {r['wall_s']:.0f} s\n")

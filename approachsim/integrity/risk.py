@@ -88,6 +88,9 @@ class FaultMode:
     """Prior probability per approach (per satellite for GPS: times the satellites in use)."""
     prior_mark: str
     prior_source: str
+    law: str = "log-uniform"
+    """Magnitude law: log-uniform over [low, high], or half-normal (|N(0, high^2)|, low unused: the estimator
+    validation's mode, whose tail is the fault's own)."""
 
     @property
     def has_channel(self) -> bool:
@@ -100,7 +103,9 @@ class FaultMode:
         return 3 if self.has_channel else 2
 
     def magnitude(self, u: float) -> float:
-        """Log-uniform magnitude from a standard normal."""
+        """The magnitude from a standard normal (log-uniform, or half-normal: high |u|)."""
+        if self.law == "half-normal":
+            return float(self.high * abs(u))
         a, b = math.log(self.low), math.log(self.high)
         return float(math.exp(a + float(sps.norm.cdf(u)) * (b - a)))
 
@@ -115,6 +120,18 @@ MODES: Mapping[str, FaultMode] = {
                                  "none found: assumed, per unit"),
 }
 """Fault modes by name (module docstring)."""
+
+VALIDATION_MODES: Mapping[str, FaultMode] = {
+    "baro-step-halfnormal": FaultMode("baro-step-halfnormal", "baro", "step", 0.0, 5.0, 1e-5, "U",
+                                      "estimator validation only", law="half-normal"),
+}
+"""Modes for validating the estimators against brute force (benchmarks/rare_event_validation.py): a fault whose
+event tail is the fault parameter's own (a baro step of 5 m |u|: an error beyond C needs a large |u|)."""
+
+
+def fault_mode(name: str) -> FaultMode:
+    """A mode of MODES or VALIDATION_MODES by name."""
+    return MODES[name] if name in MODES else VALIDATION_MODES[name]
 
 
 def modes_for(profile: Any, names: Sequence[str] | None = None) -> list[FaultMode]:
@@ -247,7 +264,7 @@ def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | 
         prof = profile
         params: dict = {}
         if mode_name is not None:
-            spec, params = fault_spec(MODES[mode_name], np.asarray(u), profile, truth, seed, run, (t_lo, t_hi))
+            spec, params = fault_spec(fault_mode(mode_name), np.asarray(u), profile, truth, seed, run, (t_lo, t_hi))
             prof = dataclasses.replace(profile, faults=(*tuple(profile.faults or ()), spec))
         ep, _ = run_bank(bank_profile(prof), truth, seed, run, sensor_modes_on=sensor_modes)
         out = limit_states(ep, profile.evaluation, profile.nav.aiding_rate_hz, float(truth.t_s[0]), confirm)
@@ -464,7 +481,8 @@ def integrity_risk(profile: Any, *, modes: Sequence[str] | None = None, method: 
     with Simulator(profile, seed, truths, workers, sensor_modes, second_level) as sim:
         say(f"fault-free: {fault_free_runs} runs")
         out["fault_free"] = fault_free(sim, fault_free_runs, level)
-        for i, m in enumerate(ms):
+        for m in ms:
+            i = list(MODES).index(m.name)  # run indices and estimator seed by the mode, not its place in the list
             say(f"{m.name}: {method}, {samples} samples per step")
             r = estimate_mode(sim, m, i, categories=cats, method=method, samples=samples, max_calls=max_calls,
                               level=level, seed=seed * 7919 + i)
