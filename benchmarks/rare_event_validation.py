@@ -52,6 +52,9 @@ def main() -> None:
                     help="brute-force values, appended as they finish (and read back: a run can be continued)")
     ap.add_argument("--brute-wall-s", type=float, default=None, help="wall time of an earlier brute-force run, s")
     ap.add_argument("--no-nais", action="store_true", help="brute force only")
+    ap.add_argument("--level-offset", type=int, default=0,
+                    help="NAIS run indices and seeds as if the levels came after this many others (a later run's "
+                         "levels stay independent of an earlier one's)")
     a = ap.parse_args()
     profile = load_profile(a.profile)
     mode = fault_mode(a.mode)
@@ -100,7 +103,7 @@ def main() -> None:
                       f"{rare.clopper_pearson(k, vmax.size, 0.95)}")
             return
         nais_rows = []
-        for j, c in enumerate(levels):
+        for j, c in enumerate(levels, start=a.level_offset):
             counter[0] = 0
             t = time.time()
             est, _ = rare.estimate(lambda u, c=c, j=j: sample(u, 6_000_000 + 100_000 * j) - c, mode.dim,
