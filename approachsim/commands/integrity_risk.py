@@ -117,6 +117,10 @@ def run(args: argparse.Namespace) -> int:
               f"{c['allocation_unit'][4:]:>4}  {c['verdict']:10}  {_fmt(c['p_false_alert_per_15s_gaussian']):>9}"
               f"        ({_fmt(c['false_alert_allocation_per_15s'])}) {c['false_alert_verdict']}")
     print(f"{res['samples']} navigation runs, {res['wall_s']:.0f} s; wrote {out / 'integrity_risk.json'}")
+    for name, m in res["modes"].items():
+        if m["failed_samples"]:
+            sys.stderr.write(f"approachsim integrity-risk: {name}: {m['failed_samples']} of {m['samples']} samples "
+                             f"failed (counted as HMI); first: {m['first_error']}\n")
     ran = res["fault_free"]["runs"] - res["fault_free"]["failed_runs"] + sum(
         m["samples"] - m["failed_samples"] for m in res["modes"].values())
     if ran == 0:

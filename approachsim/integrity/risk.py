@@ -197,7 +197,7 @@ def fault_spec(mode: FaultMode, u: Array, profile: Any, truth: Any, seed: int, r
         ch = int(used[min(int(sps.norm.cdf(u[2]) * n_used), n_used - 1)])
         channel = int(np.asarray(g.prn)[ch])
     elif mode.sensor == "pseudolite":
-        n_used = len(profile.sensors.pseudolite.units)
+        n_used = len(profile.sensors.pseudolite.positions_rwy)
         channel = min(int(sps.norm.cdf(u[2]) * n_used), n_used - 1)
     target = {"gnss": "pseudorange", "pseudolite": "pseudorange", "baro": "h", "radalt": "h"}[mode.sensor]
     spec = FaultSpec(sensor=mode.sensor, kind=mode.kind, start_s=onset, target=target, channel=channel,
@@ -404,6 +404,7 @@ def estimate_mode(sim: Simulator, mode: FaultMode, index: int, *, categories: Se
             "prior": prior, "prior_mark": mode.prior_mark, "prior_source": mode.prior_source,
             "estimator": est.as_dict(), "categories": per_cat, "worst_profile": dp,
             "samples": len(store), "failed_samples": int(np.nansum(allc.get("failed", np.zeros(1)))),
+            "first_error": next((r["error"] for r in store if r.get("error")), None),
             "wall_s": time.time() - t,
             "detected_fraction_first_step": float(np.nanmean(fc.get("cat1_detected", np.full(1, np.nan))))}
 

@@ -95,3 +95,11 @@ def test_totals_and_verdicts() -> None:
     assert t3["CAT I"]["verdict"] == "not shown"  # 1e-5 x 0.03 = 3e-7 > 2e-7, and nothing estimated
     assert not t3["CAT I"]["every_term_estimated"]
     assert t3["CAT I"]["p_false_alert_per_15s_gaussian"] == 1e-6 and t3["CAT I"]["false_alert_verdict"] == "shown"
+
+
+def test_pseudolite_unit_from_the_profile() -> None:
+    cand = load_profile(shipped_profile("gbas-cat3-candidate"))
+    m = MODES["pseudolite-step"]
+    spec, p = fault_spec(m, np.array([0.0, 0.0, 0.9]), cand, None, 1, 0, (0.0, 10.0))
+    assert spec.sensor == "pseudolite" and spec.target == "pseudorange" and p["n_channels"] == 2
+    assert spec.channel == 1  # Phi(0.9) = 0.82 of two units
