@@ -5,7 +5,8 @@ integrity.risk.totals, so a change of the combination is seen on stored studies)
     PYTHONPATH=. python benchmarks/integrity_risk_tables.py --merge A/integrity_risk.json B/integrity_risk.json
 
 --merge: one study from several runs of the same profile and seed with different --modes (run side by side): the
-first file's fault-free term, every file's modes (a mode in two files: the first), the runs and wall times summed.
+first file's fault-free term, every file's modes (a mode in two files: the later file's, e.g. a mode rerun after a
+fix), the runs and wall times summed (a replaced mode's runs included: they were spent).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ def merged(paths: list[str]) -> dict:
         if (st["profile"], st["seed"]) != (out["profile"], out["seed"]):
             raise SystemExit("--merge: the files are not of one profile and seed")
         for k, v in st["modes"].items():
-            out["modes"].setdefault(k, v)
+            out["modes"][k] = v
     out["samples"] = sum(st["samples"] for st in studies)
     out["wall_s"] = sum(st["wall_s"] for st in studies)
     return out

@@ -398,7 +398,7 @@ def estimate_mode(sim: Simulator, mode: FaultMode, index: int, *, categories: Se
               "onset_s_before_lowest_dh": float((1.0 - sps.norm.cdf(u[0])) * (t_hi - t_lo)),
               "magnitude": mode.magnitude(float(u[1])), "unit": "m/s" if mode.kind == "ramp" else "m"}
     n_ch = allc.get("fault_n_channels", np.array([1.0]))
-    prior = mode.prior * (float(np.nanmax(n_ch)) if mode.sensor == "gnss" else 1.0)
+    prior = mode.prior * (float(np.nanmax(n_ch)) if mode.has_channel else 1.0)  # per satellite / unit
     return {"mode": mode.name, "sensor": mode.sensor, "kind": mode.kind,
             "range": [mode.low, mode.high], "unit": "m/s" if mode.kind == "ramp" else "m",
             "prior": prior, "prior_mark": mode.prior_mark, "prior_source": mode.prior_source,
