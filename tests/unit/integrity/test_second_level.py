@@ -46,14 +46,14 @@ def test_ambiguous_epochs_neither_confirm_nor_contradict() -> None:
     assert np.all(mode[2:] == 0) and ok[2:].all() and not ok[:2].any()
 
 
-def test_a_clear_contradiction_replaces_the_exclusion() -> None:
+def test_a_clear_contradiction_alerts_and_keeps_the_exclusion() -> None:
     det = np.ones(12, bool)
     stat = np.ones((12, 3))
     stat[:5, 0] = 10.0
     stat[5:, 1] = 10.0
     mode, ok = second_level(det, stat)
-    assert np.all(mode[2:7] == 0) and np.all(mode[7:] == 1)
-    assert not ok[5] and not ok[6] and ok[7:].all()  # contradicted: alert until mode 1 is confirmed
+    assert np.all(mode[2:] == 0)  # confirmed once, kept
+    assert ok[2:5].all() and not ok[5:].any()  # contradicted from epoch 5 on: the alert stays on
 
 
 @pytest.mark.parametrize("cat, dh_ft", [("CAT I", 200.0), ("CAT II", 100.0), ("CAT III", 50.0)])
