@@ -1,4 +1,5 @@
-"""Command line: `approachsim fly | sense | navigate | evaluate | study | regress | reproduce | profiles`.
+"""Command line: `approachsim fly | sense | navigate | evaluate | integrity-risk | study | regress | reproduce |
+profiles`.
 
 Each sub-command lives in its own module under approachsim/commands/, with `register(subparsers)`.
 User mistakes (bad profile, bad option) exit with status 2 and one line naming the field, never a traceback.
@@ -21,6 +22,7 @@ COMMAND_MODULES = (
     "approachsim.commands.navigate",
     "approachsim.commands.reproduce",
     "approachsim.commands.evaluate",
+    "approachsim.commands.integrity_risk",
     "approachsim.commands.study",
     "approachsim.commands.regress",
     "approachsim.commands.profiles",

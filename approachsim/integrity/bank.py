@@ -1,7 +1,11 @@
 """The sub-filter bank of solution-separation integrity over one run's records, and its protection levels.
 
 The main filter uses every measurement; sub-filter k is the same navigation system on the same records with
-GNSS channel k never used (every channel the main filter used during the run is a fault mode). The bank runs
+GNSS channel k never used (every channel the main filter used during the run is a fault mode). With
+`sensor_modes` (run_bank) the baro, the radar altimeter and each pseudolite unit are fault modes too: sub-filter k
+then never uses that source (its record invalid throughout, as an outage: the navigation holds the baro damping
+loop without a baro, nav/fde.py). Mode codes (`BankEpochs.channels`): a GNSS channel index >= 0, BARO_MODE,
+RADALT_MODE, PSEUDOLITE_MODE - u for pseudolite unit u. The bank runs
 as K + 1 copies of the run in one batched NavSystem pass (same sensor draws, same initial-error draw: the
 copies differ only in the excluded channel), with the shared covariance where the configuration allows it.
 
@@ -33,23 +37,80 @@ from approachsim.integrity.separation import SeparationResult, identify_statisti
 Array = np.ndarray
 
 
+BARO_MODE = -2
+"""Mode code of the baro (a sub-filter without it)."""
+RADALT_MODE = -3
+"""Mode code of the radar altimeter."""
+PSEUDOLITE_MODE = -10
+"""Mode code of pseudolite unit 0; unit u is PSEUDOLITE_MODE - u."""
+
+
+def mode_name(code: int) -> str:
+    """A mode code's source: "gnss <channel>", "baro", "radalt" or "pseudolite <unit>"."""
+    if code >= 0:
+        return f"gnss {code}"
+    if code == BARO_MODE:
+        return "baro"
+    if code == RADALT_MODE:
+        return "radalt"
+    return f"pseudolite {PSEUDOLITE_MODE - code}"
+
+
+def sensor_modes(records: dict[str, Any]) -> list[int]:
+    """Mode codes of the non-GNSS sources in `records` (one run): baro, radar altimeter, each pseudolite unit with a
+    valid sample."""
+    out = []
+    if "baro" in records:
+        out.append(BARO_MODE)
+    if "radalt" in records:
+        out.append(RADALT_MODE)
+    if "pseudolite" in records:
+        v = np.asarray(records["pseudolite"].valid, bool)
+        v = v.reshape(-1, v.shape[-1])
+        out.extend(PSEUDOLITE_MODE - u for u in np.nonzero(np.any(v, axis=0))[0])
+    return out
+
+
 def used_channels(valid: Array) -> Array:
     """Indices of the GNSS channels valid at any sample (valid (m, channels) of one run)."""
     return np.nonzero(np.any(np.asarray(valid, bool), axis=0))[0]
 
 
 def bank_records(records: dict[str, Any], channels: Array) -> dict[str, Any]:
-    """K + 1 copies of one run's records (run axis first): copy 0 as given, copy k + 1 with GNSS channel
-    channels[k] marked invalid. Records must come from SensorSuite.measure(..., runs=[i] * (K + 1))."""
+    """K + 1 copies of one run's records (run axis first): copy 0 as given, copy k + 1 without mode channels[k]
+    (a GNSS channel index, or a sensor mode code: that source's samples invalid and nan, as an outage). Records
+    must come from SensorSuite.measure(..., runs=[i] * (K + 1))."""
     g = records["gnss"]
     valid = np.array(g.valid, dtype=bool, copy=True)
     if valid.ndim != 3 or valid.shape[0] != len(channels) + 1:
         raise ValueError("bank_records: measure the run K + 1 times (runs=[i] * (K + 1)) first")
-    for k, c in enumerate(channels):
-        valid[k + 1, :, c] = False
     out = dict(records)
+    for k, c in enumerate(channels):
+        c = int(c)
+        if c >= 0:
+            valid[k + 1, :, c] = False
+        else:
+            name = "baro" if c == BARO_MODE else "radalt" if c == RADALT_MODE else "pseudolite"
+            if name not in out:
+                raise ValueError(f"bank_records: mode {mode_name(c)} but no {name} record")
+            out[name] = _without(out[name], k + 1, None if name != "pseudolite" else PSEUDOLITE_MODE - c)
     out["gnss"] = dataclasses.replace(g, valid=valid)
     return out
+
+
+def _without(rec: Any, copy: int, unit: int | None) -> Any:
+    """The record with copy `copy`'s samples (unit `unit` only, when given) invalid and their values nan."""
+    valid = np.array(rec.valid, dtype=bool, copy=True)
+    sl = (copy, slice(None)) if unit is None else (copy, slice(None), unit)
+    valid[sl] = False
+    upd: dict[str, Any] = {"valid": valid}
+    for f in ("h_baro_m", "h_agl_m", "pseudorange_m"):
+        v = getattr(rec, f, None)
+        if v is not None:
+            v = np.array(v, dtype=float, copy=True)
+            v[sl] = np.nan
+            upd[f] = v
+    return dataclasses.replace(rec, **upd)
 
 
 @dataclass(frozen=True)
@@ -127,7 +188,7 @@ class CategoryIntegrity:
     result: SeparationResult
     """The main filter's separation test and protection levels (before any exclusion)."""
     excluded_channel: int
-    """GNSS channel excluded at the first detection (-1: none)."""
+    """Mode excluded at the first detection: a GNSS channel, or a sensor mode code (-1: none)."""
     t_detect_s: float
     """Time of the first detection (nan: none), s."""
     time_to_alert_s: float
@@ -135,12 +196,60 @@ class CategoryIntegrity:
     (negative: detected before; nan: the error never exceeded it), s."""
     alert: Array
     """(e,) the output cannot be protected: PL >= AL (unavailable), the flag a crew would see."""
+    err_m: Array | None = None
+    """(e, 2) |error| of the output (the main solution; after an exclusion the excluded sub-solution), m."""
 
 
-def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, window: Array | None = None
-                   ) -> CategoryIntegrity:
+SECOND_LEVEL_RATIO = 2.0
+"""Second-level identification: the candidate's statistic must be at least this multiple of the runner-up's."""
+SECOND_LEVEL_EPOCHS = 3
+"""Second-level identification: ... for this many consecutive detected epochs before its exclusion."""
+
+
+def second_level(detected: Array, stat: Array, ratio: float = SECOND_LEVEL_RATIO,
+                 epochs: int = SECOND_LEVEL_EPOCHS) -> tuple[Array, Array]:
+    """Confirmed identification with a second look (issue 26: the misidentified ramp of run 44).
+
+    From the first detection on, at each detected epoch the candidate is the mode with the largest identification
+    statistic stat (epochs, modes) if it is at least `ratio` times the runner-up, else none (ambiguous). A mode is
+    excluded once it has been the candidate at `epochs` consecutive detected epochs, and kept (replacing it when
+    another mode was confirmed the same way made the satellite-ramp study worse: 30 instead of 2 HMI in 3000 at
+    CAT II, docs/integrity.md). The output is protected (confirmed) only at epochs where the excluded
+    mode is not contradicted (a later detected epoch whose clear candidate is another mode contradicts it; an
+    ambiguous one does not); elsewhere from the first detection on it is not: the caller raises the alert
+    (PL = inf). Returns (excluded mode per epoch, -1 none; confirmed (epochs,))."""
+    det = np.asarray(detected, bool)
+    st = np.asarray(stat, float)
+    n = det.size
+    mode = np.full(n, -1)
+    ok = np.ones(n, bool)
+    if not det.any():
+        return mode, ok
+    order = np.argsort(st, axis=1)
+    top = order[:, -1]
+    second = st[np.arange(n), order[:, -2]] if st.shape[1] > 1 else np.zeros(n)
+    clear = st[np.arange(n), top] >= ratio * np.maximum(second, 0.0)
+    current, last, run = -1, -2, 0
+    for e in range(int(np.argmax(det)), n):
+        if det[e]:
+            c = int(top[e]) if clear[e] else -1
+            run = run + 1 if (c == last and c >= 0) else (1 if c >= 0 else 0)
+            last = c
+            if c >= 0 and current < 0 and run >= epochs:  # a confirmed exclusion is kept: a contradiction alerts
+                current = c
+            ok[e] = current >= 0 and c in (current, -1)  # an ambiguous epoch does not contradict an exclusion
+        else:
+            ok[e] = current >= 0
+        mode[e] = current
+    return mode, ok
+
+
+def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, window: Array | None = None,
+                   confirm: bool = False) -> CategoryIntegrity:
     """Protection levels, detection and the per-epoch counts of one category (Annex 10 alert limits at the
-    aircraft's distance from the threshold and height above it)."""
+    aircraft's distance from the threshold and height above it). confirm: identify with the second look
+    (second_level: the output is not protected until a mode's exclusion is confirmed, and again whenever a later
+    detection names another mode); default: exclude the first detection's suspect for good."""
     sel = np.ones(ep.t_s.shape, bool) if window is None else np.asarray(window, bool)
     n_modes = max(ep.ek.shape[1], 1)
     r = separation(ep.e0[sel], ep.p0[sel], ep.ek[sel], ep.pk[sel], req.k_ff(), req.k_fa(epoch_hz, 2 * n_modes),
@@ -151,7 +260,17 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
     e_main = np.abs(ep.e0[sel])
     err, pl = e_main.copy(), r.pl_m.copy()
     excluded, t_det = -1, float("nan")
-    if r.detected.any():  # exclude the suspect from the first detection on: its sub-solution is the output
+    if r.detected.any() and confirm:
+        stat = ep.wtest[sel] if ep.wtest is not None else np.max(r.test_ratio, axis=2)
+        mode, ok = second_level(r.detected, stat)
+        t_det = float(t[int(np.argmax(r.detected))])
+        on = mode >= 0
+        kk = np.where(on, mode, 0)
+        err = np.where(on[:, None], np.abs(ep.ek[sel][np.arange(kk.size), kk]), err)
+        pl = np.where(on[:, None], req.k_ff() * np.sqrt(ep.pk[sel][np.arange(kk.size), kk]), pl)
+        pl = np.where(ok[:, None], pl, np.inf)
+        excluded = int(ep.channels[mode[-1]]) if mode[-1] >= 0 else -1
+    elif r.detected.any():  # exclude the suspect from the first detection on: its sub-solution is the output
         i = int(np.argmax(r.detected))
         # identification: the full navigation-state statistic (Baarda's w-test squared) where the bank has it,
         # else the largest two-axis normalized separation
@@ -167,7 +286,7 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
     mi = np.any(err > pl, axis=1)
     hmi = np.any(err > al, axis=1) & avail
     return CategoryIntegrity(req.category, int(sel.sum()), avail, mi, hmi, r.detected, pl, al, r, excluded, t_det,
-                             tta, ~avail)
+                             tta, ~avail, err)
 
 
 def _no_modes(ep: BankEpochs, sel: Array, req: IntegrityRequirement) -> SeparationResult:
@@ -189,9 +308,11 @@ def score_run(ep: BankEpochs, epoch_hz: float, start_height_m: float, dh_m: dict
     return out
 
 
-def run_bank(profile: Any, truth: Any, seed: int, run: int) -> tuple[BankEpochs, Any]:
+def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: bool = False
+             ) -> tuple[BankEpochs, Any]:
     """Measure run `run` of the campaign seeded `seed` on `truth`, navigate it with the main filter and the
     sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun).
+    sensor_modes_on: the baro, radar altimeter and pseudolite units are fault modes too (module docstring).
 
     The copies share the run's IMU record and its INS (NavSystem.run(copies=True), feed-forward): the IMU is
     drawn and applied once; the other sensors are measured for the K + 1 copies (the same draws: the same
@@ -209,12 +330,16 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int) -> tuple[BankEpochs,
     if "gnss" not in one:
         raise ValueError("integrity bank: the profile has no GNSS receiver")
     channels = used_channels(np.asarray(one["gnss"].valid)[0])
+    if sensor_modes_on:
+        channels = np.concatenate([channels, np.asarray(sensor_modes(one), dtype=int)]).astype(int)
     copies = len(channels) + 1
     nav = NavSystem.from_profile(profile)
     states = start_states(suite, truth, errors)
     states = replace(states, **{f.name: np.repeat(getattr(states, f.name), copies, axis=0)
                                 for f in fields(states) if isinstance(getattr(states, f.name), np.ndarray)})
-    share = not nav.nav.feedback and "imu" in one
+    # a sub-filter without the baro has its own INS when the baro damping loop drives the INS vertical channel
+    own_ins = bool(sensor_modes_on and "baro" in one and nav.loop_gains() is not None)
+    share = not nav.nav.feedback and "imu" in one and not own_ins
     rest = suite.without("imu") if share else suite  # feed-forward: one IMU record for every copy
     recs = rest.apply(truth, rest.draw(truth.t_s, seed, [run] * copies))
     if share:

@@ -140,7 +140,7 @@ def run_integrity(ep: BankEpochs, cfg: Any, *, epoch_hz: float, t0_s: float, ons
         s = score_category(ep, req, epoch_hz, win)
         t = ep.t_s[win]
         err = np.abs(ep.e0[win])
-        if s.excluded_channel >= 0:  # the output after the exclusion is the excluded sub-solution
+        if s.excluded_channel != -1:  # the output after the exclusion is the excluded sub-solution
             k = int(np.nonzero(ep.channels == s.excluded_channel)[0][0])
             i = int(np.argmax(s.result.detected))
             err[i:] = np.abs(ep.ek[win][i:, k])

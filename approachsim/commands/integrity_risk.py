@@ -1,0 +1,151 @@
+"""`approachsim integrity-risk PROFILE [--modes M,...] [--method nais|ce|mc] [--samples N] [--max-calls N]
+[--fault-free-runs N] [--truths T] [--seed S] [--workers K] [--sensor-modes] [--second-level] [--out DIR]
+[--require CAT]`: the
+probability of hazardously misleading information per category by rare-event simulation (integrity/risk.py,
+docs/integrity.md "Integrity risk"), against the Annex 10 allocations.
+
+Writes DIR/integrity_risk.json (docs/contract.md) and prints one line per category. Exit status: 0 the study ran;
+1 the --require'd category's P(HMI) is not shown within its allocation; 2 bad input (one line naming the option);
+3 no sample completed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+from approachsim.config import ProfileError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the `integrity-risk` sub-command."""
+    from approachsim.commands._help import command_parser
+
+    p = command_parser(
+        sub, "integrity-risk", help="P(HMI) per category by importance sampling over the fault modes",
+        description="Estimates the integrity risk of a profile per category: P(HMI) = fault-free term + sum over\n"
+        "the fault modes (GPS satellite ramp and step, baro step, radar-altimeter bias, pseudolite step) of\n"
+        "prior x P(HMI | fault), each conditional probability by non-parametric adaptive importance sampling\n"
+        "(OpenTURNS NAIS) over the fault's onset, magnitude and channel, with its confidence bounds and the\n"
+        "number of navigation runs spent; compares the upper bound with the Annex 10 allocation\n"
+        "(docs/integrity.md). Writes DIR/integrity_risk.json.",
+        examples=["approachsim integrity-risk profiles/default.toml --samples 200 --out out/risk",
+                  "approachsim integrity-risk profiles/default.toml --modes sat-ramp --method mc --samples 2000",
+                  "approachsim integrity-risk profiles/gbas-cat3-candidate.toml --require \"CAT I\""],
+    )
+    p.add_argument("profile", type=Path, help="approach profile (TOML)")
+    p.add_argument("--modes", default=None,
+                   help="comma-separated fault modes (default: every mode the profile's sensors have): "
+                        "sat-ramp, sat-step, baro-step, radalt-bias, pseudolite-step")
+    p.add_argument("--method", default="nais", choices=("nais", "ce", "mc"),
+                   help="nais (default), ce (cross-entropy IS, biased low in our checks: docs/integrity.md) or mc")
+    p.add_argument("--samples", type=int, default=200, help="samples per adaptive step (mc: in all); default 200")
+    p.add_argument("--max-calls", type=int, default=None, help="navigation runs per mode at most (default 8 x samples)")
+    p.add_argument("--fault-free-runs", type=int, default=100, help="fault-free runs for the overbound (default 100)")
+    p.add_argument("--truths", type=int, default=4, help="flown approaches the samples share (default 4)")
+    p.add_argument("--seed", type=int, default=None, help="study seed (default: the profile's run.seed)")
+    p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
+    p.add_argument("--out", type=Path, default=None, help="output directory (default: integrity-risk-<profile>)")
+    p.add_argument("--sensor-modes", action="store_true",
+                   help="the bank also leaves out the baro, the radar altimeter and each pseudolite (default: GPS "
+                        "satellites only, as evaluate's bank)")
+    p.add_argument("--second-level", action="store_true",
+                   help="the bank confirms an identification before excluding (a second look: docs/integrity.md; "
+                        "default: the first detection's suspect, as evaluate's bank)")
+    p.add_argument("--require", default=None, metavar="CAT",
+                   help="exit 1 unless this category's P(HMI) upper bound is within its allocation")
+    p.set_defaults(func=run)
+
+
+def check_options(args: argparse.Namespace, profile: object) -> dict:
+    """Validate the options (ProfileError naming the option); the keyword arguments of integrity_risk."""
+    from approachsim.integrity.risk import MODES, modes_for
+
+    if not 10 <= args.samples <= 1_000_000:
+        raise ProfileError(f"--samples: must be in [10, 1000000], got {args.samples}")
+    if args.max_calls is not None and args.max_calls < args.samples:
+        raise ProfileError(f"--max-calls: must be at least --samples ({args.samples}), got {args.max_calls}")
+    if not 2 <= args.fault_free_runs <= 100_000:
+        raise ProfileError(f"--fault-free-runs: must be in [2, 100000], got {args.fault_free_runs}")
+    if not 1 <= args.truths <= 1000:
+        raise ProfileError(f"--truths: must be in [1, 1000], got {args.truths}")
+    if args.workers is not None and not 1 <= args.workers <= 1024:
+        raise ProfileError(f"--workers: must be in [1, 1024], got {args.workers}")
+    seed = profile.run.seed if args.seed is None else args.seed  # type: ignore[attr-defined]
+    if not 0 <= seed < 2**63:
+        raise ProfileError(f"--seed: must be in [0, 2^63), got {seed}")
+    names = None if args.modes is None else [m.strip() for m in args.modes.split(",") if m.strip()]
+    try:
+        modes_for(profile, names)
+    except ValueError as e:
+        raise ProfileError(f"--modes: {e}") from None
+    if profile.sensors.gnss is None:  # type: ignore[attr-defined]
+        raise ProfileError("profile: integrity-risk needs a GPS receiver ([sensors.gnss]): the bank monitors GPS")
+    if names is not None and not names:
+        raise ProfileError(f"--modes: name at least one of {', '.join(MODES)}")
+    return {"modes": names, "method": args.method, "samples": args.samples, "max_calls": args.max_calls,
+            "fault_free_runs": args.fault_free_runs, "truths": args.truths, "seed": seed, "workers": args.workers,
+            "sensor_modes": bool(getattr(args, "sensor_modes", False)),
+            "second_level": bool(getattr(args, "second_level", False))}
+
+
+def _fmt(x: float | None) -> str:
+    return "-" if x is None or not math.isfinite(x) else f"{x:.2g}"
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the study, write integrity_risk.json, print the table."""
+    from approachsim.commands.evaluate import parse_require
+    from approachsim.integrity.risk import integrity_risk
+    from approachsim.profile import load_profile
+
+    profile = load_profile(args.profile)
+    kw = check_options(args, profile)
+    require = parse_require(args.require)
+    out = args.out if args.out is not None else Path(f"integrity-risk-{profile.name}")
+    if out.exists() and not out.is_dir():
+        raise ProfileError(f"--out: {str(out)!r} exists and is not a directory")
+    res = integrity_risk(profile, log=lambda s: print(s, file=sys.stderr, flush=True), **kw)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "integrity_risk.json").write_text(json.dumps(_clean(res), indent=1, allow_nan=False) + "\n")
+    print(f"{'category':9} {'P(HMI)':>9} {'upper':>9} {'allocation':>12}  verdict     P(FA)/15s upper  (allocation)")
+    for cat, c in res["categories"].items():
+        print(f"{cat:9} {_fmt(c['p_hmi']):>9} {_fmt(c['p_hmi_upper']):>9} {_fmt(c['allocation']):>7} "
+              f"{c['allocation_unit'][4:]:>4}  {c['verdict']:10}  {_fmt(c['p_false_alert_per_15s_gaussian']):>9}"
+              f"        ({_fmt(c['false_alert_allocation_per_15s'])}) {c['false_alert_verdict']}")
+    print(f"{res['samples']} navigation runs, {res['wall_s']:.0f} s; wrote {out / 'integrity_risk.json'}")
+    for name, m in res["modes"].items():
+        if m["failed_samples"]:
+            sys.stderr.write(f"approachsim integrity-risk: {name}: {m['failed_samples']} of {m['samples']} samples "
+                             f"failed (counted as HMI); first: {m['first_error']}\n")
+    ran = res["fault_free"]["runs"] - res["fault_free"]["failed_runs"] + sum(
+        m["samples"] - m["failed_samples"] for m in res["modes"].values())
+    if ran == 0:
+        sys.stderr.write("approachsim integrity-risk: no sample completed\n")
+        return 3
+    if require is not None and res["categories"][require]["verdict"] != "shown":
+        c = res["categories"][require]
+        sys.stderr.write(f"approachsim integrity-risk: --require {require}: P(HMI) {c['verdict']} within "
+                         f"{c['allocation']:g} ({c['allocation_unit']})\n")
+        return 1
+    return 0
+
+
+def _clean(x: object) -> object:
+    """JSON-ready: numpy scalars as Python numbers, nan and inf as None (the contract's strict JSON)."""
+    if isinstance(x, dict):
+        return {str(k): _clean(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_clean(v) for v in x]
+    if isinstance(x, bool | str) or x is None:
+        return x
+    try:
+        f = float(x)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return str(x)
+    if not math.isfinite(f):
+        return None
+    return int(f) if isinstance(x, int) else f

@@ -1,0 +1,85 @@
+"""The tables of docs/integrity.md "Integrity risk" from integrity_risk.json files (the totals recomputed with
+integrity.risk.totals, so a change of the combination is seen on stored studies).
+
+    PYTHONPATH=. python benchmarks/integrity_risk_tables.py DIR/integrity_risk.json [...]
+    PYTHONPATH=. python benchmarks/integrity_risk_tables.py --merge A/integrity_risk.json B/integrity_risk.json
+
+--merge: one study from several runs of the same profile and seed with different --modes (run side by side): the
+first file's fault-free term, every file's modes (a mode in two files: the later file's, e.g. a mode rerun after a
+fix), the runs and wall times summed (a replaced mode's runs included: they were spent).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from approachsim.integrity.risk import totals
+
+
+def g(x: float | None) -> str:
+    return "-" if x is None else f"{x:.2g}"
+
+
+def merged(paths: list[str]) -> dict:
+    """One study from several (module docstring)."""
+    studies = [json.loads(Path(p).read_text()) for p in paths]
+    out = dict(studies[0])
+    out["modes"] = {}
+    for st in studies:
+        if (st["profile"], st["seed"]) != (out["profile"], out["seed"]):
+            raise SystemExit("--merge: the files are not of one profile and seed")
+        for k, v in st["modes"].items():
+            out["modes"][k] = v
+    out["samples"] = sum(st["samples"] for st in studies)
+    out["wall_s"] = sum(st["wall_s"] for st in studies)
+    return out
+
+
+def main() -> None:
+    args = sys.argv[1:]
+    runs = [merged(args[1:])] if args and args[0] == "--merge" else [json.loads(Path(p).read_text()) for p in args]
+    for r in runs:
+        cats = totals(r, r["confidence"])
+        print(f"\n### {r['profile']} (seed {r['seed']}, {r['method']}, {r['samples_per_step']} per step, "
+              f"bank sensor modes {r.get('bank_sensor_modes', False)}): {r['samples']} runs, {r['wall_s']:.0f} s\n")
+        ff = r["fault_free"]
+        print(f"fault-free: {ff['runs']} runs, normalized error RMS v/l/sep "
+              f"{g(ff['normalized_error_rms']['vertical'])}/{g(ff['normalized_error_rms']['lateral'])}/"
+              f"{g(ff['normalized_error_rms']['separation'])}, upper "
+              f"{g(ff['normalized_error_rms_upper']['vertical'])}/{g(ff['normalized_error_rms_upper']['lateral'])}/"
+              f"{g(ff['normalized_error_rms_upper']['separation'])}, largest |e|/sigma "
+              f"{g(ff['largest_normalized_error'])}\n")
+        print("| mode | prior | runs | steps | CAT I P(HMI given fault) [lower, upper] (hits/N) | CAT II | CAT III | "
+              "worst profile |")
+        print("|---|---|---|---|---|---|---|---|")
+        for name, m in r["modes"].items():
+            cells = []
+            for cat in ("CAT I", "CAT II", "CAT III"):
+                c = m["categories"].get(cat, {})
+                if c.get("shown"):
+                    cells.append(f"{g(c['probability'])} [{g(c['lower'])}, {g(c['upper'])}] ({c['hits']}/"
+                                 f"{c['samples']})")
+                else:
+                    cells.append(f"<= {g(c.get('upper'))} ({c.get('bound', '')})")
+            wp = m.get("worst_profile")
+            w = "-" if not wp else (f"{wp['magnitude']:.3g} {wp['unit']}, onset {wp['onset_s_before_lowest_dh']:.0f} s "
+                                    "before the lowest DH")
+            print(f"| {name} | {g(m['prior'])} [{m['prior_mark']}] | {m['samples']} | {m['estimator']['steps']} | "
+                  + " | ".join(cells) + f" | {w} |")
+        print("\n| category | P(HMI) | lower | upper | allocation | verdict | P(FA)/15 s (Gaussian, overbound) | "
+              "P(FA)/15 s MC upper | FA verdict |")
+        print("|---|---|---|---|---|---|---|---|---|")
+        for cat, c in cats.items():
+            print(f"| {cat} | {g(c['p_hmi'])} | {g(c['p_hmi_lower'])} | {g(c['p_hmi_upper'])} | {g(c['allocation'])} "
+                  f"{c['allocation_unit']} | {c['verdict']} | {g(c['p_false_alert_per_15s_gaussian'])} | "
+                  f"{g(c['p_false_alert_per_15s_upper_mc'])} | {c['false_alert_verdict']} |")
+        need = {f"{cat} {k}": t["first_step_needed"] for cat, c in cats.items() for k, t in c["terms"].items()
+                if "first_step_needed" in t}
+        if need:
+            print("\nfirst-step runs that would bound a term not estimated (0 HMI):", need)
+
+
+if __name__ == "__main__":
+    main()
