@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from approachsim import geo
+from approachsim.glidepath import GlidePath
 from approachsim.nav import ins
 from approachsim.nav.kernels import inloop as ik
 from approachsim.nav.kernels import strapdown as sk
@@ -283,11 +283,11 @@ class NavInTheLoop:
 
 
 def path_deviation(r_rwy: Array, runway: Any) -> Array:
-    """Deviation (..., 2) of runway-frame points from the desired path: (cross-track y, height above the
-    ideal glidepath z - (tch - x tan gp)), m."""
+    """Deviation (..., 2) of runway-frame points from the desired path: (cross-track y, height above the straight
+    ILS glide path cone, approachsim.glidepath: the one geometric reference the flight and the campaign's FTE use),
+    m."""
     r = np.asarray(r_rwy, dtype=float)
-    return np.stack([r[..., 1], geo.glidepath_deviation_m(r[..., 0], r[..., 2], runway.tch_m,
-                                                          math.tan(runway.glidepath_rad))], axis=-1)
+    return np.stack([r[..., 1], GlidePath.of(runway).deviation_rwy_m(r)], axis=-1)
 
 
 def approach_errors(truth: Truth, guidance_r_rwy: Array, runway: Any) -> ApproachErrors:
