@@ -175,7 +175,8 @@ def verdict_table(summary: dict, det: dict) -> str:
     ta = det.get("time_averaged_rms_ft", {})
     if ta:
         lines.append(
-            "time-averaged RMS over the approach (Gray & Maybeck 1995, Tables 3-6), ft: "
+            "time-averaged RMS over the approach, as in Gray & Maybeck's Tables 3-6 (An integrated GPS/INS/Baro and "
+            "radar altimeter system for aircraft precision approach landings), ft: "
             + ", ".join(f"{k.replace('_', ' ')} {_f(v, '.2f').strip()}" for k, v in ta.items())
         )
     best = summary["best_category"] or "none"

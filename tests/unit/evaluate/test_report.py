@@ -43,7 +43,8 @@ def test_outputs_and_report(tmp_path):
     table = verdict_table(summary, det)
     assert table.splitlines()[0] == "synthetic: 13 runs (1 failed), seed 1, open loop"
     assert "CAT III" in table and "best category:" in table and "FTE" not in table
-    assert "time-averaged RMS over the approach (Gray & Maybeck 1995, Tables 3-6), ft: latitude " in table
+    assert "time-averaged RMS over the approach, as in Gray & Maybeck's Tables 3-6 (An integrated GPS/INS/Baro and " \
+        "radar altimeter system for aircraft precision approach landings), ft: latitude " in table
     # 12 runs of ~3 ft lateral, ~3.3 ft vertical: CAT I's upper bounds are below 28.1 / 6.8 ft, but the failed
     # run counts against every category (no failure allowed by default): every category fails
     e1 = summary["decision_heights"]["CAT I"]
