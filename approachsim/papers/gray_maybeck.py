@@ -203,6 +203,17 @@ PAPER_BEST: dict[int, str | None] = {
 """Tables 7 (cases I-VIII) and 8 (IX-XVI): the most demanding category met ("No" rows: none; no case met
 CAT III)."""
 
+_BARO_ASSUMPTION = (
+    "Baro: the paper's 50-150 ft 1 sigma read as a first-order Gauss-Markov bias of 100 ft with a 3600 s "
+    "correlation time (gap fill), plus 1 m white noise.")
+_RADALT_ASSUMPTION = (
+    "Radar altimeter: R = (0.01 h)^2 + 0.25 with the 0.25 read as m^2 (0.5 m floor), white noise only, below "
+    "3000 ft AGL, flat terrain at the runway elevation (assumption 11).")
+_PSEUDOLITE_ASSUMPTION = (
+    "Pseudolite: one, synchronized to GPS time, 1000 ft past the threshold and 500 ft left of the centreline, "
+    "30 ft high (gap fill: the paper's site is not given), code noise 0.3 m, all other errors zero (assumption 4).")
+"""The gap fills the closed-loop study (ASSUMPTIONS) and the faithful variant (FAITHFUL_ASSUMPTIONS) share."""
+
 ASSUMPTIONS = (
     "Aircraft: the bundled JSBSim 737 flies the paper's KC-135 tanker approach at 133 kt on a 3 deg glideslope "
     "(assumption 14c), calm air, from 10 nmi out (the paper's PROFGEN profile starts earlier: only the final "
@@ -211,12 +222,9 @@ ASSUMPTIONS = (
     "NRC 1995 P(Y) budget (satellite clock/ephemeris 3.6 m, multipath 1.8 m, noise 0.6 m, iono 0.3 m and tropo "
     "0.2 m at zenith) on the best-PDOP four (PDOP 2.0 at the pinned epoch, assumption 13), so the horizontal "
     "and vertical figures are UERE x HDOP and UERE x VDOP (computed in the note), not set directly.",
-    "Baro: the paper's 50-150 ft 1 sigma read as a first-order Gauss-Markov bias of 100 ft with a 3600 s "
-    "correlation time (gap fill), plus 1 m white noise.",
-    "Radar altimeter: R = (0.01 h)^2 + 0.25 with the 0.25 read as m^2 (0.5 m floor), white noise only, below "
-    "3000 ft AGL, flat terrain at the runway elevation (assumption 11).",
-    "Pseudolite: one, synchronized to GPS time, 1000 ft past the threshold and 500 ft left of the centreline, "
-    "30 ft high (gap fill: the paper's site is not given), code noise 0.3 m, all other errors zero (assumption 4).",
+    _BARO_ASSUMPTION,
+    _RADALT_ASSUMPTION,
+    _PSEUDOLITE_ASSUMPTION,
     "Filter: our error-state EKF, tightly coupled, feed-forward (sec. 5), without per-channel range-error "
     "states (the paper's 2-state GPS clock model with the other range errors in R).",
     "GPS outages: 60-120 s (single) and 60-120 s + 160-220 s (double) after the run start (gap fill).",
@@ -237,12 +245,9 @@ FAITHFUL_ASSUMPTIONS = (
     "Initial errors: per INS grade, our free-inertial propagation of 8 min alignment + 60 min flight (the grade's "
     "turn-on biases and random walks, Schuler dynamics on a stationary earth) as the prior of the converged start "
     "(the filter has aided the INS before the final).",
-    "Baro: the paper's 50-150 ft 1 sigma read as a first-order Gauss-Markov bias of 100 ft with a 3600 s "
-    "correlation time (gap fill), plus 1 m white noise.",
-    "Radar altimeter: R = (0.01 h)^2 + 0.25 with the 0.25 read as m^2 (0.5 m floor), white noise only, below "
-    "3000 ft AGL, flat terrain at the runway elevation (assumption 11).",
-    "Pseudolite: one, synchronized to GPS time, 1000 ft past the threshold and 500 ft left of the centreline, "
-    "30 ft high (gap fill: the paper's site is not given), code noise 0.3 m, all other errors zero (assumption 4).",
+    _BARO_ASSUMPTION,
+    _RADALT_ASSUMPTION,
+    _PSEUDOLITE_ASSUMPTION,
     "GPS outages: short, 20 s each: 100-120 s (single) and 100-120 s + 200-220 s (double) after the run start "
     "(gap fill; the paper gives their number only).",
 )
