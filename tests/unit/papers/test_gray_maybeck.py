@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from gm_tables import mean_squares
 
 from approachsim import geo, units
 from approachsim.cli import main
@@ -103,15 +104,9 @@ def test_percent_change_formula_is_the_papers(tid: str) -> None:
         assert abs(abs((a - b) / a * 100.0) - pct) < 0.35, (tid, a, b, pct)
 
 
-def _ms(values_ft: dict[int, list[float]], n: int, spread: float = 0.1) -> dict[int, dict[str, np.ndarray]]:
-    """Per-run mean squares whose RMS over runs is values_ft (per state), with a small run-to-run spread."""
-    rng = np.random.default_rng(5)
-    out = {}
-    for c, v in values_ft.items():
-        w = 1.0 + spread * rng.standard_normal(n)
-        w = w / np.sqrt(np.mean(w**2))
-        out[c] = {s: (v[j] * w) ** 2 for j, s in enumerate(gm.STATES)}
-    return out
+def _ms(values_ft: dict[int, list[float]], n: int) -> dict[int, dict[str, np.ndarray]]:
+    """Per-run mean squares whose RMS over runs is values_ft (per state), spread 0.1, seed 5."""
+    return mean_squares(values_ft, n, spread=0.1, seed=5)
 
 
 def test_group_comparison_and_its_claims_follow_the_numbers() -> None:

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pytest
+from gm_tables import mean_squares
 
 from approachsim.config import ProfileError
 from approachsim.papers import gray_maybeck as gm
@@ -91,14 +92,9 @@ def test_free_inertial_initial_errors_per_grade() -> None:
         assert 0.5 * nominal < c < 1.5 * nominal
 
 
-def _ms(values_ft: dict[int, list[float]], n: int, spread: float = 0.3) -> dict[int, dict[str, np.ndarray]]:
-    rng = np.random.default_rng(11)
-    out = {}
-    for c, v in values_ft.items():
-        w = 1.0 + spread * rng.standard_normal(n)
-        w = w / np.sqrt(np.mean(w**2))
-        out[c] = {s: (v[j] * w) ** 2 for j, s in enumerate(gm.STATES)}
-    return out
+def _ms(values_ft: dict[int, list[float]], n: int) -> dict[int, dict[str, np.ndarray]]:
+    """Per-run mean squares whose RMS over runs is values_ft (per state), spread 0.3, seed 11."""
+    return mean_squares(values_ft, n, spread=0.3, seed=11)
 
 
 def test_magnitude_rule_on_a_constructed_table() -> None:
