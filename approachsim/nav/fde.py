@@ -28,7 +28,8 @@ filter is rolled back: it restarts from its state `rollback_epochs` epochs ago a
 are subtracted as they were applied: y+ = y - c_e). Then the epoch is tested again (several exclusions per
 epoch are possible).
 
-Protection (per epoch, approach axes vertical / lateral, the output's covariance P+):
+Protection (per epoch, approach axes vertical / lateral, the output's covariance P+), the formula of
+integrity.protection that the offline solution-separation bank uses too (one source; there T_k = K_fa sigma_ss,k):
     PL_H0 = K_ff sigma,  PL_H1 = max_j |a' K_j| sqrt(lambda / (S^-1)_jj) + K_md sigma
 with K_j the gain column of measurement j and lambda the non-centrality with P(chi^2(m, lambda) < T) = P_md
 (the largest single-epoch bias the residual test misses with P_md: the slope method of snapshot RAIM, Brown
@@ -50,6 +51,7 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.stats import chi2, ncx2, norm
 
+from approachsim.integrity.protection import epoch_shift, protection_levels
 from approachsim.integrity.requirements import (
     REQUIREMENTS,
     IntegrityRequirement,
@@ -303,14 +305,12 @@ class FdeState:
         A = self._axes
         P = filt.covariance(fs)[0:3, 0:3]
         sigma = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", A, P, A), 0.0))
-        pl_h0 = self._k_ff * sigma
-        if test is None:
-            return pl_h0
+        if test is None:  # no measurement this epoch: nothing can be faulted in it
+            return self._k_ff * sigma
         m = len(test.names)
         lam = _noncentrality(_chi2_threshold(self._p_fa_q, m), m, self._p_md)
-        slope = np.abs(A @ test.gain[0:3])  # (2, m): position error per metre of bias on measurement j
-        pl_h1 = np.max(slope * np.sqrt(lam / test.s_inv_diag), axis=1) + self._k_md * sigma
-        return np.maximum(pl_h0, pl_h1)
+        t = epoch_shift(A, test.gain[0:3], test.s_inv_diag, lam)  # (m, 2): the largest undetected bias's effect
+        return protection_levels(sigma, t, sigma[None, :], self._k_ff, self._k_md)[2]
 
     # --- output -----------------------------------------------------------------------------------------------
 
