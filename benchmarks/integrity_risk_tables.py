@@ -75,6 +75,11 @@ def main() -> None:
             print(f"| {cat} | {g(c['p_hmi'])} | {g(c['p_hmi_lower'])} | {g(c['p_hmi_upper'])} | {g(c['allocation'])} "
                   f"{c['allocation_unit']} | {c['verdict']} | {g(c['p_false_alert_per_15s_gaussian'])} | "
                   f"{g(c['p_false_alert_per_15s_upper_mc'])} | {c['false_alert_verdict']} |")
+        print("\n| mode | prior used | largest prior within its share: CAT I | CAT II | CAT III |")
+        print("|---|---|---|---|---|")
+        for name, m in r["modes"].items():
+            allowed = [cats[cat]["terms"].get(name, {}).get("prior_allowed") for cat in ("CAT I", "CAT II", "CAT III")]
+            print(f"| {name} | {g(m['prior'])} [{m['prior_mark']}] | " + " | ".join(g(a) for a in allowed) + " |")
         need = {f"{cat} {k}": t["first_step_needed"] for cat, c in cats.items() for k, t in c["terms"].items()
                 if "first_step_needed" in t}
         if need:

@@ -531,7 +531,13 @@ def totals(study: Mapping[str, Any], level: float) -> dict:
         # sample, by an equal share of the allocation (Clopper-Pearson at 0 hits: 1 - (1 - level)^(1 / n))
         share = alloc / max(1, len(terms))
         for name, tm in terms.items():
-            if name != "fault_free" and not tm["shown"] and tm["prior"] > share:
+            if name == "fault_free":
+                continue
+            # the largest prior at which this term's upper bound stays within its equal share: what the fault
+            # rate of a source without a sourced prior must be shown to be for this term not to decide the verdict
+            up = tm["conditional_upper"]
+            tm["prior_allowed"] = share / up if up is not None and up > 0.0 else None
+            if not tm["shown"] and tm["prior"] > share:
                 tm["first_step_needed"] = math.ceil(math.log(1.0 - level) / math.log1p(-share / tm["prior"]))
         fa = study["fault_free"]["categories"][cat]["false_alert"]
         fa_up = max(fa["rate_per_15s_gaussian"], 0.0)

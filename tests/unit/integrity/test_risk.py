@@ -95,6 +95,10 @@ def test_totals_and_verdicts() -> None:
     assert t3["CAT I"]["verdict"] == "not shown"  # 1e-5 x 0.03 = 3e-7 > 2e-7, and nothing estimated
     assert not t3["CAT I"]["every_term_estimated"]
     assert t3["CAT I"]["p_false_alert_per_15s_gaussian"] == 1e-6 and t3["CAT I"]["false_alert_verdict"] == "shown"
+    # the prior each term could carry within its equal share (two terms: the fault-free one and the ramp)
+    assert t["CAT I"]["terms"]["sat-ramp"]["prior_allowed"] == pytest.approx(2e-7 / 2 / 2e-4)
+    assert t3["CAT III"]["terms"]["sat-ramp"]["prior_allowed"] == pytest.approx(1e-9 / 2 / 0.03)
+    assert "prior_allowed" not in t["CAT I"]["terms"]["fault_free"]
 
 
 def test_pseudolite_unit_from_the_profile() -> None:
