@@ -101,7 +101,8 @@ class AutopilotGains:
     retard_height_m: float = 25.0 * units.FT
     """Main-gear height where the throttle goes to idle in the flare, m."""
     tecs: bool = False
-    """Speed and path law: True the total energy control law (TECS), False the classic one (autopilot.py)."""
+    """Speed and path law: True the total energy control law (TECS), False the classic one (autopilot.py).
+    The TECS defaults below are PX4's (for an aircraft file without TECS gains); the 737 file's are tecs_gains'."""
     tecs_t_h_s: float = 5.0
     """TECS height time constant T_h: height-rate setpoint h'_gp - d / T_h, s (PX4 FW_T_ALT_TC)."""
     tecs_t_v_s: float = 5.0
