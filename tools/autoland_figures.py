@@ -5,6 +5,7 @@ a 20 kt crosswind, flight technical error against the straight glide path cone.
     python tools/autoland_figures.py crosswind --runs 1000 --out xwind.json    # landings, 20 kt from the right
     python tools/autoland_figures.py fte --runs 20 --out fte.json              # calm and moderate, 1000-200 ft
     [--law classic|tecs] [--workers N]
+    python tools/autoland_figures.py paired --a tecs.json --b classic.json --out paired.json  # same seeds, A - B
 
 Every flight flies on the true state (no navigation in the loop), seeded: envelope case i, seed 1000 + i, runs
 0..seeds-1 (the envelope test's seed is run 0); crosswind and FTE: seed 1, runs 0..N-1 of the default profile.
@@ -206,9 +207,44 @@ def fte(runs: int, law: str | None, workers: int) -> dict:
     return res
 
 
+def _rows(d: dict) -> list[dict]:
+    """The rows of an envelope or FTE output (the docs/data copies store rows as lists under row_keys)."""
+    rows = d["rows"]
+    if rows and isinstance(rows[0], list):
+        rows = [dict(zip(d["row_keys"], r, strict=True)) for r in rows]
+    return rows
+
+
+def paired(a: dict, b: dict) -> dict:
+    """Law A against law B on the same seeds (two envelope outputs, or two FTE outputs' moderate flights): per
+    flight both completed, the vertical FTE RMS difference A - B (mean, its 95 % normal interval, how many larger),
+    and each law's range of the air-mass speed error (envelope) or its pooled RMS (FTE)."""
+    fte = "moderate" in a
+    ra = {(r.get("case", 0), r["run"]): r for r in _rows(a["moderate"] if fte else a)}
+    rb = {(r.get("case", 0), r["run"]): r for r in _rows(b["moderate"] if fte else b)}
+    key = "cone_rms_ft" if fte else "vertical_rms_ft"
+    both = sorted(k for k in ra if k in rb and key in ra[k] and key in rb[k]
+                  and ra[k]["termination"] == rb[k]["termination"] == "reached stop height")
+    d = np.array([ra[k][key] - rb[k][key] for k in both])
+    out = {"flights_both_completed": len(both), "metric": key,
+           "a_minus_b_mean_ft": float(d.mean()), "a_minus_b_ci95_ft": float(1.96 * d.std(ddof=1) / math.sqrt(len(d))),
+           "a_larger": int(np.sum(d > 0)), "a_mean_ft": float(np.mean([ra[k][key] for k in both])),
+           "b_mean_ft": float(np.mean([rb[k][key] for k in both]))}
+    if not fte:
+        for name, r in (("a", ra), ("b", rb)):
+            lo = np.array([r[k]["airmass_err_min_kt"] for k in both])
+            hi = np.array([r[k]["airmass_err_max_kt"] for k in both])
+            out[f"{name}_airmass_err_kt_range"] = [float(lo.min()), float(hi.max())]
+            out[f"{name}_airmass_err_kt_mean_span"] = float(np.mean(hi - lo))
+            out[f"{name}_vertical_rms_ft_max"] = float(max(r[k][key] for k in both))
+    return out
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("what", choices=["envelope", "crosswind", "fte"])
+    p.add_argument("what", choices=["envelope", "crosswind", "fte", "paired"])
+    p.add_argument("--a", type=Path, help="paired: law A's envelope or fte output")
+    p.add_argument("--b", type=Path, help="paired: law B's output on the same seeds")
     p.add_argument("--seeds", type=int, default=20)
     p.add_argument("--runs", type=int, default=1000)
     p.add_argument("--turbulence", default="moderate", help="envelope: moderate | design; crosswind: light ...")
@@ -218,7 +254,9 @@ def main() -> None:
     p.add_argument("--out", type=Path, required=True)
     a = p.parse_args()
     t0 = time.time()
-    if a.what == "envelope":
+    if a.what == "paired":
+        res = paired(json.loads(a.a.read_text(encoding="utf-8")), json.loads(a.b.read_text(encoding="utf-8")))
+    elif a.what == "envelope":
         res = envelope(a.seeds, a.turbulence, a.law, a.workers)
     elif a.what == "crosswind":
         res = crosswind(a.runs, a.law, a.workers, a.wind_kt, "light" if a.turbulence == "moderate" else a.turbulence)

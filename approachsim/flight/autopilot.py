@@ -20,8 +20,8 @@ law = "classic" (glidepath to pitch, speed to throttle, each loop alone):
     e_f <- e_f + dt/tau_v (V_c - V - e_f)                          filtered speed error (turbulence)
     thr = thr_0 + k_v_p e_f + k_v_i int e_f                        autothrottle (integral frozen at saturation)
 
-law = "tecs" (total energy control, Lambregts 1983; the structure and default gains of PX4's TECS by
-P. Riseborough, normalised by g V so that every energy rate is a flight-path angle, rad):
+law = "tecs" (total energy control, Lambregts 1983, in the structure of PX4's TECS by P. Riseborough, normalised
+by g V so that every energy rate is a flight-path angle, rad):
 
     V' = (V - V_l) / tau_r,  V_l <- V_l + dt V'                    acceleration of the smoothed speed (washout)
     h'_c = clip(h'_gp - d / T_h, -sink_max, climb_max)             height-rate setpoint, h'_gp = h' - d'
@@ -36,8 +36,11 @@ P. Riseborough, normalised by g V so that every energy rate is a flight-path ang
 
 K_thr (throttle per rad of energy-rate) is g / (dV'/d thr) of the aircraft's linearization: PX4 scales its
 throttle terms by the throttle range over the total-energy-rate range, which is the same number when thrust is
-linear in throttle; the other gains are PX4's defaults (aircraft file). w_k = clip(spd_weight, 0, 1),
-w_p = clip(2 - spd_weight, 0, 1).
+linear in throttle. w_k = clip(spd_weight, 0, 1), w_p = clip(2 - spd_weight, 0, 1). The other gains are designed
+from the classic law's by approachsim.flight.design.tecs_gains (Lambregts' K_EP = k_pd, K_EI = k_pi, K_TP = K_thr
+k_td, K_TI = K_thr k_ti): at fixed speed the pitch channel is the classic glidepath PID divided by the elevator's
+share w_p + w_k of the distribution rate, at fixed path the thrust channel is the classic autothrottle PI, and
+K_TP / K_TI = K_EP / K_EI.
 
 Landing runs (h_gear: main-gear height above the terrain, the radio altitude) add:
 

@@ -18,7 +18,8 @@ The control laws are the same as autopilot.py's, linearized (no limits); the cla
     dr      = -k_beta beta                                                 sideslip   -> rudder (+ = nose left)
 
 or, with gains.tecs, the total energy control law of autopilot.py (thrust from the total-energy rate error,
-pitch from the energy-distribution rate error, the speed derivative by a washout), in the same states.
+pitch from the energy-distribution rate error, the speed derivative by a washout), in the same states; its gains
+come from the classic ones by `tecs_gains` (the derivation is in its docstring).
 
 Each loop is broken at one point with every other loop closed (the classical loop-at-a-time check):
 "elevator", "throttle", "aileron", "rudder" at the actuator commands, "glidepath" at theta_c and "localizer"
@@ -100,7 +101,8 @@ class AutopilotGains:
     retard_height_m: float = 25.0 * units.FT
     """Main-gear height where the throttle goes to idle in the flare, m."""
     tecs: bool = False
-    """Speed and path law: True the total energy control law (TECS), False the classic one (autopilot.py)."""
+    """Speed and path law: True the total energy control law (TECS), False the classic one (autopilot.py).
+    The TECS defaults below are PX4's (for an aircraft file without TECS gains); the 737 file's are tecs_gains'."""
     tecs_t_h_s: float = 5.0
     """TECS height time constant T_h: height-rate setpoint h'_gp - d / T_h, s (PX4 FW_T_ALT_TC)."""
     tecs_t_v_s: float = 5.0
@@ -339,3 +341,49 @@ def loop_margins(lin: Linearization, g: AutopilotGains, glidepath_rad: float, en
 def closed_loop_poles(lin: Linearization, g: AutopilotGains, glidepath_rad: float, engine_lag_s: float) -> Array:
     """Eigenvalues of the fully closed linear loop (all real parts must be negative), 1/s."""
     return np.linalg.eigvals(closed_loop(lin, g, glidepath_rad, engine_lag_s, None).A)
+
+
+def tecs_gains(g: AutopilotGains, vt_mps: float, spd_weight: float) -> dict[str, float]:
+    """TECS gains designed from the classic law's loop-shaped ones (the aircraft file's TECS section holds them,
+    evaluated at the default profile's trim TAS vt_mps): {field of AutopilotGains: value}.
+
+    Lambregts' structure (Lambregts, "Functional integration of vertical flight path and speed control using energy
+    principles", 1983; Faleiro & Lambregts, "Analysis and tuning of a 'Total Energy Control System' control law
+    using eigenstructure assignment", 1999): thrust = K_TP (total-energy rate) + K_TI int(its error), elevator (here
+    the pitch command) = K_EP (distribution rate) + K_EI int(its error), rates as angles (gamma +- V'/g); in
+    autopilot.py's notation K_TP = K_thr k_td, K_TI = K_thr k_ti, K_EP = k_pd, K_EI = k_pi, and the path and speed
+    errors enter through h'_c = h'_gp - d / T_h and V'_c = (V_c - V) / T_V. The published TSRV 737 gains (Bruce,
+    NASA-CR-178285, 1987) were not found, so the gains are derived here, in three steps:
+
+    1. Pitch at fixed speed. With e_v = 0 the pitch command is -(k_pd d' + (k_pi + k_pd / T_h) d + (k_pi / T_h)
+       int d) / V (seb_ff = 0): the classic glidepath PID when k_pd = k_gs_d V, k_pi + k_pd / T_h = k_gs_p V and
+       k_pi / T_h = k_gs_i V; T_h is the larger root of k_gs_i V T^2 - k_gs_p V T + k_pd = 0 (integral-dominated,
+       as Lambregts' integral on the error; the smaller root puts the same PID in the setpoint path instead).
+    2. The elevator's share. At constant thrust V'/g = -dgamma in the short term (point mass), so the elevator moves
+       the distribution rate w_p gamma - w_k V'/g by (w_p + w_k) dgamma: k_pd and k_pi are divided by w_p + w_k
+       (with w_k = 0, path priority, they are the classic law's; with equal weights, half).
+    3. Thrust at fixed path. With e_h = 0 the throttle is K_thr / g ((1 + k_td) / T_V + k_ti) e + K_thr k_ti / (g
+       T_V) int e + K_thr k_td / g e' for a speed error e: the classic autothrottle's PI when the first two are
+       k_v_p and k_v_i; Lambregts' K_TP / K_TI = K_EP / K_EI (equal proportional-to-integral ratios of the two
+       channels, which keeps their responses alike) fixes k_td, and T_V is again the larger root.
+    """
+    wk = min(max(spd_weight, 0.0), 1.0)
+    wp = min(max(2.0 - spd_weight, 0.0), 1.0)
+    v = vt_mps
+    k_pd = g.k_gs_d * v
+    a, b = g.k_gs_i * v, g.k_gs_p * v
+    t_h = (b + math.sqrt(b * b - 4.0 * a * k_pd)) / (2.0 * a)
+    k_pi = a * t_h
+    share = wp + wk
+    k_pd, k_pi = k_pd / share, k_pi / share
+    p, i = g.k_v_p * units.G0 / g.tecs_thr_per_rad, g.k_v_i * units.G0 / g.tecs_thr_per_rad
+    k_td = 0.0
+    for _ in range(200):  # fixed point of k_td = (k_pd / k_pi) k_ti(k_td); contracts (ratio ~0.6 per pass)
+        t_v = (p + math.sqrt(p * p - 4.0 * i * (1.0 + k_td))) / (2.0 * i)
+        k_td_new = k_pd / k_pi * i * t_v
+        if abs(k_td_new - k_td) < 1e-12:
+            break
+        k_td = k_td_new
+    t_v = (p + math.sqrt(p * p - 4.0 * i * (1.0 + k_td))) / (2.0 * i)
+    return {"tecs_t_h_s": t_h, "tecs_k_pitch_damp": k_pd, "tecs_k_pitch_i": k_pi, "tecs_seb_ff": 0.0,
+            "tecs_t_v_s": t_v, "tecs_k_thr_damp": k_td, "tecs_k_thr_i": i * t_v, "tecs_spd_weight": spd_weight}

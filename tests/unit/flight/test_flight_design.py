@@ -86,15 +86,51 @@ def test_loop_transfer_of_a_known_system():
 
 
 def test_tecs_loops_have_their_margins(setup):
-    """The total energy control law (aircraft file's TECS gains, PX4/ArduPilot defaults) on the same
+    """The total energy control law (the aircraft file's TECS gains, design.tecs_gains) on the same
     linearization: every loop GM >= 6 dB, PM >= 45 deg, closed loop stable."""
     lin, ac, gp = setup
     g = dataclasses.replace(ac.gains, tecs=True)
     assert np.max(design.closed_loop_poles(lin, g, gp, ac.engine_lag_s).real) < 0.0
-    for m in design.loop_margins(lin, g, gp, ac.engine_lag_s):
+    result = design.loop_margins(lin, g, gp, ac.engine_lag_s)
+    for m in result:
         print(f"TECS {m.loop:10s} GM {m.gm_db:6.1f} dB  PM {m.pm_deg:6.1f} deg  wc {m.wc_rad_s:.3f} rad/s")
         assert m.gm_db >= GM_MIN_DB, m
         assert m.pm_deg >= PM_MIN_DEG, m
+    by = {m.loop: m for m in result}
+    assert by["glidepath"].wc_rad_s > 0.3  # it tracks, as the classic law's (test_every_loop_has_its_margins)
+
+
+@pytest.mark.parametrize("spd_weight", [0.0, 0.5, 1.0])
+def test_tecs_design_rule_keeps_the_margins_at_every_speed_weight(setup, spd_weight):
+    """design.tecs_gains at the profile's own trim speed, for path priority (0), 0.5 and Lambregts' equal
+    weighting (1): every loop keeps GM >= 6 dB and PM >= 45 deg. Without step 2 of the rule (the pitch gains not
+    divided by w_p + w_k) the equal-weight law loses them: the step is what keeps the elevator loop's margin."""
+    lin, ac, gp = setup
+    gains = design.tecs_gains(ac.gains, lin.vt_mps, spd_weight)
+    g = dataclasses.replace(ac.gains, tecs=True, **gains)
+    assert np.max(design.closed_loop_poles(lin, g, gp, ac.engine_lag_s).real) < 0.0
+    for m in design.loop_margins(lin, g, gp, ac.engine_lag_s):
+        print(f"TECS w_k {spd_weight} {m.loop:10s} GM {m.gm_db:6.1f} dB  PM {m.pm_deg:6.1f} deg  wc {m.wc_rad_s:.3f}")
+        assert m.gm_db >= GM_MIN_DB, m
+        assert m.pm_deg >= PM_MIN_DEG, m
+    if spd_weight == 1.0:
+        share = 2.0  # w_p + w_k
+        bad = dataclasses.replace(g, tecs_k_pitch_damp=share * g.tecs_k_pitch_damp,
+                                  tecs_k_pitch_i=share * g.tecs_k_pitch_i)
+        by = {m.loop: m for m in design.loop_margins(lin, bad, gp, ac.engine_lag_s)}
+        assert by["elevator"].pm_deg < PM_MIN_DEG or by["glidepath"].pm_deg < PM_MIN_DEG
+
+
+@pytest.mark.parametrize("setup", ["default"], indirect=True)
+def test_tecs_file_gains_are_the_design_rule(setup):
+    """The aircraft file's TECS gains are design.tecs_gains of its classic gains at the default profile's trim TAS
+    (73.1 m/s), written to 3 significant digits: within half a unit of the third digit, 5e-3 relative."""
+    lin, ac, gp = setup
+    assert lin.vt_mps == pytest.approx(73.1, abs=0.05)
+    g = ac.gains
+    for name, want in design.tecs_gains(g, lin.vt_mps, g.tecs_spd_weight).items():
+        print(f"{name} file {getattr(g, name)} rule {want:.4f}")
+        assert getattr(g, name) == pytest.approx(want, rel=5e-3, abs=1e-12), name
 
 
 def test_tecs_thrust_gain_and_decrab_gains_are_the_linearizations(setup):
