@@ -67,9 +67,14 @@ def test_closed_loop_is_stable(setup):
 
 
 def test_the_check_can_fail(setup):
-    """Ten times the glidepath gains destroys the margins: the check has teeth."""
+    """Ten times the glidepath gains (the law's own: the classic PID's, or TECS's pitch-channel gains) destroys
+    the margins: the check has teeth."""
     lin, ac, gp = setup
-    g = dataclasses.replace(ac.gains, k_gs_p=10 * ac.gains.k_gs_p, k_gs_d=10 * ac.gains.k_gs_d)
+    g = ac.gains
+    if g.tecs:
+        g = dataclasses.replace(g, tecs_k_pitch_damp=10 * g.tecs_k_pitch_damp, tecs_k_pitch_i=10 * g.tecs_k_pitch_i)
+    else:
+        g = dataclasses.replace(g, k_gs_p=10 * g.k_gs_p, k_gs_d=10 * g.k_gs_d)
     poles = design.closed_loop_poles(lin, g, gp, ac.engine_lag_s)
     m = {x.loop: x for x in design.loop_margins(lin, g, gp, ac.engine_lag_s)}["glidepath"]
     assert np.max(poles.real) >= 0.0 or m.gm_db < GM_MIN_DB or m.pm_deg < PM_MIN_DEG
