@@ -6,7 +6,10 @@ and figures of the issue's table, with the machine's load (the machine is shared
                                                             # open-loop navigation us per 120 Hz step
     python benchmarks/bench_compiled.py scaling --ns 10 100 1000   # open loop end to end: wall, peak RSS
     python benchmarks/bench_compiled.py scaling --accuracy-only --ns 10 100 1000 10000   # without the bank
-    python benchmarks/bench_compiled.py dask --n 1000      # local pool vs Dask LocalCluster: same bits, efficiency
+    python benchmarks/bench_compiled.py dask --n 1000      # local pool vs Dask LocalCluster (Dask's defaults and
+                                                            # the recommended settings): same bits, efficiency
+    python benchmarks/bench_compiled.py dask --accuracy-only --skip-defaults --n 10000   # without the bank,
+                                                            # recommended settings only
     python benchmarks/bench_compiled.py evaluate           # the default `approachsim evaluate` (20 closed-loop runs)
 
 Results go in benchmarks/RESULTS.md under "Compiled core". No pass/fail: benchmarks are scripts, not tests.
@@ -15,6 +18,7 @@ Results go in benchmarks/RESULTS.md under "Compiled core". No pass/fail: benchma
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import resource
@@ -167,9 +171,9 @@ def bench_ratios(repeat: int) -> None:
     print(f"  {load()}")
 
 
-def _open_loop(n: int, scheduler: str | None = None, integrity: bool = True):
+def _open_loop(n: int, scheduler: str | None = None, integrity: bool = True, progress: bool = False):
     """n open-loop runs of the default profile end to end (no report); integrity False: accuracy only
-    (evaluation.integrity = []: no solution-separation bank)."""
+    (evaluation.integrity = []: no solution-separation bank). progress: the runner's progress lines on stderr."""
     import dataclasses
 
     from approachsim.campaign.evaluation import evaluate_profile
@@ -181,7 +185,7 @@ def _open_loop(n: int, scheduler: str | None = None, integrity: bool = True):
     with tempfile.TemporaryDirectory() as d:
         t = time.perf_counter()
         ev = evaluate_profile(prof, runs=n, seed=1, mode="open", out_dir=Path(d), workers=None if scheduler else 2,
-                              scheduler=scheduler, progress=False)
+                              scheduler=scheduler, progress=progress)
         return time.perf_counter() - t, ev
 
 
@@ -205,23 +209,99 @@ def _one(n: int, accuracy_only: bool) -> None:
           f"{rss_mb(resource.RUSAGE_CHILDREN):6.0f} MB; {load()}")
 
 
-def bench_dask(n: int) -> None:
-    """The same N open-loop runs on the local pool (2 workers) and on a Dask LocalCluster (2 worker processes,
-    one thread each): every run's record must be the same bits; efficiency = local wall / Dask wall."""
+DASK_RECOMMENDED = {
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+    "distributed.worker.profile.enabled": False,
+}
+"""The Dask settings docs/contract.md recommends for campaigns: glibc's default malloc (Dask's nannies start workers
+with MALLOC_TRIM_THRESHOLD_=65536, which also fixes the mmap threshold at 128 kB: every large numpy temporary is
+then a fresh mmap and its pages faulted in again, measured 15x the page faults and +20 % CPU per run) and no
+statistical profiler thread sampling the task's stack every 10 ms."""
+
+
+@contextlib.contextmanager
+def _dask_cluster(settings: dict):
+    """A LocalCluster of 2 worker processes with one thread each (as the local pool's 2 workers) under `settings`.
+
+    The nannies write their pre-spawn environment into this process's os.environ: it is restored afterwards, so
+    that each cluster's workers get exactly its own settings."""
+    import dask
     from distributed import LocalCluster
 
-    print(f"dask: {load()}")
-    wall_l, ev_l = _open_loop(n)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, protocol="tcp://", host="127.0.0.1",
-                      dashboard_address=":0") as cluster:
-        wall_d, ev_d = _open_loop(n, cluster.scheduler_address)
+    saved = dict(os.environ)
+    os.environ.pop("MALLOC_TRIM_THRESHOLD_", None)
+    try:
+        with dask.config.set(settings), LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                                     protocol="tcp://", host="127.0.0.1",
+                                                     dashboard_address=":0") as cluster:
+            yield cluster
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
 
-    def records(ev):
-        return [json.dumps(r.record(), sort_keys=True) for r in sorted(ev.results, key=lambda r: r.run)]
 
-    same = records(ev_l) == records(ev_d)
-    print(f"  N={n}: local pool {wall_l:.1f} s, Dask LocalCluster {wall_d:.1f} s, efficiency {wall_l / wall_d:.2f}; "
-          f"records bit-identical: {same}; {load()}")
+def _cpu_s(proc) -> float:
+    """CPU seconds (user + system) of a psutil process and its live descendants."""
+    import psutil
+
+    total = 0.0
+    for p in [proc] + proc.children(recursive=True):
+        try:
+            c = p.cpu_times()
+            total += c.user + c.system
+        except psutil.Error:
+            pass
+    return total
+
+
+def _timed_campaign(n: int, scheduler: str | None, accuracy_only: bool) -> tuple[float, float, float, list[str]]:
+    """(wall s, CPU s of the workers, CPU s of this process, per-run record digests) of one open-loop campaign.
+
+    Workers' CPU: the local pool's children are reaped at the end (RUSAGE_CHILDREN); a LocalCluster's worker
+    processes live on (psutil). This process runs the client and, for a LocalCluster, its scheduler and nannies.
+    The records are kept as SHA-256 digests of their JSON lines (a 10^4-run campaign's results are ~0.9 GB
+    with the integrity bank) and the campaign's results dropped."""
+    import hashlib
+
+    import psutil
+
+    me = psutil.Process()
+    kids = lambda: sum(_cpu_s(c) for c in me.children())  # noqa: E731
+    ch0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    k0, s0 = kids(), resource.getrusage(resource.RUSAGE_SELF)
+    wall, ev = _open_loop(n, scheduler, integrity=not accuracy_only, progress=True)
+    k1, s1 = kids(), resource.getrusage(resource.RUSAGE_SELF)
+    ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    reaped = ch1.ru_utime + ch1.ru_stime - ch0.ru_utime - ch0.ru_stime
+    workers = reaped + (k1 - k0 if scheduler else 0.0)
+    main = s1.ru_utime + s1.ru_stime - s0.ru_utime - s0.ru_stime
+    digests = [hashlib.sha256(json.dumps(r.record(), sort_keys=True).encode()).hexdigest()
+               for r in sorted(ev.results, key=lambda r: r.run)]
+    return wall, workers, main, digests
+
+
+def bench_dask(n: int, accuracy_only: bool, skip_defaults: bool = False) -> None:
+    """The same N open-loop runs on the local pool (2 workers) and on a Dask LocalCluster (2 worker processes, one
+    thread each), first with Dask's default settings, then with DASK_RECOMMENDED: every run's record must be the
+    same bits; efficiency = local wall / Dask wall. CPU seconds (workers, this process) say where the time goes
+    independently of the other sessions' load; progress lines go to stderr. skip_defaults: only the recommended
+    settings (a third less time at N = 10^4)."""
+    what = "accuracy only (evaluation.integrity = [])" if accuracy_only else "with the integrity bank (the default)"
+    print(f"dask, N={n}, {what}: {load()}", flush=True)
+    wall_l, cpu_l, main_l, dig_l = _timed_campaign(n, None, accuracy_only)
+    print(f"  local pool (2 processes)          : {wall_l:7.1f} s wall; CPU: workers {cpu_l:7.1f} s, this process "
+          f"{main_l:5.1f} s; {load()}", flush=True)
+    variants = (("Dask defaults", {}), ("recommended settings", DASK_RECOMMENDED))
+    for label, settings in variants[1:] if skip_defaults else variants:
+        t = time.perf_counter()
+        with _dask_cluster(settings) as cluster:
+            start = time.perf_counter() - t
+            wall_d, cpu_d, main_d, dig_d = _timed_campaign(n, cluster.scheduler_address, accuracy_only)
+        print(f"  LocalCluster, {label:20s}: {wall_d:7.1f} s wall; CPU: workers {cpu_d:7.1f} s, this process (client, "
+              f"scheduler, nannies) {main_d:5.1f} s; cluster start {start:.1f} s (not timed); {load()}")
+        print(f"    efficiency (local wall / Dask wall) {wall_l / wall_d:.2f}, CPU ratio (local / Dask, all processes) "
+              f"{(cpu_l + main_l) / (cpu_d + main_d):.2f}; records bit-identical to the local pool's: "
+              f"{dig_d == dig_l}", flush=True)
 
 
 def bench_evaluate() -> None:
@@ -241,7 +321,8 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--ns", type=int, nargs="+", default=[10, 100, 1000])
     ap.add_argument("--n", type=int, default=1000)
-    ap.add_argument("--accuracy-only", action="store_true", help="scaling: without the integrity bank")
+    ap.add_argument("--accuracy-only", action="store_true", help="scaling, dask: without the integrity bank")
+    ap.add_argument("--skip-defaults", action="store_true", help="dask: only the recommended LocalCluster settings")
     args = ap.parse_args()
     if args.part == "compile":
         bench_compile()
@@ -250,7 +331,7 @@ def main() -> None:
     elif args.part == "scaling":
         bench_scaling(args.ns, args.accuracy_only)
     elif args.part == "dask":
-        bench_dask(args.n)
+        bench_dask(args.n, args.accuracy_only, args.skip_defaults)
     elif args.part == "evaluate":
         bench_evaluate()
     else:

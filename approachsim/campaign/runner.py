@@ -265,13 +265,21 @@ def _connect(address: str, timeout_s: float):
 
 
 def _dask(client, tasks: list, args: tuple) -> Iterator[list[RunResult]]:
+    """Submit every task, yield each task's results as it finishes and release it on the cluster.
+
+    A finished task's results stay in its worker's memory while the client holds its future: releasing each
+    one once fetched keeps the workers' memory flat (with the integrity bank a run's result is about 90 kB,
+    most of it its dense integrity histograms: 0.9 GB per 10^4 runs otherwise held on the workers until the end).
+    BLAS is pinned to one thread inside every task by run_task, on Dask workers as in the local pool."""
     from distributed import as_completed
 
     try:
         run_fn, group_fn, profile, seed = args
-        futures = [client.submit(run_task, run_fn, group_fn, profile, seed, t, pure=False) for t in tasks]
-        for f in as_completed(futures):
-            yield f.result()
+        for f in as_completed(client.submit(run_task, run_fn, group_fn, profile, seed, t, pure=False)
+                              for t in tasks):
+            res = f.result()
+            f.release()
+            yield res
     finally:
         client.close()
 

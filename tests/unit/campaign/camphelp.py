@@ -44,3 +44,15 @@ def profile_run(profile, seed: int, run: int) -> RunResult:
     """A run that reads the (real) profile it was sent: the evaluation decision height and a nav field."""
     return RunResult(run=run, ok=True, scalars={"dh_cat1_ft": profile.evaluation.dh_cat1_ft,
                                                  "n_tuning": float(len(getattr(profile, "nav", {}).__dict__))})
+
+
+def dask_probe_run(profile: dict, seed: int, run: int) -> RunResult:
+    """A run on a Dask worker that reports what its task sees: the results its worker holds (tasks finished and
+    not yet released by the client) and the BLAS libraries' thread count inside the task."""
+    from distributed import get_worker
+    from threadpoolctl import threadpool_info
+
+    time.sleep(profile.get("sleep_s", 0.0))
+    blas = [p["num_threads"] for p in threadpool_info() if p.get("user_api") == "blas"]
+    return RunResult(run=run, ok=True, scalars={"held": float(len(get_worker().data)),
+                                                "blas_threads": float(max(blas, default=1))})

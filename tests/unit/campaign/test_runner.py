@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
-from camphelp import synth_group, synth_run
+from camphelp import dask_probe_run, synth_group, synth_run
 
 from approachsim.campaign.result import RunResult
 from approachsim.campaign.runner import plan_chunks, run_campaign
@@ -68,6 +68,23 @@ def test_dask_local_cluster_is_bit_identical(tmp_path):
     assert _same(local.results, remote.results)
     assert _same(local.results, grouped.results)
     assert (tmp_path / "series" / "run_000000.parquet").is_file()
+
+
+def test_dask_tasks_release_their_results_and_pin_blas():
+    """On Dask the client releases each task once its results are fetched (a 10^4-run campaign would otherwise
+    keep every result in the workers' memory until the end) and BLAS runs single-threaded inside the task, as in
+    the local pool (runner.run_task)."""
+    import distributed
+
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1", dashboard_address=":0"
+    ) as cluster:
+        res = _run({"sleep_s": 0.1}, run_fn=dask_probe_run, per_task=1, scheduler=cluster.scheduler_address)
+    held = [r.scalars["held"] for r in res.results]
+    assert all(r.ok for r in res.results) and len(held) == 24
+    # one worker thread runs the 24 one-run tasks in turn: unreleased, run i's task would see about i results held
+    assert max(held[12:]) < 12, held
+    assert {r.scalars["blas_threads"] for r in res.results} == {1.0}
 
 
 def test_bad_scheduler_address_is_a_user_error():
