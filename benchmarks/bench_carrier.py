@@ -14,7 +14,7 @@ and the scoring with the integrity bank, as `approachsim evaluate --mode open` d
 Each case is warmed up once (one run: numba's compile and cache load), then the cases are timed interleaved
 (--repeat rounds of code, carrier, generic), the minimum per case kept. Prints the wall times, the ratios carrier /
 code (the goal: <= 2) and generic / carrier (the speed-up), and the load average before and after (a shared machine:
-read the ratios). No pass/fail.
+read the ratios). BLAS single-threaded, as `approachsim` and the campaign's workers run it. No pass/fail.
 """
 
 from __future__ import annotations
@@ -26,9 +26,12 @@ import time
 from pathlib import Path
 from unittest import mock
 
-from approachsim.campaign.pipeline import open_loop_group
-from approachsim.nav.system import NavSystem
-from approachsim.profile import load_profile
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # as the console script (cli.main) and
+    os.environ.setdefault(_var, "1")  # the campaign's workers: two BLAS threads on a loaded machine cost 60x on eigh
+
+from approachsim.campaign.pipeline import open_loop_group  # noqa: E402 (after the BLAS threads are set)
+from approachsim.nav.system import NavSystem  # noqa: E402
+from approachsim.profile import load_profile  # noqa: E402
 
 PROFILES = Path(__file__).resolve().parents[1] / "profiles"
 
