@@ -12,9 +12,10 @@ and the scoring with the integrity bank, as `approachsim evaluate --mode open` d
               path (EpochEngine.of is None then): what the carrier variant took before issue 26
 
 Each case is warmed up once (one run: numba's compile and cache load), then the cases are timed interleaved
-(--repeat rounds of code, carrier, generic), the minimum per case kept. Prints the wall times, the ratios carrier /
-code (the goal: <= 2) and generic / carrier (the speed-up), and the load average before and after (a shared machine:
-read the ratios). BLAS single-threaded, as `approachsim` and the campaign's workers run it. No pass/fail.
+(--repeat rounds of code, carrier, generic). Prints each round's wall times and ratios, the median over the rounds of
+each ratio -- carrier / code (the goal: <= 2), generic / code and generic / carrier (the speed-up) -- and the load
+average before and after (a shared machine: the load moves between cases, a round's ratio is the robust figure).
+BLAS single-threaded, as `approachsim` and the campaign's workers run it. No pass/fail.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import statistics
 import time
 from pathlib import Path
 from unittest import mock
@@ -68,18 +70,23 @@ def main() -> None:
     print(f"load average before: {os.getloadavg()}")
     for c in cases:
         _time(c, a.seed, [0])
-    best = {c: float("inf") for c in cases}
     runs = list(range(a.runs))
-    for _ in range(a.repeat):
-        for c in cases:
-            best[c] = min(best[c], _time(c, a.seed, runs))
-            print(f"  {c:8s} {best[c]:8.1f} s")
+    rounds = []
+    for r in range(a.repeat):
+        t = {c: _time(c, a.seed, runs) for c in cases}
+        rounds.append(t)
+        print(f"  round {r + 1}: " + ", ".join(f"{c} {t[c]:.1f} s" for c in cases) + f"; carrier / code "
+              f"{t['carrier'] / t['code']:.2f}, generic / code {t['generic'] / t['code']:.2f}, generic / carrier "
+              f"{t['generic'] / t['carrier']:.2f}")
     print(f"load average after: {os.getloadavg()}")
-    print(f"open loop, {a.runs} runs, seed {a.seed}: code {best['code']:.1f} s, carrier {best['carrier']:.1f} s, "
-          f"carrier generic (before) {best['generic']:.1f} s")
-    print(f"carrier / code            {best['carrier'] / best['code']:.2f}   (goal <= 2)")
-    print(f"generic / code (before)   {best['generic'] / best['code']:.2f}")
-    print(f"generic / carrier         {best['generic'] / best['carrier']:.2f}   (the speed-up)")
+
+    def med(f) -> float:
+        return float(statistics.median(f(t) for t in rounds))
+
+    print(f"open loop, {a.runs} runs, seed {a.seed}, median over {a.repeat} interleaved rounds of each round's ratio:")
+    print(f"carrier / code            {med(lambda t: t['carrier'] / t['code']):.2f}   (goal <= 2)")
+    print(f"generic / code (before)   {med(lambda t: t['generic'] / t['code']):.2f}")
+    print(f"generic / carrier         {med(lambda t: t['generic'] / t['carrier']):.2f}   (the speed-up)")
 
 
 if __name__ == "__main__":
