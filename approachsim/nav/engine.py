@@ -6,8 +6,12 @@ kernels/epoch.py, with the arrays it needs built once per navigation system and 
 
 Used when the filter is the optimal 'ekf' (no gain policy to call back), the GPS is tightly coupled, the damping
 loop (if any) has constant gains and the online FDE is off: exactly the configurations NavSystem.shares_covariance
-names. Everything else (robust and U-D filters, loose coupling, adaptive loops, FDE) takes the generic path of
-nav/navigator.py and nav/shared.py, which is also the engine's test oracle (tests/unit/nav/test_epoch_engine.py).
+names. With carrier phase the engine carries the carrier states too (kernels/carrier.py): the gio Gauss-Markov and
+amb random constants in the model, the carrier-phase rows after the code rows, and each run's float ambiguities
+reset where its carrier arc changes (`new_arcs`: the arc bookkeeping of every path, per-run, shared and compiled).
+Everything else (robust and U-D filters, loose coupling, adaptive loops, FDE) takes the generic path of
+nav/navigator.py and nav/shared.py, which is also the engine's test oracle (tests/unit/nav/test_epoch_engine.py,
+tests/unit/nav/test_carrier_engine.py).
 
 Also here: `StatusBuffer`, a run's status records kept as whole epochs of arrays (the engine's) or UpdateStatus
 objects (the generic path), in processing order.
@@ -32,20 +36,61 @@ from approachsim.sensors.gnss.receiver import IONO_SHELL_M
 
 Array = np.ndarray
 
-_MAX_ROWS = 2 + 64 + 16
-"""Rows an epoch can have: baro, radalt, GNSS channels, pseudolites (bounded by the layout below)."""
+_MAX_ROWS = 2 + 2 * 64 + 16
+"""Rows an epoch can have: baro, radalt, GNSS channels' code and carrier, pseudolites (bounded by the layout below)."""
 
 
 @lru_cache(maxsize=512)
 def code_name(code: int) -> str:
-    """The status-log name of a row code (kernels/epoch.py): "baro", "radalt", "gps07", "pl0"."""
+    """The status-log name of a row code (kernels/epoch.py): "baro", "radalt", "gps07", "cp07", "pl0"."""
     if code == ke.CODE_BARO:
         return "baro"
     if code == ke.CODE_RADALT:
         return "radalt"
+    if code >= ke.CODE_CP:
+        return f"cp{code - ke.CODE_CP:02d}"
     if code >= ke.CODE_PL:
         return f"pl{code - ke.CODE_PL}"
     return f"gps{code - ke.CODE_GPS:02d}"
+
+
+def new_arcs(last: Array | None, arc: Array) -> tuple[Array, Array]:
+    """The carrier arcs that begin at this epoch: (new (k,) bool, where the arc id arc (k,) is valid (>= 0) and
+    differs from last, the arc id of each channel at the last epoch that had its carrier (None: none yet); the
+    updated last). A new arc is a new float ambiguity (sensors/gnss/carrier.py)."""
+    arc = np.asarray(arc, dtype=np.int64)
+    if last is None:
+        last = np.full(arc.shape, -1, dtype=np.int64)
+    return (arc >= 0) & (arc != last), np.where(arc >= 0, arc, last)
+
+
+def stacked_new_arcs(last: Array, arc: Array) -> tuple[Array, Array]:
+    """`new_arcs` over E epochs at once: last (N, k) the runs' arc ids before the first, arc (N, E, k) the ids at the
+    epochs (-1 where a channel has no carrier there). Returns new (N, E, k) int64 (1: the ambiguity resets) and the
+    ids after the last epoch."""
+    new = np.zeros(arc.shape, dtype=np.int64)
+    last = np.array(last, dtype=np.int64)
+    for e in range(arc.shape[1]):
+        a = arc[:, e]
+        new[:, e] = (a >= 0) & (a != last)
+        last = np.where(a >= 0, a, last)
+    return new, last
+
+
+def reset_arcs(layout: em.StateLayout, phi: Array, qd: Array, new: Array, prior: float) -> tuple[Array, Array]:
+    """The epoch's Phi, Qd with the float ambiguity of every channel with new (k,) set reset to its prior (m^2): row
+    and column of Phi and Qd zeroed, prior on Qd's diagonal, so P- = Phi P+ Phi' + Qd holds the prior there (copies;
+    phi, qd themselves when nothing is new). The numpy twin of kernels/carrier.reset_ambiguities."""
+    idx = layout.index["amb"].start + np.flatnonzero(new)
+    if not idx.size:
+        return phi, qd
+    phi, qd = phi.copy(), qd.copy()
+    phi[idx, :] = 0.0
+    phi[:, idx] = 0.0
+    qd[idx, :] = 0.0
+    qd[:, idx] = 0.0
+    qd[idx, idx] = prior
+    return phi, qd
 
 
 class StatusBuffer:
@@ -159,6 +204,14 @@ class EpochEngine:
             if bud.gbas is not None:
                 self._gbas = bud.gbas.channel_kernel_args()
         self.F, self.Qc, self.phi, self.qd = (np.zeros((n, n)) for _ in range(4))
+        self.carrier = lay.has("amb")
+        """Carrier phase: the rows, states and arc resets of kernels/carrier.py."""
+        self.cp_r = float(system.rows.carrier_sigma_m) ** 2 if self.carrier else 0.0
+        """The carrier rows' noise variance, m^2 (nav/rows.py's)."""
+        self.amb_prior = float(g.carrier.ambiguity_sigma_m) ** 2 if self.carrier else 0.0
+        """A float ambiguity's prior variance at a new arc, m^2 (nav/noise.py's P0 of amb)."""
+        self._no_new = np.zeros(0, dtype=np.int64)
+        self._phi_tmp = np.zeros((n, n))
         self.loop = em.kernel_loop(system.loop_gains() if lay.has("ac") else None)
         """The damping loop's constant gains (the engine runs constant or no loops only)."""
 
@@ -178,6 +231,14 @@ class EpochEngine:
             x, dh, v = (np.full(el.shape[0], g) for g in REFERENCE_GEOMETRY)
             gbas_channel_sigmas(el, x, dh, v, *self._gbas, gse, gmp)
         return gse, gmp
+
+    def carrier_channel_sigmas(self, el: Array) -> tuple[Array, Array, Array]:
+        """Carrier phase: the GPS channel states' slow (without the ionosphere), ionospheric and fast 1-sigma (m) at
+        elevations el (..., k) rad, each element on its own: nav/noise.py's floor (nan: 0.5 rad, at least 2 deg) and
+        the receiver budget's carrier_channel_sigmas_m (elementwise numpy), broadcast to el's shape."""
+        e = np.maximum(np.nan_to_num(np.asarray(el, dtype=float), nan=0.5), np.radians(2.0))
+        out = self.system.sensors.gnss.budget().carrier_channel_sigmas_m(e)
+        return tuple(np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), e.shape)) for a in out)
 
     @staticmethod
     def stack(dbs: list[RunDatabase]) -> tuple[Array, Array, Array]:
@@ -212,6 +273,8 @@ class EpochEngine:
             r_sv = np.ascontiguousarray(r_sv, dtype=float)
         else:
             rho, r_sv, sig = np.zeros((M, 0)), self._none3, self._none1
+        cp = (np.ascontiguousarray(obs.gnss_phi_m[sl], dtype=float) if self.carrier and obs.gnss_phi_m is not None
+              else self._none2 if M == 1 else np.zeros((M, 0)))
         if obs.pl_rho_m is not None:
             pl_rho = np.ascontiguousarray(obs.pl_rho_m[sl])
             r_pl = np.ascontiguousarray(obs.pl_r_ecef, dtype=float)
@@ -225,8 +288,9 @@ class EpochEngine:
             db_x = dbs[0].db_x
             db_u = np.stack([d.db_u for d in dbs]) if db_x.size else np.zeros((M, 0))
         return (baro_h, baro_r, radalt_h, self.ra_pct, self.ra_floor), (self.tx, self.th, self.rwy, dbp, db_x, db_u,
-                                                                         rho, r_sv, sig, self.channel_states, pl_rho,
-                                                                         r_pl, pl_sig, self.pl_states)
+                                                                         rho, r_sv, sig, self.channel_states, cp,
+                                                                         self.cp_r, pl_rho, r_pl, pl_sig,
+                                                                         self.pl_states)
 
     def epoch(self, X: Array, P: Array, phi: Array, qd: Array, own: bool, ref_y: Array, ins_y: Array,
               obs: Observations, members: list[int], t_s: float, statuses: list[StatusBuffer],
@@ -244,15 +308,23 @@ class EpochEngine:
             statuses[j].add_epoch(self.codes[:k], t_s, nu[j, :k], self.S[:k])
 
     def own(self, X: Array, P: Array, y: Array, f_ned: Array, elevation_rad: Array | None, held: bool, dt: float,
-            obs: Observations, i: int, t_s: float, statuses: StatusBuffer, db: RunDatabase) -> bool:
+            obs: Observations, i: int, t_s: float, statuses: StatusBuffer, db: RunDatabase,
+            new: Array | None = None) -> bool:
         """The per-run EKF's whole epoch of run i (kernels/epoch.own_epoch: its error model about its INS state y
         (16,) with the mean specific force f_ned (3,), discretized over dt, then every update), in place on X (1, n)
-        and P. False when the model needs the numpy discretization (nothing changed: take the generic path)."""
+        and P. False when the model needs the numpy discretization (nothing changed: take the generic path). new (k,):
+        carrier phase, the channels whose arc begins here (`new_arcs`; their ambiguities reset)."""
         q, gse, gmp = self.system.noise_model.kernel_arrays(elevation_rad)
+        if self.carrier:
+            gio, gio_tau = em.kernel_carrier(self.system.noise_model.noise(elevation_rad), self.system.layout.n_sv)
+            new = self._no_new if new is None else np.asarray(new, dtype=np.int64)
+        else:
+            gio, gio_tau, new = self._none1, 1.0, self._no_new
         first, rest = self._obs_args(obs, [i], [db])
         nu = self._nu[:1]
         k = ke.own_epoch(X, P, self.lay, q, gse, gmp, self.loop, held, dt, f_ned, y, self.F, self.Qc, self.phi,
-                         self.qd, *first, *rest, self.codes, nu, self.S, self.h, self.b, self.ws)
+                         self.qd, *first, *rest, gio, gio_tau, new, self.amb_prior, self.codes, nu, self.S, self.h,
+                         self.b, self.ws)
         if k < 0:
             return False
         statuses.add_epoch(self.codes[:k], t_s, nu[0, :k], self.S[:k])
@@ -260,10 +332,11 @@ class EpochEngine:
 
     def singletons(self, X: Array, P3: Array, phi2: Array, qd2: Array, held: Array, obs: Observations, t_s: float,
                    dt: float, ins_y: Array, ref_y: Array, ref_agl_m: float, statuses: list[StatusBuffer],
-                   db_stack: tuple[Array, Array, Array]) -> None:
+                   db_stack: tuple[Array, Array, Array], new: Array | None = None) -> None:
         """The shared-mode epoch of N runs each its own class (kernels/epoch.singleton_epochs), in place on X (N, n)
         and P3 (N, n, n); phi2, qd2 (2, n, n) the model without / with the damping loop held, held (N,) int; the
-        GPS channel states' Qd at each run's own elevations; db_stack: the runs' databases (`stack`)."""
+        GPS channel states' Qd at each run's own elevations; db_stack: the runs' databases (`stack`); new (N, k):
+        carrier phase, the channels whose arc begins here in each run (`new_arcs`)."""
         N = X.shape[0]
         lay = self.system.layout
         baro_h = obs.baro_h_m if obs.baro_h_m is not None else np.full(N, np.nan)
@@ -285,14 +358,22 @@ class EpochEngine:
             pl_sig = self._pl_sig if self.pl_states else np.ascontiguousarray(obs.pl_sigma_m, dtype=float)
         else:
             pl_rho, r_pl, pl_sig = np.zeros((N, 0)), self._none3, self._none1
+        ch_gio, f_gio = np.zeros((N, 0)), 0.0
         if lay.has("gse") and obs.has_gnss and obs.per_run_sky:  # one sky: qd2 is already at its elevations
             el = np.ascontiguousarray(obs.gnss_el_rad, dtype=float)
-            ch_gse, ch_gmp = self.channel_sigmas(el)
             nz = self.system.noise_model.noise(None)
+            if self.carrier:
+                ch_gse, ch_gio, ch_gmp = self.carrier_channel_sigmas(el)
+                f_gio = float(-np.expm1(-2.0 * dt / nz.gio_tau_s))
+            else:
+                ch_gse, ch_gmp = self.channel_sigmas(el)
             f_gse, f_gmp = (float(-np.expm1(-2.0 * dt / tau)) for tau in (nz.gse_tau_s, nz.gmp_tau_s))
         else:
             ch_gse = ch_gmp = np.zeros((N, 0))
             f_gse = f_gmp = 0.0
+        cp = (np.ascontiguousarray(obs.gnss_phi_m, dtype=float) if self.carrier and obs.gnss_phi_m is not None
+              else np.zeros((N, 0)))
+        new = np.zeros((N, 0), dtype=np.int64) if new is None else np.ascontiguousarray(new, dtype=np.int64)
         dbp, db_x, db_u = db_stack
         codes = np.zeros((N, _MAX_ROWS), dtype=np.int64)
         nu = np.zeros((N, _MAX_ROWS))
@@ -301,8 +382,8 @@ class EpochEngine:
         ke.singleton_epochs(X, P3, phi2, qd2, held, ch_gse, ch_gmp, f_gse, f_gmp, self.qd, self.lay, ref_y,
                             ref_agl_m, np.ascontiguousarray(ins_y), baro_h, baro_r, radalt_h, self.ra_pct,
                             self.ra_floor, self.tx, self.th, self.rwy, dbp, db_x, db_u, rho, r_sv, sig,
-                            self.channel_states, pl_rho, r_pl, pl_sig, self.pl_states, codes, nu, S, n_rows, self.h,
-                            self.b, self.ws)
+                            self.channel_states, cp, self.cp_r, pl_rho, r_pl, pl_sig, self.pl_states, ch_gio, f_gio,
+                            new, self.amb_prior, self._phi_tmp, codes, nu, S, n_rows, self.h, self.b, self.ws)
         for i in range(N):
             k = n_rows[i]
             statuses[i].add_epoch(codes[i, :k], t_s, nu[i, :k], S[i, :k])

@@ -130,12 +130,16 @@ class StateLayout:
     @cached_property
     def packed(self) -> Array:
         """The layout as kernels.errormodel's int64 array: lay[L_N] = n, lay[L_<group>] its first index (-1
-        absent), lay[L_NSV], lay[L_NPL] the channel counts (built once per layout object: do not modify)."""
+        absent), lay[L_NSV], lay[L_NPL] the channel counts, lay[L_GIO], lay[L_AMB] the carrier groups (built once
+        per layout object: do not modify)."""
         lay = np.full(ek.LAY_SIZE, -1, dtype=np.int64)
         lay[ek.L_N], lay[ek.L_NSV], lay[ek.L_NPL] = self.n, self.n_sv, self.n_pl
         for k, g in enumerate(ek.LAY_GROUPS):
             if g in self.index:
                 lay[1 + k] = self.index[g].start
+        for g, at in (("gio", ek.L_GIO), ("amb", ek.L_AMB)):  # carrier phase (kernels/carrier.py)
+            if g in self.index:
+                lay[at] = self.index[g].start
         return lay
 
 
@@ -183,6 +187,11 @@ class ErrorNoise:
         """kernel_noise's cache, by channel count (the object is frozen: its arrays are packed once)."""
         return {}
 
+    @cached_property
+    def _carrier_arrays(self) -> dict[int, Array]:
+        """kernel_carrier's cache, by channel count."""
+        return {}
+
 
 def kernel_noise(noise: ErrorNoise, n_sv: int) -> tuple[Array, Array, Array]:
     """The noise as kernels.errormodel's arrays: q (Q_SIZE,) the scalars at ek.Q_*, and the per-channel
@@ -195,6 +204,16 @@ def kernel_noise(noise: ErrorNoise, n_sv: int) -> tuple[Array, Array, Array]:
                for a in (noise.gse_sigma_m, noise.gmp_sigma_m)]
         cache[n_sv] = (q, per[0], per[1])
     return cache[n_sv]
+
+
+def kernel_carrier(noise: ErrorNoise, n_sv: int) -> tuple[Array, float]:
+    """The carrier-phase states' noise as kernels.carrier.dynamics' arguments: gio_sigma_m broadcast to (n_sv,) m,
+    and gio_tau_s. Cached on the noise object beside kernel_noise's (read-only)."""
+    cache = noise._carrier_arrays
+    if n_sv not in cache:
+        cache[n_sv] = (np.ascontiguousarray(np.broadcast_to(np.asarray(noise.gio_sigma_m, dtype=float), (n_sv,)))
+                       if n_sv else np.zeros(0))
+    return cache[n_sv], float(noise.gio_tau_s)
 
 
 _NO_LOOP = np.zeros(ek.LOOP_SIZE)

@@ -30,7 +30,7 @@ from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import FilterState, UpdateStatus
-from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer
+from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, new_arcs, reset_arcs, stacked_new_arcs
 from approachsim.nav.fde import FdeState
 from approachsim.nav.kernels import epoch as ke
 from approachsim.nav.kernels import output as ko
@@ -275,11 +275,12 @@ class Navigator:
         r_ins = None
         for i, run in enumerate(self.runs):
             held = self.loop_held(obs, i)
+            new = self._arc_flags(run, obs, i)
             if self.engine is not None and run.fde is None:  # the whole epoch compiled (nav/engine.py)
                 X, P = run.fs.x.copy()[None], np.array(run.fs.P, dtype=float)
                 y = self.x[self.ins_of[i]]
                 if self.engine.own(X, P, y, np.ascontiguousarray(f_ned_mean[i]), obs.elevations(i), held,
-                                   dt_epoch, obs, i, t, run.statuses, self.dbs[i]):
+                                   dt_epoch, obs, i, t, run.statuses, self.dbs[i], new):
                     run.fs = FilterState(x=X[0], P=P, memory=run.fs.memory)
                     continue
             if r_ins is None:
@@ -289,8 +290,8 @@ class Navigator:
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
                                 noise, gains, loop_held=held)
             phi, qd = em.discretize(F, Qc, dt_epoch)
-            if lay.has("amb") and obs.gnss_arc is not None:
-                phi, qd = self._new_arcs(run, obs.gnss_arc[i], phi, qd)
+            if new is not None:
+                phi, qd = reset_arcs(lay, phi, qd, new, self._amb_prior())
             if self.engine is not None and run.fde is None:  # the compiled updates on the numpy discretization
                 X, P = run.fs.x.copy()[None], np.array(run.fs.P, dtype=float)
                 y = self.x[self.ins_of[i]:self.ins_of[i] + 1]
@@ -314,21 +315,35 @@ class Navigator:
         a new ambiguity) reset to its prior: row and column of Phi zeroed (estimate 0, no correlation kept) and
         the prior variance put in Qd, so P- = Phi P+ Phi' + Qd holds the prior there. A reset as part of the
         prediction: every filter form and the FDE's stored epochs (re-run after a rollback) take it as it is."""
-        arc = np.asarray(arc, dtype=np.int64)
-        if run.arcs is None:
-            run.arcs = np.full(arc.shape, -1, dtype=np.int64)
-        new = np.flatnonzero((arc >= 0) & (arc != run.arcs))
-        if new.size:
-            idx = self.layout.index["amb"].start + new
-            prior = self.system.sensors.gnss.carrier.ambiguity_sigma_m ** 2  # nav/noise.py's P0 of amb
-            phi, qd = phi.copy(), qd.copy()
-            phi[idx, :] = 0.0
-            phi[:, idx] = 0.0
-            qd[idx, :] = 0.0
-            qd[:, idx] = 0.0
-            qd[idx, idx] = prior
-        run.arcs = np.where(arc >= 0, arc, run.arcs)
-        return phi, qd
+        new, run.arcs = new_arcs(run.arcs, arc)
+        return reset_arcs(self.layout, phi, qd, new, self._amb_prior())
+
+    def _amb_prior(self) -> float:
+        """A float ambiguity's prior variance at a new arc, m^2 (nav/noise.py's P0 of amb)."""
+        return self.system.sensors.gnss.carrier.ambiguity_sigma_m ** 2
+
+    def _arc_flags(self, run: RunFilter, obs: Observations, i: int) -> Array | None:
+        """Run i's channels whose carrier arc begins at this epoch ((k,) bool, engine.new_arcs; the run's arc ids
+        updated), or None (no carrier phase, or no GNSS sample at the epoch)."""
+        if not self.layout.has("amb") or obs.gnss_arc is None:
+            return None
+        new, run.arcs = new_arcs(run.arcs, obs.gnss_arc[i])
+        return new
+
+    def with_resets(self, phi: Array, qd: Array, new: Array) -> tuple[Array, Array]:
+        """Phi, Qd with the ambiguities of the channels of new (k,) bool reset (engine.reset_arcs; phi, qd
+        themselves when none is new)."""
+        if not np.any(new):
+            return phi, qd
+        return reset_arcs(self.layout, phi, qd, new, self._amb_prior())
+
+    def arc_resets(self, obs: Observations) -> Array:
+        """(N, k) bool: every run's channels whose carrier arc begins at this epoch (`_arc_flags`; (N, 0) without
+        carrier phase or a GNSS sample): the shared covariance splits its classes on it and resets the ambiguities."""
+        flags = [self._arc_flags(r, obs, i) for i, r in enumerate(self.runs)]
+        if any(f is None for f in flags):
+            return np.zeros((len(self.runs), 0), dtype=bool)
+        return np.array(flags, dtype=bool).reshape(len(self.runs), -1)
 
     def _feedback(self, s: ins.InsState) -> ins.InsState:
         """Closed-loop correction: INS -= estimated nav error; bias estimates go to the increments; reset."""
@@ -397,7 +412,10 @@ class Navigator:
         pl_sig = np.ascontiguousarray(np.broadcast_to(eng._pl_sig if eng.pl_states else o["pl_sig"],
                                                       (E, pl_rho.shape[2])), dtype=float)
         # the channel states' Qd at each run's own sky (per-run skies; one sky: the model's own)
-        if lay.has("gse") and per_run_sky and k:
+        ch_gio = np.zeros((N, E, 0))
+        if lay.has("gse") and per_run_sky and k and eng.carrier:  # the slow state without the ionosphere (gio)
+            ch_gse, ch_gio, ch_gmp = eng.carrier_channel_sigmas(el)
+        elif lay.has("gse") and per_run_sky and k:
             ch_gse, ch_gmp = eng.channel_sigmas(el.reshape(N * E, k))
             ch_gse, ch_gmp = ch_gse.reshape(N, E, k), ch_gmp.reshape(N, E, k)
         else:
@@ -405,6 +423,7 @@ class Navigator:
         nz = system.noise_model.noise(None)
         f_gse = -np.expm1(-2.0 * dt / nz.gse_tau_s) if lay.has("gse") else np.zeros(E)
         f_gmp = -np.expm1(-2.0 * dt / nz.gmp_tau_s) if lay.has("gse") else np.zeros(E)
+        cp, new, gio, gio_tau, f_gio, arcs = self._stacked_carrier(o, noise, nz, dt)
         dbp, db_x, db_u = self.db_stack
         X = np.array([r.fs.x for r in self.runs])
         P3 = sh.P.copy()
@@ -417,9 +436,10 @@ class Navigator:
         ins_y = np.ascontiguousarray(self.rows[self.ins_of][:, e_rows])
         done = ke.shared_pass(X, P3, eng.lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse,
                               ch_gmp, f_gse, f_gmp, ins_y, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
-                              eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho, r_sv, sig, eng.channel_states, pl_rho,
-                              r_pl, pl_sig, eng.pl_states, codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav, self._ic,
-                              eng.h, eng.b, eng.ws)
+                              eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho, r_sv, sig, eng.channel_states, cp,
+                              eng.cp_r, pl_rho, r_pl, pl_sig, eng.pl_states, gio, gio_tau, ch_gio, f_gio, new,
+                              eng.amb_prior, codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav, self._ic, eng.h, eng.b,
+                              eng.ws)
         if done != E:
             self.x[:] = x0
             self.f_sum[:] = 0.0
@@ -436,8 +456,24 @@ class Navigator:
         for i, r in enumerate(self.runs):
             r.fs = FilterState(x=X[i], P=P3[i], memory=r.fs.memory)
             r.statuses.add_epochs(codes[i], n_rows[i], t_e, nu[i], S[i])
+            if arcs is not None:
+                r.arcs = arcs[i]
         self.t_last = float(t_e[-1]) if E else self.t_last
         return True
+
+    def _stacked_carrier(self, o: dict, noise: em.ErrorNoise, nz: em.ErrorNoise, dt: Array) -> tuple:
+        """compiled_pass's carrier-phase arguments of kernels/epoch.shared_pass: (cp (N, E, k), new (N, E, k),
+        gio (n_sv,), gio_tau, f_gio (E,), the runs' arc ids after the pass (N, k)); empty arrays and None without
+        carrier phase. noise: the model's noise, nz the elevation-free one (the taus)."""
+        N, E = self.n_runs, dt.shape[0]
+        if not self.engine.carrier or o.get("cp") is None:
+            return np.zeros((N, E, 0)), np.zeros((N, E, 0), dtype=np.int64), np.zeros(0), 1.0, np.zeros(E), None
+        arc = o["arc"]
+        last = np.array([np.full(arc.shape[2], -1, dtype=np.int64) if r.arcs is None else r.arcs for r in self.runs],
+                        dtype=np.int64).reshape(N, arc.shape[2])
+        new, arcs = stacked_new_arcs(last, arc)
+        gio, gio_tau = em.kernel_carrier(noise, self.layout.n_sv)
+        return o["cp"], new, gio, gio_tau, -np.expm1(-2.0 * dt / nz.gio_tau_s), arcs
 
     # --- output --------------------------------------------------------------------------------------------
 
@@ -550,6 +586,10 @@ def _stacked_observations(records: Any, t_e: Array, tol: float, batched: bool, n
         out["el"] = np.ascontiguousarray(np.broadcast_to(g.elevation_rad[:, j] if sky else g.elevation_rad[j],
                                                          (n_runs, E, k)), dtype=float)
         out["per_run_sky"] = sky
+        if g.carrier_phase_m is not None:  # the carrier phase and its arc id where the channel is valid at the epoch
+            okv = per_run(g.valid)[:, j] & ok[None, :, None]
+            out["cp"] = np.ascontiguousarray(np.where(okv, per_run(g.carrier_phase_m)[:, j], np.nan))
+            out["arc"] = np.where(okv, per_run(g.carrier_arc)[:, j], -1).astype(np.int64)
         if E and not sky:
             out["el0"] = np.asarray(g.elevation_rad[j[0]], dtype=float)
     else:

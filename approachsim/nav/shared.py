@@ -108,19 +108,21 @@ class SharedCovariance:
             F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ref, ref.c_bn[0],
                                 noise, system.loop_gains(), loop_held=h)
             models[h] = em.discretize(F, Qc, dt_epoch)
-        self.split(np.column_stack([obs.schedule(), np.array(held, dtype=bool)]))
+        # carrier phase: the channels whose arc begins here reset their ambiguities (a class shares them: split on it)
+        new = nav.arc_resets(obs)
+        self.split(np.column_stack([obs.schedule(), np.array(held, dtype=bool), new]))
         if nav.engine is not None and self.singletons:  # every run its own class: one compiled call for all
-            self._aid_singletons(nav, ref, t, dt_epoch, obs, held, models)
+            self._aid_singletons(nav, ref, t, dt_epoch, obs, held, models, new)
             return s
         if nav.engine is not None:  # the compiled epoch, class by class (nav/engine.py)
-            self._aid_engine(nav, ref, t, dt_epoch, obs, held, models)
+            self._aid_engine(nav, ref, t, dt_epoch, obs, held, models, new)
             return s
         # x- = Phi x+ (row by row: no batch-size-dependent BLAS path)
-        X = np.stack([models[held[i]][0] @ r.fs.x for i, r in enumerate(runs)])
+        X = np.stack([nav.with_resets(*models[held[i]], new[i])[0] @ r.fs.x for i, r in enumerate(runs)])
         for c, members in self.classes():
             phi, qd = models[held[members[0]]]
-            self.predict_class(c, phi, system.noise_model.channel_qd(qd, obs.elevations(members[0]), dt_epoch)
-                               if obs.per_run_sky else qd)
+            qd = system.noise_model.channel_qd(qd, obs.elevations(members[0]), dt_epoch) if obs.per_run_sky else qd
+            self.predict_class(c, *nav.with_resets(phi, qd, new[members[0]]))
         r_ins = ins.position_ecef(s)
         r_ref = ins.position_ecef(ref)[0]
         x0 = np.zeros(lay.n)
@@ -155,7 +157,7 @@ class SharedCovariance:
         return s
 
     def _aid_engine(self, nav: Any, ref: ins.InsState, t: float, dt_epoch: float, obs: Observations, held: list,
-                    models: dict) -> None:
+                    models: dict, new: Array) -> None:
         """`aid`'s predict and updates by kernels/epoch.class_epoch in shared mode (rows at the truth), one call
         per class; the classes are already split."""
         system = nav.system
@@ -167,6 +169,7 @@ class SharedCovariance:
             phi, qd = models[held[members[0]]]
             if obs.per_run_sky:
                 qd = system.noise_model.channel_qd(qd, obs.elevations(members[0]), dt_epoch)
+            phi, qd = nav.with_resets(phi, qd, new[members[0]])
             X = np.stack([runs[i].fs.x for i in members])
             P = self.P[c]  # its own array (split copies)
             ins_y = nav.x[nav.ins_of[members]]
@@ -176,7 +179,7 @@ class SharedCovariance:
                 runs[i].fs = FilterState(x=X[j], P=P, memory=runs[i].fs.memory)
 
     def _aid_singletons(self, nav: Any, ref: ins.InsState, t: float, dt_epoch: float, obs: Observations,
-                        held: list, models: dict) -> None:
+                        held: list, models: dict, new: Array) -> None:
         """`_aid_engine` when every run is its own class: all runs in one kernels/epoch.singleton_epochs call (each
         its own covariance, the channel Qd at its own sky)."""
         system = nav.system
@@ -188,6 +191,6 @@ class SharedCovariance:
         phi2 = np.stack([models.get(False, models.get(True))[0], models.get(True, models.get(False))[0]])
         qd2 = np.stack([models.get(False, models.get(True))[1], models.get(True, models.get(False))[1]])
         nav.engine.singletons(X, self.P, phi2, qd2, np.array(held, dtype=np.int64), obs, t, dt_epoch,
-                              nav.x[nav.ins_of], ref_y, ref_agl, [r.statuses for r in runs], nav.db_stack)
+                              nav.x[nav.ins_of], ref_y, ref_agl, [r.statuses for r in runs], nav.db_stack, new)
         for i, r in enumerate(runs):
             r.fs = FilterState(x=X[i], P=self.P[i], memory=r.fs.memory)

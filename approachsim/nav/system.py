@@ -167,12 +167,12 @@ class NavSystem:
         """Whether runs on one truth can share one covariance (`run(..., shared_covariance=True)`): the optimal
         'ekf' filter, tightly coupled GPS (the loose fix's covariance depends on each run's ranges), and a baro
         loop the error model sees with constant gains (the adaptive forms linearize about each run's
-        estimate). Decided from the configuration alone, so a campaign picks it once per profile. Not with carrier
-        phase: each run resets its ambiguities at its own arcs (nav/navigator.py), and the compiled epoch
-        (nav/engine.py, which needs this too) does not carry the carrier states: the generic per-run path."""
+        estimate). Decided from the configuration alone, so a campaign picks it once per profile. With carrier
+        phase too: a class splits where its runs' carrier arcs begin at different epochs (nav/shared.py), and the
+        compiled epoch (nav/engine.py, which needs this too) carries the carrier states."""
         g = self.loop_gains()
         return (self.nav.filter == "ekf" and self.nav.gps_coupling == "tight" and not self.nav.fde.enabled
-                and (g is None or g.form == "constant") and not self.layout.has("amb"))
+                and (g is None or g.form == "constant"))
 
     # --- the start -----------------------------------------------------------------------------------------
 

@@ -18,6 +18,8 @@ nothing of the stages (import-linter contract in pyproject.toml).
                   Riccati segment of the converged start (nav/base.py's predict_reference, joseph_reference;
                   nav/initial.py's converged_covariance_reference)
     measurements  the baro, radar-altimeter and pseudorange rows with their innovations (nav/measurements.py)
+    carrier       the carrier-phase states' dynamics, the float ambiguities' reset at a new arc and the carrier
+                  row (nav/errormodel.py, nav/engine.py's reset_arcs, nav/measurements.py carrier_phase)
 
 One aiding epoch of one run from preallocated arrays (what a compiled per-run loop calls; the arrays of the
 frozen objects from errormodel.kernel_inputs, measurements.terrain_arrays / database_arrays, and the scratch

@@ -3,8 +3,9 @@ scalar update of the epoch, for one run or for the runs of a shared-covariance c
 
     n_rows = class_epoch(X, P, phi, qd, lay, own, ref, ins, <observations>, codes, nu_out, S_out, h, b, ws)
 
-Order of the rows (nav/rows.py): baro, radar altimeter, each GNSS channel in channel order, each pseudolite in
-unit order; a row exists when member 0's value is finite (a class shares one schedule: nav/shared.py).
+Order of the rows (nav/rows.py): baro, radar altimeter, each GNSS channel in channel order, each channel's
+carrier phase (carrier phase only), each pseudolite in unit order; a row exists when member 0's value is finite
+(a class shares one schedule: nav/shared.py).
 
     predict    x_m <- Phi x_m (each member),  P <- Phi P Phi' + Qd                      (kernels/kalman.py)
     each row   own (one run, the per-run EKF): h and nu = z - g(x_hat) at the run's own INS and current x_hat
@@ -16,7 +17,13 @@ unit order; a row exists when member 0's value is finite (a class shares one sch
 Rows and innovations are kernels/measurements.py's. The numpy paths (nav/navigator.py with nav/rows.py, and
 nav/shared.py) are the test oracle (tests/unit/nav/test_epoch_engine.py: equal to 1e-12 relative norm-wise).
 
-Codes of the rows written to `codes`: CODE_BARO, CODE_RADALT, CODE_GPS + channel, CODE_PL + unit.
+Codes of the rows written to `codes`: CODE_BARO, CODE_RADALT, CODE_GPS + channel, CODE_PL + unit, CODE_CP + channel
+(a GNSS channel's carrier phase).
+
+Carrier phase (the layout's gio and amb groups, kernels/carrier.py): the code rows carry -1 at the channel's gio;
+after every code row, each channel's carrier-phase row (nav/rows.py's order); the float ambiguities of the channels
+whose arc began are reset in the epoch's Phi, Qd before the prediction (own_epoch, singleton_epochs, shared_pass;
+class_epoch's caller otherwise).
 """
 
 from __future__ import annotations
@@ -26,12 +33,13 @@ import math
 import numpy as np
 from numba import njit
 
+from approachsim.nav.kernels import carrier as kcar
 from approachsim.nav.kernels import errormodel as ek
 from approachsim.nav.kernels import geodesy as gk
 from approachsim.nav.kernels import kalman as kk
 from approachsim.nav.kernels import measurements as km
 
-CODE_BARO, CODE_RADALT, CODE_GPS, CODE_PL = 0, 1, 100, 200
+CODE_BARO, CODE_RADALT, CODE_GPS, CODE_PL, CODE_CP = 0, 1, 100, 200, 300
 """Row codes (module docstring)."""
 
 
@@ -72,6 +80,7 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
                 tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
                 db_u: np.ndarray,
                 rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
+                cp: np.ndarray, cp_r: float,
                 pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
                 codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray,
                 h: np.ndarray, b: np.ndarray, ws: tuple) -> int:
@@ -83,8 +92,9 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
     with noise variance baro_r m^2; radalt_h (M,) m with sigma = sqrt((ra_pct h)^2 + ra_floor^2) at the measured
     height (own) or at ref_agl (shared); the filter's terrain tx, th, rwy and each member's database dbp (M, 4),
     db_x (k,), db_u (M, k) (kernels.measurements); rho (M, s) pseudoranges m (nan: none), r_sv (s, 3) ECEF m,
-    sig (s,) their 1-sigma, channel_states: the rows carry the gse / gmp states; pl_rho (M, p), r_pl (p, 3),
-    pl_sig (p,), pl_states. Out: codes (R,), nu_out (M, R), S_out (R,); scratch h, b (n,), ws (kalman.workspace).
+    sig (s,) their 1-sigma, channel_states: the rows carry the gse / gmp states; cp (M, s) carrier phases m (nan:
+    none; (M, 0) without carrier phase) with noise variance cp_r m^2; pl_rho (M, p), r_pl (p, 3), pl_sig (p,),
+    pl_states. Out: codes (R,), nu_out (M, R), S_out (R,); scratch h, b (n,), ws (kalman.workspace).
     """
     M = X.shape[0]
     n = X.shape[1]
@@ -146,6 +156,7 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
             nu_out[m, k] = nu[m]
         k += 1
     # GNSS channels
+    i_gio = lay[ek.L_GIO]
     for c in range(rho.shape[1]):
         if rho[0, c] != rho[0, c]:
             continue
@@ -160,8 +171,31 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
                 _ecef(ins[m], r_ins)
                 _c_en(ins[m, 0], ins[m, 1], c_ins)
                 nu[m] = km._pseudorange(lay, X[m], r_ins, c_ins, r_sv[c], rho[m, c], sv, -1, x0, False)
+        if i_gio >= 0 and sv >= 0:  # carrier phase: the code's ionosphere is the gio state, -1 in the row
+            h[i_gio + c] = -1.0
+            for m in range(M):
+                nu[m] = nu[m] + X[m, i_gio + c]
         S_out[k] = _apply(X, P, h, sig[c] ** 2, nu, b, kc)
         codes[k] = CODE_GPS + c
+        for m in range(M):
+            nu_out[m, k] = nu[m]
+        k += 1
+    # GNSS carrier phases (kernels/carrier.py)
+    for c in range(cp.shape[1]):
+        if cp[0, c] != cp[0, c]:
+            continue
+        if own:
+            _ecef(ins[0], r_ins)
+            _c_en(ins[0, 0], ins[0, 1], c_ins)
+            nu[0] = kcar.carrier_phase(lay, X[0], r_ins, c_ins, r_sv[c], cp[0, c], c, h, True)
+        else:
+            kcar.carrier_phase(lay, x0, r_ref, c_ref, r_sv[c], cp[0, c], c, h, True)
+            for m in range(M):
+                _ecef(ins[m], r_ins)
+                _c_en(ins[m, 0], ins[m, 1], c_ins)
+                nu[m] = kcar.carrier_phase(lay, X[m], r_ins, c_ins, r_sv[c], cp[m, c], c, x0, False)
+        S_out[k] = _apply(X, P, h, cp_r, nu, b, kc)
+        codes[k] = CODE_CP + c
         for m in range(M):
             nu_out[m, k] = nu[m]
         k += 1
@@ -197,21 +231,27 @@ def own_epoch(X: np.ndarray, P: np.ndarray, lay: np.ndarray, q: np.ndarray, gse:
               tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
               db_u: np.ndarray,
               rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
+              cp: np.ndarray, cp_r: float,
               pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
+              gio: np.ndarray, gio_tau: float, new: np.ndarray, amb_prior: float,
               codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray,
               h: np.ndarray, b: np.ndarray, ws: tuple) -> int:
     """The per-run EKF's whole epoch of one run: the error model linearized about its INS state y (16,) (packed,
     kernels/strapdown.py) with the interval's mean specific force f_ned (3,) NED m/s^2 (kernels.errormodel
-    dynamics: lay, q, gse, gmp, loop, held as there), discretized over dt (s) into phi, qd (scratch F, Qc), then
-    class_epoch in own mode (X (1, n), the observation arguments as there). Returns the number of rows, or -1 when
-    the model is too large for the compiled discretization (X, P untouched: the caller takes the numpy path)."""
+    dynamics: lay, q, gse, gmp, loop, held as there; carrier phase: gio (n_sv,) m and gio_tau s, kernels.carrier),
+    discretized over dt (s) into phi, qd (scratch F, Qc), the ambiguities of the channels with new[c] != 0 reset
+    to amb_prior m^2 (kernels.carrier.reset_ambiguities; new (k,), empty without carrier phase), then class_epoch in
+    own mode (X (1, n), the observation arguments as there). Returns the number of rows, or -1 when the model is
+    too large for the compiled discretization (X, P untouched: the caller takes the numpy path)."""
     c_bn = y[6:15].reshape(3, 3)
     ek.dynamics(lay, q, gse, gmp, y[0], y[2], y[3:6], f_ned, c_bn, loop, held, F, Qc)
+    kcar.dynamics(lay, gio, gio_tau, F, Qc)
     if not ek.discretize(F, Qc, dt, phi, qd):
         return -1
+    kcar.reset_ambiguities(phi, qd, lay, new, amb_prior)
     return class_epoch(X, P, phi, qd, lay, True, y, y.reshape(1, 16), baro_h, baro_r, radalt_h, ra_pct, ra_floor,
-                       0.0, tx, th, rwy, dbp, db_x, db_u, rho, r_sv, sig, channel_states, pl_rho, r_pl, pl_sig,
-                       pl_states, codes, nu_out, S_out, h, b, ws)
+                       0.0, tx, th, rwy, dbp, db_x, db_u, rho, r_sv, sig, channel_states, cp, cp_r, pl_rho, r_pl,
+                       pl_sig, pl_states, codes, nu_out, S_out, h, b, ws)
 
 
 @njit(cache=True)
@@ -223,17 +263,22 @@ def singleton_epochs(X: np.ndarray, P3: np.ndarray, phi2: np.ndarray, qd2: np.nd
                      tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
                      db_u: np.ndarray,
                      rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
+                     cp: np.ndarray, cp_r: float,
                      pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
+                     ch_gio: np.ndarray, f_gio: float, new: np.ndarray, amb_prior: float, phi_tmp: np.ndarray,
                      codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray, n_rows: np.ndarray,
                      h: np.ndarray, b: np.ndarray, ws: tuple) -> None:
     """class_epoch in shared mode for N runs that are each their own class (per-run GPS skies, the integrity bank's
     copies): run i with X[i], P3[i] (its covariance), the model phi2[held[i]], qd2[held[i]] (the damping loop held
     or not) whose GPS channel states' Qd entries are sigma^2 (1 - exp(-2 dt / tau)) at run i's elevations
     (ch_gse, ch_gmp (N, k) sigmas, m; f_gse, f_gmp the factors; nothing changed when k = 0), its INS ins[i] and
-    observations row i of every per-run array (r_sv (N, s, 3), sig (N, s)); the rows at the reference ref (16,)
-    as class_epoch. Out per run: codes[i], nu_out[i], S_out[i] (R,) and n_rows[i]."""
+    observations row i of every per-run array (r_sv (N, s, 3), sig (N, s), cp (N, s)); the rows at the reference
+    ref (16,) as class_epoch. Carrier phase: the gio states' Qd entries likewise from ch_gio (N, k) and f_gio, and
+    run i's ambiguities with new[i, c] != 0 reset to amb_prior (in phi_tmp (n, n), a copy of its Phi, when it has
+    one; new (N, 0) and ch_gio (N, 0) without carrier phase). Out per run: codes[i], nu_out[i], S_out[i] (R,) and
+    n_rows[i]."""
     N = X.shape[0]
-    ig, im = lay[ek.L_GSE], lay[ek.L_GMP]
+    ig, im, io = lay[ek.L_GSE], lay[ek.L_GMP], lay[ek.L_GIO]
     for i in range(N):
         hd = held[i]
         qd_tmp[:, :] = qd2[hd]
@@ -241,11 +286,28 @@ def singleton_epochs(X: np.ndarray, P3: np.ndarray, phi2: np.ndarray, qd2: np.nd
             for c in range(ch_gse.shape[1]):
                 qd_tmp[ig + c, ig + c] = ch_gse[i, c] ** 2 * f_gse
                 qd_tmp[im + c, im + c] = ch_gmp[i, c] ** 2 * f_gmp
-        n_rows[i] = class_epoch(X[i:i + 1], P3[i], phi2[hd], qd_tmp, lay, False, ref, ins[i:i + 1],
+        if io >= 0:
+            for c in range(ch_gio.shape[1]):
+                qd_tmp[io + c, io + c] = ch_gio[i, c] ** 2 * f_gio
+        phi = _with_resets(phi2[hd], qd_tmp, lay, new[i], amb_prior, phi_tmp)
+        n_rows[i] = class_epoch(X[i:i + 1], P3[i], phi, qd_tmp, lay, False, ref, ins[i:i + 1],
                                 baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], ra_pct, ra_floor, ref_agl, tx, th, rwy,
                                 dbp[i:i + 1], db_x, db_u[i:i + 1], rho[i:i + 1], r_sv[i], sig[i], channel_states,
-                                pl_rho[i:i + 1], r_pl, pl_sig, pl_states, codes[i], nu_out[i:i + 1], S_out[i], h, b,
-                                ws)
+                                cp[i:i + 1], cp_r, pl_rho[i:i + 1], r_pl, pl_sig, pl_states, codes[i],
+                                nu_out[i:i + 1], S_out[i], h, b, ws)
+
+
+@njit(cache=True)
+def _with_resets(phi: np.ndarray, qd: np.ndarray, lay: np.ndarray, new: np.ndarray, prior: float,
+                 phi_tmp: np.ndarray) -> np.ndarray:
+    """phi itself when no channel of new (k,) begins an arc, else phi_tmp holding phi with those ambiguities reset
+    (kernels.carrier.reset_ambiguities; qd, the caller's own copy, is reset in place)."""
+    for c in range(new.shape[0]):
+        if new[c] != 0:
+            phi_tmp[:, :] = phi
+            kcar.reset_ambiguities(phi_tmp, qd, lay, new, prior)
+            return phi_tmp
+    return phi
 
 
 @njit(cache=True)
@@ -281,7 +343,10 @@ def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, g
                 tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
                 db_u: np.ndarray,
                 rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
+                cp: np.ndarray, cp_r: float,
                 pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
+                gio: np.ndarray, gio_tau: float, ch_gio: np.ndarray, f_gio: np.ndarray, new: np.ndarray,
+                amb_prior: float,
                 codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray, n_rows: np.ndarray,
                 x_out: np.ndarray, p33_out: np.ndarray, pcc_out: np.ndarray, pd_out: np.ndarray,
                 pnav_out: np.ndarray, ic: int, h: np.ndarray, b: np.ndarray, ws: tuple) -> int:
@@ -294,7 +359,9 @@ def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, g
     every run i as singleton_epochs (ch_gse, ch_gmp (N, E, k) its channel sigmas, f_gse, f_gmp (E,) their factors;
     ins (N, E, 16) its INS at the epoch; the observations indexed [i, e]: baro_h (N, E) with baro_r (E,) m^2, radalt_h
     (N, E), rho (N, E, s), r_sv (N, E, s, 3), sig (N, E, s), pl_rho (N, E, p), pl_sig (E, p); ref_agl (E,) m; db
-    per run). Out per
+    per run). Carrier phase (kernels/carrier.py; empty arrays without): the gio states in the model (gio (n_sv,) m,
+    gio_tau s) with their Qd entries at run i's sky from ch_gio (N, E, k) and f_gio (E,), cp (N, E, s) the carrier
+    phases with variance cp_r m^2, and run i's ambiguities with new[i, e, c] != 0 reset to amb_prior m^2. Out per
     run and epoch: codes, nu_out, S_out (N, E, R), n_rows (N, E), and after the epoch's updates x_out (N, E, n),
     p33_out (N, E, 3, 3), pcc_out (N, E) (P[ic, ic]), pd_out (N, E, n), pnav_out (N, E, 9, 9). Returns -1 - e when
     epoch e's model is too large for the compiled discretization (nothing of epoch e done), else E."""
@@ -305,7 +372,8 @@ def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, g
     phi2 = np.empty((2, n, n))
     qd2 = np.empty((2, n, n))
     qd_tmp = np.empty((n, n))
-    ig, im = lay[ek.L_GSE], lay[ek.L_GMP]
+    phi_tmp = np.empty((n, n))
+    ig, im, io = lay[ek.L_GSE], lay[ek.L_GMP], lay[ek.L_GIO]
     for e in range(E):
         y = ref[e]
         any_held = False
@@ -316,6 +384,7 @@ def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, g
             if hd == 1 and not any_held:
                 break
             ek.dynamics(lay, q, gse, gmp, y[0], y[2], y[3:6], f_ref[e], ref_cbn[e], loop, hd == 1, F, Qc)
+            kcar.dynamics(lay, gio, gio_tau, F, Qc)
             if not ek.discretize(F, Qc, dt[e], phi2[hd], qd2[hd]):
                 return -1 - e
         for i in range(N):
@@ -325,12 +394,17 @@ def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, g
                 for c in range(ch_gse.shape[2]):
                     qd_tmp[ig + c, ig + c] = ch_gse[i, e, c] ** 2 * f_gse[e]
                     qd_tmp[im + c, im + c] = ch_gmp[i, e, c] ** 2 * f_gmp[e]
+            if io >= 0:
+                for c in range(ch_gio.shape[2]):
+                    qd_tmp[io + c, io + c] = ch_gio[i, e, c] ** 2 * f_gio[e]
+            phi = _with_resets(phi2[hd], qd_tmp, lay, new[i, e], amb_prior, phi_tmp)
             P = P3[i]
-            n_rows[i, e] = class_epoch(X[i:i + 1], P, phi2[hd], qd_tmp, lay, False, y, ins[i, e:e + 1],
+            n_rows[i, e] = class_epoch(X[i:i + 1], P, phi, qd_tmp, lay, False, y, ins[i, e:e + 1],
                                        baro_h[i, e:e + 1], baro_r[e], radalt_h[i, e:e + 1], ra_pct, ra_floor,
                                        ref_agl[e], tx, th, rwy, dbp[i:i + 1], db_x, db_u[i:i + 1], rho[i, e:e + 1],
-                                       r_sv[i, e], sig[i, e], channel_states, pl_rho[i, e:e + 1], r_pl, pl_sig[e],
-                                       pl_states, codes[i, e], nu_out[i, e:e + 1], S_out[i, e], h, b, ws)
+                                       r_sv[i, e], sig[i, e], channel_states, cp[i, e:e + 1], cp_r,
+                                       pl_rho[i, e:e + 1], r_pl, pl_sig[e], pl_states, codes[i, e],
+                                       nu_out[i, e:e + 1], S_out[i, e], h, b, ws)
             for a in range(n):
                 x_out[i, e, a] = X[i, a]
                 pd_out[i, e, a] = P[a, a]

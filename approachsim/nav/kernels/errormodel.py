@@ -36,7 +36,9 @@ from approachsim.nav.kernels import geodesy as gk
 
 L_N, L_DP, L_DV, L_PSI, L_BG, L_BA, L_BB, L_SB, L_CLK, L_AC = range(10)
 L_GSE, L_GMP, L_PMP, L_PTR, L_PCLK, L_RAB, L_RAM, L_TDB, L_NSV, L_NPL = range(10, 20)
-LAY_SIZE = 20
+L_GIO, L_AMB = 20, 21
+"""The carrier-phase groups' first index (-1 absent): after every other group (kernels/carrier.py)."""
+LAY_SIZE = 22
 LAY_GROUPS = ("dp", "dv", "psi", "bg", "ba", "bb", "sb", "clk", "ac", "gse", "gmp", "pmp", "ptr", "pclk", "rab",
               "ram", "tdb")
 """Group names in the order of lay[1:18]."""

@@ -74,10 +74,12 @@ def test_layout_prior_and_the_split_of_the_slow_state():
                                                                      (1 - np.exp(-0.2)) + 0.002**2))
 
 
-def test_generic_path_and_no_shared_covariance_with_carrier():
+def test_compiled_path_and_shared_covariance_with_carrier():
+    """The compiled engine carries the carrier states (nav/engine.py, kernels/carrier.py; its equality with the
+    generic path: test_carrier_engine.py), so carrier phase shares the covariance as the code does."""
     on, off = NavSystem.from_profile(CARRIER), NavSystem.from_profile(CODE)
     assert off.shares_covariance() and EpochEngine.of(off) is not None
-    assert not on.shares_covariance() and EpochEngine.of(on) is None
+    assert on.shares_covariance() and EpochEngine.of(on) is not None and EpochEngine.of(on).carrier
 
 
 def test_carrier_row_is_its_model_at_the_true_state():
