@@ -201,8 +201,16 @@ class Autopilot:
         if h_gear is not None and psi is not None and (self.aligning or h_gear <= g.align_height_m):
             self.aligning = True
             crab = _wrap(psi - (self.heading_rad + conv))
-            dr = g.k_r_align * (r + crab / g.align_tau_s) + g.k_beta_align * beta
-            da = g.k_phi * (phi_c + g.k_phi_align * beta - phi) - g.k_p * p + g.k_da_align * beta
+            k_pb = g.k_phi_align  # bank per sideslip at the approach speed (dynamic pressure ratio)
+            if g.align_cas_mps > 0.0:
+                sq = self.trim.cas_mps / g.align_cas_mps
+                k_pb = k_pb * (sq * sq)
+            # the sideslip the bank allowance admits; the rest of the wind correction (crab + beta) stays as crab
+            b_max = g.align_bank_max_rad / k_pb if k_pb > 0.0 else math.inf
+            eta = crab + beta
+            crab_res = eta - min(max(eta, -b_max), b_max)
+            dr = g.k_r_align * (r + (crab - crab_res) / g.align_tau_s) + g.k_beta_align * beta
+            da = g.k_phi * (phi_c + k_pb * beta - phi) - g.k_p * p + g.k_da_align * beta
         else:
             dr = -g.k_beta * beta
             da = g.k_phi * (phi_c - phi) - g.k_p * p

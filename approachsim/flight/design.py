@@ -139,6 +139,13 @@ class AutopilotGains:
     """Decrab bank command per sideslip (the bank whose side force balances it), rad/rad."""
     k_da_align: float = 0.0
     """Decrab aileron per sideslip (the aileron that holds the dihedral roll moment), 1/rad."""
+    align_bank_max_rad: float = math.inf
+    """Decrab bank allowance: the largest bank the held sideslip may need, rad; the sideslip is limited to
+    align_bank_max / (k_phi_align (V_c / align_cas)^2) and the rest of the wind correction stays as crab
+    (inf: full decrab)."""
+    align_cas_mps: float = 0.0
+    """Calibrated airspeed of the linearization k_phi_align comes from, m/s (the bank per sideslip scales with the
+    dynamic pressure: k_phi_align (V_c / align_cas)^2 at the approach speed V_c; 0: not scheduled)."""
 
 
 @dataclass(frozen=True)
