@@ -4,6 +4,7 @@ a 20 kt crosswind, flight technical error against the straight glide path cone.
     python tools/autoland_figures.py envelope --seeds 20 --out envelope.json   # 28 cases x 20 seeds, moderate
     python tools/autoland_figures.py crosswind --runs 1000 --out xwind.json    # landings, 20 kt from the right
     python tools/autoland_figures.py fte --runs 20 --out fte.json              # calm and moderate, 1000-200 ft
+    python tools/autoland_figures.py pair --a partial.json --b full.json          # paired: two crosswind outputs
     [--law classic|tecs] [--workers N]
     crosswind only: [--wind-kt KT] [--turbulence none|light|moderate|severe] (default light)
                     [--decrab aircraft|full] (full: no bank allowance, the sideslip decrab before the partial one)
@@ -216,9 +217,29 @@ def fte(runs: int, law: str | None, workers: int) -> dict:
     return res
 
 
+def pair(a_path: Path, b_path: Path) -> dict:
+    """Paired differences a - b of two crosswind outputs on the same seeds (runs landed in both): mean and the
+    half-width of its 95 % normal interval, per touchdown quantity."""
+    a, b = (json.loads(p.read_text(encoding="utf-8")) for p in (a_path, b_path))
+    ra = {r["run"]: r for r in a["rows"] if r["termination"] == "touchdown"}
+    rb = {r["run"]: r for r in b["rows"] if r["termination"] == "touchdown"}
+    both = sorted(set(ra) & set(rb))
+    deg, ft, fps = 180.0 / math.pi, 1.0 / units.FT, 1.0 / units.FPS
+    out: dict = {"a": str(a_path), "b": str(b_path), "paired_landings": len(both)}
+    for key, f, name in (("td_bank_rad", deg, "bank_deg"), ("td_gear_slip_rad", deg, "drift_deg"),
+                         ("td_crab_rad", deg, "crab_deg"), ("td_sink_mps", fps, "sink_fps"),
+                         ("td_x_m", ft, "gear_x_ft"), ("td_y_m", ft, "gear_y_ft")):
+        d = np.array([ra[i][key] - rb[i][key] for i in both]) * f
+        out[name] = {"mean_a_minus_b": float(d.mean()),
+                     "ci95_half_width": float(1.96 * d.std(ddof=1) / math.sqrt(len(d)))}
+    return out
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("what", choices=["envelope", "crosswind", "fte"])
+    p.add_argument("what", choices=["envelope", "crosswind", "fte", "pair"])
+    p.add_argument("--a", type=Path, help="pair: the first crosswind output")
+    p.add_argument("--b", type=Path, help="pair: the second crosswind output (the same seeds)")
     p.add_argument("--seeds", type=int, default=20)
     p.add_argument("--runs", type=int, default=1000)
     p.add_argument("--turbulence", default=None,
@@ -235,6 +256,8 @@ def main() -> None:
         res = envelope(a.seeds, a.turbulence or "moderate", a.law, a.workers)
     elif a.what == "crosswind":
         res = crosswind(a.runs, a.law, a.workers, a.wind_kt, a.turbulence or "light", a.decrab)
+    elif a.what == "pair":
+        res = pair(a.a, a.b)
     else:
         res = fte(a.runs, a.law, a.workers)
     res["wall_s"] = time.time() - t0
