@@ -343,6 +343,16 @@ def loop_margins(lin: Linearization, g: AutopilotGains, glidepath_rad: float, en
     return out
 
 
+def bank_per_sideslip(lin: Linearization) -> float:
+    """Bank angle (rad) per rad of steady sideslip held by the rudder, from the lateral trim equations of the
+    linearization: the rudder that balances the yaw moment, k_beta = -N_beta / N_dr, and the bank whose gravity
+    component balances the side force, phi / beta = -(Y_beta + Y_dr k_beta) / (g cos(theta) / V) (the beta row's
+    phi coefficient). The decrab's k_phi_align; proportional to the dynamic pressure at a given weight."""
+    a, b = lin.A, lin.B
+    k_beta = -a[_R, _BETA] / b[_R, _DR]
+    return float(-(a[_BETA, _BETA] + b[_BETA, _DR] * k_beta) / a[_BETA, _PHI])
+
+
 def closed_loop_poles(lin: Linearization, g: AutopilotGains, glidepath_rad: float, engine_lag_s: float) -> Array:
     """Eigenvalues of the fully closed linear loop (all real parts must be negative), 1/s."""
     return np.linalg.eigvals(closed_loop(lin, g, glidepath_rad, engine_lag_s, None).A)

@@ -127,11 +127,8 @@ def test_the_decrab_sideslip_limit_follows_the_dynamic_pressure(setup):
     file derives k_phi_align at 140 KCAS) is the design value scaled by the dynamic pressure ratio, within 3 %
     (gray-maybeck flies 133 kt: 0.794 against 0.778; hot-high flies 140 KCAS at a higher TAS: the same q)."""
     lin, ac, gp = setup
-    a, b = lin.A, lin.B
-    beta, phi, r = 4, 5, 8
     g = ac.gains
-    k_beta = -a[r, beta] / b[r, 3]
-    k_phi = -(a[beta, beta] + b[beta, 3] * k_beta) / a[beta, phi]
+    k_phi = design.bank_per_sideslip(lin)
     sq = ac.approach_speed_mps / g.align_cas_mps
     scheduled = g.k_phi_align * sq * sq
     print(f"bank per sideslip: linearization {k_phi:.3f}, scheduled {scheduled:.3f}; sideslip limit "
