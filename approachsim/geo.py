@@ -33,20 +33,6 @@ _M_WGS84 = OMEGA_E**2 * A_WGS84**2 * B_WGS84 / GM_WGS84
 Array = NDArray[np.float64]
 
 
-def glidepath_height_m(along_m: ArrayLike, tch_m: float, tan_gp: float) -> Array:
-    """Height above the threshold (m) of a path parallel to the ellipsoid at runway-frame x = along_m (m, negative
-    before the threshold): TCH - x tan(glidepath). It follows the Earth's curvature; the synthetic trajectories
-    (approachsim/synthetic.py, manoeuvre.py) fly it. The glide path the aircraft flies and is scored against is
-    the straight cone of approachsim.glidepath, (x - x_gpi)^2 / (2 R) above this."""
-    return tch_m - np.asarray(along_m) * tan_gp
-
-
-def glidepath_deviation_m(along_m: ArrayLike, height_m: ArrayLike, tch_m: float, tan_gp: float) -> Array:
-    """Deviation (m, + above) of a point at runway-frame x = along_m, height above the threshold height_m from the
-    ideal glidepath: h - (TCH - x tan(glidepath))."""
-    return np.asarray(height_m) - glidepath_height_m(along_m, tch_m, tan_gp)
-
-
 def radii(lat_rad: ArrayLike) -> tuple[Array, Array]:
     """Meridian radius R_N (north-south) and prime-vertical radius R_E (east-west), m."""
     s2 = np.sin(lat_rad) ** 2

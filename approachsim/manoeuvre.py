@@ -41,6 +41,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from approachsim import geo
+from approachsim.glidepath import GlidePath
 from approachsim.records import Truth
 from approachsim.sensors import atmosphere
 from approachsim.synthetic import (
@@ -135,7 +136,8 @@ def vertical_manoeuvre(
     Samples at t = 0, 1/rate_hz, ..., duration_s; starts at (lat0, lon0) (default the runway threshold) at
     ellipsoid height h0_m, flying ground_speed_mps (m/s) along track_rad (default the runway heading).
     terrain_h_m: constant terrain ellipsoid height (default the threshold height). The runway-frame fields
-    (r_rwy, gs_dev_m, loc_dev_m) are relative to `runway` with a 3 deg glidepath and 15.24 m TCH.
+    (r_rwy, gs_dev_m, loc_dev_m) are relative to `runway`, gs_dev_m to the straight glide path cone
+    (approachsim.glidepath) of a 3 deg glidepath with a 15.24 m TCH.
     """
     n = int(round(duration_s * rate_hz)) + 1
     if n < 2:
@@ -211,7 +213,8 @@ def vertical_manoeuvre(
         t_air_k=t_air,
         h_agl_m=h - terr,
         r_rwy=np.column_stack([r_tan[:, 0], r_tan[:, 1], hat]),
-        gs_dev_m=geo.glidepath_deviation_m(r_tan[:, 0], hat, tch, math.tan(glidepath)),
+        gs_dev_m=GlidePath(glidepath, tch, runway.heading_rad, runway.threshold_lat_rad).deviation_m(
+            r_tan[:, 0], r_tan[:, 1], hat),
         loc_dev_m=r_tan[:, 1].copy(),
         controls=np.zeros((n, 4)),
         airspeed_mps=np.linalg.norm(v_ned, axis=-1) * np.sqrt(rho / _RHO0),

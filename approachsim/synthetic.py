@@ -6,8 +6,10 @@ specific force and body rates are *exactly* those of its position/velocity/attit
 WGS-84 NED mechanization equations that a strapdown INS integrates. Two trajectories:
 
 ``stationary``  the IMU at rest on the Earth at a fixed lat/lon/height and attitude.
-``glidepath_descent``  straight, unaccelerated descent along a glidepath toward a RunwayFrame: constant NED
-    velocity, wings level, constant attitude relative to the local NED frame.
+``glidepath_descent``  straight, unaccelerated descent down the straight glide path cone
+    (approachsim.glidepath: the line from the glide path intercept point at the glide path angle above its
+    horizontal plane) toward a RunwayFrame: constant ECEF velocity, wings level, constant attitude relative to
+    the local NED frame.
 
 How each is consistent (the contract an INS test can rely on; Groves 2nd ed. eq. 5.44-5.56, NED frame):
 
@@ -16,23 +18,27 @@ How each is consistent (the contract an INS test can rely on; Groves 2nd ed. eq.
   each sample's own lat and h.
 * Earth rate w_ie_ned = OMEGA_E (cos lat, 0, -sin lat); transport rate
   w_en_ned = (vE / (R_E + h), -vN / (R_N + h), -vE tan(lat) / (R_E + h)) with geo.radii at the sample's lat.
-* Position is the solution of lat' = vN / (R_N + h), lon' = vE / ((R_E + h) cos lat), h' = -vD for the
-  constant v_ned, integrated with an 8th-order Runge-Kutta (DOP853, rtol 1e-13, position error < 1e-7 m over
-  an approach), so lat/lon/h/r_ecef are the exact trajectory of that velocity, not a linearization.
-* Velocity is constant, so the velocity equation v' = C_bn f_body + g_ned - (2 w_ie + w_en) x v_ned = 0 gives
-  the specific force at each sample exactly: f_ned = (2 w_ie + w_en) x v_ned - g_ned, f_body = C_nb' f_ned.
+* Position is the straight line r_ecef(t) = r_end + v_e (t - t_end), lat/lon/h its exact geodetic coordinates
+  (geo.ecef_to_geodetic), so lat/lon/h/r_ecef are the exact trajectory of that velocity, not a linearization.
+* Velocity is constant in ECEF (v_e), so its NED components turn with the NED frame: v_ned = C_en' v_e and
+  v_ned' = -w_en x v_ned (C_en' ' = -[w_en x] C_en'). The velocity equation
+  v_ned' = C_bn f_body + g_ned - (2 w_ie + w_en) x v_ned then gives the specific force at each sample exactly:
+  f_ned = v_ned' + (2 w_ie + w_en) x v_ned - g_ned = 2 w_ie x v_ned - g_ned, f_body = C_nb' f_ned.
   (Stationary: v = 0, f_body = C_nb' (0, 0, -g): the accelerometers read 1 g up.)
 * Attitude is constant relative to NED (C_nb' = 0 in the NED frame), so the body turns with the NED frame
   relative to inertial space: w_ib_body = C_nb' (w_ie + w_en) (stationary: C_nb' w_ie, Earth rate).
 
-Both w_ib_body and f_body therefore vary only through lat and h (micro-rad/s and micro-g over an approach),
-so the IMU's increments (sensors/imu.py: the sample at the start of each interval held over it) differ from
-the exact integral by dt^2/2 df/dt per step, which telescopes to dt/2 (f_end - f_start), nanometres per
-second of velocity over a 10 nmi approach.
+Both w_ib_body and f_body therefore vary only through lat, h and the turning of v_ned (micro-rad/s and
+micro-g over an approach), so the IMU's increments (sensors/imu.py: the sample at the start of each interval held
+over it) differ from the exact integral by dt^2/2 df/dt per step, which telescopes to dt/2 (f_end - f_start),
+nanometres per second of velocity over a 10 nmi approach.
 
-The atmosphere fields use the ISA troposphere with the given ISA deviation and sea-level pressure
-(sensors/atmosphere.py); airspeed_mps is the equivalent airspeed of the ground speed (still air);
-controls are zero. Heights are ellipsoid heights and MSL is the ellipsoid (no geoid, as profile.py says).
+The glidepath deviation gs_dev_m is taken against the straight cone (approachsim.glidepath, the one glide path
+reference; before issue 25's follow-up these records flew and scored a path parallel to the ellipsoid, which
+curves d^2 / (2 R) below the cone: 27 m at 10 nmi). The atmosphere fields use the ISA troposphere with the
+given ISA deviation and sea-level pressure (sensors/atmosphere.py); airspeed_mps is the equivalent airspeed of
+the ground speed (still air); controls are zero. Heights are ellipsoid heights and MSL is the ellipsoid (no
+geoid, as profile.py says).
 """
 
 from __future__ import annotations
@@ -40,9 +46,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from approachsim import geo
+from approachsim.glidepath import GlidePath
 from approachsim.records import Truth
 from approachsim.sensors import atmosphere
 
@@ -129,8 +135,12 @@ def _assemble(
     tch_m: float,
     isa_dev_k: float,
     sea_level_pa: float,
+    *,
+    r_ecef: Array | None = None,
+    constant_ecef_velocity: bool = False,
 ) -> Truth:
-    """Truth fields from a trajectory with constant attitude relative to NED and constant NED velocity."""
+    """Truth fields from a trajectory with constant attitude relative to NED and a velocity constant in NED (at
+    rest) or, constant_ecef_velocity, constant in ECEF (the straight line: v_ned' = -w_en x v_ned)."""
     n = t_s.shape[0]
     c_nb = euler_to_c_nb(euler)
     c_bn = np.swapaxes(c_nb, -1, -2)
@@ -138,14 +148,18 @@ def _assemble(
     w_en = transport_rate_ned(lat, h, v_ned)
     # constant attitude in NED: the body turns with the NED frame, w_ib = w_ie + w_en (resolved in body)
     w_ib_body = np.einsum("nij,nj->ni", c_bn, w_ie + w_en)
-    # constant velocity: 0 = f_ned + g_ned - (2 w_ie + w_en) x v  =>  f_ned = (2 w_ie + w_en) x v - g_ned
+    # v_ned' = f_ned + g_ned - (2 w_ie + w_en) x v  =>  f_ned = v_ned' + (2 w_ie + w_en) x v - g_ned
     f_ned = np.cross(2.0 * w_ie + w_en, v_ned) - gravity_ned(lat, h)
+    if constant_ecef_velocity:
+        f_ned = f_ned - np.cross(w_en, v_ned)
     f_body = np.einsum("nij,nj->ni", c_bn, f_ned)
-    r_ecef = geo.geodetic_to_ecef(lat, lon, h)
+    if r_ecef is None:
+        r_ecef = geo.geodetic_to_ecef(lat, lon, h)
     r_tan = runway.from_ecef(r_ecef)
     hat = runway.height_above_threshold(h)
     r_rwy = np.column_stack([r_tan[:, 0], r_tan[:, 1], hat])
-    gs_dev = geo.glidepath_deviation_m(r_tan[:, 0], hat, tch_m, math.tan(glidepath_rad))
+    cone = GlidePath(glidepath_rad, tch_m, runway.heading_rad, runway.threshold_lat_rad)
+    gs_dev = cone.deviation_m(r_tan[:, 0], r_tan[:, 1], hat)
     h_geo = atmosphere.geopotential_m(h)
     p = atmosphere.static_pressure_pa(h_geo, isa_dev_k, sea_level_pa)
     t_air = atmosphere.air_temperature_k(h_geo, isa_dev_k)
@@ -228,15 +242,17 @@ def glidepath_descent(
     isa_dev_k: float = 0.0,
     sea_level_pa: float = atmosphere.P0_PA,
 ) -> Truth:
-    """Synthetic truth of an unaccelerated straight descent along the glidepath toward `runway`.
+    """Synthetic truth of an unaccelerated straight descent down the glide path cone toward `runway`.
 
-    Flies the constant NED velocity v = V (cos psi, sin psi, tan(glidepath)) (psi the runway heading, V the
-    ground speed, m/s), wings level at pitch_rad, for the time V needs for start - end distance, and ends
-    exactly on the extended centreline and glidepath at end_distance_m before the threshold (height above
-    the threshold tch_m + end tan(glidepath)); the trajectory is integrated backward from that point.
-    Because the velocity is constant in NED (a rhumb line, not a great circle), the start lies off the
-    centreline (about 18 m at 10 nmi on a 298 deg runway at 37.6 N) and a few metres off in distance;
-    gs_dev_m and loc_dev_m report it honestly.
+    The path is the straight line of the cone (approachsim.glidepath) in the vertical plane of the centreline:
+    from the glide path intercept point (GPI: TCH / tan(gp) past the threshold on the centreline, at the
+    threshold's ellipsoid height) back along the runway direction at the glide path angle above the GPI's
+    horizontal plane. It is flown at the constant ECEF velocity whose horizontal part at the GPI is
+    ground_speed_mps (m/s) towards the GPI, wings level at pitch_rad and the runway heading, for the time that
+    speed needs for start - end distance, ending on the line end_distance_m before the threshold (runway-frame
+    x = -end_distance_m to < 1 mm; height above the threshold the cone's there: tch_m + end tan(gp) + the Earth's
+    drop under the GPI's horizontal plane). The line is on the cone: gs_dev_m is the cone's second-order
+    approximation error (< 5 mm, tests/unit/test_glidepath.py) and loc_dev_m below 1 mm.
 
     Terrain: a constant ellipsoid height (terrain_h_m scalar, default the threshold height), or heights
     terrain_h_m at runway-frame x = terrain_along_m (linear interpolation, as profile.Terrain).
@@ -246,30 +262,23 @@ def glidepath_descent(
     duration = (start_distance_m - end_distance_m) / ground_speed_mps
     t = _time_base(duration, rate_hz)
     psi = runway.heading_rad
-    v = ground_speed_mps * np.array([math.cos(psi), math.sin(psi), math.tan(glidepath_rad)])
-    h1 = runway.threshold_h_m + tch_m + end_distance_m * math.tan(glidepath_rad)
-    # the end point: runway-frame x = -end, y = 0 at ellipsoid height h1 (fixed point on the tangent plane)
-    target = np.array([-end_distance_m, 0.0])
-    xy = target.copy()
-    for _ in range(5):
-        lat1, lon1, _ = geo.ecef_to_geodetic(runway.to_ecef(np.array([xy[0], xy[1], 0.0])))
-        xy = xy - (runway.from_ecef(geo.geodetic_to_ecef(lat1, lon1, h1))[:2] - target)
-    lat1, lon1, _ = geo.ecef_to_geodetic(runway.to_ecef(np.array([xy[0], xy[1], 0.0])))
-
-    def rhs(_t: float, y: Array) -> Array:
-        lat, _lon, h = y
-        r_n, r_e = geo.radii(lat)
-        return np.array([v[0] / (r_n + h), v[1] / ((r_e + h) * math.cos(lat)), -v[2]])
-
-    # integrated backward from the end point, so the path ends exactly on the centreline and glidepath
-    sol = solve_ivp(
-        rhs, (t[-1], 0.0), [float(lat1), float(lon1), h1], method="DOP853", t_eval=t[::-1], rtol=1e-13, atol=1e-15
-    )
-    if not sol.success:  # pragma: no cover - DOP853 on this smooth field does not fail
-        raise RuntimeError(f"synthetic trajectory integration failed: {sol.message}")
-    lat, lon, h = (y[::-1].copy() for y in sol.y)
+    tan_gp = math.tan(glidepath_rad)
+    x_gpi = tch_m / tan_gp
+    # the GPI and its local vertical: NED axes there, the runway direction in its horizontal plane
+    lat_g, lon_g, _ = geo.ecef_to_geodetic(runway.to_ecef(np.array([x_gpi, 0.0, 0.0])))
+    gpi = geo.geodetic_to_ecef(lat_g, lon_g, runway.threshold_h_m)
+    c_ecef_to_ned_g = geo.c_ecef_to_ned(lat_g, lon_g)
+    u = c_ecef_to_ned_g @ runway.c_ecef_to_rwy[0]  # runway x axis in the GPI's NED
+    u_h = np.array([u[0], u[1], 0.0]) / math.hypot(u[0], u[1])
+    # the line: ned = -D u_h - (0, 0, D tan gp) at horizontal distance D before the GPI; velocity V (u_h + tan gp down)
+    d_end = x_gpi + end_distance_m
+    r_end = gpi + c_ecef_to_ned_g.T @ (-d_end * u_h - np.array([0.0, 0.0, d_end * tan_gp]))
+    v_e = c_ecef_to_ned_g.T @ (ground_speed_mps * (u_h + np.array([0.0, 0.0, tan_gp])))
+    r_ecef = r_end + (t - t[-1])[:, None] * v_e
+    lat, lon, h = geo.ecef_to_geodetic(r_ecef)
     n = t.shape[0]
-    r_tan = runway.from_ecef(geo.geodetic_to_ecef(lat, lon, h))
+    v_ned = np.einsum("nij,j->ni", geo.c_ecef_to_ned(lat, lon), v_e)
+    r_tan = runway.from_ecef(r_ecef)
     if terrain_h_m is None:
         terr = np.full(n, runway.threshold_h_m)
     elif terrain_along_m is None:
@@ -281,7 +290,7 @@ def glidepath_descent(
         lat,
         lon,
         h,
-        np.tile(v, (n, 1)),
+        v_ned,
         np.tile(np.array([0.0, pitch_rad, psi]), (n, 1)),
         runway,
         terr,
@@ -289,6 +298,8 @@ def glidepath_descent(
         tch_m,
         isa_dev_k,
         sea_level_pa,
+        r_ecef=r_ecef,
+        constant_ecef_velocity=True,
     )
 
 

@@ -4,8 +4,11 @@ a 20 kt crosswind, flight technical error against the straight glide path cone.
     python tools/autoland_figures.py envelope --seeds 20 --out envelope.json   # 28 cases x 20 seeds, moderate
     python tools/autoland_figures.py crosswind --runs 1000 --out xwind.json    # landings, 20 kt from the right
     python tools/autoland_figures.py fte --runs 20 --out fte.json              # calm and moderate, 1000-200 ft
+    python tools/autoland_figures.py pair --a partial.json --b full.json          # paired: two crosswind outputs
     [--law classic|tecs] [--workers N]
-    python tools/autoland_figures.py paired --a tecs.json --b classic.json --out paired.json  # same seeds, A - B
+    python tools/autoland_figures.py paired --a tecs.json --b classic.json --out paired.json  # laws, same seeds, A - B
+    crosswind only: [--wind-kt KT] [--turbulence none|light|moderate|severe] (default light)
+                    [--decrab aircraft|full] (full: no bank allowance, the sideslip decrab before the partial one)
 
 Every flight flies on the true state (no navigation in the loop), seeded: envelope case i, seed 1000 + i, runs
 0..seeds-1 (the envelope test's seed is run 0); crosswind and FTE: seed 1, runs 0..N-1 of the default profile.
@@ -17,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import copy
+import dataclasses
 import json
 import math
 import os
@@ -132,8 +136,11 @@ def _xwind_profile(law: str | None, speed_kt: float, turb: str) -> dict:
 
 
 def _xwind_job(args: tuple) -> list[dict]:
-    runs, law, speed_kt, turb = args
+    runs, law, speed_kt, turb, decrab = args
     approach = Approach(parse_profile(_xwind_profile(law, speed_kt, turb), source=DEFAULT), land=True)
+    if decrab == "full":  # the full sideslip decrab: no bank allowance, the whole wind correction as sideslip
+        ac = approach.aircraft
+        approach.aircraft = dataclasses.replace(ac, gains=dataclasses.replace(ac.gains, align_bank_max_rad=math.inf))
     arms = approach.main_gear_lever_arms_m
     out = []
     for r in runs:
@@ -146,10 +153,10 @@ def _xwind_job(args: tuple) -> list[dict]:
     return out
 
 
-def crosswind(runs: int, law: str | None, workers: int, speed_kt: float, turb: str) -> dict:
+def crosswind(runs: int, law: str | None, workers: int, speed_kt: float, turb: str, decrab: str = "aircraft") -> dict:
     chunks = [list(range(i, runs, workers * 4)) for i in range(workers * 4)]
     with ProcessPoolExecutor(workers) as ex:
-        rows = sorted((r for rs in ex.map(_xwind_job, [(c, law, speed_kt, turb) for c in chunks]) for r in rs),
+        rows = sorted((r for rs in ex.map(_xwind_job, [(c, law, speed_kt, turb, decrab) for c in chunks]) for r in rs),
                       key=lambda r: r["run"])
     td = [r for r in rows if r["termination"] == "touchdown"]
 
@@ -161,6 +168,7 @@ def crosswind(runs: int, law: str | None, workers: int, speed_kt: float, turb: s
     deg, ft, fps = 180.0 / math.pi, 1.0 / units.FT, 1.0 / units.FPS
     return {
         "landings": runs, "completed": len(td), "failed": runs - len(td), "law": law or "aircraft default",
+        "decrab": decrab,
         "wind": f"{speed_kt:g} kt from the right", "turbulence": turb,
         "failures": sorted({r["termination"] for r in rows if r["termination"] != "touchdown"}),
         "gear_x_ft": st("td_x_m", ft), "gear_y_ft": st("td_y_m", ft),
@@ -170,6 +178,9 @@ def crosswind(runs: int, law: str | None, workers: int, speed_kt: float, turb: s
         "imu_x_ft": st("td_imu_x_m", ft), "imu_sink_fps": st("td_imu_sink_mps", fps),
         "flight_field_x_ft": st("flight_td_x_m", ft), "flight_field_sink_fps": st("flight_td_sink_mps", fps),
         "drift_over_5deg": int(sum(abs(r["td_gear_slip_rad"]) * deg > 5.0 for r in td)),
+        # the bank criterion in use (12 deg at 1e-8, evaluate/touchdown.py): its distance from the mean in sd
+        "bank_z_12deg": float((12.0 - abs(st("td_bank_rad", deg)["mean"])) / st("td_bank_rad", deg)["sd"]),
+        "rows": rows,
     }
 
 
@@ -240,14 +251,35 @@ def paired(a: dict, b: dict) -> dict:
     return out
 
 
+def pair(a_path: Path, b_path: Path) -> dict:
+    """Paired differences a - b of two crosswind outputs on the same seeds (runs landed in both): mean and the
+    half-width of its 95 % normal interval, per touchdown quantity."""
+    a, b = (json.loads(p.read_text(encoding="utf-8")) for p in (a_path, b_path))
+    ra = {r["run"]: r for r in a["rows"] if r["termination"] == "touchdown"}
+    rb = {r["run"]: r for r in b["rows"] if r["termination"] == "touchdown"}
+    both = sorted(set(ra) & set(rb))
+    deg, ft, fps = 180.0 / math.pi, 1.0 / units.FT, 1.0 / units.FPS
+    out: dict = {"a": str(a_path), "b": str(b_path), "paired_landings": len(both)}
+    for key, f, name in (("td_bank_rad", deg, "bank_deg"), ("td_gear_slip_rad", deg, "drift_deg"),
+                         ("td_crab_rad", deg, "crab_deg"), ("td_sink_mps", fps, "sink_fps"),
+                         ("td_x_m", ft, "gear_x_ft"), ("td_y_m", ft, "gear_y_ft")):
+        d = np.array([ra[i][key] - rb[i][key] for i in both]) * f
+        out[name] = {"mean_a_minus_b": float(d.mean()),
+                     "ci95_half_width": float(1.96 * d.std(ddof=1) / math.sqrt(len(d)))}
+    return out
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("what", choices=["envelope", "crosswind", "fte", "paired"])
-    p.add_argument("--a", type=Path, help="paired: law A's envelope or fte output")
-    p.add_argument("--b", type=Path, help="paired: law B's output on the same seeds")
+    p.add_argument("what", choices=["envelope", "crosswind", "fte", "paired", "pair"])
+    p.add_argument("--a", type=Path, help="paired: law A's envelope or fte output; pair: a crosswind output")
+    p.add_argument("--b", type=Path, help="paired / pair: the other output on the same seeds")
     p.add_argument("--seeds", type=int, default=20)
     p.add_argument("--runs", type=int, default=1000)
-    p.add_argument("--turbulence", default="moderate", help="envelope: moderate | design; crosswind: light ...")
+    p.add_argument("--turbulence", default=None,
+                   help="envelope: moderate (default) | design; crosswind: none | light (default) | moderate ...")
+    p.add_argument("--decrab", choices=["aircraft", "full"], default="aircraft",
+                   help="crosswind: the aircraft file's decrab (aircraft) or the full sideslip decrab (full)")
     p.add_argument("--wind-kt", type=float, default=20.0)
     p.add_argument("--law", default=None)
     p.add_argument("--workers", type=int, default=max(1, min(2, os.cpu_count() or 1)))
@@ -257,9 +289,11 @@ def main() -> None:
     if a.what == "paired":
         res = paired(json.loads(a.a.read_text(encoding="utf-8")), json.loads(a.b.read_text(encoding="utf-8")))
     elif a.what == "envelope":
-        res = envelope(a.seeds, a.turbulence, a.law, a.workers)
+        res = envelope(a.seeds, a.turbulence or "moderate", a.law, a.workers)
     elif a.what == "crosswind":
-        res = crosswind(a.runs, a.law, a.workers, a.wind_kt, "light" if a.turbulence == "moderate" else a.turbulence)
+        res = crosswind(a.runs, a.law, a.workers, a.wind_kt, a.turbulence or "light", a.decrab)
+    elif a.what == "pair":
+        res = pair(a.a, a.b)
     else:
         res = fte(a.runs, a.law, a.workers)
     res["wall_s"] = time.time() - t0

@@ -105,6 +105,9 @@ def _gains(s: Section) -> AutopilotGains:
         k_beta_align=pos_default("k_beta_align"),
         k_phi_align=pos_default("k_phi_align"),
         k_da_align=pos_default("k_da_align"),
+        align_bank_max_rad=math.radians(s.number("align_bank_max_deg", math.inf, lo=0.0, hi=90.0, lo_open=True,
+                                                 unit="deg")),
+        align_cas_mps=s.number("align_design_cas_kt", 0.0, lo=0.0, hi=300.0, unit="kt") * units.KT,
     )
     s.done()
     return g

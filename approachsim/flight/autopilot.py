@@ -52,9 +52,16 @@ Landing runs (h_gear: main-gear height above the terrain, the radio altitude) ad
 * a decrab (runway alignment) below align_height: the rudder turns the heading onto the runway's and holds the
   sideslip that the crosswind then needs (the 737 FCTM's sideslip technique: "prior to the flare the airplane
   centerline is aligned on or parallel to the runway centerline", upwind wing low; the localizer loop banks into
-  the wind): r_c = -crab / tau_align,  dr = k_r_align (r - r_c) + k_beta_align beta, crab = psi - runway heading.
-  k_beta_align = -N_beta / N_dr holds the sideslip (yaw moment balance), k_r_align = (1/tau_r + N_r) / -N_dr puts the
-  yaw-rate loop's pole at -1/tau_r, tau_r = tau_align / 3 (linearization derivatives; the aircraft file has them).
+  the wind): r_c = -(crab - crab_res) / tau_align,  dr = k_r_align (r - r_c) + k_beta_align beta,
+  crab = psi - runway heading. k_beta_align = -N_beta / N_dr holds the sideslip (yaw moment balance),
+  k_r_align = (1/tau_r + N_r) / -N_dr puts the yaw-rate loop's pole at -1/tau_r, tau_r = tau_align / 3
+  (linearization derivatives; the aircraft file has them). The decrab is partial in a strong crosswind (as the
+  737's alignment mode: "Sideslip is limited to 5 degrees"): the bank that holds a sideslip beta is k_pb beta,
+  k_pb = k_phi_align (V_c / V_design)^2 (the side-force balance -(Y_beta + Y_dr k_beta_align) / (g / V) of the
+  linearization, proportional to the dynamic pressure), so the sideslip is limited to b_max = bank_max / k_pb and
+  the rest of the wind correction eta = crab + beta (the air-relative track's angle to the runway, which the yaw
+  manoeuvre only shares out between crab and sideslip) stays as crab: crab_res = eta - clip(eta, -b_max, b_max)
+  (0 when |eta| <= b_max: the full decrab); the bank command adds k_pb beta, the aileron k_da_align beta.
 
 Sign conventions of the 737 FCS: + elevator = nose down, + aileron = roll right, + rudder = nose left.
 This class is the readable oracle; the flight loop runs its compiled twin (flight/kernels.py autopilot_step, equal
@@ -204,8 +211,16 @@ class Autopilot:
         if h_gear is not None and psi is not None and (self.aligning or h_gear <= g.align_height_m):
             self.aligning = True
             crab = _wrap(psi - (self.heading_rad + conv))
-            dr = g.k_r_align * (r + crab / g.align_tau_s) + g.k_beta_align * beta
-            da = g.k_phi * (phi_c + g.k_phi_align * beta - phi) - g.k_p * p + g.k_da_align * beta
+            k_pb = g.k_phi_align  # bank per sideslip at the approach speed (dynamic pressure ratio)
+            if g.align_cas_mps > 0.0:
+                sq = self.trim.cas_mps / g.align_cas_mps
+                k_pb = k_pb * (sq * sq)
+            # the sideslip the bank allowance admits; the rest of the wind correction (crab + beta) stays as crab
+            b_max = g.align_bank_max_rad / k_pb if k_pb > 0.0 else math.inf
+            eta = crab + beta
+            crab_res = eta - min(max(eta, -b_max), b_max)
+            dr = g.k_r_align * (r + (crab - crab_res) / g.align_tau_s) + g.k_beta_align * beta
+            da = g.k_phi * (phi_c + k_pb * beta - phi) - g.k_p * p + g.k_da_align * beta
         else:
             dr = -g.k_beta * beta
             da = g.k_phi * (phi_c - phi) - g.k_p * p

@@ -141,6 +141,13 @@ class AutopilotGains:
     """Decrab bank command per sideslip (the bank whose side force balances it), rad/rad."""
     k_da_align: float = 0.0
     """Decrab aileron per sideslip (the aileron that holds the dihedral roll moment), 1/rad."""
+    align_bank_max_rad: float = math.inf
+    """Decrab bank allowance: the largest bank the held sideslip may need, rad; the sideslip is limited to
+    align_bank_max / (k_phi_align (V_c / align_cas)^2) and the rest of the wind correction stays as crab
+    (inf: full decrab)."""
+    align_cas_mps: float = 0.0
+    """Calibrated airspeed of the linearization k_phi_align comes from, m/s (the bank per sideslip scales with the
+    dynamic pressure: k_phi_align (V_c / align_cas)^2 at the approach speed V_c; 0: not scheduled)."""
 
 
 @dataclass(frozen=True)
@@ -336,6 +343,16 @@ def loop_margins(lin: Linearization, g: AutopilotGains, glidepath_rad: float, en
         gm_db, pm_deg, wc = margins(loop_transfer(closed_loop(lin, g, glidepath_rad, engine_lag_s, name)))
         out.append(LoopMargin(loop=name, gm_db=gm_db, pm_deg=pm_deg, wc_rad_s=wc))
     return out
+
+
+def bank_per_sideslip(lin: Linearization) -> float:
+    """Bank angle (rad) per rad of steady sideslip held by the rudder, from the lateral trim equations of the
+    linearization: the rudder that balances the yaw moment, k_beta = -N_beta / N_dr, and the bank whose gravity
+    component balances the side force, phi / beta = -(Y_beta + Y_dr k_beta) / (g cos(theta) / V) (the beta row's
+    phi coefficient). The decrab's k_phi_align; proportional to the dynamic pressure at a given weight."""
+    a, b = lin.A, lin.B
+    k_beta = -a[_R, _BETA] / b[_R, _DR]
+    return float(-(a[_BETA, _BETA] + b[_BETA, _DR] * k_beta) / a[_BETA, _PHI])
 
 
 def closed_loop_poles(lin: Linearization, g: AutopilotGains, glidepath_rad: float, engine_lag_s: float) -> Array:

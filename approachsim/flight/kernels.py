@@ -365,15 +365,15 @@ AP_GAINS = ("k_theta", "k_q", "k_gs_p", "k_gs_d", "k_gs_i", "k_v_p", "k_v_i", "t
             "tecs_thr_per_rad", "tecs_k_thr_damp", "tecs_k_thr_i", "tecs_k_pitch_damp", "tecs_k_pitch_i",
             "tecs_seb_ff", "tecs_spd_weight", "tecs_rate_tau_s", "tecs_sink_max_mps", "tecs_climb_max_mps",
             "tecs_vert_acc_mps2", "align_height_m", "align_tau_s", "k_r_align", "k_beta_align", "k_phi_align",
-            "k_da_align")
+            "k_da_align", "align_bank_max_rad", "align_cas_mps")
 """flight.design.AutopilotGains fields, in the order of the autopilot parameter vector."""
 (AP_K_THETA, AP_K_Q, AP_K_GS_P, AP_K_GS_D, AP_K_GS_I, AP_K_V_P, AP_K_V_I, AP_TAU_V, AP_K_PHI, AP_K_P, AP_K_BETA,
  AP_K_LOC_P, AP_K_LOC_D, AP_K_LOC_I, AP_BANK_LIMIT, AP_PITCH_LIMIT, AP_TAU_WIND, AP_FLARE_H, AP_TD_SINK,
  AP_K_FLARE, AP_K_FLARE_I, AP_RETARD_H, AP_TECS, AP_T_H, AP_T_V, AP_K_THR, AP_K_TD, AP_K_TI, AP_K_PD, AP_K_PI,
  AP_SEB_FF, AP_SPD_W, AP_RATE_TAU, AP_SINK_MAX, AP_CLIMB_MAX, AP_VERT_ACC, AP_ALIGN_H, AP_ALIGN_TAU, AP_K_R_ALIGN,
- AP_K_BETA_ALIGN, AP_K_PHI_ALIGN, AP_K_DA_ALIGN, AP_THETA0, AP_THR0, AP_CAS0, AP_CH, AP_SH, AP_HEADING, AP_TAN_GP,
- AP_X_GPI, AP_CONE_A, AP_CONE_B, AP_CONE_C, AP_CONV, AP_DT) = range(55)
-N_AP_PAR = 55
+ AP_K_BETA_ALIGN, AP_K_PHI_ALIGN, AP_K_DA_ALIGN, AP_ALIGN_BANK_MAX, AP_ALIGN_CAS, AP_THETA0, AP_THR0, AP_CAS0, AP_CH,
+ AP_SH, AP_HEADING, AP_TAN_GP, AP_X_GPI, AP_CONE_A, AP_CONE_B, AP_CONE_C, AP_CONV, AP_DT) = range(57)
+N_AP_PAR = 57
 (APS_INT_D, APS_INT_Y, APS_E_F, APS_WIND, APS_INT_E, APS_FLARING, APS_THETA_FLARE0, APS_INT_FLARE,
  APS_THETA_C, APS_V_LAG, APS_INT_T, APS_INT_B, APS_FLARE_TAU, APS_FLARE_H_OFF, APS_ALIGNING) = range(15)
 N_AP_STATE = 15
@@ -538,8 +538,16 @@ def autopilot_step(par: Array, st: Array, x: float, y: float, z: float, vn: floa
         st[APS_ALIGNING] = 1.0
         crab = psi - (par[AP_HEADING] + conv) + math.pi
         crab = crab - _TWO_PI * math.floor(crab / _TWO_PI) - math.pi
-        dr = par[AP_K_R_ALIGN] * (r + crab / par[AP_ALIGN_TAU]) + par[AP_K_BETA_ALIGN] * beta
-        da = (par[AP_K_PHI] * (phi_c + par[AP_K_PHI_ALIGN] * beta - phi) - par[AP_K_P] * p
+        k_pb = par[AP_K_PHI_ALIGN]  # bank per sideslip at the approach speed (dynamic pressure ratio)
+        if par[AP_ALIGN_CAS] > 0.0:
+            sq = par[AP_CAS0] / par[AP_ALIGN_CAS]
+            k_pb = k_pb * (sq * sq)
+        # the sideslip the bank allowance admits; the rest of the wind correction (crab + beta) stays as crab
+        b_max = par[AP_ALIGN_BANK_MAX] / k_pb if k_pb > 0.0 else math.inf
+        eta = crab + beta
+        crab_res = eta - min(max(eta, -b_max), b_max)
+        dr = par[AP_K_R_ALIGN] * (r + (crab - crab_res) / par[AP_ALIGN_TAU]) + par[AP_K_BETA_ALIGN] * beta
+        da = (par[AP_K_PHI] * (phi_c + k_pb * beta - phi) - par[AP_K_P] * p
               + par[AP_K_DA_ALIGN] * beta)
     else:
         dr = -par[AP_K_BETA] * beta

@@ -82,3 +82,16 @@ def test_bad_leg_is_refused():
         manoeuvre.VerticalLeg(10.0, 10.0, 100.0)
     with pytest.raises(ValueError, match="dh_m"):
         manoeuvre.VerticalLeg(0.0, 10.0, float("nan"))
+
+
+def test_glidepath_deviation_is_against_the_straight_cone(truth):
+    """gs_dev_m is the height above the straight glide path cone (approachsim.glidepath, 3 deg, 15.24 m TCH), the
+    one glide path reference, not above the path parallel to the ellipsoid (which lies x^2 / 2R lower: the two
+    differ by metres over the manoeuvre's 36 km)."""
+    from approachsim.glidepath import GlidePath
+
+    cone = GlidePath(math.radians(3.0), 15.24, RWY.heading_rad, RWY.threshold_lat_rad)
+    # the same expression on the same operands: equal to rounding (floor(4, 1000 m) = 8.9e-13 m; 1e-9 is 1100x)
+    np.testing.assert_allclose(truth.gs_dev_m, cone.deviation_rwy_m(truth.r_rwy), rtol=0, atol=1e-9)
+    flat = truth.r_rwy[:, 2] - (15.24 - truth.r_rwy[:, 0] * math.tan(math.radians(3.0)))
+    assert np.max(flat - truth.gs_dev_m) > 5.0

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from approachsim import geo, synthetic
+from approachsim.glidepath import GlidePath
 
 RWY = geo.RunwayFrame(math.radians(37.6117), math.radians(-122.3581), 4.0, math.radians(298.0))
 
@@ -87,18 +88,34 @@ def test_descent_is_consistent_in_ecef():
     _check_ecef_consistency(tr, tol_acc=2e-7, tol_rate=1e-11)
 
 
-def test_descent_follows_glidepath_and_reaches_threshold():
-    tr = synthetic.glidepath_descent(RWY, rate_hz=10.0, start_distance_m=18520.0, tch_m=15.24)
-    # runway coordinates from 6.4e6 m ECEF positions: floor(2, 6.4e6, 6.4e6) = 2.8e-9 m; 1e-6 m is 350x that
-    assert tr.r_rwy[-1, :2] == pytest.approx([0.0, 0.0], abs=1e-6)
-    assert tr.r_rwy[-1, 2] == pytest.approx(15.24, abs=1e-6)
-    assert tr.r_rwy[0, 0] == pytest.approx(-18520.0, abs=10.0)  # rhumb line at altitude vs tangent-plane chord
-    assert np.max(np.abs(tr.gs_dev_m)) < 1.0
-    assert np.max(np.abs(tr.loc_dev_m)) < 25.0  # rhumb line vs great circle, zero at the end
-    assert abs(tr.loc_dev_m[-1]) < 1e-6
-    # constant velocity: the specific force differs from -g only by Coriolis/transport terms (< 0.02 m/s^2)
+def test_descent_follows_the_straight_cone_and_reaches_the_threshold():
+    """The descent is the straight line of the glide path cone (approachsim.glidepath): its elevation angle seen
+    from the GPI, above the GPI's horizontal plane, is the glide path angle at every sample (exact ECEF
+    geometry), the recorded gs_dev_m is the cone's second-order approximation error (< 5 mm), and it ends on the
+    centreline at the threshold at the cone's height there."""
+    gp = math.radians(3.0)
+    tr = synthetic.glidepath_descent(RWY, rate_hz=10.0, start_distance_m=18520.0, tch_m=15.24, glidepath_rad=gp)
+    cone = GlidePath(gp, 15.24, RWY.heading_rad, RWY.threshold_lat_rad)
+    # the exact cone: elevation from the GPI (on the centreline at the threshold's ellipsoid height)
+    lat_g, lon_g, _ = geo.ecef_to_geodetic(RWY.to_ecef(np.array([cone.gpi_m, 0.0, 0.0])))
+    gpi = geo.geodetic_to_ecef(lat_g, lon_g, RWY.threshold_h_m)
+    ned = (tr.r_ecef - gpi) @ geo.c_ecef_to_ned(lat_g, lon_g).T
+    elevation = np.arctan2(-ned[:, 2], np.hypot(ned[:, 0], ned[:, 1]))
+    # atan2 of differences of 6.4e6 m ECEF positions (floor(2, 6.4e6) = 2.8e-9 m) over >= 290 m: 1e-11 rad; 1e-9 is
+    # 100x that
+    assert np.max(np.abs(elevation - gp)) < 1e-9
+    assert np.max(np.abs(tr.gs_dev_m)) < 5e-3  # the second-order drop's error (glidepath module docstring)
+    np.testing.assert_allclose(tr.gs_dev_m, cone.deviation_rwy_m(tr.r_rwy), rtol=0, atol=1e-12)
+    assert np.max(np.abs(tr.loc_dev_m)) < 1e-3  # the centreline's vertical plane at the GPI vs the threshold's
+    # the end: on the centreline at the threshold, the cone's height (TCH + the 6.6 mm drop under the GPI's plane)
+    assert tr.r_rwy[-1, :2] == pytest.approx([0.0, 0.0], abs=1e-3)
+    assert tr.r_rwy[-1, 2] == pytest.approx(float(cone.height_m(0.0)), abs=5e-3)
+    assert tr.r_rwy[0, 0] == pytest.approx(-18520.0, abs=7.0)  # the duration rounded to the 0.1 s grid (7 m)
+    # 27 m above the path parallel to the ellipsoid it flew before, at 10 nmi (x^2 / 2R)
+    assert tr.r_rwy[0, 2] - (15.24 - tr.r_rwy[0, 0] * math.tan(gp)) == pytest.approx(27.5, abs=1.0)
+    # constant ECEF velocity: the specific force differs from -g only by the Coriolis term 2 W x v (< 0.02 m/s^2)
     g = np.linalg.norm(geo.gravity_ned(tr.lat_rad, tr.h_m), axis=-1)
     assert np.max(np.abs(np.linalg.norm(tr.f_body, axis=1) - g)) < 0.02
-    # and those terms are present (2 W x v ~ 2 * 7.29e-5 * 70 = 0.01 m/s^2)
+    # and it is there (2 * 7.29e-5 * 70 = 0.01 m/s^2)
     f_ned = np.einsum("nij,nj->ni", synthetic.euler_to_c_nb(tr.euler_rad), tr.f_body)
     assert np.max(np.abs(f_ned[:, :2])) > 5e-3

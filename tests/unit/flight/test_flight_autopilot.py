@@ -103,11 +103,17 @@ def test_the_flare_command_starts_at_the_entry_sink_and_ends_at_the_touchdown_si
     assert -(0.0 - ap._flare_h_off) / tau == pytest.approx(-g.touchdown_sink_mps)
 
 
+def _full_decrab(ap):
+    g = dataclasses.replace(ap.g, align_bank_max_rad=math.inf)
+    return Autopilot(g, ap.trim, Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0), ap.dt)
+
+
 def test_the_decrab_yaws_towards_the_runway_and_holds_the_sideslip(ap):
-    """Below the align height, crabbed 8 deg right of the runway (heading 0) with the wind from the right (beta > 0
-    once aligned): rudder nose left (+) from the heading error; the sideslip terms add rudder, bank and aileron
-    into the wind (right)."""
+    """Full decrab (no bank allowance): below the align height, crabbed 8 deg right of the runway (heading 0) with
+    the wind from the right (beta > 0 once aligned): rudder nose left (+) from the heading error; the sideslip terms
+    add rudder, bank and aileron into the wind (right)."""
     x = -200.0
+    ap = _full_decrab(ap)
     g = ap.g
     h = 0.5 * g.align_height_m
     de, da, dr, thr = ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, h,
@@ -118,3 +124,51 @@ def test_the_decrab_yaws_towards_the_runway_and_holds_the_sideslip(ap):
                                psi=0.0, r=0.0)
     assert dr_b == pytest.approx(g.k_beta_align * 0.1, rel=1e-9)  # aligned: the rudder that holds beta = 0.1
     assert da_b > 0.0  # right wing down into the wind
+
+
+def _align_step(ap, crab_rad, beta_rad):
+    x = -200.0
+    return ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, beta_rad, 72.0,
+                   0.5 * ap.g.align_height_m, psi=crab_rad, r=0.0)
+
+
+def test_the_partial_decrab_limits_the_sideslip_to_the_bank_allowance(ap):
+    """The sideslip limit is the bank allowance over the bank per sideslip at the approach speed,
+    b_max = bank_max / (k_phi_align (V_c / V_design)^2). Crabbed 8 deg with no sideslip yet (wind correction
+    eta = crab + beta = 8 deg > b_max): the heading error the rudder works on is b_max, so the aircraft keeps
+    8 deg - b_max of crab; within the limit (eta = 4 deg) the law is the full decrab's, bit for bit."""
+    g = ap.g
+    assert math.isfinite(g.align_bank_max_rad) and g.align_cas_mps > 0.0
+    sq = ap.trim.cas_mps / g.align_cas_mps
+    b_max = g.align_bank_max_rad / (g.k_phi_align * sq * sq)
+    assert math.degrees(b_max) == pytest.approx(5.7, abs=0.05)  # 4.9 deg / 0.862 at 72 m/s (140 KCAS: 72.02 m/s)
+    full = _full_decrab(ap)
+    _, _, dr, _ = _align_step(ap, math.radians(8.0), 0.0)
+    assert dr == pytest.approx(g.k_r_align * b_max / g.align_tau_s, rel=1e-12)
+    _, _, dr_full, _ = _align_step(full, math.radians(8.0), 0.0)
+    assert dr_full == pytest.approx(g.k_r_align * math.radians(8.0) / g.align_tau_s, rel=1e-12)
+    # crab 3 deg left, sideslip 1 deg: inside the limit, the same commands as the full decrab
+    ap2 = Autopilot(g, ap.trim, Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0), ap.dt)
+    full2 = _full_decrab(ap)
+    assert _align_step(ap2, math.radians(3.0), math.radians(1.0)) == _align_step(full2, math.radians(3.0),
+                                                                                   math.radians(1.0))
+    # at the held limit (beta = b_max, crab = eta - b_max) the heading error is zero and the bank fed forward is
+    # the allowance
+    ap3 = Autopilot(g, ap.trim, Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0), ap.dt)
+    _, _, dr3, _ = _align_step(ap3, math.radians(2.5), b_max)
+    assert dr3 == pytest.approx(g.k_beta_align * b_max, rel=1e-9)
+    assert g.k_phi_align * sq * sq * b_max == pytest.approx(g.align_bank_max_rad, rel=1e-12)
+
+
+def test_the_sideslip_limit_scales_with_the_dynamic_pressure(ap):
+    """At 133 kt the bank per sideslip is (133 / 140)^2 of the design speed's, so the limit is (140 / 133)^2 as
+    large: the same bank allowance holds more sideslip at a lower dynamic pressure (crabbed 12 deg, no sideslip)."""
+    g = ap.g
+    slow = Autopilot(g, Trim(theta_rad=0.02, throttle=0.47, cas_mps=133.0 * units.KT),
+                     Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0), ap.dt)
+    fast = Autopilot(g, Trim(theta_rad=0.02, throttle=0.47, cas_mps=140.0 * units.KT),
+                     Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0), ap.dt)
+    dr_slow = _align_step(slow, math.radians(12.0), 0.0)[2]
+    dr_fast = _align_step(fast, math.radians(12.0), 0.0)[2]
+    assert dr_fast == pytest.approx(g.k_r_align * g.align_bank_max_rad / g.k_phi_align / g.align_tau_s, rel=1e-12)
+    assert dr_slow / dr_fast == pytest.approx((140.0 / 133.0) ** 2, rel=1e-12)

@@ -160,3 +160,18 @@ def test_tecs_thrust_gain_and_decrab_gains_are_the_linearizations(setup):
     for want, got in ((k_thr, g.tecs_thr_per_rad), (k_beta, g.k_beta_align), (k_phi, g.k_phi_align),
                       (k_da, g.k_da_align), (k_r, g.k_r_align)):
         assert got == pytest.approx(want, rel=0.15)
+
+
+def test_the_decrab_sideslip_limit_follows_the_dynamic_pressure(setup):
+    """The partial decrab's sideslip limit is align_bank_max / (k_phi_align (V_c / V_design)^2): the bank per
+    sideslip of each shipped profile's own linearization (-(Y_beta + Y_dr k_beta_align) / (g / V), as the aircraft
+    file derives k_phi_align at 140 KCAS) is the design value scaled by the dynamic pressure ratio, within 3 %
+    (gray-maybeck flies 133 kt: 0.794 against 0.778; hot-high flies 140 KCAS at a higher TAS: the same q)."""
+    lin, ac, gp = setup
+    g = ac.gains
+    k_phi = design.bank_per_sideslip(lin)
+    sq = ac.approach_speed_mps / g.align_cas_mps
+    scheduled = g.k_phi_align * sq * sq
+    print(f"bank per sideslip: linearization {k_phi:.3f}, scheduled {scheduled:.3f}; sideslip limit "
+          f"{np.degrees(g.align_bank_max_rad / scheduled):.2f} deg for {np.degrees(g.align_bank_max_rad):.1f} deg")
+    assert scheduled == pytest.approx(k_phi, rel=0.03)

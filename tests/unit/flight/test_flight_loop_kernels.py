@@ -98,7 +98,9 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
     ap = _autopilot(gains)
     par, st = fk.autopilot_arrays(ap)
     seen = {"pitch limited": 0, "bank limited": 0, "throttle 1": 0, "throttle 0": 0, "flaring": 0, "idle": 0,
-            "aligning": 0}
+            "aligning": 0, "sideslip limited": 0, "full decrab": 0}
+    sq = ap.trim.cas_mps / gains.align_cas_mps
+    b_max = gains.align_bank_max_rad / (gains.k_phi_align * sq * sq)  # the partial decrab's sideslip limit
     for k in range(n):
         args = (x[k], y[k], z[k], *v[k], att[k, 0], att[k, 1], att[k, 2], att[k, 3], att[k, 4], cas[k])
         int_p = ap.int_b if gains.tecs else ap.int_d
@@ -119,10 +121,14 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
         seen["flaring"] += ap.flaring
         seen["idle"] += ap.flaring and h_gear[k] <= gains.retard_height_m
         seen["aligning"] += ap.aligning
+        eta = abs(math.remainder(psi[k] - 0.4, 2.0 * math.pi) + att[k, 4])  # crab + beta (convergence: < 1e-4)
+        seen["sideslip limited"] += ap.aligning and eta > 1.05 * b_max
+        seen["full decrab"] += ap.aligning and eta < 0.95 * b_max
     assert seen["pitch limited"] > 0 and seen["bank limited"] > 0, seen
     assert seen["throttle 1"] > 0 and seen["throttle 0"] > 0, seen
     if flare:
         assert seen["flaring"] > 100 and seen["idle"] > 0 and seen["aligning"] > 100, seen
+        assert seen["sideslip limited"] > 20 and seen["full decrab"] > 20, seen
     else:
         assert seen["flaring"] == 0 and seen["aligning"] == 0, seen
 
