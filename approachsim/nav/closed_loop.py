@@ -48,13 +48,25 @@ _AIDING = ("baro", "radalt", "gnss", "pseudolite")
 _NAN1 = np.full(1, math.nan)
 
 
+def _per_channel(a: Array | float, n_sv: int) -> Array:
+    """a (one value, or one per channel) as a contiguous (n_sv,) float array: np.broadcast_to's values, without
+    its cost when a is that already."""
+    if isinstance(a, np.ndarray) and a.shape == (n_sv,) and a.dtype == np.float64 and a.flags.c_contiguous:
+        return a
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), (n_sv,)))
+
+
 @dataclass(frozen=True)
 class InLoop:
     """The compiled per-row navigation of one closed-loop run (nav/kernels/inloop.py): the work vector nw (NW,),
-    the IMU error terms cg, ca (m, 3) by sample, the INS rows (1, n, 16), the snapshot index per row (n,), the baro
-    rows (n,) int8, scratch increments dth, dv (1, 1, 3), and act(k, truth, code): the source's Python part."""
+    the packed arrays fa (float64) and ia (int64) and, as views of them (inloop.views), the IMU error terms cg, ca
+    (m, 3) by sample, the INS rows (1, n, 16), the guidance rows (n, 6), the snapshot index per row (n,), the baro
+    sample per row, its errors and lag weights, scratch increments dth, dv (1, 1, 3); and act(k, truth, code): the
+    source's Python part."""
 
     nw: Array
+    fa: Array
+    ia: Array
     cg: Array
     ca: Array
     rows3: Array
@@ -67,6 +79,8 @@ class InLoop:
     """The baro's lag weights (empty: no lag)."""
     dth: Array
     dv: Array
+    guidance: Array
+    """(n, 6) the guidance of every row (runway-frame position m, NED velocity m/s; nan until flown)."""
     act: Any
 
     @property
@@ -277,9 +291,14 @@ class NavInTheLoop:
                     nw[ik.W_BSF] = float(np.ravel(e.constants["scale_factor"])[0])
                     baro_e = np.ascontiguousarray(np.column_stack([e.series["bias"], e.series["noise"]]))
                     lag_w = np.ascontiguousarray(baro.lag_weights(self.dt), dtype=float)
-            self._inloop = InLoop(nw, np.ascontiguousarray(c_g), np.ascontiguousarray(c_a),
-                                  np.full((1, n, ins.NX), np.nan), np.zeros(n, dtype=np.int64), baro_j, baro_e,
-                                  lag_w, np.zeros((1, 1, 3)), np.zeros((1, 1, 3)), self.act)
+            m = c_g.shape[0]
+            nw[ik.W_N], nw[ik.W_M], nw[ik.W_NBE], nw[ik.W_NLAG] = n, m, baro_e.shape[0], lag_w.shape[0]
+            n_f, n_i = ik.packed_sizes(n, m, baro_e.shape[0], lag_w.shape[0])
+            fa, ia = np.empty(n_f), np.empty(n_i, dtype=np.int64)
+            cg, ca, rows, snap, bj, be, lw, dth, dv, guidance = ik.views(nw, fa, ia)
+            cg[...], ca[...], be[...], lw[...], bj[...], snap[...] = c_g, c_a, baro_e, lag_w, baro_j, 0
+            rows[...], guidance[...], dth[...], dv[...] = np.nan, np.nan, 0.0, 0.0
+            self._inloop = InLoop(nw, fa, ia, cg, ca, rows[None], snap, bj, be, lw, dth, dv, guidance, self.act)
         return self._inloop
 
     def act(self, k: int, truth: Truth, code: int) -> None:
@@ -367,10 +386,7 @@ class NavInTheLoop:
         if el is None or fe.budget is None or n_sv == 0:
             return fe.no_gnss
         el = np.maximum(np.where(np.isnan(el), 0.5, el), np.radians(2.0))  # nav/noise.py's guard
-        gse, gmp = fe.budget.channel_sigmas_m(el)
-        c = np.ascontiguousarray
-        return (fe.q, c(np.broadcast_to(np.asarray(gse, dtype=float), (n_sv,))),
-                c(np.broadcast_to(np.asarray(gmp, dtype=float), (n_sv,))))
+        return (fe.q, *(_per_channel(a, n_sv) for a in fe.budget.channel_sigmas_m(el)))
 
     def _fast_epoch(self, k: int, t: float, recs: dict[str, Any]) -> bool:
         """The aiding epoch at truth row k (time t) in one compiled call (closed_loop_epoch.loop_epoch), from the
