@@ -9,6 +9,12 @@ The source reads truth rows <= k only (records.NavigationSource): at row k it ap
 errors to the increment (k-1, k], steps the INS, and at aiding epochs applies the other sensors' pre-drawn
 errors to row k and runs the filter (system.NavSystem.aid). Guidance gets the navigation output
 (feed-forward INS - estimated error, or the fed-back INS) in the runway frame.
+
+Flown by JSBSim (`inloop`), the row runs inside the flight's compiled step (nav/kernels/inloop.py) and an aiding
+epoch is one compiled call (nav/kernels/closed_loop_epoch.py: the per-run EKF's epoch and the Navigator's
+bookkeeping) on the sensors' one-row records, when the configuration has the compiled epoch
+(`fast_epoch_unavailable`: not with feedback, the online FDE, the robust or U-D filters, loose coupling, an adaptive
+loop, carrier phase); otherwise, and as its test oracle (`fast_epochs = False`), the Navigator's numpy path.
 """
 
 from __future__ import annotations
