@@ -20,6 +20,7 @@ loop, carrier phase); otherwise, and as its test oracle (`fast_epochs = False`),
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field, fields
 from typing import Any
 
@@ -93,6 +94,17 @@ class InLoop:
     def rows(self) -> Array:
         """(n, 16) the one run's INS rows (a view)."""
         return self.rows3[0]
+
+
+@dataclass(frozen=True)
+class _Act:
+    """InLoop.act: the source's `act` through a weak reference, so that the source and its InLoop form no reference
+    cycle (their ~20 MB of arrays are freed when the caller drops the source, not at the next cyclic collection)."""
+
+    source: weakref.ref
+
+    def __call__(self, k: int, truth: Truth, code: int) -> None:
+        self.source().act(k, truth, code)
 
 
 @dataclass
@@ -304,7 +316,8 @@ class NavInTheLoop:
             cg, ca, rows, snap, bj, be, lw, dth, dv, guidance = ik.views(nw, fa, ia)
             cg[...], ca[...], be[...], lw[...], bj[...], snap[...] = c_g, c_a, baro_e, lag_w, baro_j, 0
             rows[...], guidance[...], dth[...], dv[...] = np.nan, np.nan, 0.0, 0.0
-            self._inloop = InLoop(nw, fa, ia, cg, ca, rows[None], snap, bj, be, lw, dth, dv, guidance, self.act)
+            self._inloop = InLoop(nw, fa, ia, cg, ca, rows[None], snap, bj, be, lw, dth, dv, guidance,
+                                  _Act(weakref.ref(self)))
         return self._inloop
 
     def act(self, k: int, truth: Truth, code: int) -> None:
