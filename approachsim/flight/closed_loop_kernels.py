@@ -2,9 +2,9 @@
 (nav/kernels/inloop.py `views`): what flight/kernels.py fly_step_nav / fly_control_nav do, with three navigation
 arguments (the work vector nw and the packed fa, ia) instead of twelve. The flight makes one such call per JSBSim
 step, and numba unboxes every array argument of every call (~0.13 us each): nine fewer arrays save ~1.2 us a step,
-~35 ms of a 31,000-step approach. The same kernels in the same order as fly_step_nav (the same bits:
-tests/unit/nav/test_closed_loop_epoch.py flies the closed loop against the Navigator path, and
-tests/unit/nav/test_system_closed_loop.py the rows against the open-loop pass)."""
+~35 ms of a 31,000-step approach. The same kernels in the same order as fly_step_nav on views of the same numbers,
+so the same bits (the closed-loop baselines of `approachsim regress` stay identical; the flown closed loop against
+the open-loop pass: tests/integration/test_nav_inloop_baro.py, test_nav_closed_loop.py)."""
 
 from __future__ import annotations
 
