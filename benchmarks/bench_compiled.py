@@ -3,6 +3,7 @@ and figures of the issue's table, with the machine's load (the machine is shared
 
     python benchmarks/bench_compiled.py compile             # import time, first-call compile: cold vs cached
     python benchmarks/bench_compiled.py ratios [--repeat 3] # closed loop / raw JSBSim, truth flight / raw,
+                                                            # the closed loop with the Navigator's epochs,
                                                             # open-loop navigation us per 120 Hz step
     python benchmarks/bench_compiled.py scaling --ns 10 100 1000   # open loop end to end: wall, peak RSS
     python benchmarks/bench_compiled.py scaling --accuracy-only --ns 10 100 1000 10000   # without the bank
@@ -120,8 +121,9 @@ def bench_ratios(repeat: int) -> None:
     budget = a.time_budget_s
     a.fly(seed=1, run=99, nav_source=NavInTheLoop(prof, seed=1, run=99, max_time_s=3.0), max_time_s=3.0)  # warm up
     a.fly(seed=1, run=99, max_time_s=3.0)
-    t = {k: [] for k in ("raw", "truth", "closed", "nav")}
-    c = {k: [] for k in ("raw", "truth", "closed", "nav")}
+    keys = ("raw", "truth", "closed", "closed_np", "nav")
+    t = {k: [] for k in keys}
+    c = {k: [] for k in keys}
     n = 0
 
     def timed(key: str, fn):  # wall and CPU time of fn()
@@ -151,6 +153,14 @@ def bench_ratios(repeat: int) -> None:
             return src.result(res.truth)
 
         timed("closed", closed)
+
+        def closed_np(i=i):  # the same with every aiding epoch on the Navigator's numpy path (the compiled epoch's
+            src = NavInTheLoop(prof, seed=1, run=i, max_time_s=budget)  # oracle): what the compiled epoch saves
+            src.fast_epochs = False
+            res = a.fly(seed=1, run=i, nav_source=src)
+            return src.result(res.truth)
+
+        timed("closed_np", closed_np)
         recs, st = measure_with_states(SensorSuite.from_profile(prof), r.truth, seed=1, runs=i)
         nav = NavSystem.from_profile(prof)
         timed("nav", lambda nav=nav, tr=r.truth, recs=recs, st=st, i=i: nav.run(tr, recs, stream(1, i, "nav"),
@@ -160,12 +170,14 @@ def bench_ratios(repeat: int) -> None:
           f"min / median")
     for k, what in (("raw", "raw JSBSim stepping (trim + run())"), ("truth", "flown on truth (Approach.fly)"),
                     ("closed", "closed loop (JSBSim + sensors + INS + EKF + autopilot, NavRun)"),
+                    ("closed_np", "  the same, aiding epochs on the Navigator's numpy path"),
                     ("nav", "open-loop navigation pass of one run (NavSystem.run)")):
         print(f"  {what:66s} {mn(t[k]):.3f} / {md(t[k]):.3f}  ({mn(c[k]):.3f} / {md(c[k]):.3f})")
     for k, goal in (("truth", 1.5), ("closed", 2.0)):
         print(f"  {k} / raw JSBSim: wall {mn(t[k]) / mn(t['raw']):.2f} (min) {md(t[k]) / md(t['raw']):.2f} (median), "
               f"CPU {mn(c[k]) / mn(c['raw']):.2f} (min)   goal <= {goal}")
-    print(f"  closed / truth flight: {md(t['closed']) / md(t['truth']):.2f} (median)")
+    print(f"  closed / truth flight: {md(t['closed']) / md(t['truth']):.2f} (median); compiled epochs save "
+          f"{(md(c['closed_np']) - md(c['closed'])) * 1e3:.0f} ms CPU per approach (median)")
     print(f"  open-loop navigation pass, one run: {mn(t['nav']) / n * 1e6:.1f} / {md(t['nav']) / n * 1e6:.1f} us per "
           f"120 Hz step (min / median)   goal <= 10")
     print(f"  {load()}")

@@ -51,6 +51,7 @@ import numpy as np
 from approachsim import units
 from approachsim.config import ProfileError
 from approachsim.evaluate.touchdown import touchdown_scalars
+from approachsim.flight import closed_loop_kernels as ck
 from approachsim.flight import kernels as fk
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
@@ -277,24 +278,30 @@ class Approach:
         hilly = par[fk.P_STEP + fk.F_N_TERRAIN] > 1
         buf = np.full((n_max, _NCOL), np.nan)
         truth = _truth_views(buf, rw.frame)
-        guidance = None if src is None else np.full((n_max, 6), np.nan)
 
         # the loop: JSBSim's reads, one compiled call (fly_step: truth row, turbulence, termination and, guided by
         # the truth, the autopilot), the writes, JSBSim's step; a navigation source sees row k between fly_step
         # and the autopilot (fly_control)
         # A source whose navigation runs compiled (`inloop()`, nav/closed_loop.py) is stepped inside the same call
-        # (fly_step_nav): Python acts only at the rows it asks for (start, baro samples, aiding epochs)
+        # (flight/closed_loop_kernels.py fly_step_closed, on the navigation's packed arrays nw, fa, ia): Python acts
+        # only at the rows it asks for (start, baro samples, aiding epochs)
         guided = src is None
         fused = None if src is None else getattr(src, "inloop", lambda: None)()
+        if fused is not None:
+            if fused.guidance.shape[0] < n_max:
+                raise ValueError(f"the navigation source has {fused.guidance.shape[0]} rows, the flight up to {n_max}: "
+                                 f"size it for the flight (NavInTheLoop(max_time_s=Approach.time_budget_s))")
+            guidance = fused.guidance  # its rows: the kernel writes them
+        else:
+            guidance = None if src is None else np.full((n_max, 6), np.nan)
         read, read_near, run_step = io.read, io.read_near, io.run
         raw0 = (0.0,) * (fk.N_RAW + len(fk.GEAR_FIELDS))
         step = _entry(fk.fly_step, 0, raw0, buf, nu, par, st, guided)
         control = None if guided else _entry(fk.fly_control, 0, guidance, buf, par, st)
         if fused is not None:
-            nav_args = (guidance, fused.nw, fused.cg, fused.ca, fused.rows, fused.snap, fused.baro_j, fused.baro_e,
-                        fused.lag_w, fused.dth, fused.dv)
-            step_nav = _entry(fk.fly_step_nav, 0, raw0, buf, nu, par, st, *nav_args)
-            control_nav = _entry(fk.fly_control_nav, 0, guidance, buf, par, st, fused.nw)
+            nav_args = (fused.nw, fused.fa, fused.ia)
+            step_nav = _entry(ck.fly_step_closed, 0, raw0, buf, nu, par, st, *nav_args)
+            control_nav = _entry(ck.fly_control_closed, 0, buf, par, st, *nav_args)
             act = fused.act
         set_de, set_da, set_dr, (set_thr0, set_thr1) = io.set_elevator, io.set_aileron, io.set_rudder, io.set_throttle
         set_gn, set_ge, set_gd = io.set_gust_fps
@@ -309,7 +316,7 @@ class Approach:
                                                                                    *nav_args)
                 if ncode:  # the source's Python part at this row, then the guidance and the autopilot
                     act(k, truth, ncode)
-                    de, da, dr, thr = control_nav(k, guidance, buf, par, st, fused.nw)
+                    de, da, dr, thr = control_nav(k, buf, par, st, *nav_args)
                 if code:
                     break
             else:

@@ -9,18 +9,28 @@ The source reads truth rows <= k only (records.NavigationSource): at row k it ap
 errors to the increment (k-1, k], steps the INS, and at aiding epochs applies the other sensors' pre-drawn
 errors to row k and runs the filter (system.NavSystem.aid). Guidance gets the navigation output
 (feed-forward INS - estimated error, or the fed-back INS) in the runway frame.
+
+Flown by JSBSim (`inloop`), the row runs inside the flight's compiled step (nav/kernels/inloop.py) and an aiding
+epoch is one compiled call (nav/kernels/closed_loop_epoch.py: the per-run EKF's epoch and the Navigator's
+bookkeeping) on the sensors' one-row records, when the configuration has the compiled epoch
+(`fast_epoch_unavailable`: not with feedback, the online FDE, the robust or U-D filters, loose coupling, an adaptive
+loop, carrier phase); otherwise, and as its test oracle (`fast_epochs = False`), the Navigator's numpy path.
 """
 
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
 
 from approachsim.glidepath import GlidePath
+from approachsim.nav import errormodel as em
 from approachsim.nav import ins
+from approachsim.nav.base import FilterState
+from approachsim.nav.kernels import closed_loop_epoch as ce
 from approachsim.nav.kernels import inloop as ik
 from approachsim.nav.kernels import strapdown as sk
 from approachsim.nav.navigator import Navigator, NavRun
@@ -39,14 +49,31 @@ _EMPTY = np.zeros((1, 3))
 
 _VEC3 = ("r_ecef", "v_ned", "euler_rad", "w_ib_body", "f_body", "r_rwy")
 
+_AIDING = ("baro", "radalt", "gnss", "pseudolite")
+"""The aiding sensors, in the order the epoch reads them."""
+
+_NAN1 = np.full(1, math.nan)
+
+
+def _per_channel(a: Array | float, n_sv: int) -> Array:
+    """a (one value, or one per channel) as a contiguous (n_sv,) float array: np.broadcast_to's values, without
+    its cost when a is that already."""
+    if isinstance(a, np.ndarray) and a.shape == (n_sv,) and a.dtype == np.float64 and a.flags.c_contiguous:
+        return a
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), (n_sv,)))
+
 
 @dataclass(frozen=True)
 class InLoop:
     """The compiled per-row navigation of one closed-loop run (nav/kernels/inloop.py): the work vector nw (NW,),
-    the IMU error terms cg, ca (m, 3) by sample, the INS rows (1, n, 16), the snapshot index per row (n,), the baro
-    rows (n,) int8, scratch increments dth, dv (1, 1, 3), and act(k, truth, code): the source's Python part."""
+    the packed arrays fa (float64) and ia (int64) and, as views of them (inloop.views), the IMU error terms cg, ca
+    (m, 3) by sample, the INS rows (1, n, 16), the guidance rows (n, 6), the snapshot index per row (n,), the baro
+    sample per row, its errors and lag weights, scratch increments dth, dv (1, 1, 3); and act(k, truth, code): the
+    source's Python part."""
 
     nw: Array
+    fa: Array
+    ia: Array
     cg: Array
     ca: Array
     rows3: Array
@@ -59,12 +86,53 @@ class InLoop:
     """The baro's lag weights (empty: no lag)."""
     dth: Array
     dv: Array
+    guidance: Array
+    """(n, 6) the guidance of every row (runway-frame position m, NED velocity m/s; nan until flown)."""
     act: Any
 
     @property
     def rows(self) -> Array:
         """(n, 16) the one run's INS rows (a view)."""
         return self.rows3[0]
+
+
+@dataclass(frozen=True)
+class _Act:
+    """InLoop.act: the source's `act` through a weak reference, so that the source and its InLoop form no reference
+    cycle (their ~20 MB of arrays are freed when the caller drops the source, not at the next cyclic collection)."""
+
+    source: weakref.ref
+
+    def __call__(self, k: int, truth: Truth, code: int) -> None:
+        self.source().act(k, truth, code)
+
+
+@dataclass
+class FastEpoch:
+    """The closed loop's compiled aiding epoch (nav/kernels/closed_loop_epoch.py loop_epoch): its constant
+    arguments, scratch and the epoch history it writes (XS, PP, PC, PD, PN: one row per epoch, the Navigator's
+    snapshots are views of them), made once at the start (NavInTheLoop.fast_epoch_unavailable says when not)."""
+
+    q: Array
+    """The error model's scalar noise (errormodel.kernel_noise of the elevation-free noise; does not depend on the
+    elevations)."""
+    no_gnss: tuple[Array, Array, Array]
+    """kernel_noise at no elevations (NoiseModel.kernel_arrays(None))."""
+    budget: Any
+    """The GNSS error budget (its channel_sigmas_m), or None without GNSS."""
+    held_possible: bool
+    """The layout has the damping loop's states and the INS has a loop (an interval without baro holds it)."""
+    P: Array
+    """The run's covariance, updated in place by the kernel (run.fs.P is this array after a compiled epoch)."""
+    X: Array
+    f_ned: Array
+    XS: Array
+    PP: Array
+    PC: Array
+    PD: Array
+    PN: Array
+    e: int = 0
+    """The next history row."""
 
 
 @dataclass
@@ -108,6 +176,12 @@ class NavInTheLoop:
         self._o_rwy = np.ascontiguousarray(self.profile.runway.frame.origin_ecef)
         self._h_thr = float(self.profile.runway.elevation_m)
         self._inloop: InLoop | None = None
+        self._fast: FastEpoch | None = None
+        self._recs: tuple[int, dict[str, Any]] | None = None
+        """The last epoch's sensor records (row, records): the baro's is the damping loop's sample at that row."""
+        self.fast_epochs = True
+        """Run the aiding epochs compiled when the configuration allows (`fast_epoch_unavailable`); False: always
+        the Navigator's numpy path (the compiled epoch's test oracle)."""
 
     def _imu_error_terms(self) -> tuple[Array, Array, Array, Array] | None:
         """The IMU error model is affine in the true increments (sensors/imu.py):
@@ -137,11 +211,18 @@ class NavInTheLoop:
         None when it has no sample there."""
         return self.prepared.one(name, truth, k)
 
-    def _observations(self, k: int, truth: Truth) -> tuple[Observations, dict[str, Any]]:
-        """The aiding sensors' samples at truth row k (their pre-drawn errors applied to the row)."""
-        recs = {name: r for name in ("baro", "radalt", "gnss", "pseudolite") if (r := self._apply(name, k, truth))
-                is not None}
-        recs = dict(tuned_records(recs, self.nav.nav.gps_sigma_scale))  # [nav] gps_sigma_scale (R tuning)
+    def _records(self, k: int, truth: Truth) -> dict[str, Any]:
+        """The aiding sensors' records at truth row k (their pre-drawn errors applied to the row), as the filter
+        weighs them ([nav] gps_sigma_scale)."""
+        one = self.prepared.one
+        recs = {name: r for name in _AIDING if (r := one(name, truth, k)) is not None}
+        return dict(tuned_records(recs, self.nav.nav.gps_sigma_scale))  # [nav] gps_sigma_scale (R tuning)
+
+    def _observations(self, k: int, truth: Truth, recs: dict[str, Any] | None = None
+                      ) -> tuple[Observations, dict[str, Any]]:
+        """The aiding sensors' samples at truth row k (their pre-drawn errors applied to the row; recs: those
+        records when already made)."""
+        recs = self._records(k, truth) if recs is None else recs
         return Observations.at(recs, float(truth.t_s[k]), 0.25 * self.dt, False), recs
 
     def step(self, k: int, truth: Truth) -> tuple[Array, Array]:
@@ -228,9 +309,15 @@ class NavInTheLoop:
                     nw[ik.W_BSF] = float(np.ravel(e.constants["scale_factor"])[0])
                     baro_e = np.ascontiguousarray(np.column_stack([e.series["bias"], e.series["noise"]]))
                     lag_w = np.ascontiguousarray(baro.lag_weights(self.dt), dtype=float)
-            self._inloop = InLoop(nw, np.ascontiguousarray(c_g), np.ascontiguousarray(c_a),
-                                  np.full((1, n, ins.NX), np.nan), np.zeros(n, dtype=np.int64), baro_j, baro_e,
-                                  lag_w, np.zeros((1, 1, 3)), np.zeros((1, 1, 3)), self.act)
+            m = c_g.shape[0]
+            nw[ik.W_N], nw[ik.W_M], nw[ik.W_NBE], nw[ik.W_NLAG] = n, m, baro_e.shape[0], lag_w.shape[0]
+            n_f, n_i = ik.packed_sizes(n, m, baro_e.shape[0], lag_w.shape[0])
+            fa, ia = np.empty(n_f), np.empty(n_i, dtype=np.int64)
+            cg, ca, rows, snap, bj, be, lw, dth, dv, guidance = ik.views(nw, fa, ia)
+            cg[...], ca[...], be[...], lw[...], bj[...], snap[...] = c_g, c_a, baro_e, lag_w, baro_j, 0
+            rows[...], guidance[...], dth[...], dv[...] = np.nan, np.nan, 0.0, 0.0
+            self._inloop = InLoop(nw, fa, ia, cg, ca, rows[None], snap, bj, be, lw, dth, dv, guidance,
+                                  _Act(weakref.ref(self)))
         return self._inloop
 
     def act(self, k: int, truth: Truth, code: int) -> None:
@@ -244,26 +331,137 @@ class NavInTheLoop:
             el = recs["gnss"].elevation_rad[0] if "gnss" in recs else None
             s, runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el, obs=obs,
                                 states=start_states(self.suite, truth, self.errors))
-            self.navigator = Navigator(nav, s, runs, float(truth.t_s[0]), self.t_s.shape[0])
+            self.navigator = Navigator(nav, s, runs, float(truth.t_s[0]), self.t_s.shape[0], rows=lp.rows3)
             self.navigator.bind(nw[ik.W_X:ik.W_X + 16].reshape(1, 16), nw[ik.W_FSUM:ik.W_FSUM + 3].reshape(1, 3),
                                 lp.rows3, lp.snap)
             self._estimate_in_force()
+            self._recs = (0, recs)
+            if self.fast_epochs and self.fast_epoch_unavailable() is None:
+                self._fast = self._fast_epoch_arrays()
         navigator = self.navigator
         run = navigator.runs[0]
         if code & ik.NAV_EPOCH:
-            obs, _ = self._observations(k, truth)
-            if self.gains is not None:  # the kernel's loop held over the interval (no baro, or excluded)
-                obs = obs.with_loop_held([nw[ik.W_ANY_BARO] == 0.0])
-                nw[ik.W_ANY_BARO] = 0.0
-            navigator.epoch(k, float(truth.t_s[k]), obs, truth)
-            self._estimate_in_force()
-        if code & ik.NAV_BARO and (b := self._apply("baro", k, truth)) is not None:
-            # nan (an outage, or the baro excluded by FDE): the INS kernel's damping loop holds
-            held = run.baro_excluded() or not bool(np.ravel(b.valid)[0])
-            nw[ik.W_HB] = math.nan if held else float(np.ravel(b.h_baro_m)[0])
-            if k == 0 and nav.nav.initial_error.start == "prior" and math.isfinite(nw[ik.W_HB]):
-                nw[ik.W_X + 2] = nw[ik.W_HB]  # the converged start's height error stands
+            t = float(truth.t_s[k])
+            recs = self._records(k, truth)
+            self._recs = (k, recs)
+            if self._fast is None or not self._fast_epoch(k, t, recs):
+                obs, _ = self._observations(k, truth, recs)
+                if self.gains is not None:  # the kernel's loop held over the interval (no baro, or excluded)
+                    obs = obs.with_loop_held([nw[ik.W_ANY_BARO] == 0.0])
+                    nw[ik.W_ANY_BARO] = 0.0
+                navigator.epoch(k, t, obs, truth)
+                self._estimate_in_force()
+        if code & ik.NAV_BARO:
+            # the baro sample of this row: the epoch's (or the start's) record when it made one
+            b = self._recs[1].get("baro") if self._recs is not None and self._recs[0] == k else \
+                self._apply("baro", k, truth)
+            if b is not None:
+                # nan (an outage, or the baro excluded by FDE): the INS kernel's damping loop holds
+                held = run.baro_excluded() or not bool(np.ravel(b.valid)[0])
+                nw[ik.W_HB] = math.nan if held else float(np.ravel(b.h_baro_m)[0])
+                if k == 0 and nav.nav.initial_error.start == "prior" and math.isfinite(nw[ik.W_HB]):
+                    nw[ik.W_X + 2] = nw[ik.W_HB]  # the converged start's height error stands
         navigator.record_row(k)
+
+    # --- the compiled aiding epoch (nav/kernels/closed_loop_epoch.py) -------------------------------------------
+
+    def fast_epoch_unavailable(self) -> str | None:
+        """Why the aiding epochs cannot run compiled (None: they can): they need the compiled per-run EKF epoch
+        (nav/engine.py: the optimal 'ekf', tight GPS coupling, a constant or no baro loop, no online FDE, no carrier
+        phase) and feed-forward output (feedback corrects the INS in numpy: Navigator._feedback). The others take
+        the Navigator's numpy path at every epoch (the same numbers)."""
+        nav = self.navigator
+        if any(r.fde is not None for r in nav.runs):
+            return "online FDE ([nav.fde] enabled): nav/fde.py's epoch"
+        if nav.engine is None or nav.shared is not None:
+            return "no compiled epoch for this filter configuration (nav/engine.py EpochEngine.of)"
+        if self.nav.nav.feedback:
+            return "feedback ([nav] feedback = true): the INS reset in numpy"
+        if self.nav.layout.has("amb"):
+            return "carrier phase: the ambiguity resets at new arcs"
+        return None
+
+    def _fast_epoch_arrays(self) -> FastEpoch:
+        """The compiled epoch's constants, scratch and history rows (one per possible epoch)."""
+        nav = self.navigator
+        lay = nav.layout
+        nm = self.nav.noise_model
+        n_ep = self.t_s.shape[0] // self.epoch_rows + 2
+        n = lay.n
+        g = nm.sensors.gnss
+        return FastEpoch(
+            q=em.kernel_noise(nm.noise(None), lay.n_sv)[0], no_gnss=nm.kernel_arrays(None),
+            budget=None if g is None else g.budget(), held_possible=lay.has("ac") and self.gains is not None,
+            P=np.array(nav.runs[0].fs.P, dtype=float), X=np.zeros((1, n)), f_ned=np.zeros(3),
+            XS=np.zeros((n_ep, n)), PP=np.zeros((n_ep, 3, 3)), PC=np.zeros(n_ep), PD=np.zeros((n_ep, n)),
+            PN=np.zeros((n_ep, 9, 9)))
+
+    def _noise_arrays(self, el: Array | None) -> tuple[Array, Array, Array]:
+        """NoiseModel.kernel_arrays(el) (nav/noise.py) with the elevation-free scalars kept: the GPS channel
+        states' sigmas at el by the receiver budget's numpy formulas (the same operations, the same bits; el is
+        finite or nan)."""
+        fe = self._fast
+        n_sv = self.nav.layout.n_sv
+        if el is None or fe.budget is None or n_sv == 0:
+            return fe.no_gnss
+        el = np.maximum(np.where(np.isnan(el), 0.5, el), np.radians(2.0))  # nav/noise.py's guard
+        return (fe.q, *(_per_channel(a, n_sv) for a in fe.budget.channel_sigmas_m(el)))
+
+    def _fast_epoch(self, k: int, t: float, recs: dict[str, Any]) -> bool:
+        """The aiding epoch at truth row k (time t) in one compiled call (closed_loop_epoch.loop_epoch), from the
+        sensors' one-row records recs: Observations.at's values for one run (nan where a record has no sample at
+        t or it is invalid), the per-run EKF's epoch (nav/engine.py own), the Navigator's snapshot and history,
+        the estimate in force. False, with nothing changed, when the model needs the numpy discretization."""
+        fe, nav, lp = self._fast, self.navigator, self._inloop
+        nw = lp.nw
+        run = nav.runs[0]
+        eng = nav.engine
+        tol = 0.25 * self.dt
+        b = recs.get("baro")
+        if b is not None and abs(b.t_s[0] - t) <= tol:
+            baro_h = np.array([b.h_baro_m[0] if b.valid[0] else math.nan])
+            baro_r = float(b.sigma_m[0]) ** 2
+        else:
+            baro_h, baro_r = _NAN1, 0.0
+        r = recs.get("radalt")
+        radalt_h = (np.array([r.h_agl_m[0] if r.valid[0] else math.nan]) if r is not None
+                    and abs(r.t_s[0] - t) <= tol else _NAN1)
+        g = recs.get("gnss")
+        el = None
+        if g is not None and abs(g.t_s[0] - t) <= tol:
+            rho = np.where(g.valid[0:1], g.pseudorange_m[0:1], np.nan)
+            r_sv = np.ascontiguousarray(g.r_sv_ecef[0], dtype=float)
+            sig = eng._code_sig if eng.channel_states else np.ascontiguousarray(g.sigma_m[0], dtype=float)
+            el = g.elevation_rad[0]
+        else:
+            rho, r_sv, sig = np.zeros((1, 0)), eng._none3, eng._none1
+        p = recs.get("pseudolite")
+        if p is not None and abs(p.t_s[0] - t) <= tol:
+            pl_rho = np.where(p.valid[0:1], p.pseudorange_m[0:1], np.nan)
+            r_pl = np.ascontiguousarray(p.r_pl_ecef, dtype=float)
+            pl_sig = eng._pl_sig if eng.pl_states else np.ascontiguousarray(p.sigma_m[0], dtype=float)
+        else:
+            pl_rho, r_pl, pl_sig = np.zeros((1, 0)), eng._none3, eng._none1
+        q, gse, gmp = self._noise_arrays(el)
+        held = fe.held_possible and nw[ik.W_ANY_BARO] == 0.0
+        if run.fs.P is not fe.P:  # the Navigator's path ran an epoch (or the start): its P from now on
+            fe.P = np.array(run.fs.P, dtype=float)
+        fe.X[0] = run.fs.x
+        db = nav.dbs[0]
+        e = fe.e
+        n_rows = ce.loop_epoch(nw, fe.X, fe.P, e, eng.lay, q, gse, gmp, eng.loop, held, t - nav.t_last, fe.f_ned,
+                               eng.F, eng.Qc, eng.phi, eng.qd, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
+                               eng.tx, eng.th, eng.rwy, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig,
+                               eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, eng.codes, eng._nu[:1],
+                               eng.S, eng.h, eng.b, eng.ws, fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic)
+        if n_rows < 0:
+            return False
+        fe.e = e + 1
+        run.statuses.add_epoch(eng.codes[:n_rows], t, eng._nu[0, :n_rows], eng.S[:n_rows])
+        run.fs = FilterState(x=fe.XS[e].copy(), P=fe.P, memory=run.fs.memory)
+        nav.epoch_done(k, t, fe.XS[e:e + 1], fe.PP[e:e + 1], fe.PC[e:e + 1], fe.PD[e:e + 1], fe.PN[e:e + 1])
+        nw[ik.W_SNAP] = nav.snap_index
+        return True
 
     def _estimate_in_force(self) -> None:
         """The compiled row's copy of the filter's state: the estimate for the guidance, the bias feedback, the

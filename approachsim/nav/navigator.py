@@ -155,7 +155,7 @@ class Navigator:
     """One pass of the navigation system over N runs (module docstring)."""
 
     def __init__(self, system: Any, s0: ins.InsState, runs: list[RunFilter], t0_s: float, n_rows: int,
-                 *, shared: Any = None, ins_of: Array | None = None) -> None:
+                 *, shared: Any = None, ins_of: Array | None = None, rows: Array | None = None) -> None:
         self.system = system
         self.layout: em.StateLayout = system.layout
         self.runs = runs
@@ -171,7 +171,11 @@ class Navigator:
             raise ValueError("Navigator: ins_of must map each run to one of the INS states")
         if n != len(runs) and system.nav.feedback:
             raise ValueError("Navigator: runs share an INS only feed-forward (feedback corrects each run's INS)")
-        self.rows = np.full((n, n_rows, ins.NX), np.nan)
+        self.rows = np.full((n, n_rows, ins.NX), np.nan) if rows is None else rows
+        """(M, n_rows, 16) the INS state at every row (nan until stepped); `rows` given: the caller's array of that
+        shape, nan-filled (the closed loop's, which its compiled row steps: no copy at `bind`)."""
+        if self.rows.shape != (n, n_rows, ins.NX):
+            raise ValueError(f"Navigator: rows must be {(n, n_rows, ins.NX)}; got {self.rows.shape}")
         self.rows[:, 0] = self.x
         self.snap = np.zeros(n_rows, dtype=int)
         self._snaps: list[tuple[Array, Array, Array]] = []
@@ -204,7 +208,8 @@ class Navigator:
         loop's compiled row (nav/kernels/inloop.py) steps them in place."""
         x[...] = self.x
         f_sum[...] = self.f_sum
-        rows[...] = self.rows
+        if rows is not self.rows:  # (the Navigator made with the caller's rows: nothing to copy)
+            rows[...] = self.rows
         snap[...] = self.snap
         self.x, self.f_sum, self.rows, self.snap = x, f_sum, rows, snap
 
@@ -257,6 +262,21 @@ class Navigator:
         self._snapshot(epoch=True)
         self.record_row(row)
         h = self._hist
+        h["t"].append(t_s)
+        h["row"].append(row)
+        h["snap"].append(len(self._snaps) - 1)
+
+    def epoch_done(self, row: int, t_s: float, x: Array, p_pos: Array, p_clk: Array, p_diag: Array,
+                   p_nav: Array) -> None:
+        """What `epoch` keeps after an epoch its caller ran itself (the closed loop's compiled epoch,
+        nav/kernels/closed_loop_epoch.py, which has reset f_sum): the snapshot x (N, n), P's position block
+        (N, 3, 3), clock variance (N,), diagonal (N, n) and navigation block (N, 9, 9), and the epoch's history
+        entry (the caller records row `row` itself)."""
+        self.t_last = t_s
+        self._snaps.append((x, p_pos, p_clk))
+        h = self._hist
+        h["pd"].append(p_diag)
+        h["pnav"].append(p_nav)
         h["t"].append(t_s)
         h["row"].append(row)
         h["snap"].append(len(self._snaps) - 1)

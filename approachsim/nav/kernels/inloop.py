@@ -11,10 +11,13 @@ Per truth row k (k > 0), with the flight's row buffer buf (flight/run.py columns
     rows[k] = the INS state; snap[k] = the filter snapshot in force
     guidance = INS - x_hat (feed-forward) in the runway frame and NED (kernels/strapdown.guidance)
 
-The work vector nw (NW) holds the one run's INS state and the small constants (W_* offsets); nav/closed_loop.py
-builds it and keeps the Navigator's INS state, specific-force sum, rows and snapshot index as views of these
-arrays, so both see the same numbers. The numpy oracle is NavInTheLoop.step (the generic per-row path, kept for
-quantized or faulted IMUs): tests/unit/nav/test_system_closed_loop.py flies both.
+The work vector nw (NW) holds the one run's INS state and the small constants (W_* offsets); the other arrays of
+the row are views of two packed arrays, fa (float64) and ia (int64) (`views`, `packed_sizes`), so that the flight
+loop's compiled call takes three navigation arguments instead of twelve (unboxing an array argument costs ~0.13 us
+of every one of the flight's ~31,000 calls). nav/closed_loop.py builds them and keeps the Navigator's INS state,
+specific-force sum, rows and snapshot index as views of these arrays, so both see the same numbers. The numpy
+oracle is NavInTheLoop.step (the generic per-row path, kept for quantized or faulted IMUs):
+tests/unit/nav/test_system_closed_loop.py flies both.
 """
 
 from __future__ import annotations
@@ -56,7 +59,9 @@ W_BSET, W_BT0L, W_BEXP, W_BSF = 76, 77, 78, 79
 """The baro's setting (Pa), ISA T0 / L (m), exponent R L / g0 and this run's scale factor (sensors/baro.py)."""
 W_BFLD, W_BCM1 = 80, 81
 """The baro's temperature correction: field geopotential elevation H_f (m) and c - 1 (sensors/baro.py)."""
-NW = 82
+W_N, W_M, W_NBE, W_NLAG = 82, 83, 84, 85
+"""Sizes of the packed arrays (`views`): truth rows n, IMU samples m, baro samples, lag weights."""
+NW = 86
 
 NAV_START, NAV_BARO, NAV_EPOCH = 1, 2, 4
 """Bits of nav_row's code: the rows at which Python must act."""
@@ -130,3 +135,34 @@ def nav_guidance(nw: np.ndarray, out: np.ndarray) -> None:
     (m/s) of the feed-forward output INS - x_hat (kernels/strapdown.guidance)."""
     c = nw[W_CRWY:W_CRWY + 6].reshape(2, 3)
     sk.guidance(nw[W_X:W_X + 16].reshape(1, 16), nw[W_XNAV:W_XNAV + 9], c, nw[W_ORWY:W_ORWY + 3], nw[W_HTHR], out)
+
+
+def packed_sizes(n: int, m: int, n_baro: int, n_lag: int) -> tuple[int, int]:
+    """Lengths of the packed arrays fa, ia (`views`) for n truth rows, m IMU samples, n_baro baro samples and n_lag
+    lag weights."""
+    return 2 * 3 * m + 16 * n + 6 * n + 2 * n_baro + n_lag + 6, 2 * n
+
+
+@njit(cache=True)
+def views(nw: np.ndarray, fa: np.ndarray, ia: np.ndarray) -> tuple:
+    """The row's arrays as views of the packed fa, ia, sizes at nw[W_N], W_M, W_NBE, W_NLAG, in this order:
+    fa = cg (m, 3) | ca (m, 3) | rows (n, 16) | guidance (n, 6) | baro_e (n_baro, 2) | lag_w (n_lag,) | dth (1, 1, 3)
+    | dv (1, 1, 3);  ia = snap (n,) | baro_j (n,). Returns (cg, ca, rows, snap, baro_j, baro_e, lag_w, dth, dv,
+    guidance): nav_row's arguments after nw, then the guidance rows."""
+    n, m, nb, nl = int(nw[W_N]), int(nw[W_M]), int(nw[W_NBE]), int(nw[W_NLAG])
+    o = 0
+    cg = fa[o:o + 3 * m].reshape(m, 3)
+    o += 3 * m
+    ca = fa[o:o + 3 * m].reshape(m, 3)
+    o += 3 * m
+    rows = fa[o:o + 16 * n].reshape(n, 16)
+    o += 16 * n
+    guidance = fa[o:o + 6 * n].reshape(n, 6)
+    o += 6 * n
+    baro_e = fa[o:o + 2 * nb].reshape(nb, 2)
+    o += 2 * nb
+    lag_w = fa[o:o + nl]
+    o += nl
+    dth = fa[o:o + 3].reshape(1, 1, 3)
+    dv = fa[o + 3:o + 6].reshape(1, 1, 3)
+    return cg, ca, rows, ia[0:n], ia[n:2 * n], baro_e, lag_w, dth, dv, guidance

@@ -1,0 +1,70 @@
+"""The closed loop's aiding epoch as one compiled call (numba, cache=True): the per-run EKF's whole epoch
+(kernels/epoch.own_epoch) with what the Navigator does around it at an epoch of a feed-forward run, so that an
+epoch of the closed loop costs one kernel call plus the sensors' one-row records (nav/closed_loop.py `_fast_epoch`).
+
+    k = loop_epoch(nw, X, P, e, <own_epoch's model and observation arguments>, XS, PP, PC, PD, PN, ic)
+
+in order:
+
+    f_ned = f_sum / dt                      the interval's mean specific force (Navigator.epoch: (f_sum / dt))
+    k = own_epoch(X, P, ..., y = INS state) predict + every scalar update (kernels/epoch.py), X (1, n), P (n, n)
+    when k >= 0 (the model fitted the compiled discretization):
+        XS[e] = x, PP[e] = P[0:3, 0:3], PC[e] = P[ic, ic], PD[e] = diag P, PN[e] = P[0:9, 0:9]
+                                            the filter snapshot and epoch history (Navigator._snapshot(epoch=True))
+        f_sum <- 0;  the estimate in force x[0:9] -> the row's work vector (nav/kernels/inloop.py W_XNAV);
+        the "baro in the interval" flag W_ANY_BARO <- 0
+
+nw is the closed loop's work vector (nav/kernels/inloop.py W_* offsets): the INS state y at W_X, f_sum at W_FSUM.
+Copies only, and one division: the snapshot's numbers are the same bits as the Navigator's numpy path; the oracle is
+that path (NavInTheLoop with the fast epoch off): tests/unit/nav/test_closed_loop_epoch.py flies both.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from approachsim.nav.kernels import epoch as ke
+from approachsim.nav.kernels import inloop as ik
+
+
+@njit(cache=True)
+def loop_epoch(nw: np.ndarray, X: np.ndarray, P: np.ndarray, e: int, lay: np.ndarray, q: np.ndarray,
+               gse: np.ndarray, gmp: np.ndarray, loop: np.ndarray, held: bool, dt: float, f_ned: np.ndarray,
+               F: np.ndarray, Qc: np.ndarray, phi: np.ndarray, qd: np.ndarray,
+               baro_h: np.ndarray, baro_r: float,
+               radalt_h: np.ndarray, ra_pct: float, ra_floor: float,
+               tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
+               db_u: np.ndarray,
+               rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
+               pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
+               codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray,
+               h: np.ndarray, b: np.ndarray, ws: tuple,
+               XS: np.ndarray, PP: np.ndarray, PC: np.ndarray, PD: np.ndarray, PN: np.ndarray, ic: int) -> int:
+    """The closed loop's epoch e (module docstring); returns own_epoch's number of rows, or -1 (nothing changed:
+    the model needs the numpy discretization, the caller takes the Navigator's path). f_ned (3,) scratch."""
+    for c in range(3):
+        f_ned[c] = nw[ik.W_FSUM + c] / dt
+    y = nw[ik.W_X:ik.W_X + 16]
+    k = ke.own_epoch(X, P, lay, q, gse, gmp, loop, held, dt, f_ned, y, F, Qc, phi, qd, baro_h, baro_r, radalt_h,
+                     ra_pct, ra_floor, tx, th, rwy, dbp, db_x, db_u, rho, r_sv, sig, channel_states, pl_rho, r_pl,
+                     pl_sig, pl_states, codes, nu_out, S_out, h, b, ws)
+    if k < 0:
+        return k
+    n = P.shape[0]
+    for i in range(n):
+        XS[e, i] = X[0, i]
+        PD[e, i] = P[i, i]
+    for i in range(3):
+        for j in range(3):
+            PP[e, i, j] = P[i, j]
+    for i in range(9):
+        for j in range(9):
+            PN[e, i, j] = P[i, j]
+    PC[e] = P[ic, ic]
+    for c in range(3):
+        nw[ik.W_FSUM + c] = 0.0
+    for i in range(9):
+        nw[ik.W_XNAV + i] = X[0, i]
+    nw[ik.W_ANY_BARO] = 0.0
+    return k
