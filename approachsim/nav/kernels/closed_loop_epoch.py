@@ -46,9 +46,12 @@ def loop_epoch(nw: np.ndarray, X: np.ndarray, P: np.ndarray, e: int, lay: np.nda
     for c in range(3):
         f_ned[c] = nw[ik.W_FSUM + c] / dt
     y = nw[ik.W_X:ik.W_X + 16]
+    # no carrier phase on this path (closed_loop.fast_epoch_unavailable sends it to the Navigator's): no carrier
+    # rows, no ionosphere states, no new arcs (the engine's own empties, nav/engine.py)
     k = ke.own_epoch(X, P, lay, q, gse, gmp, loop, held, dt, f_ned, y, F, Qc, phi, qd, baro_h, baro_r, radalt_h,
-                     ra_pct, ra_floor, tx, th, rwy, dbp, db_x, db_u, rho, r_sv, sig, channel_states, pl_rho, r_pl,
-                     pl_sig, pl_states, codes, nu_out, S_out, h, b, ws)
+                     ra_pct, ra_floor, tx, th, rwy, dbp, db_x, db_u, rho, r_sv, sig, channel_states,
+                     np.zeros((1, 0)), 0.0, pl_rho, r_pl, pl_sig, pl_states,
+                     np.zeros(0), 1.0, np.zeros(0, dtype=np.int64), 0.0, codes, nu_out, S_out, h, b, ws)
     if k < 0:
         return k
     n = P.shape[0]
