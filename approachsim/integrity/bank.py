@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from approachsim.integrity import bankpass
 from approachsim.integrity.requirements import (
     REQUIREMENTS,
     IntegrityRequirement,
@@ -145,23 +146,31 @@ def _axes(heading_rad: float) -> Array:
 
 def bank_epochs(main: Any, subs: list[Any], channels: Array, truth: Any, heading_rad: float) -> BankEpochs:
     """Project the NavRuns of the main filter and the sub-filters on the approach axes at the epochs."""
-    A = _axes(heading_rad)
-    t = np.asarray(main.t_epoch_s)
+    err = np.stack([np.asarray(r.true_error_nav) for r in [main, *subs]])
+    pnav = np.stack([np.asarray(r.P_nav) for r in [main, *subs]])
+    return bank_epochs_arrays(np.asarray(main.t_epoch_s), err, pnav, channels, truth, heading_rad)
 
-    def err(run: Any) -> tuple[Array, Array]:
-        e = np.asarray(run.true_error_nav)[:, 0:3] @ A.T
-        p = np.einsum("ij,ejk,ik->ei", A, np.asarray(run.P_nav)[:, 0:3, 0:3], A)
+
+def bank_epochs_arrays(t: Array, err: Array, pnav: Array, channels: Array, truth: Any, heading_rad: float
+                       ) -> BankEpochs:
+    """`bank_epochs` from the copies' arrays: t (e,) epoch times, err (K + 1, e, 9) output errors and pnav
+    (K + 1, e, 9, 9) navigation covariances, copy 0 the main filter."""
+    A = _axes(heading_rad)
+
+    def axes(k: int) -> tuple[Array, Array]:
+        e = err[k][:, 0:3] @ A.T
+        p = np.einsum("ij,ejk,ik->ei", A, pnav[k][:, 0:3, 0:3], A)
         return e, p
 
-    e0, p0 = err(main)
-    subs_ep = [err(r) for r in subs]
+    e0, p0 = axes(0)
+    subs_ep = [axes(k) for k in range(1, err.shape[0])]
     ek = np.stack([s[0] for s in subs_ep], axis=1) if subs_ep else np.zeros((t.size, 0, 2))
     pk = np.stack([s[1] for s in subs_ep], axis=1) if subs_ep else np.zeros((t.size, 0, 2))
     r = np.stack([np.interp(t, truth.t_s, truth.r_rwy[:, i]) for i in range(3)], axis=1)
     w = None
-    if subs:  # full navigation-state separations e_k - e_0 (9 states) and their covariances P_k - P_0
-        d9 = np.stack([np.asarray(s.true_error_nav) - np.asarray(main.true_error_nav) for s in subs], axis=1)
-        p9 = np.stack([np.asarray(s.P_nav) - np.asarray(main.P_nav) for s in subs], axis=1)
+    if subs_ep:  # full navigation-state separations e_k - e_0 (9 states) and their covariances P_k - P_0
+        d9 = np.stack([err[k] - err[0] for k in range(1, err.shape[0])], axis=1)
+        p9 = np.stack([pnav[k] - pnav[0] for k in range(1, err.shape[0])], axis=1)
         w = identify_statistic(d9, p9)
     return BankEpochs(t, e0, p0, ek, pk, np.asarray(channels), r[:, 0], r[:, 2], w)
 
@@ -314,7 +323,10 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun).
     sensor_modes_on: the baro, radar altimeter and pseudolite units are fault modes too (module docstring).
 
-    The copies share the run's IMU record and its INS (NavSystem.run(copies=True), feed-forward): the IMU is
+    Where integrity.bankpass applies (the compiled optimal filter, feed-forward, per-run GPS skies: the default),
+    the run is measured once and bankpass.bank_pass navigates every copy in one compiled call on the reduced
+    state (the same numbers; the main NavRun then has no solution and the reduced layout). Elsewhere the copies
+    share the run's IMU record and its INS (NavSystem.run(copies=True), feed-forward): the IMU is
     drawn and applied once; the other sensors are measured for the K + 1 copies (the same draws: the same
     streams), whose GNSS records then lose one channel each (bank_records)."""
     from dataclasses import fields, replace
@@ -335,16 +347,20 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     copies = len(channels) + 1
     nav = NavSystem.from_profile(profile)
     states = start_states(suite, truth, errors)
-    states = replace(states, **{f.name: np.repeat(getattr(states, f.name), copies, axis=0)
-                                for f in fields(states) if isinstance(getattr(states, f.name), np.ndarray)})
     # a sub-filter without the baro has its own INS when the baro damping loop drives the INS vertical channel
     own_ins = bool(sensor_modes_on and "baro" in one and nav.loop_gains() is not None)
     share = not nav.nav.feedback and "imu" in one and not own_ins
+    if share and bankpass.applicable(nav, one):  # the compiled pass on the reduced state (integrity/bankpass.py)
+        bp = bankpass.bank_pass(nav, truth, one, channels, stream(seed, run, "nav"), states)
+        ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth, profile.runway.heading_rad)
+        return ep, bp.main_run()
     rest = suite.without("imu") if share else suite  # feed-forward: one IMU record for every copy
     recs = rest.apply(truth, rest.draw(truth.t_s, seed, [run] * copies))
     if share:
         recs["imu"] = one["imu"]
     recs = bank_records(recs, channels)
+    states = replace(states, **{f.name: np.repeat(getattr(states, f.name), copies, axis=0)
+                                for f in fields(states) if isinstance(getattr(states, f.name), np.ndarray)})
     # every copy starts from the main filter's converged state (the first copy's schedule: all channels)
     navs = nav.run(truth, recs, [stream(seed, run, "nav") for _ in range(copies)],
                    shared_covariance=nav.shares_covariance(), states=states, copies=share)

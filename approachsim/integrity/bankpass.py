@@ -1,0 +1,254 @@
+"""The integrity bank's navigation pass (issue 26, speed): the main filter and the K sub-filters of one open-loop run
+over the run's records in one compiled call, on the states the bank can move.
+
+What integrity.bank.run_bank did before through NavSystem.run(copies=True) (and still does where this pass does not
+apply, `applicable`), with the same arithmetic:
+
+- one draw of the run's sensors (every copy's records are the same draws: the same streams), one converged start
+  (the copies share the main filter's: nav/system.py NavSystem.start), one INS over every row (feed-forward: the
+  INS does not depend on the filter), the copies' observations stacked once and copy k + 1 without its mode's
+  samples (integrity.bank.bank_records: an invalid sample is no measurement);
+- kernels/epoch.shared_pass over every epoch of every copy, each its own class (per-run GPS sky), on the *reduced*
+  state: the GPS channel states (gse, gmp) of the channels the run never measures are dropped.
+
+Why the reduced state changes no bit. A dropped channel's two states are first-order Gauss-Markov (diagonal
+Phi, Qd: kernels/errormodel.py makes them lone states, closed form) that no measurement row touches, and at the
+start they are uncorrelated with every other state (nav/initial.py: a channel not updated in the converged
+segment keeps its prior row exactly; checked here, else the channel is kept). So their rows and columns of P stay
+exactly zero off the diagonal: in the prediction W = Phi P, Phi W' + Qd their terms are exact zeros, and the
+scalar updates (kernels/kalman.gain and _joseph_cov) skip the rows where P h is zero and add exact zeros in the
+other rows' dropped columns. Every remaining term is summed in the same order (the kept states keep their order),
+so the kept states' estimates and covariances are the same floating-point numbers (tests/unit/integrity/
+test_bankpass.py compares them with the full-state pass bit for bit). The bank needs only the navigation states'
+estimates and covariance block: the dropped states never reach it. The cost of an epoch falls with the square
+of the state count: 70 states (24 channels) to 22 + 2 x (channels used), about 32 with best-four selection.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from approachsim.nav import errormodel as em
+from approachsim.nav import ins
+from approachsim.nav.base import workspace
+from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer
+from approachsim.nav.kernels import epoch as ke
+from approachsim.nav.navigator import NavRun, StatusLog, _stacked_observations, true_error_rows
+from approachsim.nav.observations import Observations
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class BankPass:
+    """The copies' filter history at the epochs (copy 0 the main filter, copy k + 1 without mode k)."""
+
+    t_s: Array
+    """(E,) epoch times, s."""
+    true_error_nav: Array
+    """(C, E, 9) output error of each copy at each epoch (dp NED m, dv m/s, psi rad)."""
+    P_nav: Array
+    """(C, E, 9, 9) its navigation-error covariance after the epoch's updates."""
+    x: Array
+    """(C, E, n_r) the reduced state's estimates after the updates."""
+    P_diag: Array
+    """(C, E, n_r) their variances."""
+    layout: em.StateLayout
+    """The reduced layout (the GPS channel states of `channels_kept` only)."""
+    channels_kept: Array
+    """(k_r,) the GPS channels whose error states the pass carries."""
+    main_rows: tuple[Array, Array, Array, Array]
+    """The main filter's measurement rows: codes, their counts per epoch, innovations, their variances (E, R)
+    (kernels/epoch.shared_pass)."""
+
+    def main_run(self) -> NavRun:
+        """The main filter's NavRun without its solution (None: the bank needs the epoch history only), on the
+        reduced layout."""
+        buf = StatusBuffer()
+        codes, counts, nu, S = self.main_rows
+        buf.add_epochs(codes, counts, self.t_s, nu, S)
+        return NavRun(solution=None, status=StatusLog.from_buffer(buf), t_epoch_s=self.t_s, x=self.x[0],
+                      P_diag=self.P_diag[0], P_nav=self.P_nav[0], true_error_nav=self.true_error_nav[0],
+                      layout=self.layout)
+
+
+def applicable(nav: Any, records: dict[str, Any]) -> bool:
+    """Whether `bank_pass` runs the bank of this navigation system on these records (one run, run axis first): the
+    compiled epoch (the optimal filter, tight coupling, constant or no damping loop, no FDE, no carrier phase:
+    nav/engine.py), feed-forward, an IMU record, and each run its own GPS sky (the default "per-run" epoch; a fixed
+    sky takes NavSystem.run's per-epoch path)."""
+    g = records.get("gnss")
+    return (g is not None and bool(g.per_run_sky) and "imu" in records and not nav.nav.feedback
+            and EpochEngine.of(nav) is not None)
+
+
+def _kept_channels(lay: em.StateLayout, used: Array, P0: Array) -> Array:
+    """The channels whose states stay: those measured, and any whose states are correlated with another state in the
+    start covariance P0 (module docstring: a dropped state must be uncorrelated with all others)."""
+    n_sv = lay.n_sv
+    keep = np.zeros(n_sv, dtype=bool)
+    keep[np.asarray(used, dtype=int)] = True
+    off = P0 != 0.0
+    np.fill_diagonal(off, False)
+    coupled = np.any(off, axis=1)
+    ig, im = lay.i("gse"), lay.i("gmp")
+    keep |= coupled[ig:ig + n_sv] | coupled[im:im + n_sv]
+    return np.flatnonzero(keep)
+
+
+def _reduced(lay: em.StateLayout, kept: Array) -> tuple[em.StateLayout, Array]:
+    """The layout with the channel states of `kept` only, and the full-layout index of each of its states (in
+    order)."""
+    red = dataclasses.replace(lay, n_sv=int(kept.size))
+    idx = []
+    for g in red.groups:
+        if g in ("gse", "gmp"):
+            idx.extend(lay.i(g) + kept)
+        else:
+            sl = lay.index[g]
+            idx.extend(range(sl.start, sl.stop))
+    return red, np.asarray(idx, dtype=int)
+
+
+def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: np.random.Generator,
+              states: Any) -> BankPass:
+    """The main filter and one sub-filter per mode of `modes` (integrity.bank mode codes) over one run's records
+    (`applicable`; run axis of length one), started from the run's realized sensor states `states`
+    (sensors.states.start_states) with its "nav" stream `rng` (module docstring)."""
+    from approachsim.integrity.bank import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
+    from approachsim.nav.system import tuned_records
+
+    records = tuned_records(records, nav.nav.gps_sigma_scale)
+    lay = nav.layout
+    eng = EpochEngine(nav)
+    imu = records["imu"]
+    dth, dvb = np.asarray(imu.dtheta_body)[:1], np.asarray(imu.dv_body)[:1]
+    m = dth.shape[1]
+    dt = float(imu.dt_s)
+    epoch_rows = max(1, int(round(1.0 / dt / nav.nav.aiding_rate_hz)))
+    tol = 0.25 * dt
+    gnss = records["gnss"]
+    # the start, as NavSystem.run's: the copies share the main filter's (one draw, repeated)
+    obs0 = Observations.at(records, float(truth.t_s[0]), tol, True)
+    el0 = np.asarray(gnss.elevation_rad)[:, 0]
+    s, runs = nav.start(truth, [rng], elevation_rad=el0[0], obs=obs0, states=states, elevation_per_run=el0)
+    # the INS once (Navigator.propagate: feed-forward, no bias feedback), with the damping loop's baro
+    baro = records.get("baro")
+    hb_full = None
+    if nav.loop_gains() is not None and baro is not None:
+        hb = np.where(baro.valid, baro.h_baro_m, np.nan)
+        idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
+        hb_full = hb[:, idx]
+    x = ins.pack(s)
+    rows = np.full((1, m + 1, ins.NX), np.nan)
+    rows[:, 0] = x
+    z3 = np.zeros((1, 3))
+    ins.propagate(x, dth, dvb, dt, bias_g=z3, bias_a=z3, h_baro_m=hb_full, loop=nav.loop_gains(),
+                  f_sum=np.zeros((1, 3)), out=rows, row0=0)
+    # the epochs and the reference (the truth at the epoch rows: nav/shared.py)
+    e_rows = np.arange(epoch_rows, m + 1, epoch_rows)
+    E = e_rows.shape[0]
+    C = len(modes) + 1
+    t_e = np.asarray(truth.t_s, dtype=float)[e_rows]
+    dt_e = np.diff(np.concatenate([[float(truth.t_s[0])], t_e]))
+    held1 = np.zeros(E, dtype=np.int64)
+    if lay.has("ac") and hb_full is not None:
+        for e, r in enumerate(e_rows):
+            held1[e] = np.all(np.isnan(hb_full[0, r - epoch_rows:r]))
+    held = np.ascontiguousarray(np.broadcast_to(held1, (C, E)))
+    ref, ref_cbn, f_ref, ref_agl = _reference(nav, truth, m, epoch_rows, e_rows)
+    # the copies' observations: copy 0 all, copy k + 1 without mode k (bank.bank_records)
+    o = _stacked_observations(records, t_e, tol, True, 1)
+    baro_h = np.repeat(o["baro_h"], C, axis=0)
+    radalt_h = np.repeat(o["radalt_h"], C, axis=0)
+    rho_all = o["rho"]
+    pl_rho = np.repeat(o["pl_rho"], C, axis=0)
+    used = np.flatnonzero(np.any(np.asarray(gnss.valid, dtype=bool)[0], axis=0))
+    x_hat, P_conv = runs[0].fs.x, np.asarray(runs[0].fs.P, dtype=float)
+    kept = _kept_channels(lay, used, P_conv) if lay.has("gse") else used
+    if lay.has("gse"):
+        red, idx = _reduced(lay, kept)
+    else:
+        red, idx = lay, np.arange(lay.n)
+    col = {int(c): j for j, c in enumerate(kept)}
+    rho = np.repeat(rho_all[:, :, kept], C, axis=0)
+    for k, c in enumerate(np.asarray(modes, dtype=int)):
+        if c >= 0:
+            rho[k + 1, :, col[c]] = np.nan
+        elif c == BARO_MODE:
+            baro_h[k + 1] = np.nan
+        elif c == RADALT_MODE:
+            radalt_h[k + 1] = np.nan
+        else:
+            pl_rho[k + 1, :, PSEUDOLITE_MODE - c] = np.nan
+    if not np.all(np.isnan(np.delete(rho_all, kept, axis=2))):
+        raise RuntimeError("bank_pass: a measured channel was dropped")
+    kr = kept.size
+    r_sv = np.ascontiguousarray(np.broadcast_to(o["r_sv"][:, :, kept], (C, E, kr, 3)))
+    el = o["el"][0][:, kept]
+    sig = np.ascontiguousarray(np.broadcast_to(eng._code_sig[kept] if eng.channel_states else o["sig"][0][:, kept],
+                                               (C, E, kr)), dtype=float)
+    r_pl = o["r_pl"] if o["r_pl"] is not None else eng._none3
+    pl_sig = np.ascontiguousarray(np.broadcast_to(eng._pl_sig if eng.pl_states else o["pl_sig"],
+                                                  (E, pl_rho.shape[2])), dtype=float)
+    noise = nav.noise(None)
+    q, gse_full, gmp_full = em.kernel_noise(noise, lay.n_sv)
+    gse, gmp = (np.ascontiguousarray(a[kept]) for a in (gse_full, gmp_full)) if lay.n_sv else (gse_full, gmp_full)
+    loop = em.kernel_loop(nav.loop_gains() if lay.has("ac") else None)
+    if red.has("gse") and kr:
+        g1, m1 = eng.channel_sigmas(el)
+        ch_gse = np.ascontiguousarray(np.broadcast_to(g1, (C, E, kr)))
+        ch_gmp = np.ascontiguousarray(np.broadcast_to(m1, (C, E, kr)))
+    else:
+        ch_gse = ch_gmp = np.zeros((C, E, 0))
+    nz = nav.noise_model.noise(None)
+    f_gse = -np.expm1(-2.0 * dt_e / nz.gse_tau_s) if lay.has("gse") else np.zeros(E)
+    f_gmp = -np.expm1(-2.0 * dt_e / nz.gmp_tau_s) if lay.has("gse") else np.zeros(E)
+    db = RunDatabase.of(nav.nav.terrain_database, runs[0].db_error)
+    dbp, db_x, db_u = EpochEngine.stack([db] * C)
+    n = red.n
+    X = np.repeat(x_hat[idx][None], C, axis=0)
+    P3 = np.repeat(P_conv[np.ix_(idx, idx)][None], C, axis=0)
+    R = 2 + kr + pl_rho.shape[2]
+    codes, nu, S = np.zeros((C, E, R), dtype=np.int64), np.zeros((C, E, R)), np.zeros((C, E, R))
+    n_rows = np.zeros((C, E), dtype=np.int64)
+    x_out, p33, pcc = np.zeros((C, E, n)), np.zeros((C, E, 3, 3)), np.zeros((C, E))
+    pd, pnav = np.zeros((C, E, n)), np.zeros((C, E, 9, 9))
+    ins_y = np.ascontiguousarray(np.broadcast_to(rows[0, e_rows], (C, E, ins.NX)))
+    ic = red.i("clk") if red.has("clk") else 0
+    done = ke.shared_pass(X, P3, red.packed, q, gse, gmp, loop, dt_e, ref, ref_cbn, f_ref, ref_agl, held, ch_gse,
+                          ch_gmp, f_gse, f_gmp, ins_y, baro_h, o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor,
+                          eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho, r_sv, sig, eng.channel_states, pl_rho, r_pl,
+                          pl_sig, eng.pl_states, codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav, ic, np.zeros(n),
+                          np.zeros(n), workspace(n))
+    if done != E:
+        raise RuntimeError("bank_pass: an epoch's model is too large for the compiled discretization")
+    # the outputs' errors at the epochs: the INS rows - x_hat against the truth rows (Navigator.results)
+    xe = x_out[:, :, 0:9].reshape(C * E, 9)
+    o_s = ins.perturb(ins.unpack(np.tile(rows[0, e_rows], (C, 1))), -xe[:, 0:3], -xe[:, 3:6], -xe[:, 6:9])
+    err = true_error_rows(o_s, truth, np.tile(e_rows, C)).reshape(C, E, 9)
+    return BankPass(t_e, err, pnav, x_out, pd, red, kept, (codes[0], n_rows[0], nu[0], S[0]))
+
+
+def _reference(nav: Any, truth: Any, m: int, epoch_rows: int, e_rows: Array) -> tuple[Array, Array, Array, Array]:
+    """The reference at the epochs (nav/shared.py, Navigator.compiled_pass): packed truth rows (E, 16), their
+    body-to-NED matrices (E, 3, 3), the interval's mean specific force NED (E, 3) m/s^2, the height above the
+    terrain (E,) m."""
+    from approachsim import geo
+
+    E = e_rows.shape[0]
+    c_bn = ins.cbn_from_quaternion(truth.q_nb[:m + 1])
+    f_ned = np.einsum("nij,nj->ni", c_bn[:m], truth.f_body[:m])
+    ref_cbn = np.ascontiguousarray(c_bn[::epoch_rows].copy()[e_rows // epoch_rows])
+    ref = np.zeros((E, ins.NX))
+    ref[:, 0], ref[:, 1], ref[:, 2] = truth.lat_rad[e_rows], truth.lon_rad[e_rows], truth.h_m[e_rows]
+    ref[:, 3:6] = truth.v_ned[e_rows]
+    ref[:, 6:15] = ref_cbn.reshape(E, 9)
+    f_ref = np.stack([f_ned[r - epoch_rows:r].mean(axis=0) for r in e_rows]) if E else np.zeros((0, 3))
+    r_ref = geo.geodetic_to_ecef(ref[:, 0], ref[:, 1], ref[:, 2])
+    ref_agl = ref[:, 2] - nav.terrain_h(r_ref) if E else np.zeros(0)
+    return ref, ref_cbn, f_ref, ref_agl
