@@ -29,8 +29,9 @@ has its own filter state, or with `shared_covariance` one covariance and gain pe
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
@@ -56,6 +57,13 @@ from approachsim.sensors.states import SensorStates
 Array = np.ndarray
 
 __all__ = ["NavRun", "NavSystem", "StatusLog", "TerrainDatabase"]
+
+_SYSTEMS: dict = {}
+"""NavSystem.from_profile's systems, by profile (a few per process)."""
+_PREPARED: dict = {}
+"""NavSystem._prepared's converged starts: key -> (system, truth, initial.Prepared), oldest first."""
+_PREPARED_MAX = 64
+"""Starts kept (two flight groups of 25 runs: a group's bank runs right after its pass)."""
 
 
 def _radalt_states(sensors: SensorsConfig, nav: NavConfig) -> dict[str, bool]:
@@ -117,9 +125,23 @@ class NavSystem:
 
     @classmethod
     def from_profile(cls, profile: Any) -> NavSystem:
-        """The navigation system of a Profile (its [nav], [sensors], runway and terrain)."""
-        nav = getattr(profile, "nav", DEFAULT_NAV)
-        return cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain)
+        """The navigation system of a Profile (its [nav], [sensors], runway and terrain); one object per profile
+        and process (a function of the profile's value: the open-loop group's pass and each run's integrity bank
+        use the same one, and so share its starts, `start`)."""
+        try:
+            sys_ = _SYSTEMS.get(profile)
+        except TypeError:  # an unhashable profile-like object: build it each time
+            sys_, profile_key = None, None
+        else:
+            profile_key = profile
+        if sys_ is None:
+            nav = getattr(profile, "nav", DEFAULT_NAV)
+            sys_ = cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain)
+            if profile_key is not None:
+                if len(_SYSTEMS) >= 8:
+                    _SYSTEMS.clear()
+                _SYSTEMS[profile_key] = sys_
+        return sys_
 
     # --- models -------------------------------------------------------------------------------------------
 
@@ -217,9 +239,10 @@ class NavSystem:
             for i, g in enumerate(rngs):
                 key = obs.elevations(i).tobytes()
                 i0 = first.setdefault(key, i)
-                d = initial.draw(self, truth, obs.run(i0), states.take(i), [g], row,
-                                 self.initial_covariance(obs.elevations(i)), prep.get(key))
-                prep[key] = d[2]
+                P0 = self.initial_covariance(obs.elevations(i))
+                if key not in prep:
+                    prep[key] = self._prepared(truth, obs.run(i0), row, P0, states.take(i))
+                d = initial.draw(self, truth, obs.run(i0), states.take(i), [g], row, P0, prep[key])
                 draws.append(d)
             e = np.concatenate([d[0] for d in draws])
             x_hat = np.concatenate([d[1] for d in draws])
@@ -234,6 +257,31 @@ class NavSystem:
         runs = [RunFilter(self.filter.init(x_hat[i], P_convs[i]), [], np.zeros(3), np.zeros(3), self._fde(), dbs[i])
                 for i in range(n)]
         return s, runs
+
+    def _prepared(self, truth: Truth, obs: Observations, row: int, P0: Array, states: SensorStates
+                  ) -> initial.Prepared:
+        """The converged start's P_conv and conditioner (initial.Prepared) of one run's sky and schedule, made once
+        per process for the same inputs (the open-loop pass of a flight group makes every run's; that run's
+        integrity bank then finds it here instead of repeating the 600 s Riccati recursion and the
+        eigen-decompositions). Keyed by this system and truth (the objects, kept alive by the entry) and the bytes
+        of everything else initial.draw reads (the row, P0, the run's observations at the row, the sensor states'
+        indices)."""
+        s_idx, _ = initial.sensor_vector(self.layout, states, P0)
+        parts = [np.asarray(P0, dtype=float).tobytes(), str(row).encode(), np.asarray(s_idx).tobytes()]
+        for f in fields(obs):
+            v = getattr(obs, f.name)
+            parts.append(f.name.encode())
+            parts.append(repr(v.shape).encode() + v.tobytes() if isinstance(v, np.ndarray) else repr(v).encode())
+        key = (id(self), id(truth), hashlib.blake2b(b"\0".join(parts), digest_size=20).digest())
+        hit = _PREPARED.get(key)
+        if hit is not None and hit[0] is self and hit[1] is truth:
+            return hit[2]
+        P_conv = initial.converged_covariance(self, truth, obs, row, P0, self.nav.initial_error.converge_s)
+        prepared = initial.Prepared(P_conv, initial.conditioner(P_conv, P0[np.ix_(s_idx, s_idx)], s_idx))
+        if len(_PREPARED) >= _PREPARED_MAX:
+            _PREPARED.pop(next(iter(_PREPARED)))
+        _PREPARED[key] = (self, truth, prepared)
+        return prepared
 
     def _fde(self) -> FdeState | None:
         """A run's online FDE state ([nav.fde] enabled), else None."""
