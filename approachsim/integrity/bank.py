@@ -317,8 +317,8 @@ def score_run(ep: BankEpochs, epoch_hz: float, start_height_m: float, dh_m: dict
     return out
 
 
-def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: bool = False
-             ) -> tuple[BankEpochs, Any]:
+def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: bool = False, *,
+             compiled: bool = True) -> tuple[BankEpochs, Any]:
     """Measure run `run` of the campaign seeded `seed` on `truth`, navigate it with the main filter and the
     sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun).
     sensor_modes_on: the baro, radar altimeter and pseudolite units are fault modes too (module docstring).
@@ -328,7 +328,8 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     state (the same numbers; the main NavRun then has no solution and the reduced layout). Elsewhere the copies
     share the run's IMU record and its INS (NavSystem.run(copies=True), feed-forward): the IMU is
     drawn and applied once; the other sensors are measured for the K + 1 copies (the same draws: the same
-    streams), whose GNSS records then lose one channel each (bank_records)."""
+    streams), whose GNSS records then lose one channel each (bank_records). compiled=False: always the latter (the
+    oracle of integrity/bankpass.py)."""
     from dataclasses import fields, replace
 
     from approachsim.nav.system import NavSystem
@@ -350,10 +351,11 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     # a sub-filter without the baro has its own INS when the baro damping loop drives the INS vertical channel
     own_ins = bool(sensor_modes_on and "baro" in one and nav.loop_gains() is not None)
     share = not nav.nav.feedback and "imu" in one and not own_ins
-    if share and bankpass.applicable(nav, one):  # the compiled pass on the reduced state (integrity/bankpass.py)
+    if compiled and share and bankpass.applicable(nav, one):  # the compiled reduced pass (integrity/bankpass.py)
         bp = bankpass.bank_pass(nav, truth, one, channels, stream(seed, run, "nav"), states)
-        ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth, profile.runway.heading_rad)
-        return ep, bp.main_run()
+        if bp is not None:
+            ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth, profile.runway.heading_rad)
+            return ep, bp.main_run()
     rest = suite.without("imu") if share else suite  # feed-forward: one IMU record for every copy
     recs = rest.apply(truth, rest.draw(truth.t_s, seed, [run] * copies))
     if share:

@@ -8,7 +8,10 @@ apply, `applicable`), with the same arithmetic:
   (the copies share the main filter's: nav/system.py NavSystem.start), one INS over every row (feed-forward: the
   INS does not depend on the filter), the copies' observations stacked once and copy k + 1 without its mode's
   samples (integrity.bank.bank_records: an invalid sample is no measurement);
-- kernels/epoch.shared_pass over every epoch of every copy, each its own class (per-run GPS sky), on the *reduced*
+- the model of every epoch (Phi, Qd at the reference: the truth) made once per flight group's truth on the full
+  layout (integrity/bank_kernel.models, kept for the last truth: the group's runs share it), cut to the run's
+  reduced state; then every epoch of every copy, each its own class (per-run GPS sky), in one call of
+  integrity/bank_kernel.bank_epochs (kernels/epoch.shared_pass's loop with the model given), on the *reduced*
   state: the GPS channel states (gse, gmp) of the channels the run never measures are dropped.
 
 Why the reduced state changes no bit. A dropped channel's two states are first-order Gauss-Markov (diagonal
@@ -32,11 +35,11 @@ from typing import Any
 
 import numpy as np
 
+from approachsim.integrity import bank_kernel as bk
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav.base import workspace
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer
-from approachsim.nav.kernels import epoch as ke
 from approachsim.nav.navigator import NavRun, StatusLog, _stacked_observations, true_error_rows
 from approachsim.nav.observations import Observations
 
@@ -115,10 +118,11 @@ def _reduced(lay: em.StateLayout, kept: Array) -> tuple[em.StateLayout, Array]:
 
 
 def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: np.random.Generator,
-              states: Any) -> BankPass:
+              states: Any) -> BankPass | None:
     """The main filter and one sub-filter per mode of `modes` (integrity.bank mode codes) over one run's records
     (`applicable`; run axis of length one), started from the run's realized sensor states `states`
-    (sensors.states.start_states) with its "nav" stream `rng` (module docstring)."""
+    (sensors.states.start_states) with its "nav" stream `rng` (module docstring). None when an epoch's model is
+    too large for the compiled discretization (the caller takes NavSystem.run, which falls back to numpy's)."""
     from approachsim.integrity.bank import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
     from approachsim.nav.system import tuned_records
 
@@ -159,7 +163,6 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     if lay.has("ac") and hb_full is not None:
         for e, r in enumerate(e_rows):
             held1[e] = np.all(np.isnan(hb_full[0, r - epoch_rows:r]))
-    held = np.ascontiguousarray(np.broadcast_to(held1, (C, E)))
     ref, ref_cbn, f_ref, ref_agl = _reference(nav, truth, m, epoch_rows, e_rows)
     # the copies' observations: copy 0 all, copy k + 1 without mode k (bank.bank_records)
     o = _stacked_observations(records, t_e, tol, True, 1)
@@ -197,7 +200,6 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
                                                   (E, pl_rho.shape[2])), dtype=float)
     noise = nav.noise(None)
     q, gse_full, gmp_full = em.kernel_noise(noise, lay.n_sv)
-    gse, gmp = (np.ascontiguousarray(a[kept]) for a in (gse_full, gmp_full)) if lay.n_sv else (gse_full, gmp_full)
     loop = em.kernel_loop(nav.loop_gains() if lay.has("ac") else None)
     if red.has("gse") and kr:
         g1, m1 = eng.channel_sigmas(el)
@@ -216,17 +218,18 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     R = 2 + kr + pl_rho.shape[2]
     codes, nu, S = np.zeros((C, E, R), dtype=np.int64), np.zeros((C, E, R)), np.zeros((C, E, R))
     n_rows = np.zeros((C, E), dtype=np.int64)
-    x_out, p33, pcc = np.zeros((C, E, n)), np.zeros((C, E, 3, 3)), np.zeros((C, E))
-    pd, pnav = np.zeros((C, E, n)), np.zeros((C, E, 9, 9))
+    x_out, pd, pnav = np.zeros((C, E, n)), np.zeros((C, E, n)), np.zeros((C, E, 9, 9))
     ins_y = np.ascontiguousarray(np.broadcast_to(rows[0, e_rows], (C, E, ins.NX)))
-    ic = red.i("clk") if red.has("clk") else 0
-    done = ke.shared_pass(X, P3, red.packed, q, gse, gmp, loop, dt_e, ref, ref_cbn, f_ref, ref_agl, held, ch_gse,
-                          ch_gmp, f_gse, f_gmp, ins_y, baro_h, o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor,
-                          eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho, r_sv, sig, eng.channel_states, pl_rho, r_pl,
-                          pl_sig, eng.pl_states, codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav, ic, np.zeros(n),
-                          np.zeros(n), workspace(n))
-    if done != E:
-        raise RuntimeError("bank_pass: an epoch's model is too large for the compiled discretization")
+    model = _models(nav, truth, q, gse_full, gmp_full, loop, dt_e, ref, ref_cbn, f_ref, held1)
+    if model is None:
+        return None
+    phi_f, qd_f = model
+    phi = np.ascontiguousarray(phi_f[:, idx[:, None], idx[None, :]])
+    qd = np.ascontiguousarray(qd_f[:, idx[:, None], idx[None, :]])
+    bk.bank_epochs(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
+                   o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho,
+                   r_sv, sig, eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, codes, nu, S, n_rows, x_out,
+                   pd, pnav, np.zeros(n), np.zeros(n), workspace(n))
     # the outputs' errors at the epochs: the INS rows - x_hat against the truth rows (Navigator.results)
     xe = x_out[:, :, 0:9].reshape(C * E, 9)
     o_s = ins.perturb(ins.unpack(np.tile(rows[0, e_rows], (C, 1))), -xe[:, 0:3], -xe[:, 3:6], -xe[:, 6:9])
@@ -234,10 +237,48 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     return BankPass(t_e, err, pnav, x_out, pd, red, kept, (codes[0], n_rows[0], nu[0], S[0]))
 
 
+_MODELS: list = []
+"""`_models`' last results: (system, truth, dt, held, (phi, qd)) (the runs of a flight group share them)."""
+
+
+def _models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array, dt: Array, ref: Array,
+            ref_cbn: Array, f_ref: Array, held: Array) -> tuple[Array, Array] | None:
+    """Phi, Qd (E, n, n) of every epoch on the full layout (bank_kernel.models: what shared_pass makes), kept
+    for the last two (system, truth) objects with the same intervals and damping-loop holds; None when an
+    epoch's model is too large for the compiled discretization."""
+    key_dt, key_held = dt.tobytes(), held.tobytes()
+    for sys_, tr, kd, kh, val in _MODELS:
+        if sys_ is nav and tr is truth and kd == key_dt and kh == key_held:
+            return val
+    E, n = dt.shape[0], nav.layout.n
+    phi, qd = np.zeros((E, n, n)), np.zeros((E, n, n))
+    if bk.models(nav.layout.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, phi, qd) != E:
+        return None  # an epoch's model is too large for the compiled discretization
+    _MODELS.insert(0, (nav, truth, key_dt, key_held, (phi, qd)))
+    del _MODELS[2:]
+    return phi, qd
+
+
+_REFERENCES: list = []
+"""`_reference`'s last results: (system, truth, m, epoch_rows, value); the runs of an open-loop flight group share
+their truth, so their banks share its reference."""
+
+
 def _reference(nav: Any, truth: Any, m: int, epoch_rows: int, e_rows: Array) -> tuple[Array, Array, Array, Array]:
     """The reference at the epochs (nav/shared.py, Navigator.compiled_pass): packed truth rows (E, 16), their
     body-to-NED matrices (E, 3, 3), the interval's mean specific force NED (E, 3) m/s^2, the height above the
-    terrain (E,) m."""
+    terrain (E,) m. Kept for the last two (system, truth) objects (the kernel only reads them)."""
+    for sys_, tr, m_, er, val in _REFERENCES:
+        if sys_ is nav and tr is truth and m_ == m and er == epoch_rows:
+            return val
+    val = _make_reference(nav, truth, m, epoch_rows, e_rows)
+    _REFERENCES.insert(0, (nav, truth, m, epoch_rows, val))
+    del _REFERENCES[2:]
+    return val
+
+
+def _make_reference(nav: Any, truth: Any, m: int, epoch_rows: int, e_rows: Array
+                    ) -> tuple[Array, Array, Array, Array]:
     from approachsim import geo
 
     E = e_rows.shape[0]
