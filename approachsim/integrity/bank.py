@@ -21,7 +21,7 @@ the category's alert limit at the aircraft's distance and height, misleading inf
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -136,7 +136,19 @@ class BankEpochs:
     """(e,) height above the threshold, m."""
     wtest: Array | None = None
     """(e, K) the identification statistic of each fault mode over the 9 navigation states
-    (integrity.separation.identify_statistic); None: identify on the two approach axes only."""
+    (integrity.separation.identify_statistic); None: made from `separations` when asked (`identification`), or
+    without them identify on the two approach axes only."""
+    separations: tuple[Array, Array] | None = field(default=None, repr=False, compare=False)
+    """(d9 (e, K, 9), p9 (e, K, 9, 9)): the sub-solutions' navigation-state separations x_k - x_0 and their
+    covariances P_k - P_0, from which `identification` makes the statistic (only runs with a detection need it)."""
+
+    def identification(self) -> Array | None:
+        """wtest, or the statistic made from `separations` (once; kept), or None: identify on the approach axes."""
+        if self.wtest is not None or self.separations is None:
+            return self.wtest
+        w = identify_statistic(*self.separations)
+        object.__setattr__(self, "wtest", w)
+        return w
 
 
 def _axes(heading_rad: float) -> Array:
@@ -167,12 +179,12 @@ def bank_epochs_arrays(t: Array, err: Array, pnav: Array, channels: Array, truth
     ek = np.stack([s[0] for s in subs_ep], axis=1) if subs_ep else np.zeros((t.size, 0, 2))
     pk = np.stack([s[1] for s in subs_ep], axis=1) if subs_ep else np.zeros((t.size, 0, 2))
     r = np.stack([np.interp(t, truth.t_s, truth.r_rwy[:, i]) for i in range(3)], axis=1)
-    w = None
+    sep = None
     if subs_ep:  # full navigation-state separations e_k - e_0 (9 states) and their covariances P_k - P_0
         d9 = np.stack([err[k] - err[0] for k in range(1, err.shape[0])], axis=1)
         p9 = np.stack([pnav[k] - pnav[0] for k in range(1, err.shape[0])], axis=1)
-        w = identify_statistic(d9, p9)
-    return BankEpochs(t, e0, p0, ek, pk, np.asarray(channels), r[:, 0], r[:, 2], w)
+        sep = (d9, p9)
+    return BankEpochs(t, e0, p0, ek, pk, np.asarray(channels), r[:, 0], r[:, 2], None, sep)
 
 
 @dataclass(frozen=True)
@@ -270,7 +282,8 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
     err, pl = e_main.copy(), r.pl_m.copy()
     excluded, t_det = -1, float("nan")
     if r.detected.any() and confirm:
-        stat = ep.wtest[sel] if ep.wtest is not None else np.max(r.test_ratio, axis=2)
+        w = ep.identification()
+        stat = w[sel] if w is not None else np.max(r.test_ratio, axis=2)
         mode, ok = second_level(r.detected, stat)
         t_det = float(t[int(np.argmax(r.detected))])
         on = mode >= 0
@@ -283,7 +296,8 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
         i = int(np.argmax(r.detected))
         # identification: the full navigation-state statistic (Baarda's w-test squared) where the bank has it,
         # else the largest two-axis normalized separation
-        k = int(np.argmax(ep.wtest[sel][i])) if ep.wtest is not None else int(r.suspect[i])
+        w = ep.identification()
+        k = int(np.argmax(w[sel][i])) if w is not None else int(r.suspect[i])
         excluded, t_det = int(ep.channels[k]), float(t[i])
         err[i:] = np.abs(ep.ek[sel][i:, k])
         pl[i:] = req.k_ff() * np.sqrt(ep.pk[sel][i:, k])
@@ -318,7 +332,7 @@ def score_run(ep: BankEpochs, epoch_hz: float, start_height_m: float, dh_m: dict
 
 
 def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: bool = False, *,
-             compiled: bool = True) -> tuple[BankEpochs, Any]:
+             compiled: bool = True, group: tuple[Any, int] | None = None) -> tuple[BankEpochs, Any]:
     """Measure run `run` of the campaign seeded `seed` on `truth`, navigate it with the main filter and the
     sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun).
     sensor_modes_on: the baro, radar altimeter and pseudolite units are fault modes too (module docstring).
@@ -329,7 +343,9 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     share the run's IMU record and its INS (NavSystem.run(copies=True), feed-forward): the IMU is
     drawn and applied once; the other sensors are measured for the K + 1 copies (the same draws: the same
     streams), whose GNSS records then lose one channel each (bank_records). compiled=False: always the latter (the
-    oracle of integrity/bankpass.py)."""
+    oracle of integrity/bankpass.py). group: (bankpass.GroupInputs, k) what the open-loop flight group's pass left
+    for this run, its run k (campaign/pipeline.py): nothing is drawn, started or integrated again (the same numbers,
+    bankpass.bank_pass_group)."""
     from dataclasses import fields, replace
 
     from approachsim.nav.system import NavSystem
@@ -337,6 +353,16 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     from approachsim.sensors.states import start_states
     from approachsim.sensors.suite import SensorSuite
 
+    if compiled and group is not None and not sensor_modes_on:
+        g, k = group
+        nav = NavSystem.from_profile(profile)
+        if g.usable(nav) and bankpass.applicable(nav, g.records):
+            channels = used_channels(np.asarray(g.records["gnss"].valid)[k])
+            bp = bankpass.bank_pass_group(nav, truth, g, k, channels)
+            if bp is not None:
+                ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth,
+                                        profile.runway.heading_rad)
+                return ep, bp.main_run()
     suite = SensorSuite.from_profile(profile)
     errors = suite.draw(truth.t_s, seed, [run])
     one = suite.apply(truth, errors)

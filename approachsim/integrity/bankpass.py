@@ -123,12 +123,9 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     (`applicable`; run axis of length one), started from the run's realized sensor states `states`
     (sensors.states.start_states) with its "nav" stream `rng` (module docstring). None when an epoch's model is
     too large for the compiled discretization (the caller takes NavSystem.run, which falls back to numpy's)."""
-    from approachsim.integrity.bank import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
     from approachsim.nav.system import tuned_records
 
     records = tuned_records(records, nav.nav.gps_sigma_scale)
-    lay = nav.layout
-    eng = EpochEngine(nav)
     imu = records["imu"]
     dth, dvb = np.asarray(imu.dtheta_body)[:1], np.asarray(imu.dv_body)[:1]
     m = dth.shape[1]
@@ -141,18 +138,89 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     el0 = np.asarray(gnss.elevation_rad)[:, 0]
     s, runs = nav.start(truth, [rng], elevation_rad=el0[0], obs=obs0, states=states, elevation_per_run=el0)
     # the INS once (Navigator.propagate: feed-forward, no bias feedback), with the damping loop's baro
-    baro = records.get("baro")
-    hb_full = None
-    if nav.loop_gains() is not None and baro is not None:
-        hb = np.where(baro.valid, baro.h_baro_m, np.nan)
-        idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
-        hb_full = hb[:, idx]
+    hb_full = _baro_held(nav, records, truth, m)
     x = ins.pack(s)
     rows = np.full((1, m + 1, ins.NX), np.nan)
     rows[:, 0] = x
     z3 = np.zeros((1, 3))
     ins.propagate(x, dth, dvb, dt, bias_g=z3, bias_a=z3, h_baro_m=hb_full, loop=nav.loop_gains(),
                   f_sum=np.zeros((1, 3)), out=rows, row0=0)
+    o = _stacked_observations(records, np.asarray(truth.t_s, dtype=float)[epoch_rows::epoch_rows], tol, True, 1)
+    used = np.flatnonzero(np.any(np.asarray(gnss.valid, dtype=bool)[0], axis=0))
+    return _core(nav, truth, modes, m, epoch_rows, runs[0].fs.x, np.asarray(runs[0].fs.P, dtype=float),
+                 runs[0].db_error, rows[0, epoch_rows::epoch_rows], None if hb_full is None else hb_full[0], o, used)
+
+
+def _baro_held(nav: Any, records: dict[str, Any], truth: Any, m: int) -> Array | None:
+    """(N, m) the baro height held at each IMU interval start for the damping loop (nan: none), as NavSystem.run;
+    None without a loop or a baro."""
+    baro = records.get("baro")
+    if nav.loop_gains() is None or baro is None:
+        return None
+    hb = np.where(baro.valid, baro.h_baro_m, np.nan)
+    idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
+    return hb[:, idx]
+
+
+class GroupInputs:
+    """What an open-loop flight group's navigation pass leaves for its runs' banks (campaign/pipeline.py): the
+    group's records (run axis first) and NavSystem.run's `keep` (each run's filter start, terrain-database error
+    and INS states at the epochs); the runs' stacked observations are made once, on the first bank's call."""
+
+    def __init__(self, records: dict[str, Any], keep: dict[str, Any]) -> None:
+        self.records = records
+        self.keep = keep
+        self._obs: dict[str, Any] | None = None
+
+    def usable(self, nav: Any) -> bool:
+        """Whether the pass kept everything, feed-forward, on this system's layout."""
+        k = self.keep
+        return (bool(k.get("feed_forward")) and "ins_epoch_rows" in k and "start" in k
+                and k["start"][0][0].shape == (nav.layout.n,))
+
+    def observations(self, nav: Any, truth: Any) -> dict[str, Any]:
+        """_stacked_observations of every run of the group at the epochs (once)."""
+        if self._obs is None:
+            from approachsim.nav.system import tuned_records
+
+            recs = tuned_records(self.records, nav.nav.gps_sigma_scale)
+            dt = float(recs["imu"].dt_s)
+            er = self.keep["epoch_rows"]
+            n = int(np.shape(recs["imu"].dtheta_body)[0])
+            self._obs = _stacked_observations(recs, np.asarray(truth.t_s, dtype=float)[er::er], 0.25 * dt, True, n)
+        return self._obs
+
+
+def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Array) -> BankPass | None:
+    """`bank_pass` for run k of an open-loop flight group from what the group's pass left (GroupInputs): its start,
+    its INS at the epochs and its records; nothing drawn or integrated again (the same numbers: the pass's start and
+    INS are the run's own, whatever the batch)."""
+    recs = group.records
+    imu = recs["imu"]
+    m = int(np.shape(imu.dtheta_body)[1])
+    er = group.keep["epoch_rows"]
+    o_all = group.observations(nav, truth)
+    o = {key: (v[k:k + 1] if isinstance(v, np.ndarray) and key not in ("baro_r", "r_pl", "pl_sig", "el0")
+               else v) for key, v in o_all.items()}
+    baro = recs.get("baro")
+    one_baro = {} if baro is None else {"baro": dataclasses.replace(baro, valid=np.asarray(baro.valid)[k:k + 1],
+                                                                    h_baro_m=np.asarray(baro.h_baro_m)[k:k + 1])}
+    hb = _baro_held(nav, one_baro, truth, m)
+    used = np.flatnonzero(np.any(np.asarray(recs["gnss"].valid, dtype=bool)[k], axis=0))
+    x_hat, P = group.keep["start"][k]
+    return _core(nav, truth, modes, m, er, x_hat, P, group.keep["db"][k], group.keep["ins_epoch_rows"][k],
+                 None if hb is None else hb[0], o, used)
+
+
+def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Array, P_conv: Array,
+          db_error: Any, ins_ep: Array, hb1: Array | None, o: dict[str, Any], used: Array) -> BankPass | None:
+    """The pass from the run's start (x_hat, P_conv, its terrain-database error), its INS states at the epochs
+    ins_ep (E, 16), its baro held for the damping loop hb1 (m,) or None, its stacked observations o (one run) and
+    the GNSS channels it measures."""
+    from approachsim.integrity.bank import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
+
+    lay = nav.layout
+    eng = EpochEngine(nav)
     # the epochs and the reference (the truth at the epoch rows: nav/shared.py)
     e_rows = np.arange(epoch_rows, m + 1, epoch_rows)
     E = e_rows.shape[0]
@@ -160,18 +228,15 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     t_e = np.asarray(truth.t_s, dtype=float)[e_rows]
     dt_e = np.diff(np.concatenate([[float(truth.t_s[0])], t_e]))
     held1 = np.zeros(E, dtype=np.int64)
-    if lay.has("ac") and hb_full is not None:
+    if lay.has("ac") and hb1 is not None:
         for e, r in enumerate(e_rows):
-            held1[e] = np.all(np.isnan(hb_full[0, r - epoch_rows:r]))
+            held1[e] = np.all(np.isnan(hb1[r - epoch_rows:r]))
     ref, ref_cbn, f_ref, ref_agl = _reference(nav, truth, m, epoch_rows, e_rows)
     # the copies' observations: copy 0 all, copy k + 1 without mode k (bank.bank_records)
-    o = _stacked_observations(records, t_e, tol, True, 1)
     baro_h = np.repeat(o["baro_h"], C, axis=0)
     radalt_h = np.repeat(o["radalt_h"], C, axis=0)
     rho_all = o["rho"]
     pl_rho = np.repeat(o["pl_rho"], C, axis=0)
-    used = np.flatnonzero(np.any(np.asarray(gnss.valid, dtype=bool)[0], axis=0))
-    x_hat, P_conv = runs[0].fs.x, np.asarray(runs[0].fs.P, dtype=float)
     kept = _kept_channels(lay, used, P_conv) if lay.has("gse") else used
     if lay.has("gse"):
         red, idx = _reduced(lay, kept)
@@ -210,7 +275,7 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     nz = nav.noise_model.noise(None)
     f_gse = -np.expm1(-2.0 * dt_e / nz.gse_tau_s) if lay.has("gse") else np.zeros(E)
     f_gmp = -np.expm1(-2.0 * dt_e / nz.gmp_tau_s) if lay.has("gse") else np.zeros(E)
-    db = RunDatabase.of(nav.nav.terrain_database, runs[0].db_error)
+    db = RunDatabase.of(nav.nav.terrain_database, db_error)
     dbp, db_x, db_u = EpochEngine.stack([db] * C)
     n = red.n
     X = np.repeat(x_hat[idx][None], C, axis=0)
@@ -219,7 +284,7 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     codes, nu, S = np.zeros((C, E, R), dtype=np.int64), np.zeros((C, E, R)), np.zeros((C, E, R))
     n_rows = np.zeros((C, E), dtype=np.int64)
     x_out, pd, pnav = np.zeros((C, E, n)), np.zeros((C, E, n)), np.zeros((C, E, 9, 9))
-    ins_y = np.ascontiguousarray(np.broadcast_to(rows[0, e_rows], (C, E, ins.NX)))
+    ins_y = np.ascontiguousarray(np.broadcast_to(ins_ep, (C, E, ins.NX)))
     model = _models(nav, truth, q, gse_full, gmp_full, loop, dt_e, ref, ref_cbn, f_ref, held1)
     if model is None:
         return None
@@ -232,7 +297,7 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
                    pd, pnav, np.zeros(n), np.zeros(n), workspace(n))
     # the outputs' errors at the epochs: the INS rows - x_hat against the truth rows (Navigator.results)
     xe = x_out[:, :, 0:9].reshape(C * E, 9)
-    o_s = ins.perturb(ins.unpack(np.tile(rows[0, e_rows], (C, 1))), -xe[:, 0:3], -xe[:, 3:6], -xe[:, 6:9])
+    o_s = ins.perturb(ins.unpack(np.tile(ins_ep, (C, 1))), -xe[:, 0:3], -xe[:, 3:6], -xe[:, 6:9])
     err = true_error_rows(o_s, truth, np.tile(e_rows, C)).reshape(C, E, 9)
     return BankPass(t_e, err, pnav, x_out, pd, red, kept, (codes[0], n_rows[0], nu[0], S[0]))
 

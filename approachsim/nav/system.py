@@ -327,8 +327,8 @@ class NavSystem:
         return Observations.at(records, t, tol, batched)
 
     def run(self, truth: Truth, records: Mapping[str, Any], rngs: np.random.Generator | list[np.random.Generator],
-            *, shared_covariance: bool = False, states: SensorStates | None = None, copies: bool = False
-            ) -> NavRun | list[NavRun]:
+            *, shared_covariance: bool = False, states: SensorStates | None = None, copies: bool = False,
+            keep: dict | None = None) -> NavRun | list[NavRun]:
         """Navigate over whole records (open loop: the truth is only read at row 0, at the epochs for the error
         history and, with the shared covariance, as the reference trajectory).
 
@@ -338,7 +338,10 @@ class NavSystem:
         states: the runs' realized sensor errors at truth row 0 (sensors.states.start_states), needed by the
         converged start. copies: the runs are copies of one run (the same IMU and baro records and start draws:
         the integrity bank's sub-filters, which differ only in the measurements they use): the INS is integrated
-        once for all of them (feed-forward only; checked).
+        once for all of them (feed-forward only; checked). keep: a dict that receives what the runs' integrity
+        banks reuse (integrity/bankpass.py, open loop): "start" [(x_hat (n,), P (n, n))] each run's filter start,
+        "db" its terrain-database error, "ins_epoch_rows" (N, E, 16) the INS states at the aiding epochs (rows
+        epoch_rows, 2 epoch_rows, ...; packed, kernels/strapdown.py), "epoch_rows", "feed_forward".
         """
         records = tuned_records(records, self.nav.gps_sigma_scale)
         if shared_covariance and not self.shares_covariance():
@@ -371,7 +374,14 @@ class NavSystem:
                                  "increments or feedback differ)")
             s, ins_of = ins.unpack(x0[:1]), np.zeros(len(gens), dtype=int)
             dth, dvb = dth[:1], dvb[:1]
+        if keep is not None:
+            keep["start"] = [(np.array(r.fs.x, dtype=float), np.array(self.filter.covariance(r.fs), dtype=float))
+                             for r in runs]
+            keep["db"] = [r.db_error for r in runs]
         nav = Navigator(self, s, runs, float(truth.t_s[0]), m + 1, shared=shared, ins_of=ins_of)
+        if keep is not None:
+            keep["feed_forward"] = not self.nav.feedback
+            keep["epoch_rows"] = epoch_rows
         baro = records.get("baro")
         hb_full = None
         if self.loop_gains() is not None and baro is not None:
@@ -386,6 +396,8 @@ class NavSystem:
                     raise ValueError("run(copies=True): the copies' baro records differ")
                 hb_full = hb_full[:1]
         if nav.can_pass() and nav.compiled_pass(records, truth, batched, dth, dvb, dt, hb_full, epoch_rows):
+            if keep is not None:
+                keep["ins_epoch_rows"] = nav.rows[:, epoch_rows::epoch_rows].copy()
             results = nav.results(truth, solutions={0} if copies else True)
             return results if batched else results[0]
         # the compiled INS steps every run over the rows between two epochs in one call; a run's numbers do not
@@ -406,6 +418,8 @@ class NavSystem:
                                 raise ValueError("run(copies=True): a copy's FDE excluded the baro (its INS differs)")
                             hb_full[i, j1:] = np.nan
             j0 = j1
+        if keep is not None:
+            keep["ins_epoch_rows"] = nav.rows[:, epoch_rows::epoch_rows].copy()
         results = nav.results(truth, solutions={0} if copies else True)  # copies: the main filter's solution only
         return results if batched else results[0]
 
