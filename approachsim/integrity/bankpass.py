@@ -30,6 +30,7 @@ of the state count: 70 states (24 channels) to 22 + 2 x (channels used), about 3
 from __future__ import annotations
 
 import dataclasses
+import weakref
 from dataclasses import dataclass
 from typing import Any
 
@@ -288,9 +289,7 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     model = _models(nav, truth, q, gse_full, gmp_full, loop, dt_e, ref, ref_cbn, f_ref, held1)
     if model is None:
         return None
-    phi_f, qd_f = model
-    phi = np.ascontiguousarray(phi_f[:, idx[:, None], idx[None, :]])
-    qd = np.ascontiguousarray(qd_f[:, idx[:, None], idx[None, :]])
+    phi, qd = _cut(model, red)
     bk.bank_epochs(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
                    o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho,
                    r_sv, sig, eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, codes, nu, S, n_rows, x_out,
@@ -303,42 +302,86 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
 
 
 _MODELS: list = []
-"""`_models`' last results: (system, truth, dt, held, (phi, qd)) (the runs of a flight group share them)."""
+"""`_models`' last result: (system, weak reference to the truth, dt, held, model) (the runs of a flight group share
+it)."""
 
 
 def _models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array, dt: Array, ref: Array,
-            ref_cbn: Array, f_ref: Array, held: Array) -> tuple[Array, Array] | None:
-    """Phi, Qd (E, n, n) of every epoch on the full layout (bank_kernel.models: what shared_pass makes), kept
-    for the last two (system, truth) objects with the same intervals and damping-loop holds; None when an
-    epoch's model is too large for the compiled discretization."""
+            ref_cbn: Array, f_ref: Array, held: Array) -> tuple[Array, Array, em.StateLayout] | None:
+    """Phi, Qd of every epoch (bank_kernel.models on the full layout: what shared_pass makes), kept in compact form
+    for the last (system, truth) objects with the same intervals and damping-loop holds: (E, n1, n1) on the layout
+    with one GPS channel, the channels' states being lone (their rows and columns zero off the diagonal, Phi's
+    diagonal the same for every channel: checked, the Qd diagonal is each copy's own, set in the kernel), and that
+    layout. None when an epoch's model is too large for the compiled discretization or the channels are not lone."""
     key_dt, key_held = dt.tobytes(), held.tobytes()
     for sys_, tr, kd, kh, val in _MODELS:
-        if sys_ is nav and tr is truth and kd == key_dt and kh == key_held:
+        if sys_ is nav and tr() is truth and kd == key_dt and kh == key_held:
             return val
-    E, n = dt.shape[0], nav.layout.n
+    lay = nav.layout
+    E, n = dt.shape[0], lay.n
     phi, qd = np.zeros((E, n, n)), np.zeros((E, n, n))
-    if bk.models(nav.layout.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, phi, qd) != E:
+    if bk.models(lay.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, phi, qd) != E:
         return None  # an epoch's model is too large for the compiled discretization
-    _MODELS.insert(0, (nav, truth, key_dt, key_held, (phi, qd)))
-    del _MODELS[2:]
-    return phi, qd
+    if lay.n_sv:
+        ch = np.r_[lay.index["gse"], lay.index["gmp"]]
+        for a in (phi, qd):
+            off = a[:, ch, :].copy()
+            off[:, np.arange(ch.size), ch] = 0.0
+            if np.any(off) or np.any(a[:, :, ch][:, np.setdiff1d(np.arange(n), ch), :]):
+                return None
+        for g in ("gse", "gmp"):
+            d = phi[:, lay.index[g], lay.index[g]]
+            if np.any(d != d[:, :1]):
+                return None
+        lay1, idx1 = _reduced(lay, np.array([0]))
+    else:
+        lay1, idx1 = lay, np.arange(n)
+    val = (np.ascontiguousarray(phi[:, idx1[:, None], idx1[None, :]]),
+           np.ascontiguousarray(qd[:, idx1[:, None], idx1[None, :]]), lay1)
+    _MODELS[:] = [(nav, weakref.ref(truth), key_dt, key_held, val)]
+    return val
+
+
+def _cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -> tuple[Array, Array]:
+    """Phi, Qd (E, n_r, n_r) of the reduced layout `red` from `_models`' compact form: the one channel's lone states
+    repeated on the diagonal of each kept channel's, every other entry as the full model's."""
+    phi1, qd1, lay1 = model
+    if not red.has("gse"):
+        return phi1, qd1
+    src, chan = [], []
+    for g in red.groups:
+        sl = red.index[g]
+        if g in ("gse", "gmp"):
+            src.extend([lay1.i(g)] * (sl.stop - sl.start))
+            chan.extend(range(sl.start, sl.stop))
+        else:
+            src.extend(range(lay1.index[g].start, lay1.index[g].stop))
+    src_a, chan_a = np.asarray(src), np.asarray(chan, dtype=int)
+    out = []
+    for a in (phi1, qd1):
+        r = a[:, src_a[:, None], src_a[None, :]]
+        d = r[:, chan_a, chan_a].copy()
+        r[:, chan_a, :] = 0.0
+        r[:, :, chan_a] = 0.0
+        r[:, chan_a, chan_a] = d
+        out.append(np.ascontiguousarray(r))
+    return out[0], out[1]
 
 
 _REFERENCES: list = []
-"""`_reference`'s last results: (system, truth, m, epoch_rows, value); the runs of an open-loop flight group share
-their truth, so their banks share its reference."""
+"""`_reference`'s last result: (system, weak reference to the truth, m, epoch_rows, value); the runs of an open-loop
+flight group share their truth, so their banks share its reference."""
 
 
 def _reference(nav: Any, truth: Any, m: int, epoch_rows: int, e_rows: Array) -> tuple[Array, Array, Array, Array]:
     """The reference at the epochs (nav/shared.py, Navigator.compiled_pass): packed truth rows (E, 16), their
     body-to-NED matrices (E, 3, 3), the interval's mean specific force NED (E, 3) m/s^2, the height above the
-    terrain (E,) m. Kept for the last two (system, truth) objects (the kernel only reads them)."""
+    terrain (E,) m. Kept for the last (system, truth) objects (the kernel only reads them)."""
     for sys_, tr, m_, er, val in _REFERENCES:
-        if sys_ is nav and tr is truth and m_ == m and er == epoch_rows:
+        if sys_ is nav and tr() is truth and m_ == m and er == epoch_rows:
             return val
     val = _make_reference(nav, truth, m, epoch_rows, e_rows)
-    _REFERENCES.insert(0, (nav, truth, m, epoch_rows, val))
-    del _REFERENCES[2:]
+    _REFERENCES[:] = [(nav, weakref.ref(truth), m, epoch_rows, val)]
     return val
 
 

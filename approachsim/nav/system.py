@@ -30,6 +30,7 @@ has its own filter state, or with `shared_covariance` one covariance and gain pe
 from __future__ import annotations
 
 import hashlib
+import weakref
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
@@ -61,7 +62,8 @@ __all__ = ["NavRun", "NavSystem", "StatusLog", "TerrainDatabase"]
 _SYSTEMS: dict = {}
 """NavSystem.from_profile's systems, by profile (a few per process)."""
 _PREPARED: dict = {}
-"""NavSystem._prepared's converged starts: key -> (system, truth, initial.Prepared), oldest first."""
+"""NavSystem._prepared's converged starts: key -> (system, weak reference to the truth, initial.Prepared), oldest
+first."""
 _PREPARED_MAX = 64
 """Starts kept (two flight groups of 25 runs: a group's bank runs right after its pass)."""
 
@@ -263,7 +265,8 @@ class NavSystem:
         """The converged start's P_conv and conditioner (initial.Prepared) of one run's sky and schedule, made once
         per process for the same inputs (the open-loop pass of a flight group makes every run's; that run's
         integrity bank then finds it here instead of repeating the 600 s Riccati recursion and the
-        eigen-decompositions). Keyed by this system and truth (the objects, kept alive by the entry) and the bytes
+        eigen-decompositions). Keyed by this system and truth (the objects: the entry keeps the system, and lives only
+        as long as the truth) and the bytes
         of everything else initial.draw reads (the row, P0, the run's observations at the row, the sensor states'
         indices)."""
         s_idx, _ = initial.sensor_vector(self.layout, states, P0)
@@ -274,13 +277,15 @@ class NavSystem:
             parts.append(repr(v.shape).encode() + v.tobytes() if isinstance(v, np.ndarray) else repr(v).encode())
         key = (id(self), id(truth), hashlib.blake2b(b"\0".join(parts), digest_size=20).digest())
         hit = _PREPARED.get(key)
-        if hit is not None and hit[0] is self and hit[1] is truth:
+        if hit is not None and hit[0] is self and hit[1]() is truth:
             return hit[2]
         P_conv = initial.converged_covariance(self, truth, obs, row, P0, self.nav.initial_error.converge_s)
         prepared = initial.Prepared(P_conv, initial.conditioner(P_conv, P0[np.ix_(s_idx, s_idx)], s_idx))
+        for k in [k for k, v in _PREPARED.items() if v[1]() is None]:  # the truths gone: their starts too
+            del _PREPARED[k]
         if len(_PREPARED) >= _PREPARED_MAX:
             _PREPARED.pop(next(iter(_PREPARED)))
-        _PREPARED[key] = (self, truth, prepared)
+        _PREPARED[key] = (self, weakref.ref(truth), prepared)
         return prepared
 
     def _fde(self) -> FdeState | None:
