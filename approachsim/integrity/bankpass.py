@@ -330,7 +330,8 @@ def _models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array,
             if np.any(off) or np.any(a[:, :, ch][:, np.setdiff1d(np.arange(n), ch), :]):
                 return None
         for g in ("gse", "gmp"):
-            d = phi[:, lay.index[g], lay.index[g]]
+            i = np.arange(lay.index[g].start, lay.index[g].stop)
+            d = phi[:, i, i]  # (E, n_sv) the channels' diagonal entries
             if np.any(d != d[:, :1]):
                 return None
         lay1, idx1 = _reduced(lay, np.array([0]))

@@ -62,11 +62,16 @@ def test_reduced_pass_equals_the_copies_pass(kind, monkeypatch):
     modes = kind == "modes"
     called = []
     orig = bankpass.bank_pass
-    monkeypatch.setattr(bankpass, "bank_pass", lambda *a, **k: called.append(1) or orig(*a, **k))
+
+    def spy(*a, **k):
+        called.append(orig(*a, **k))
+        return called[-1]
+
+    monkeypatch.setattr(bankpass, "bank_pass", spy)
     for run in (0, 1):
         new, _ = run_bank(prof, truth, SEED, run, sensor_modes_on=modes)
         old, main = run_bank(prof, truth, SEED, run, sensor_modes_on=modes, compiled=False)
-        assert len(called) == run + 1  # the compiled pass ran
+        assert len(called) == run + 1 and called[-1] is not None  # the compiled pass ran (no fallback)
         assert np.array_equal(new.channels, old.channels) and new.ek.shape == old.ek.shape
         assert new.ek.shape[1] >= 4 + (2 if modes else 0)
         np.testing.assert_array_equal(new.t_s, old.t_s)
@@ -109,6 +114,7 @@ def test_group_pass_equals_the_runs_own():
                 states=start_states(suite, truth, errors), keep=keep)
         g = bankpass.GroupInputs(records, keep)
         assert g.usable(nav)
+        assert all(bankpass.bank_pass_group(nav, truth, g, k, np.zeros(0, int)) is not None for k in range(len(runs)))
         return [run_bank(prof, truth, SEED, i, group=(g, k))[0] for k, i in enumerate(runs)]
 
     three = group_banks([0, 1, 2])
