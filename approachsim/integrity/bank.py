@@ -6,8 +6,11 @@ GNSS channel k never used (every channel the main filter used during the run is 
 then never uses that source (its record invalid throughout, as an outage: the navigation holds the baro damping
 loop without a baro, nav/fde.py). Mode codes (`BankEpochs.channels`): a GNSS channel index >= 0, BARO_MODE,
 RADALT_MODE, PSEUDOLITE_MODE - u for pseudolite unit u. The bank runs
-as K + 1 copies of the run in one batched NavSystem pass (same sensor draws, same initial-error draw: the
-copies differ only in the excluded channel), with the shared covariance where the configuration allows it.
+as K + 1 copies of the run in one batched pass (same sensor draws, same initial-error draw: the
+copies differ only in the excluded channel), with the shared covariance where the configuration allows it: with
+the compiled optimal filter and per-run GPS skies (the default) one compiled call on the states the copies can move
+(integrity/bankpass.py; in an open-loop campaign from the start and INS its flight group's pass left), elsewhere
+NavSystem.run(copies=True). Both give the same numbers (tests/unit/integrity/test_bankpass.py).
 
 At each filter epoch, in the approach frame (vertical up; lateral = cross-track, + right of the runway
 heading), the separation of sub-solution k is e_k - e_0 (the difference of the output errors against truth,
