@@ -308,37 +308,36 @@ it)."""
 
 def _models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array, dt: Array, ref: Array,
             ref_cbn: Array, f_ref: Array, held: Array) -> tuple[Array, Array, em.StateLayout] | None:
-    """Phi, Qd of every epoch (bank_kernel.models on the full layout: what shared_pass makes), kept in compact form
-    for the last (system, truth) objects with the same intervals and damping-loop holds: (E, n1, n1) on the layout
-    with one GPS channel, the channels' states being lone (their rows and columns zero off the diagonal, Phi's
-    diagonal the same for every channel: checked, the Qd diagonal is each copy's own, set in the kernel), and that
-    layout. None when an epoch's model is too large for the compiled discretization or the channels are not lone."""
+    """Phi, Qd of every epoch (bank_kernel.models: what shared_pass makes) in compact form, kept for the last (system,
+    truth) objects with the same intervals and damping-loop holds: (E, n1, n1) on the layout with one GPS channel
+    (the channels' states are lone, their rows and columns zero off the diagonal: checked; Phi's diagonal is the
+    same for every channel, the Qd diagonal each copy's own, set in the kernel), and that layout. Discretized on
+    that layout: the same numbers as on the full one (the bankpass docstring's argument: lone states are closed
+    form, the coupled component the same matrix). None when an epoch's model is too large for the compiled
+    discretization or the channels are not lone."""
     key_dt, key_held = dt.tobytes(), held.tobytes()
     for sys_, tr, kd, kh, val in _MODELS:
         if sys_ is nav and tr() is truth and kd == key_dt and kh == key_held:
             return val
     lay = nav.layout
-    E, n = dt.shape[0], lay.n
-    phi, qd = np.zeros((E, n, n)), np.zeros((E, n, n))
-    if bk.models(lay.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, phi, qd) != E:
-        return None  # an epoch's model is too large for the compiled discretization
-    if lay.n_sv:
-        ch = np.r_[lay.index["gse"], lay.index["gmp"]]
-        for a in (phi, qd):
-            off = a[:, ch, :].copy()
-            off[:, np.arange(ch.size), ch] = 0.0
-            if np.any(off) or np.any(a[:, :, ch][:, np.setdiff1d(np.arange(n), ch), :]):
-                return None
-        for g in ("gse", "gmp"):
-            i = np.arange(lay.index[g].start, lay.index[g].stop)
-            d = phi[:, i, i]  # (E, n_sv) the channels' diagonal entries
-            if np.any(d != d[:, :1]):
-                return None
-        lay1, idx1 = _reduced(lay, np.array([0]))
+    if lay.n_sv:  # one channel stands for all: its states' F, Qc depend on the channel only through the sigma, which
+        # enters Qc alone (kernels/errormodel.dynamics: a Markov state of the common tau), and each copy's Qd sets it
+        lay1, _ = _reduced(lay, np.array([0]))
+        gse, gmp = np.ascontiguousarray(gse[:1]), np.ascontiguousarray(gmp[:1])
     else:
-        lay1, idx1 = lay, np.arange(n)
-    val = (np.ascontiguousarray(phi[:, idx1[:, None], idx1[None, :]]),
-           np.ascontiguousarray(qd[:, idx1[:, None], idx1[None, :]]), lay1)
+        lay1 = lay
+    E, n = dt.shape[0], lay1.n
+    phi, qd = np.zeros((E, n, n)), np.zeros((E, n, n))
+    if bk.models(lay1.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, phi, qd) != E:
+        return None  # an epoch's model is too large for the compiled discretization
+    if lay1.n_sv:  # the channel's states lone: their rows and columns zero off the diagonal
+        ch = np.array([lay1.i("gse"), lay1.i("gmp")])
+        rest = np.setdiff1d(np.arange(n), ch)
+        for a in (phi, qd):
+            if (np.any(a[:, ch][:, :, rest]) or np.any(a[:, rest][:, :, ch]) or np.any(a[:, ch[0], ch[1]])
+                    or np.any(a[:, ch[1], ch[0]])):
+                return None
+    val = (phi, qd, lay1)
     _MODELS[:] = [(nav, weakref.ref(truth), key_dt, key_held, val)]
     return val
 
