@@ -102,7 +102,7 @@ def spec_for(profile: Any, mode: str, land: bool = False) -> PipelineSpec:
 
 def _score(
     profile: Any, run: int, truth: Any, nav: Any, clock_true: Any, gnss: Any = None, flight: Any = None,
-    seed: int | None = None,
+    seed: int | None = None, bank_group: Any = None,
 ) -> RunResult:
     from approachsim.evaluate.score import HEIGHT_GRID_FT, score_run
 
@@ -124,7 +124,8 @@ def _score(
         from approachsim import units
         from approachsim.integrity.campaign import score_with_bank
 
-        s_int, counts, a_int = score_with_bank(profile, truth, seed, run, nav, HEIGHT_GRID_FT * units.FT)
+        s_int, counts, a_int = score_with_bank(profile, truth, seed, run, nav, HEIGHT_GRID_FT * units.FT,
+                                               group=bank_group)
         scalars.update(s_int)
         arrays = {**arrays, **a_int}
     return RunResult(run=run, ok=True, scalars=scalars, arrays=arrays, series=series, counts=counts)
@@ -294,14 +295,22 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     nav = NavSystem.from_profile(profile)
     # optimal filter: one covariance per measurement schedule for all runs (linearized along the shared truth);
     # robust / adaptive configurations filter each run on its own
+    # with the integrity bank: the pass keeps each run's start and INS for its bank (integrity/bankpass.py)
+    keep = {} if profile.evaluation.integrity_on else None
     navruns = nav.run(truth, records, [stream(seed, i, "nav") for i in runs],
-                      shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors))
+                      shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors), keep=keep)
+    group = None
+    if keep is not None:
+        from approachsim.integrity.bankpass import GroupInputs
+
+        group = GroupInputs(records, keep)
     out = []
     for k, (i, nr) in enumerate(zip(runs, navruns, strict=True)):
         try:
             g = records.get("gnss")
             out.append(_score(profile, i, truth, nr.solution, _clock_truth(records, k, truth.t_s),
-                              None if g is None else g.run(k), seed=seed))
+                              None if g is None else g.run(k), seed=seed,
+                              bank_group=None if group is None else (group, k)))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out

@@ -6,8 +6,11 @@ GNSS channel k never used (every channel the main filter used during the run is 
 then never uses that source (its record invalid throughout, as an outage: the navigation holds the baro damping
 loop without a baro, nav/fde.py). Mode codes (`BankEpochs.channels`): a GNSS channel index >= 0, BARO_MODE,
 RADALT_MODE, PSEUDOLITE_MODE - u for pseudolite unit u. The bank runs
-as K + 1 copies of the run in one batched NavSystem pass (same sensor draws, same initial-error draw: the
-copies differ only in the excluded channel), with the shared covariance where the configuration allows it.
+as K + 1 copies of the run in one batched pass (same sensor draws, same initial-error draw: the
+copies differ only in the excluded channel), with the shared covariance where the configuration allows it: with
+the compiled optimal filter and per-run GPS skies (the default) one compiled call on the states the copies can move
+(integrity/bankpass.py; in an open-loop campaign from the start and INS its flight group's pass left), elsewhere
+NavSystem.run(copies=True). Both give the same numbers (tests/unit/integrity/test_bankpass.py).
 
 At each filter epoch, in the approach frame (vertical up; lateral = cross-track, + right of the runway
 heading), the separation of sub-solution k is e_k - e_0 (the difference of the output errors against truth,
@@ -21,11 +24,12 @@ the category's alert limit at the aircraft's distance and height, misleading inf
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from approachsim.integrity import bankpass
 from approachsim.integrity.requirements import (
     REQUIREMENTS,
     IntegrityRequirement,
@@ -135,7 +139,19 @@ class BankEpochs:
     """(e,) height above the threshold, m."""
     wtest: Array | None = None
     """(e, K) the identification statistic of each fault mode over the 9 navigation states
-    (integrity.separation.identify_statistic); None: identify on the two approach axes only."""
+    (integrity.separation.identify_statistic); None: made from `separations` when asked (`identification`), or
+    without them identify on the two approach axes only."""
+    separations: tuple[Array, Array] | None = field(default=None, repr=False, compare=False)
+    """(d9 (e, K, 9), p9 (e, K, 9, 9)): the sub-solutions' navigation-state separations x_k - x_0 and their
+    covariances P_k - P_0, from which `identification` makes the statistic (only runs with a detection need it)."""
+
+    def identification(self) -> Array | None:
+        """wtest, or the statistic made from `separations` (once; kept), or None: identify on the approach axes."""
+        if self.wtest is not None or self.separations is None:
+            return self.wtest
+        w = identify_statistic(*self.separations)
+        object.__setattr__(self, "wtest", w)
+        return w
 
 
 def _axes(heading_rad: float) -> Array:
@@ -145,25 +161,33 @@ def _axes(heading_rad: float) -> Array:
 
 def bank_epochs(main: Any, subs: list[Any], channels: Array, truth: Any, heading_rad: float) -> BankEpochs:
     """Project the NavRuns of the main filter and the sub-filters on the approach axes at the epochs."""
-    A = _axes(heading_rad)
-    t = np.asarray(main.t_epoch_s)
+    err = np.stack([np.asarray(r.true_error_nav) for r in [main, *subs]])
+    pnav = np.stack([np.asarray(r.P_nav) for r in [main, *subs]])
+    return bank_epochs_arrays(np.asarray(main.t_epoch_s), err, pnav, channels, truth, heading_rad)
 
-    def err(run: Any) -> tuple[Array, Array]:
-        e = np.asarray(run.true_error_nav)[:, 0:3] @ A.T
-        p = np.einsum("ij,ejk,ik->ei", A, np.asarray(run.P_nav)[:, 0:3, 0:3], A)
+
+def bank_epochs_arrays(t: Array, err: Array, pnav: Array, channels: Array, truth: Any, heading_rad: float
+                       ) -> BankEpochs:
+    """`bank_epochs` from the copies' arrays: t (e,) epoch times, err (K + 1, e, 9) output errors and pnav
+    (K + 1, e, 9, 9) navigation covariances, copy 0 the main filter."""
+    A = _axes(heading_rad)
+
+    def axes(k: int) -> tuple[Array, Array]:
+        e = err[k][:, 0:3] @ A.T
+        p = np.einsum("ij,ejk,ik->ei", A, pnav[k][:, 0:3, 0:3], A)
         return e, p
 
-    e0, p0 = err(main)
-    subs_ep = [err(r) for r in subs]
+    e0, p0 = axes(0)
+    subs_ep = [axes(k) for k in range(1, err.shape[0])]
     ek = np.stack([s[0] for s in subs_ep], axis=1) if subs_ep else np.zeros((t.size, 0, 2))
     pk = np.stack([s[1] for s in subs_ep], axis=1) if subs_ep else np.zeros((t.size, 0, 2))
     r = np.stack([np.interp(t, truth.t_s, truth.r_rwy[:, i]) for i in range(3)], axis=1)
-    w = None
-    if subs:  # full navigation-state separations e_k - e_0 (9 states) and their covariances P_k - P_0
-        d9 = np.stack([np.asarray(s.true_error_nav) - np.asarray(main.true_error_nav) for s in subs], axis=1)
-        p9 = np.stack([np.asarray(s.P_nav) - np.asarray(main.P_nav) for s in subs], axis=1)
-        w = identify_statistic(d9, p9)
-    return BankEpochs(t, e0, p0, ek, pk, np.asarray(channels), r[:, 0], r[:, 2], w)
+    sep = None
+    if subs_ep:  # full navigation-state separations e_k - e_0 (9 states) and their covariances P_k - P_0
+        d9 = np.stack([err[k] - err[0] for k in range(1, err.shape[0])], axis=1)
+        p9 = np.stack([pnav[k] - pnav[0] for k in range(1, err.shape[0])], axis=1)
+        sep = (d9, p9)
+    return BankEpochs(t, e0, p0, ek, pk, np.asarray(channels), r[:, 0], r[:, 2], None, sep)
 
 
 @dataclass(frozen=True)
@@ -261,7 +285,8 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
     err, pl = e_main.copy(), r.pl_m.copy()
     excluded, t_det = -1, float("nan")
     if r.detected.any() and confirm:
-        stat = ep.wtest[sel] if ep.wtest is not None else np.max(r.test_ratio, axis=2)
+        w = ep.identification()
+        stat = w[sel] if w is not None else np.max(r.test_ratio, axis=2)
         mode, ok = second_level(r.detected, stat)
         t_det = float(t[int(np.argmax(r.detected))])
         on = mode >= 0
@@ -274,7 +299,8 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
         i = int(np.argmax(r.detected))
         # identification: the full navigation-state statistic (Baarda's w-test squared) where the bank has it,
         # else the largest two-axis normalized separation
-        k = int(np.argmax(ep.wtest[sel][i])) if ep.wtest is not None else int(r.suspect[i])
+        w = ep.identification()
+        k = int(np.argmax(w[sel][i])) if w is not None else int(r.suspect[i])
         excluded, t_det = int(ep.channels[k]), float(t[i])
         err[i:] = np.abs(ep.ek[sel][i:, k])
         pl[i:] = req.k_ff() * np.sqrt(ep.pk[sel][i:, k])
@@ -308,15 +334,21 @@ def score_run(ep: BankEpochs, epoch_hz: float, start_height_m: float, dh_m: dict
     return out
 
 
-def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: bool = False
-             ) -> tuple[BankEpochs, Any]:
+def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: bool = False, *,
+             compiled: bool = True, group: tuple[Any, int] | None = None) -> tuple[BankEpochs, Any]:
     """Measure run `run` of the campaign seeded `seed` on `truth`, navigate it with the main filter and the
     sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun).
     sensor_modes_on: the baro, radar altimeter and pseudolite units are fault modes too (module docstring).
 
-    The copies share the run's IMU record and its INS (NavSystem.run(copies=True), feed-forward): the IMU is
+    Where integrity.bankpass applies (the compiled optimal filter, feed-forward, per-run GPS skies: the default),
+    the run is measured once and bankpass.bank_pass navigates every copy in one compiled call on the reduced
+    state (the same numbers; the main NavRun then has no solution and the reduced layout). Elsewhere the copies
+    share the run's IMU record and its INS (NavSystem.run(copies=True), feed-forward): the IMU is
     drawn and applied once; the other sensors are measured for the K + 1 copies (the same draws: the same
-    streams), whose GNSS records then lose one channel each (bank_records)."""
+    streams), whose GNSS records then lose one channel each (bank_records). compiled=False: always the latter (the
+    oracle of integrity/bankpass.py). group: (bankpass.GroupInputs, k) what the open-loop flight group's pass left
+    for this run, its run k (campaign/pipeline.py): nothing is drawn, started or integrated again (the same numbers,
+    bankpass.bank_pass_group)."""
     from dataclasses import fields, replace
 
     from approachsim.nav.system import NavSystem
@@ -324,6 +356,16 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     from approachsim.sensors.states import start_states
     from approachsim.sensors.suite import SensorSuite
 
+    if compiled and group is not None and not sensor_modes_on:
+        g, k = group
+        nav = NavSystem.from_profile(profile)
+        if g.usable(nav) and bankpass.applicable(nav, g.records):
+            channels = used_channels(np.asarray(g.records["gnss"].valid)[k])
+            bp = bankpass.bank_pass_group(nav, truth, g, k, channels)
+            if bp is not None:
+                ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth,
+                                        profile.runway.heading_rad)
+                return ep, bp.main_run()
     suite = SensorSuite.from_profile(profile)
     errors = suite.draw(truth.t_s, seed, [run])
     one = suite.apply(truth, errors)
@@ -335,16 +377,21 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     copies = len(channels) + 1
     nav = NavSystem.from_profile(profile)
     states = start_states(suite, truth, errors)
-    states = replace(states, **{f.name: np.repeat(getattr(states, f.name), copies, axis=0)
-                                for f in fields(states) if isinstance(getattr(states, f.name), np.ndarray)})
     # a sub-filter without the baro has its own INS when the baro damping loop drives the INS vertical channel
     own_ins = bool(sensor_modes_on and "baro" in one and nav.loop_gains() is not None)
     share = not nav.nav.feedback and "imu" in one and not own_ins
+    if compiled and share and bankpass.applicable(nav, one):  # the compiled reduced pass (integrity/bankpass.py)
+        bp = bankpass.bank_pass(nav, truth, one, channels, stream(seed, run, "nav"), states)
+        if bp is not None:
+            ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth, profile.runway.heading_rad)
+            return ep, bp.main_run()
     rest = suite.without("imu") if share else suite  # feed-forward: one IMU record for every copy
     recs = rest.apply(truth, rest.draw(truth.t_s, seed, [run] * copies))
     if share:
         recs["imu"] = one["imu"]
     recs = bank_records(recs, channels)
+    states = replace(states, **{f.name: np.repeat(getattr(states, f.name), copies, axis=0)
+                                for f in fields(states) if isinstance(getattr(states, f.name), np.ndarray)})
     # every copy starts from the main filter's converged state (the first copy's schedule: all channels)
     navs = nav.run(truth, recs, [stream(seed, run, "nav") for _ in range(copies)],
                    shared_covariance=nav.shares_covariance(), states=states, copies=share)

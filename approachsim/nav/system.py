@@ -29,8 +29,10 @@ has its own filter state, or with `shared_covariance` one covariance and gain pe
 
 from __future__ import annotations
 
+import hashlib
+import weakref
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
@@ -56,6 +58,14 @@ from approachsim.sensors.states import SensorStates
 Array = np.ndarray
 
 __all__ = ["NavRun", "NavSystem", "StatusLog", "TerrainDatabase"]
+
+_SYSTEMS: dict = {}
+"""NavSystem.from_profile's systems, by profile (a few per process)."""
+_PREPARED: dict = {}
+"""NavSystem._prepared's converged starts: key -> (system, weak reference to the truth, initial.Prepared), oldest
+first."""
+_PREPARED_MAX = 64
+"""Starts kept (two flight groups of 25 runs: a group's bank runs right after its pass)."""
 
 
 def _radalt_states(sensors: SensorsConfig, nav: NavConfig) -> dict[str, bool]:
@@ -117,9 +127,23 @@ class NavSystem:
 
     @classmethod
     def from_profile(cls, profile: Any) -> NavSystem:
-        """The navigation system of a Profile (its [nav], [sensors], runway and terrain)."""
-        nav = getattr(profile, "nav", DEFAULT_NAV)
-        return cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain)
+        """The navigation system of a Profile (its [nav], [sensors], runway and terrain); one object per profile
+        and process (a function of the profile's value: the open-loop group's pass and each run's integrity bank
+        use the same one, and so share its starts, `start`)."""
+        try:
+            sys_ = _SYSTEMS.get(profile)
+        except TypeError:  # an unhashable profile-like object: build it each time
+            sys_, profile_key = None, None
+        else:
+            profile_key = profile
+        if sys_ is None:
+            nav = getattr(profile, "nav", DEFAULT_NAV)
+            sys_ = cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain)
+            if profile_key is not None:
+                if len(_SYSTEMS) >= 8:
+                    _SYSTEMS.clear()
+                _SYSTEMS[profile_key] = sys_
+        return sys_
 
     # --- models -------------------------------------------------------------------------------------------
 
@@ -217,9 +241,10 @@ class NavSystem:
             for i, g in enumerate(rngs):
                 key = obs.elevations(i).tobytes()
                 i0 = first.setdefault(key, i)
-                d = initial.draw(self, truth, obs.run(i0), states.take(i), [g], row,
-                                 self.initial_covariance(obs.elevations(i)), prep.get(key))
-                prep[key] = d[2]
+                P0 = self.initial_covariance(obs.elevations(i))
+                if key not in prep:
+                    prep[key] = self._prepared(truth, obs.run(i0), row, P0, states.take(i))
+                d = initial.draw(self, truth, obs.run(i0), states.take(i), [g], row, P0, prep[key])
                 draws.append(d)
             e = np.concatenate([d[0] for d in draws])
             x_hat = np.concatenate([d[1] for d in draws])
@@ -234,6 +259,34 @@ class NavSystem:
         runs = [RunFilter(self.filter.init(x_hat[i], P_convs[i]), [], np.zeros(3), np.zeros(3), self._fde(), dbs[i])
                 for i in range(n)]
         return s, runs
+
+    def _prepared(self, truth: Truth, obs: Observations, row: int, P0: Array, states: SensorStates
+                  ) -> initial.Prepared:
+        """The converged start's P_conv and conditioner (initial.Prepared) of one run's sky and schedule, made once
+        per process for the same inputs (the open-loop pass of a flight group makes every run's; that run's
+        integrity bank then finds it here instead of repeating the 600 s Riccati recursion and the
+        eigen-decompositions). Keyed by this system and truth (the objects: the entry keeps the system, and lives only
+        as long as the truth) and the bytes
+        of everything else initial.draw reads (the row, P0, the run's observations at the row, the sensor states'
+        indices)."""
+        s_idx, _ = initial.sensor_vector(self.layout, states, P0)
+        parts = [np.asarray(P0, dtype=float).tobytes(), str(row).encode(), np.asarray(s_idx).tobytes()]
+        for f in fields(obs):
+            v = getattr(obs, f.name)
+            parts.append(f.name.encode())
+            parts.append(repr(v.shape).encode() + v.tobytes() if isinstance(v, np.ndarray) else repr(v).encode())
+        key = (id(self), id(truth), hashlib.blake2b(b"\0".join(parts), digest_size=20).digest())
+        hit = _PREPARED.get(key)
+        if hit is not None and hit[0] is self and hit[1]() is truth:
+            return hit[2]
+        P_conv = initial.converged_covariance(self, truth, obs, row, P0, self.nav.initial_error.converge_s)
+        prepared = initial.Prepared(P_conv, initial.conditioner(P_conv, P0[np.ix_(s_idx, s_idx)], s_idx))
+        for k in [k for k, v in _PREPARED.items() if v[1]() is None]:  # the truths gone: their starts too
+            del _PREPARED[k]
+        if len(_PREPARED) >= _PREPARED_MAX:
+            _PREPARED.pop(next(iter(_PREPARED)))
+        _PREPARED[key] = (self, weakref.ref(truth), prepared)
+        return prepared
 
     def _fde(self) -> FdeState | None:
         """A run's online FDE state ([nav.fde] enabled), else None."""
@@ -279,8 +332,8 @@ class NavSystem:
         return Observations.at(records, t, tol, batched)
 
     def run(self, truth: Truth, records: Mapping[str, Any], rngs: np.random.Generator | list[np.random.Generator],
-            *, shared_covariance: bool = False, states: SensorStates | None = None, copies: bool = False
-            ) -> NavRun | list[NavRun]:
+            *, shared_covariance: bool = False, states: SensorStates | None = None, copies: bool = False,
+            keep: dict | None = None) -> NavRun | list[NavRun]:
         """Navigate over whole records (open loop: the truth is only read at row 0, at the epochs for the error
         history and, with the shared covariance, as the reference trajectory).
 
@@ -290,7 +343,10 @@ class NavSystem:
         states: the runs' realized sensor errors at truth row 0 (sensors.states.start_states), needed by the
         converged start. copies: the runs are copies of one run (the same IMU and baro records and start draws:
         the integrity bank's sub-filters, which differ only in the measurements they use): the INS is integrated
-        once for all of them (feed-forward only; checked).
+        once for all of them (feed-forward only; checked). keep: a dict that receives what the runs' integrity
+        banks reuse (integrity/bankpass.py, open loop): "start" [(x_hat (n,), P (n, n))] each run's filter start,
+        "db" its terrain-database error, "ins_epoch_rows" (N, E, 16) the INS states at the aiding epochs (rows
+        epoch_rows, 2 epoch_rows, ...; packed, kernels/strapdown.py), "epoch_rows", "feed_forward".
         """
         records = tuned_records(records, self.nav.gps_sigma_scale)
         if shared_covariance and not self.shares_covariance():
@@ -323,7 +379,14 @@ class NavSystem:
                                  "increments or feedback differ)")
             s, ins_of = ins.unpack(x0[:1]), np.zeros(len(gens), dtype=int)
             dth, dvb = dth[:1], dvb[:1]
+        if keep is not None:
+            keep["start"] = [(np.array(r.fs.x, dtype=float), np.array(self.filter.covariance(r.fs), dtype=float))
+                             for r in runs]
+            keep["db"] = [r.db_error for r in runs]
         nav = Navigator(self, s, runs, float(truth.t_s[0]), m + 1, shared=shared, ins_of=ins_of)
+        if keep is not None:
+            keep["feed_forward"] = not self.nav.feedback
+            keep["epoch_rows"] = epoch_rows
         baro = records.get("baro")
         hb_full = None
         if self.loop_gains() is not None and baro is not None:
@@ -338,6 +401,8 @@ class NavSystem:
                     raise ValueError("run(copies=True): the copies' baro records differ")
                 hb_full = hb_full[:1]
         if nav.can_pass() and nav.compiled_pass(records, truth, batched, dth, dvb, dt, hb_full, epoch_rows):
+            if keep is not None:
+                keep["ins_epoch_rows"] = nav.rows[:, epoch_rows::epoch_rows].copy()
             results = nav.results(truth, solutions={0} if copies else True)
             return results if batched else results[0]
         # the compiled INS steps every run over the rows between two epochs in one call; a run's numbers do not
@@ -358,6 +423,8 @@ class NavSystem:
                                 raise ValueError("run(copies=True): a copy's FDE excluded the baro (its INS differs)")
                             hb_full[i, j1:] = np.nan
             j0 = j1
+        if keep is not None:
+            keep["ins_epoch_rows"] = nav.rows[:, epoch_rows::epoch_rows].copy()
         results = nav.results(truth, solutions={0} if copies else True)  # copies: the main filter's solution only
         return results if batched else results[0]
 

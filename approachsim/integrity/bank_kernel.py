@@ -1,0 +1,83 @@
+"""The integrity bank's compiled pass (numba, cache=True): kernels/epoch.shared_pass with the model given.
+
+    bank_epochs(X, P3, phi, qd, lay, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins, <observations>, ...)
+
+shared_pass makes each epoch's model (F, Qc at the reference, Phi, Qd by Van Loan) itself, once per call; the bank
+calls it once per run, so every run of an open-loop flight group made the same models again (they depend on the
+shared truth only). Here Phi and Qd (E, n, n) come in, made once per truth on the full layout and cut to the run's
+reduced state (integrity/bankpass.py `models`); the rest is shared_pass's loop: per epoch and copy, the channel
+states' Qd at the copy's sky, then kernels/epoch.class_epoch in shared mode (the same function, so the same
+arithmetic). tests/unit/integrity/test_bankpass.py: equal to shared_pass bit for bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from approachsim.nav.kernels import epoch as ke
+from approachsim.nav.kernels import errormodel as ek
+
+
+@njit(cache=True)
+def bank_epochs(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.ndarray, lay: np.ndarray,
+                ch_gse: np.ndarray, ch_gmp: np.ndarray, f_gse: np.ndarray, f_gmp: np.ndarray,
+                ref: np.ndarray, ref_agl: np.ndarray, ins: np.ndarray,
+                baro_h: np.ndarray, baro_r: np.ndarray,
+                radalt_h: np.ndarray, ra_pct: float, ra_floor: float,
+                tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
+                db_u: np.ndarray,
+                rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
+                pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
+                codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray, n_rows: np.ndarray,
+                x_out: np.ndarray, pd_out: np.ndarray, pnav_out: np.ndarray,
+                h: np.ndarray, b: np.ndarray, ws: tuple) -> None:
+    """Every epoch of every copy (kernels/epoch.shared_pass's loop) with the epoch's model phi[e], qd[e] (E, n, n)
+    given (the damping loop held or not as the copies' INS: the bank's copies share one). Arguments as shared_pass
+    (ch_gse, ch_gmp (N, E, k), f_gse, f_gmp (E,), ref (E, 16), ref_agl (E,), ins (N, E, 16), the observations
+    indexed [i, e]); out per copy and epoch: codes, nu_out, S_out (N, E, R), n_rows (N, E), x_out (N, E, n),
+    pd_out (N, E, n) and pnav_out (N, E, 9, 9) after the epoch's updates."""
+    N, n = X.shape
+    E = phi.shape[0]
+    qd_tmp = np.empty((n, n))
+    ig, im = lay[ek.L_GSE], lay[ek.L_GMP]
+    for e in range(E):
+        y = ref[e]
+        for i in range(N):
+            qd_tmp[:, :] = qd[e]
+            if ig >= 0:
+                for c in range(ch_gse.shape[2]):
+                    qd_tmp[ig + c, ig + c] = ch_gse[i, e, c] ** 2 * f_gse[e]
+                    qd_tmp[im + c, im + c] = ch_gmp[i, e, c] ** 2 * f_gmp[e]
+            P = P3[i]
+            n_rows[i, e] = ke.class_epoch(X[i:i + 1], P, phi[e], qd_tmp, lay, False, y, ins[i, e:e + 1],
+                                          baro_h[i, e:e + 1], baro_r[e], radalt_h[i, e:e + 1], ra_pct, ra_floor,
+                                          ref_agl[e], tx, th, rwy, dbp[i:i + 1], db_x, db_u[i:i + 1],
+                                          rho[i, e:e + 1], r_sv[i, e], sig[i, e], channel_states,
+                                          pl_rho[i, e:e + 1], r_pl, pl_sig[e], pl_states, codes[i, e],
+                                          nu_out[i, e:e + 1], S_out[i, e], h, b, ws)
+            for a in range(n):
+                x_out[i, e, a] = X[i, a]
+                pd_out[i, e, a] = P[a, a]
+            for a in range(9):
+                for c in range(9):
+                    pnav_out[i, e, a, c] = P[a, c]
+
+
+@njit(cache=True)
+def models(lay: np.ndarray, q: np.ndarray, gse: np.ndarray, gmp: np.ndarray, loop: np.ndarray, dt: np.ndarray,
+           ref: np.ndarray, ref_cbn: np.ndarray, f_ref: np.ndarray, held: np.ndarray, phi: np.ndarray,
+           qd: np.ndarray) -> int:
+    """Phi, Qd (E, n, n) of every epoch at the reference, as shared_pass makes them (kernels/errormodel.dynamics
+    at ref[e] (E, 16) with ref_cbn[e], f_ref[e], the damping loop held where held[e] != 0, then discretize over
+    dt[e]). Returns E, or -1 - e when epoch e's model is too large for the compiled discretization."""
+    E = dt.shape[0]
+    n = phi.shape[1]
+    F = np.empty((n, n))
+    Qc = np.empty((n, n))
+    for e in range(E):
+        y = ref[e]
+        ek.dynamics(lay, q, gse, gmp, y[0], y[2], y[3:6], f_ref[e], ref_cbn[e], loop, held[e] != 0, F, Qc)
+        if not ek.discretize(F, Qc, dt[e], phi[e], qd[e]):
+            return -1 - e
+    return E

@@ -1,0 +1,403 @@
+"""The integrity bank's navigation pass (issue 26, speed): the main filter and the K sub-filters of one open-loop run
+over the run's records in one compiled call, on the states the bank can move.
+
+What integrity.bank.run_bank did before through NavSystem.run(copies=True) (and still does where this pass does not
+apply, `applicable`), with the same arithmetic:
+
+- one draw of the run's sensors (every copy's records are the same draws: the same streams), one converged start
+  (the copies share the main filter's: nav/system.py NavSystem.start), one INS over every row (feed-forward: the
+  INS does not depend on the filter), the copies' observations stacked once and copy k + 1 without its mode's
+  samples (integrity.bank.bank_records: an invalid sample is no measurement);
+- the model of every epoch (Phi, Qd at the reference: the truth) made once per flight group's truth on the full
+  layout (integrity/bank_kernel.models, kept for the last truth: the group's runs share it), cut to the run's
+  reduced state; then every epoch of every copy, each its own class (per-run GPS sky), in one call of
+  integrity/bank_kernel.bank_epochs (kernels/epoch.shared_pass's loop with the model given), on the *reduced*
+  state: the GPS channel states (gse, gmp) of the channels the run never measures are dropped.
+
+Why the reduced state changes no bit. A dropped channel's two states are first-order Gauss-Markov (diagonal
+Phi, Qd: kernels/errormodel.py makes them lone states, closed form) that no measurement row touches, and at the
+start they are uncorrelated with every other state (nav/initial.py: a channel not updated in the converged
+segment keeps its prior row exactly; checked here, else the channel is kept). So their rows and columns of P stay
+exactly zero off the diagonal: in the prediction W = Phi P, Phi W' + Qd their terms are exact zeros, and the
+scalar updates (kernels/kalman.gain and _joseph_cov) skip the rows where P h is zero and add exact zeros in the
+other rows' dropped columns. Every remaining term is summed in the same order (the kept states keep their order),
+so the kept states' estimates and covariances are the same floating-point numbers (tests/unit/integrity/
+test_bankpass.py compares them with the full-state pass bit for bit). The bank needs only the navigation states'
+estimates and covariance block: the dropped states never reach it. The cost of an epoch falls with the square
+of the state count: 70 states (24 channels) to 22 + 2 x (channels used), about 32 with best-four selection.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import weakref
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from approachsim.integrity import bank_kernel as bk
+from approachsim.nav import errormodel as em
+from approachsim.nav import ins
+from approachsim.nav.base import workspace
+from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer
+from approachsim.nav.navigator import NavRun, StatusLog, _stacked_observations, true_error_rows
+from approachsim.nav.observations import Observations
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class BankPass:
+    """The copies' filter history at the epochs (copy 0 the main filter, copy k + 1 without mode k)."""
+
+    t_s: Array
+    """(E,) epoch times, s."""
+    true_error_nav: Array
+    """(C, E, 9) output error of each copy at each epoch (dp NED m, dv m/s, psi rad)."""
+    P_nav: Array
+    """(C, E, 9, 9) its navigation-error covariance after the epoch's updates."""
+    x: Array
+    """(C, E, n_r) the reduced state's estimates after the updates."""
+    P_diag: Array
+    """(C, E, n_r) their variances."""
+    layout: em.StateLayout
+    """The reduced layout (the GPS channel states of `channels_kept` only)."""
+    channels_kept: Array
+    """(k_r,) the GPS channels whose error states the pass carries."""
+    main_rows: tuple[Array, Array, Array, Array]
+    """The main filter's measurement rows: codes, their counts per epoch, innovations, their variances (E, R)
+    (kernels/epoch.shared_pass)."""
+
+    def main_run(self) -> NavRun:
+        """The main filter's NavRun without its solution (None: the bank needs the epoch history only), on the
+        reduced layout."""
+        buf = StatusBuffer()
+        codes, counts, nu, S = self.main_rows
+        buf.add_epochs(codes, counts, self.t_s, nu, S)
+        return NavRun(solution=None, status=StatusLog.from_buffer(buf), t_epoch_s=self.t_s, x=self.x[0],
+                      P_diag=self.P_diag[0], P_nav=self.P_nav[0], true_error_nav=self.true_error_nav[0],
+                      layout=self.layout)
+
+
+def applicable(nav: Any, records: dict[str, Any]) -> bool:
+    """Whether `bank_pass` runs the bank of this navigation system on these records (one run, run axis first): the
+    compiled epoch (the optimal filter, tight coupling, constant or no damping loop, no FDE, no carrier phase:
+    nav/engine.py), feed-forward, an IMU record, and each run its own GPS sky (the default "per-run" epoch; a fixed
+    sky takes NavSystem.run's per-epoch path)."""
+    g = records.get("gnss")
+    return (g is not None and bool(g.per_run_sky) and "imu" in records and not nav.nav.feedback
+            and EpochEngine.of(nav) is not None)
+
+
+def _kept_channels(lay: em.StateLayout, used: Array, P0: Array) -> Array:
+    """The channels whose states stay: those measured, and any whose states are correlated with another state in the
+    start covariance P0 (module docstring: a dropped state must be uncorrelated with all others)."""
+    n_sv = lay.n_sv
+    keep = np.zeros(n_sv, dtype=bool)
+    keep[np.asarray(used, dtype=int)] = True
+    off = P0 != 0.0
+    np.fill_diagonal(off, False)
+    coupled = np.any(off, axis=1)
+    ig, im = lay.i("gse"), lay.i("gmp")
+    keep |= coupled[ig:ig + n_sv] | coupled[im:im + n_sv]
+    return np.flatnonzero(keep)
+
+
+def _reduced(lay: em.StateLayout, kept: Array) -> tuple[em.StateLayout, Array]:
+    """The layout with the channel states of `kept` only, and the full-layout index of each of its states (in
+    order)."""
+    red = dataclasses.replace(lay, n_sv=int(kept.size))
+    idx = []
+    for g in red.groups:
+        if g in ("gse", "gmp"):
+            idx.extend(lay.i(g) + kept)
+        else:
+            sl = lay.index[g]
+            idx.extend(range(sl.start, sl.stop))
+    return red, np.asarray(idx, dtype=int)
+
+
+def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: np.random.Generator,
+              states: Any) -> BankPass | None:
+    """The main filter and one sub-filter per mode of `modes` (integrity.bank mode codes) over one run's records
+    (`applicable`; run axis of length one), started from the run's realized sensor states `states`
+    (sensors.states.start_states) with its "nav" stream `rng` (module docstring). None when an epoch's model is
+    too large for the compiled discretization (the caller takes NavSystem.run, which falls back to numpy's)."""
+    from approachsim.nav.system import tuned_records
+
+    records = tuned_records(records, nav.nav.gps_sigma_scale)
+    imu = records["imu"]
+    dth, dvb = np.asarray(imu.dtheta_body)[:1], np.asarray(imu.dv_body)[:1]
+    m = dth.shape[1]
+    dt = float(imu.dt_s)
+    epoch_rows = max(1, int(round(1.0 / dt / nav.nav.aiding_rate_hz)))
+    tol = 0.25 * dt
+    gnss = records["gnss"]
+    # the start, as NavSystem.run's: the copies share the main filter's (one draw, repeated)
+    obs0 = Observations.at(records, float(truth.t_s[0]), tol, True)
+    el0 = np.asarray(gnss.elevation_rad)[:, 0]
+    s, runs = nav.start(truth, [rng], elevation_rad=el0[0], obs=obs0, states=states, elevation_per_run=el0)
+    # the INS once (Navigator.propagate: feed-forward, no bias feedback), with the damping loop's baro
+    hb_full = _baro_held(nav, records, truth, m)
+    x = ins.pack(s)
+    rows = np.full((1, m + 1, ins.NX), np.nan)
+    rows[:, 0] = x
+    z3 = np.zeros((1, 3))
+    ins.propagate(x, dth, dvb, dt, bias_g=z3, bias_a=z3, h_baro_m=hb_full, loop=nav.loop_gains(),
+                  f_sum=np.zeros((1, 3)), out=rows, row0=0)
+    o = _stacked_observations(records, np.asarray(truth.t_s, dtype=float)[epoch_rows::epoch_rows], tol, True, 1)
+    used = np.flatnonzero(np.any(np.asarray(gnss.valid, dtype=bool)[0], axis=0))
+    return _core(nav, truth, modes, m, epoch_rows, runs[0].fs.x, np.asarray(runs[0].fs.P, dtype=float),
+                 runs[0].db_error, rows[0, epoch_rows::epoch_rows], None if hb_full is None else hb_full[0], o, used)
+
+
+def _baro_held(nav: Any, records: dict[str, Any], truth: Any, m: int) -> Array | None:
+    """(N, m) the baro height held at each IMU interval start for the damping loop (nan: none), as NavSystem.run;
+    None without a loop or a baro."""
+    baro = records.get("baro")
+    if nav.loop_gains() is None or baro is None:
+        return None
+    hb = np.where(baro.valid, baro.h_baro_m, np.nan)
+    idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
+    return hb[:, idx]
+
+
+class GroupInputs:
+    """What an open-loop flight group's navigation pass leaves for its runs' banks (campaign/pipeline.py): the
+    group's records (run axis first) and NavSystem.run's `keep` (each run's filter start, terrain-database error
+    and INS states at the epochs); the runs' stacked observations are made once, on the first bank's call."""
+
+    def __init__(self, records: dict[str, Any], keep: dict[str, Any]) -> None:
+        self.records = records
+        self.keep = keep
+        self._obs: dict[str, Any] | None = None
+
+    def usable(self, nav: Any) -> bool:
+        """Whether the pass kept everything, feed-forward, on this system's layout."""
+        k = self.keep
+        return (bool(k.get("feed_forward")) and "ins_epoch_rows" in k and "start" in k
+                and k["start"][0][0].shape == (nav.layout.n,))
+
+    def observations(self, nav: Any, truth: Any) -> dict[str, Any]:
+        """_stacked_observations of every run of the group at the epochs (once)."""
+        if self._obs is None:
+            from approachsim.nav.system import tuned_records
+
+            recs = tuned_records(self.records, nav.nav.gps_sigma_scale)
+            dt = float(recs["imu"].dt_s)
+            er = self.keep["epoch_rows"]
+            n = int(np.shape(recs["imu"].dtheta_body)[0])
+            self._obs = _stacked_observations(recs, np.asarray(truth.t_s, dtype=float)[er::er], 0.25 * dt, True, n)
+        return self._obs
+
+
+def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Array) -> BankPass | None:
+    """`bank_pass` for run k of an open-loop flight group from what the group's pass left (GroupInputs): its start,
+    its INS at the epochs and its records; nothing drawn or integrated again (the same numbers: the pass's start and
+    INS are the run's own, whatever the batch)."""
+    recs = group.records
+    imu = recs["imu"]
+    m = int(np.shape(imu.dtheta_body)[1])
+    er = group.keep["epoch_rows"]
+    o_all = group.observations(nav, truth)
+    o = {key: (v[k:k + 1] if isinstance(v, np.ndarray) and key not in ("baro_r", "r_pl", "pl_sig", "el0")
+               else v) for key, v in o_all.items()}
+    baro = recs.get("baro")
+    one_baro = {} if baro is None else {"baro": dataclasses.replace(baro, valid=np.asarray(baro.valid)[k:k + 1],
+                                                                    h_baro_m=np.asarray(baro.h_baro_m)[k:k + 1])}
+    hb = _baro_held(nav, one_baro, truth, m)
+    used = np.flatnonzero(np.any(np.asarray(recs["gnss"].valid, dtype=bool)[k], axis=0))
+    x_hat, P = group.keep["start"][k]
+    return _core(nav, truth, modes, m, er, x_hat, P, group.keep["db"][k], group.keep["ins_epoch_rows"][k],
+                 None if hb is None else hb[0], o, used)
+
+
+def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Array, P_conv: Array,
+          db_error: Any, ins_ep: Array, hb1: Array | None, o: dict[str, Any], used: Array) -> BankPass | None:
+    """The pass from the run's start (x_hat, P_conv, its terrain-database error), its INS states at the epochs
+    ins_ep (E, 16), its baro held for the damping loop hb1 (m,) or None, its stacked observations o (one run) and
+    the GNSS channels it measures."""
+    from approachsim.integrity.bank import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
+
+    lay = nav.layout
+    eng = EpochEngine(nav)
+    # the epochs and the reference (the truth at the epoch rows: nav/shared.py)
+    e_rows = np.arange(epoch_rows, m + 1, epoch_rows)
+    E = e_rows.shape[0]
+    C = len(modes) + 1
+    t_e = np.asarray(truth.t_s, dtype=float)[e_rows]
+    dt_e = np.diff(np.concatenate([[float(truth.t_s[0])], t_e]))
+    held1 = np.zeros(E, dtype=np.int64)
+    if lay.has("ac") and hb1 is not None:
+        for e, r in enumerate(e_rows):
+            held1[e] = np.all(np.isnan(hb1[r - epoch_rows:r]))
+    ref, ref_cbn, f_ref, ref_agl = _reference(nav, truth, m, epoch_rows, e_rows)
+    # the copies' observations: copy 0 all, copy k + 1 without mode k (bank.bank_records)
+    baro_h = np.repeat(o["baro_h"], C, axis=0)
+    radalt_h = np.repeat(o["radalt_h"], C, axis=0)
+    rho_all = o["rho"]
+    pl_rho = np.repeat(o["pl_rho"], C, axis=0)
+    kept = _kept_channels(lay, used, P_conv) if lay.has("gse") else used
+    if lay.has("gse"):
+        red, idx = _reduced(lay, kept)
+    else:
+        red, idx = lay, np.arange(lay.n)
+    col = {int(c): j for j, c in enumerate(kept)}
+    rho = np.repeat(rho_all[:, :, kept], C, axis=0)
+    for k, c in enumerate(np.asarray(modes, dtype=int)):
+        if c >= 0:
+            rho[k + 1, :, col[c]] = np.nan
+        elif c == BARO_MODE:
+            baro_h[k + 1] = np.nan
+        elif c == RADALT_MODE:
+            radalt_h[k + 1] = np.nan
+        else:
+            pl_rho[k + 1, :, PSEUDOLITE_MODE - c] = np.nan
+    if not np.all(np.isnan(np.delete(rho_all, kept, axis=2))):
+        raise RuntimeError("bank_pass: a measured channel was dropped")
+    kr = kept.size
+    r_sv = np.ascontiguousarray(np.broadcast_to(o["r_sv"][:, :, kept], (C, E, kr, 3)))
+    el = o["el"][0][:, kept]
+    sig = np.ascontiguousarray(np.broadcast_to(eng._code_sig[kept] if eng.channel_states else o["sig"][0][:, kept],
+                                               (C, E, kr)), dtype=float)
+    r_pl = o["r_pl"] if o["r_pl"] is not None else eng._none3
+    pl_sig = np.ascontiguousarray(np.broadcast_to(eng._pl_sig if eng.pl_states else o["pl_sig"],
+                                                  (E, pl_rho.shape[2])), dtype=float)
+    noise = nav.noise(None)
+    q, gse_full, gmp_full = em.kernel_noise(noise, lay.n_sv)
+    loop = em.kernel_loop(nav.loop_gains() if lay.has("ac") else None)
+    if red.has("gse") and kr:
+        g1, m1 = eng.channel_sigmas(el)
+        ch_gse = np.ascontiguousarray(np.broadcast_to(g1, (C, E, kr)))
+        ch_gmp = np.ascontiguousarray(np.broadcast_to(m1, (C, E, kr)))
+    else:
+        ch_gse = ch_gmp = np.zeros((C, E, 0))
+    nz = nav.noise_model.noise(None)
+    f_gse = -np.expm1(-2.0 * dt_e / nz.gse_tau_s) if lay.has("gse") else np.zeros(E)
+    f_gmp = -np.expm1(-2.0 * dt_e / nz.gmp_tau_s) if lay.has("gse") else np.zeros(E)
+    db = RunDatabase.of(nav.nav.terrain_database, db_error)
+    dbp, db_x, db_u = EpochEngine.stack([db] * C)
+    n = red.n
+    X = np.repeat(x_hat[idx][None], C, axis=0)
+    P3 = np.repeat(P_conv[np.ix_(idx, idx)][None], C, axis=0)
+    R = 2 + kr + pl_rho.shape[2]
+    codes, nu, S = np.zeros((C, E, R), dtype=np.int64), np.zeros((C, E, R)), np.zeros((C, E, R))
+    n_rows = np.zeros((C, E), dtype=np.int64)
+    x_out, pd, pnav = np.zeros((C, E, n)), np.zeros((C, E, n)), np.zeros((C, E, 9, 9))
+    ins_y = np.ascontiguousarray(np.broadcast_to(ins_ep, (C, E, ins.NX)))
+    model = _models(nav, truth, q, gse_full, gmp_full, loop, dt_e, ref, ref_cbn, f_ref, held1)
+    if model is None:
+        return None
+    phi, qd = _cut(model, red)
+    bk.bank_epochs(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
+                   o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho,
+                   r_sv, sig, eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, codes, nu, S, n_rows, x_out,
+                   pd, pnav, np.zeros(n), np.zeros(n), workspace(n))
+    # the outputs' errors at the epochs: the INS rows - x_hat against the truth rows (Navigator.results)
+    xe = x_out[:, :, 0:9].reshape(C * E, 9)
+    o_s = ins.perturb(ins.unpack(np.tile(ins_ep, (C, 1))), -xe[:, 0:3], -xe[:, 3:6], -xe[:, 6:9])
+    err = true_error_rows(o_s, truth, np.tile(e_rows, C)).reshape(C, E, 9)
+    return BankPass(t_e, err, pnav, x_out, pd, red, kept, (codes[0], n_rows[0], nu[0], S[0]))
+
+
+_MODELS: list = []
+"""`_models`' last result: (system, weak reference to the truth, dt, held, model) (the runs of a flight group share
+it)."""
+
+
+def _models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array, dt: Array, ref: Array,
+            ref_cbn: Array, f_ref: Array, held: Array) -> tuple[Array, Array, em.StateLayout] | None:
+    """Phi, Qd of every epoch (bank_kernel.models: what shared_pass makes) in compact form, kept for the last (system,
+    truth) objects with the same intervals and damping-loop holds: (E, n1, n1) on the layout with one GPS channel
+    (the channels' states are lone, their rows and columns zero off the diagonal: checked; Phi's diagonal is the
+    same for every channel, the Qd diagonal each copy's own, set in the kernel), and that layout. Discretized on
+    that layout: the same numbers as on the full one (the bankpass docstring's argument: lone states are closed
+    form, the coupled component the same matrix). None when an epoch's model is too large for the compiled
+    discretization or the channels are not lone."""
+    key_dt, key_held = dt.tobytes(), held.tobytes()
+    for sys_, tr, kd, kh, val in _MODELS:
+        if sys_ is nav and tr() is truth and kd == key_dt and kh == key_held:
+            return val
+    lay = nav.layout
+    if lay.n_sv:  # one channel stands for all: its states' F, Qc depend on the channel only through the sigma, which
+        # enters Qc alone (kernels/errormodel.dynamics: a Markov state of the common tau), and each copy's Qd sets it
+        lay1, _ = _reduced(lay, np.array([0]))
+        gse, gmp = np.ascontiguousarray(gse[:1]), np.ascontiguousarray(gmp[:1])
+    else:
+        lay1 = lay
+    E, n = dt.shape[0], lay1.n
+    phi, qd = np.zeros((E, n, n)), np.zeros((E, n, n))
+    if bk.models(lay1.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, phi, qd) != E:
+        return None  # an epoch's model is too large for the compiled discretization
+    if lay1.n_sv:  # the channel's states lone: their rows and columns zero off the diagonal
+        ch = np.array([lay1.i("gse"), lay1.i("gmp")])
+        rest = np.setdiff1d(np.arange(n), ch)
+        for a in (phi, qd):
+            if (np.any(a[:, ch][:, :, rest]) or np.any(a[:, rest][:, :, ch]) or np.any(a[:, ch[0], ch[1]])
+                    or np.any(a[:, ch[1], ch[0]])):
+                return None
+    val = (phi, qd, lay1)
+    _MODELS[:] = [(nav, weakref.ref(truth), key_dt, key_held, val)]
+    return val
+
+
+def _cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -> tuple[Array, Array]:
+    """Phi, Qd (E, n_r, n_r) of the reduced layout `red` from `_models`' compact form: the one channel's lone states
+    repeated on the diagonal of each kept channel's, every other entry as the full model's."""
+    phi1, qd1, lay1 = model
+    if not red.has("gse"):
+        return phi1, qd1
+    src, chan = [], []
+    for g in red.groups:
+        sl = red.index[g]
+        if g in ("gse", "gmp"):
+            src.extend([lay1.i(g)] * (sl.stop - sl.start))
+            chan.extend(range(sl.start, sl.stop))
+        else:
+            src.extend(range(lay1.index[g].start, lay1.index[g].stop))
+    src_a, chan_a = np.asarray(src), np.asarray(chan, dtype=int)
+    out = []
+    for a in (phi1, qd1):
+        r = a[:, src_a[:, None], src_a[None, :]]
+        d = r[:, chan_a, chan_a].copy()
+        r[:, chan_a, :] = 0.0
+        r[:, :, chan_a] = 0.0
+        r[:, chan_a, chan_a] = d
+        out.append(np.ascontiguousarray(r))
+    return out[0], out[1]
+
+
+_REFERENCES: list = []
+"""`_reference`'s last result: (system, weak reference to the truth, m, epoch_rows, value); the runs of an open-loop
+flight group share their truth, so their banks share its reference."""
+
+
+def _reference(nav: Any, truth: Any, m: int, epoch_rows: int, e_rows: Array) -> tuple[Array, Array, Array, Array]:
+    """The reference at the epochs (nav/shared.py, Navigator.compiled_pass): packed truth rows (E, 16), their
+    body-to-NED matrices (E, 3, 3), the interval's mean specific force NED (E, 3) m/s^2, the height above the
+    terrain (E,) m. Kept for the last (system, truth) objects (the kernel only reads them)."""
+    for sys_, tr, m_, er, val in _REFERENCES:
+        if sys_ is nav and tr() is truth and m_ == m and er == epoch_rows:
+            return val
+    val = _make_reference(nav, truth, m, epoch_rows, e_rows)
+    _REFERENCES[:] = [(nav, weakref.ref(truth), m, epoch_rows, val)]
+    return val
+
+
+def _make_reference(nav: Any, truth: Any, m: int, epoch_rows: int, e_rows: Array
+                    ) -> tuple[Array, Array, Array, Array]:
+    from approachsim import geo
+
+    E = e_rows.shape[0]
+    c_bn = ins.cbn_from_quaternion(truth.q_nb[:m + 1])
+    f_ned = np.einsum("nij,nj->ni", c_bn[:m], truth.f_body[:m])
+    ref_cbn = np.ascontiguousarray(c_bn[::epoch_rows].copy()[e_rows // epoch_rows])
+    ref = np.zeros((E, ins.NX))
+    ref[:, 0], ref[:, 1], ref[:, 2] = truth.lat_rad[e_rows], truth.lon_rad[e_rows], truth.h_m[e_rows]
+    ref[:, 3:6] = truth.v_ned[e_rows]
+    ref[:, 6:15] = ref_cbn.reshape(E, 9)
+    f_ref = np.stack([f_ned[r - epoch_rows:r].mean(axis=0) for r in e_rows]) if E else np.zeros((0, 3))
+    r_ref = geo.geodetic_to_ecef(ref[:, 0], ref[:, 1], ref[:, 2])
+    ref_agl = ref[:, 2] - nav.terrain_h(r_ref) if E else np.zeros(0)
+    return ref, ref_cbn, f_ref, ref_agl
