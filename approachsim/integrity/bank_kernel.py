@@ -40,6 +40,7 @@ def bank_epochs(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.ndarray, 
     N, n = X.shape
     E = phi.shape[0]
     qd_tmp = np.empty((n, n))
+    no_cp = np.zeros((1, 0))  # no carrier rows (bankpass.applicable: carrier phase takes the NavSystem path)
     ig, im = lay[ek.L_GSE], lay[ek.L_GMP]
     for e in range(E):
         y = ref[e]
@@ -53,7 +54,7 @@ def bank_epochs(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.ndarray, 
             n_rows[i, e] = ke.class_epoch(X[i:i + 1], P, phi[e], qd_tmp, lay, False, y, ins[i, e:e + 1],
                                           baro_h[i, e:e + 1], baro_r[e], radalt_h[i, e:e + 1], ra_pct, ra_floor,
                                           ref_agl[e], tx, th, rwy, dbp[i:i + 1], db_x, db_u[i:i + 1],
-                                          rho[i, e:e + 1], r_sv[i, e], sig[i, e], channel_states,
+                                          rho[i, e:e + 1], r_sv[i, e], sig[i, e], channel_states, no_cp, 0.0,
                                           pl_rho[i, e:e + 1], r_pl, pl_sig[e], pl_states, codes[i, e],
                                           nu_out[i, e:e + 1], S_out[i, e], h, b, ws)
             for a in range(n):

@@ -82,12 +82,16 @@ class BankPass:
 
 def applicable(nav: Any, records: dict[str, Any]) -> bool:
     """Whether `bank_pass` runs the bank of this navigation system on these records (one run, run axis first): the
-    compiled epoch (the optimal filter, tight coupling, constant or no damping loop, no FDE, no carrier phase:
-    nav/engine.py), feed-forward, an IMU record, and each run its own GPS sky (the default "per-run" epoch; a fixed
+    compiled epoch (the optimal filter, tight coupling, constant or no damping loop, no FDE: nav/engine.py) without
+    carrier phase, feed-forward, an IMU record, and each run its own GPS sky (the default "per-run" epoch; a fixed
     sky takes NavSystem.run's per-epoch path)."""
     g = records.get("gnss")
-    return (g is not None and bool(g.per_run_sky) and "imu" in records and not nav.nav.feedback
-            and EpochEngine.of(nav) is not None)
+    if g is None or not bool(g.per_run_sky) or "imu" not in records or nav.nav.feedback:
+        return False
+    eng = EpochEngine.of(nav)
+    # carrier phase runs compiled in the navigation (nav/engine.py) but the bank's per-group models (bank_kernel.
+    # models) have no ionosphere / ambiguity dynamics nor arc resets: it takes NavSystem.run's path
+    return eng is not None and not eng.carrier
 
 
 def _kept_channels(lay: em.StateLayout, used: Array, P0: Array) -> Array:

@@ -115,10 +115,11 @@ def test_outside_the_envelope_exits_2_through_the_cli(tmp_path, command):
 
 
 def test_a_flight_made_to_fail_ends_with_its_reason_and_exit_3(tmp_path):
-    """Glidepath gains x 0.1: the aircraft drifts off the glidepath below 1000 ft; the stabilized-approach
-    monitor ends the flight, `fly` writes its outputs and exits 3 saying why."""
+    """Glidepath gains x 0.1 (the classic law's and TECS's pitch channel, whichever the file flies): the aircraft
+    drifts off the glidepath below 1000 ft; the stabilized-approach monitor ends the flight, `fly` writes its
+    outputs and exits 3 saying why."""
     ac = (ROOT / "aircraft" / "737.toml").read_text(encoding="utf-8")
-    for key in ("k_gs_p", "k_gs_d", "k_gs_i"):
+    for key in ("k_gs_p", "k_gs_d", "k_gs_i", "tecs_k_pitch_damp", "tecs_k_pitch_i"):
         ac, n = re.subn(rf"^{key} = ([0-9.eE+-]+)", lambda m, k=key: f"{k} = {float(m.group(1)) * 0.1:.6g}", ac,
                         count=1, flags=re.M)
         assert n == 1, key
