@@ -56,7 +56,6 @@ from approachsim.flight.envelope import (
 from approachsim.flight.turbulence import COEFF_EVERY, POE_ALT_FT, POE_SIGMA_FPS
 from approachsim.glidepath import GlidePath, cone_height
 from approachsim.nav.kernels import geodesy as gk
-from approachsim.nav.kernels import inloop as nav
 
 Array = np.ndarray
 
@@ -833,31 +832,3 @@ def split_rows(buf: Array, n: int, cols: Array, outs: Any) -> None:
             c = cols[f]
             for j in range(o.shape[1]):
                 o[k, j] = row[c + j]
-
-
-@njit(cache=True)
-def fly_step_nav(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array, guidance: Array, nw: Array,
-                 cg: Array, ca: Array, rows: Array, snap: Array, baro_j: Array, baro_e: Array, lag_w: Array,
-                 dth: Array, dv: Array) -> tuple[int, int, float, float, float, float, float, float, float, float,
-                                                 bool]:
-    """fly_step of a closed loop whose navigation runs in compiled code (nav/kernels/inloop.py): after the truth row,
-    the navigation's row k (IMU increment, INS step, the INS row recorded); when it needs nothing of Python, the
-    guidance (INS - x_hat) into guidance[k] and the autopilot on it. Returns (TERM_* code, the inloop NAV_* bits:
-    nonzero means Python acts at this row and then calls fly_control_nav, elevator, aileron, rudder, throttle, gusts
-    (ft/s), terrain (ft), read the gear next step) as fly_step."""
-    code, de, da, dr, thr, gn, ge, gd, terr_ft, near = fly_step(k, raw, buf, nu, par, st, False)
-    ncode = nav.nav_row(k, buf, nw, cg, ca, rows, snap, baro_j, baro_e, lag_w, dth, dv)
-    if ncode == 0:
-        nav.nav_guidance(nw, guidance[k])
-        if code == TERM_NONE:
-            de, da, dr, thr = fly_control(k, guidance, buf, par, st)
-    return code, ncode, de, da, dr, thr, gn, ge, gd, terr_ft, near
-
-
-@njit(cache=True)
-def fly_control_nav(k: int, guidance: Array, buf: Array, par: Array, st: Array, nw: Array
-                    ) -> tuple[float, float, float, float]:
-    """After Python acted at row k (fly_step_nav's NAV_* bits): the guidance of the navigation state into
-    guidance[k] and the autopilot on it (fly_control)."""
-    nav.nav_guidance(nw, guidance[k])
-    return fly_control(k, guidance, buf, par, st)

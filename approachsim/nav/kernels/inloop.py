@@ -1,5 +1,5 @@
 """The closed loop's per-row navigation as a compiled kernel (numba, cache=True), called by the flight loop's
-compiled step (flight/kernels.py fly_step_nav) so that a closed-loop row costs no Python beyond JSBSim's reads and
+compiled step (flight/closed_loop_kernels.py) so that a closed-loop row costs no Python beyond JSBSim's reads and
 writes; Python runs only at the rows where the navigation needs it (the start, a baro sample of the damping loop,
 an aiding epoch: nav/closed_loop.py).
 
