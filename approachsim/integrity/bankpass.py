@@ -234,8 +234,7 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     dt_e = np.diff(np.concatenate([[float(truth.t_s[0])], t_e]))
     held1 = np.zeros(E, dtype=np.int64)
     if lay.has("ac") and hb1 is not None:
-        for e, r in enumerate(e_rows):
-            held1[e] = np.all(np.isnan(hb1[r - epoch_rows:r]))
+        held1[:] = np.all(np.isnan(hb1[:E * epoch_rows]).reshape(E, epoch_rows), axis=1)  # the epochs' intervals
     ref, ref_cbn, f_ref, ref_agl = _reference(nav, truth, m, epoch_rows, e_rows)
     # the copies' observations: copy 0 all, copy k + 1 without mode k (bank.bank_records)
     baro_h = np.repeat(o["baro_h"], C, axis=0)
@@ -346,9 +345,25 @@ def _models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array,
     return val
 
 
+_CUTS: list = []
+"""`_cut`'s results for the last model: (model, {reduced layout: (Phi, Qd)}) (the runs of a flight group share the
+model and mostly a few channel counts; the kernel only reads them)."""
+
+
 def _cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -> tuple[Array, Array]:
     """Phi, Qd (E, n_r, n_r) of the reduced layout `red` from `_models`' compact form: the one channel's lone states
-    repeated on the diagonal of each kept channel's, every other entry as the full model's."""
+    repeated on the diagonal of each kept channel's, every other entry as the full model's. Kept per layout for the
+    last model."""
+    if not _CUTS or _CUTS[0][0] is not model:
+        _CUTS[:] = [(model, {})]
+    memo = _CUTS[0][1]
+    key = red.packed.tobytes()
+    if key not in memo:
+        memo[key] = _make_cut(model, red)
+    return memo[key]
+
+
+def _make_cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -> tuple[Array, Array]:
     phi1, qd1, lay1 = model
     if not red.has("gse"):
         return phi1, qd1

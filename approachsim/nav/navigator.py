@@ -406,8 +406,9 @@ class Navigator:
         # the damping loop held where the INS had no baro over the whole interval (as NavSystem.run's per-epoch path)
         held = np.zeros((N, E), dtype=np.int64)
         if lay.has("ac") and h_baro is not None:
-            for e, r in enumerate(e_rows):
-                held[:, e] = np.all(np.isnan(h_baro[:, r - epoch_rows:r]), axis=1)[self.ins_of]
+            # the intervals are the consecutive blocks of epoch_rows rows before each epoch row
+            blocks = np.isnan(h_baro[:, :E * epoch_rows]).reshape(h_baro.shape[0], E, epoch_rows)
+            held[:, :] = np.all(blocks, axis=2)[self.ins_of]
         # the reference: the truth at the epoch rows
         ref = np.zeros((E, ins.NX))
         ref[:, 0], ref[:, 1], ref[:, 2] = truth.lat_rad[e_rows], truth.lon_rad[e_rows], truth.h_m[e_rows]
