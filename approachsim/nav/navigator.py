@@ -455,12 +455,21 @@ class Navigator:
         x_out, p33, pcc = np.zeros((N, E, n)), np.zeros((N, E, 3, 3)), np.zeros((N, E))
         pd, pnav = np.zeros((N, E, n)), np.zeros((N, E, 9, 9))
         ins_y = np.ascontiguousarray(self.rows[self.ins_of][:, e_rows])
-        done = ke.shared_pass(X, P3, eng.lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse,
-                              ch_gmp, f_gse, f_gmp, ins_y, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
-                              eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho, r_sv, sig, eng.channel_states, cp,
-                              eng.cp_r, pl_rho, r_pl, pl_sig, eng.pl_states, gio, gio_tau, ch_gio, f_gio, new,
-                              eng.amb_prior, codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav, self._ic, eng.h, eng.b,
-                              eng.ws)
+        done = -1
+        if per_run_sky and k and lay.has("gse") and not eng.carrier:  # each run on its reduced state
+            from approachsim.nav.reduced import reduced_singletons
+
+            args = (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse,
+                    f_gmp, ins_y, baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig)
+            done = reduced_singletons(system, truth, eng, args, (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav),
+                                      self._ic)
+        if done < 0:
+            done = ke.shared_pass(X, P3, eng.lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse,
+                                  ch_gmp, f_gse, f_gmp, ins_y, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
+                                  eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho, r_sv, sig, eng.channel_states, cp,
+                                  eng.cp_r, pl_rho, r_pl, pl_sig, eng.pl_states, gio, gio_tau, ch_gio, f_gio, new,
+                                  eng.amb_prior, codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav, self._ic, eng.h,
+                                  eng.b, eng.ws)
         if done != E:
             self.x[:] = x0
             self.f_sum[:] = 0.0

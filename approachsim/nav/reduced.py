@@ -1,0 +1,116 @@
+"""The open-loop pass of runs that are each their own class (per-run GPS skies) on each run's reduced state.
+
+Navigator.compiled_pass filters such runs with kernels/epoch.shared_pass on the full layout: 24 GPS channels' gse /
+gmp states, of which a run measures 4-6 with best-four selection. The channels a run never measures are lone
+first-order Gauss-Markov states, uncorrelated with the rest at the start (checked: a correlated one is kept), which
+no row touches: dropping them removes exact zeros from every sum and keeps the others' order, so the kept states
+are the same floating-point numbers (integrity/bankpass.py's module docstring gives the argument; its reduced
+models and the compiled pass integrity/bank_kernel.bank_epochs are the ones used here). The dropped states are
+then carried in closed form exactly as the full pass computes them (x <- 0 + phi x; P <- Qd + phi (0 + phi P)):
+x_out, P's diagonal and the final X, P are those of shared_pass bit for bit
+(tests/unit/nav/test_reduced_pass.py). The cost of an epoch falls with the square of the state count: 70 -> ~32.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from approachsim.nav.kernels import epoch as ke
+from approachsim.nav.kernels import kalman as kk
+
+Array = np.ndarray
+
+
+def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tuple, ic: int) -> int:
+    """shared_pass for per-run-sky runs, each on its reduced state. args: shared_pass's inputs (X, P3, lay, q, gse,
+    gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse, f_gmp, ins_y, baro_h, baro_r,
+    radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig) without carrier phase; out: its outputs
+    (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav), filled here; ic the clock state's index. Returns E, or -1
+    with nothing changed when a model cannot be reduced (the caller runs shared_pass)."""
+    from approachsim.integrity import bank_kernel as bk
+    from approachsim.integrity import bankpass as bp
+
+    (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse, f_gmp, ins_y,
+     baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig) = args
+    codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav = out
+    N, E = held.shape
+    models = []
+    for i in range(N):  # every run's model first: nothing is changed when one cannot be reduced
+        model = bp._models(system, truth, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, np.ascontiguousarray(held[i]))
+        if model is None:
+            return -1
+        models.append(model)
+    measured = np.any(np.isfinite(rho), axis=1)  # (N, k)
+    ig, im = lay.i("gse"), lay.i("gmp")
+    ws: dict[int, tuple] = {}
+    for i in range(N):
+        phi1, _qd1, lay1 = models[i]
+        kept = bp._kept_channels(lay, np.flatnonzero(measured[i]), P3[i])
+        red, idx = bp._reduced(lay, kept)
+        phi, qd = bp._cut(models[i], red)
+        n_r, kr = red.n, kept.size
+        Xr = np.ascontiguousarray(X[i:i + 1, idx])
+        Pr = np.ascontiguousarray(P3[i][np.ix_(idx, idx)][None])
+        R_r = 2 + kr + pl_rho.shape[2]
+        c_r, n_r_rows = np.zeros((1, E, R_r), dtype=np.int64), np.zeros((1, E), dtype=np.int64)
+        nu_r, S_r = np.zeros((1, E, R_r)), np.zeros((1, E, R_r))
+        x_r, pd_r, pnav_r = np.zeros((1, E, n_r)), np.zeros((1, E, n_r)), np.zeros((1, E, 9, 9))
+        if n_r not in ws:
+            ws[n_r] = (np.zeros(n_r), np.zeros(n_r), kk.workspace(n_r))
+        h, b, w = ws[n_r]
+        sel = (slice(i, i + 1), slice(None), kept)
+        bk.bank_epochs(Xr, Pr, phi, qd, red.packed, np.ascontiguousarray(ch_gse[sel]),
+                       np.ascontiguousarray(ch_gmp[sel]), f_gse, f_gmp, ref, ref_agl, ins_y[i:i + 1],
+                       baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy,
+                       dbp[i:i + 1], db_x, db_u[i:i + 1], np.ascontiguousarray(rho[sel]),
+                       np.ascontiguousarray(r_sv[sel]), np.ascontiguousarray(sig[sel]), eng.channel_states,
+                       pl_rho[i:i + 1], r_pl, pl_sig, eng.pl_states, c_r, nu_r, S_r, n_r_rows, x_r, pd_r, pnav_r, h,
+                       b, w)
+        # the rows: the reduced channel c is the full layout's kept[c]
+        gps = (c_r[0] >= ke.CODE_GPS) & (c_r[0] < ke.CODE_PL)
+        codes[i, :, :R_r] = np.where(gps, ke.CODE_GPS + kept[np.clip(c_r[0] - ke.CODE_GPS, 0, max(kr - 1, 0))],
+                                     c_r[0]) if kr else c_r[0]
+        nu[i, :, :R_r], S[i, :, :R_r], n_rows[i] = nu_r[0], S_r[0], n_r_rows[0]
+        # the kept states
+        x_out[i][:, idx] = x_r[0]
+        pd[i][:, idx] = pd_r[0]
+        pnav[i] = pnav_r[0]
+        p33[i] = pnav_r[0][:, 0:3, 0:3]
+        pcc[i] = pd_r[0][:, int(np.flatnonzero(idx == ic)[0])]
+        # the dropped channels' states, lone: as the full pass's predict makes them, every epoch
+        drop = np.setdiff1d(np.arange(lay.n_sv), kept)
+        xg, xm = X[i, ig + drop].copy(), X[i, im + drop].copy()
+        pg, pm = P3[i, ig + drop, ig + drop].copy(), P3[i, im + drop, im + drop].copy()
+        lone_states(np.ascontiguousarray(phi1[:, lay1.i("gse"), lay1.i("gse")]),
+                    np.ascontiguousarray(phi1[:, lay1.i("gmp"), lay1.i("gmp")]), ch_gse[i], ch_gmp[i], f_gse, f_gmp,
+                    drop, ig, im, xg, xm, pg, pm, x_out[i], pd[i])
+        # the final state and covariance (the dropped states' rows and columns stay zero off the diagonal)
+        X[i, idx] = Xr[0]
+        X[i, ig + drop], X[i, im + drop] = xg, xm
+        P3[i][np.ix_(idx, idx)] = Pr[0]
+        P3[i, ig + drop, ig + drop], P3[i, im + drop, im + drop] = pg, pm
+    return E
+
+
+
+@njit(cache=True)
+def lone_states(f_g: Array, f_m: Array, ch_gse: Array, ch_gmp: Array, f_gse: Array, f_gmp: Array, drop: Array,
+                ig: int, im: int, xg: Array, xm: Array, pg: Array, pm: Array, x_out: Array, pd_out: Array) -> None:
+    """The dropped channels' gse / gmp states over the E epochs, in place from their start xg, xm, pg, pm (k_d,):
+    each epoch x <- 0 + phi x and P <- Qd + phi (0 + phi P) (kernels/kalman._predict_cov's sums for a lone state,
+    Qd = sigma^2 f as kernels/epoch.singleton_epochs sets it; phi f_g, f_m (E,), the sigmas ch_gse, ch_gmp (E, k)
+    of the run, factors f_gse, f_gmp (E,)); written to x_out, pd_out (E, n) at ig + drop, im + drop."""
+    for e in range(f_g.shape[0]):
+        for a in range(drop.shape[0]):
+            c = drop[a]
+            xg[a] = 0.0 + f_g[e] * xg[a]
+            xm[a] = 0.0 + f_m[e] * xm[a]
+            pg[a] = ch_gse[e, c] ** 2 * f_gse[e] + f_g[e] * (0.0 + f_g[e] * pg[a])
+            pm[a] = ch_gmp[e, c] ** 2 * f_gmp[e] + f_m[e] * (0.0 + f_m[e] * pm[a])
+            x_out[e, ig + c] = xg[a]
+            x_out[e, im + c] = xm[a]
+            pd_out[e, ig + c] = pg[a]
+            pd_out[e, im + c] = pm[a]
