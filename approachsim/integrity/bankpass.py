@@ -87,8 +87,8 @@ class BankPass:
 def applicable(nav: Any, records: dict[str, Any]) -> bool:
     """Whether `bank_pass` runs the bank of this navigation system on these records (one run, run axis first): the
     compiled epoch (the optimal filter, tight coupling, constant or no damping loop, no FDE: nav/engine.py), with or
-    without carrier phase, feed-forward, an IMU record, and each run its own GPS sky (the default "per-run" epoch; a fixed
-    sky takes NavSystem.run's per-epoch path)."""
+    without carrier phase, feed-forward, an IMU record, and each run its own GPS sky (the default "per-run" epoch;
+    a fixed sky takes NavSystem.run's per-epoch path)."""
     g = records.get("gnss")
     if g is None or not bool(g.per_run_sky) or "imu" not in records or nav.nav.feedback:
         return False
@@ -294,8 +294,9 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     loop = em.kernel_loop(nav.loop_gains() if lay.has("ac") else None)
     ch_gio = np.zeros((C, E, 0))
     if red.has("gse") and kr and carrier:  # the slow state without the ionosphere (gio): Navigator.compiled_pass
-        g1, i1, m1 = eng.carrier_channel_sigmas(el)
-        ch_gse, ch_gio, ch_gmp = (np.ascontiguousarray(np.broadcast_to(a, (C, E, kr))) for a in (g1, i1, m1))
+        # (numpy elementwise, on every channel as the navigation's pass, then the kept ones)
+        sky = eng.carrier_channel_sigmas(o["el"][0])
+        ch_gse, ch_gio, ch_gmp = (np.ascontiguousarray(np.broadcast_to(a[:, kept], (C, E, kr))) for a in sky)
     elif red.has("gse") and kr:
         g1, m1 = eng.channel_sigmas(el)
         ch_gse = np.ascontiguousarray(np.broadcast_to(g1, (C, E, kr)))
