@@ -8,6 +8,10 @@ shared truth only). Here Phi and Qd (E, n, n) come in, made once per truth on th
 reduced state (integrity/bankpass.py `models`); the rest is shared_pass's loop: per epoch and copy, the channel
 states' Qd at the copy's sky, then kernels/epoch.class_epoch in shared mode (the same function, so the same
 arithmetic). tests/unit/integrity/test_bankpass.py: equal to shared_pass bit for bit.
+
+With carrier phase: carrier_models (`models` plus kernels/carrier.dynamics) and bank_epochs_carrier (shared_pass's
+carrier step: the gio states' Qd at each copy's sky, its ambiguities reset at its new arcs, the carrier rows);
+tests/unit/integrity/test_bankpass_carrier.py.
 """
 
 from __future__ import annotations
@@ -41,7 +45,7 @@ def bank_epochs(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.ndarray, 
     N, n = X.shape
     E = phi.shape[0]
     qd_tmp = np.empty((n, n))
-    no_cp = np.zeros((1, 0))  # no carrier rows (bankpass.applicable: carrier phase takes the NavSystem path)
+    no_cp = np.zeros((1, 0))  # no carrier rows (carrier phase: bank_epochs_carrier)
     ig, im = lay[ek.L_GSE], lay[ek.L_GMP]
     for e in range(E):
         y = ref[e]

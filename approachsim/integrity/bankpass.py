@@ -25,6 +25,19 @@ so the kept states' estimates and covariances are the same floating-point number
 test_bankpass.py compares them with the full-state pass bit for bit). The bank needs only the navigation states'
 estimates and covariance block: the dropped states never reach it. The cost of an epoch falls with the square
 of the state count: 70 states (24 channels) to 22 + 2 x (channels used), about 32 with best-four selection.
+
+Carrier phase (the layout's gio and amb groups, nav/kernels/carrier.py). A channel's four states (gse, gmp, gio,
+amb) go together (`CHANNEL_GROUPS`): gio is a Gauss-Markov state and amb a random constant, both lone (diagonal
+Phi, Qd: kernels/errormodel.discretize's closed form), and a channel never measured has no carrier phase and no
+arc, so its ambiguity is never reset; the argument above holds for them unchanged. The model adds kernels/carrier.
+dynamics (bank_kernel.carrier_models); each copy's epoch is shared_pass's carrier step (bank_kernel.
+bank_epochs_carrier): the gio states' Qd at the copy's sky, then its ambiguities reset where its carrier arc begins
+(engine.stacked_new_arcs over the copy's arc ids: a copy without channel c has no phase and no arc there,
+bank.bank_records, so it never resets amb_c), the reset zeroing a kept row and column of Phi (a copy) and Qd as on
+the full layout, then class_epoch with the carrier rows after the code rows. The copies start with no arc (the
+converged start is code only: nav/initial.py). The candidate's 121 states (24 channels) to 25 + 4 x (channels used)
+(tests/unit/integrity/test_bankpass_carrier.py: bit for bit against the copies' full-state pass, with an outage
+that opens a new arc).
 """
 
 from __future__ import annotations
