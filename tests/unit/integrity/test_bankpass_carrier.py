@@ -3,9 +3,9 @@ integrity/bank_kernel.bank_epochs_carrier) against the path it replaces, NavSyst
 state (run_bank(..., compiled=False): Navigator.compiled_pass, kernels/epoch.shared_pass with the carrier states):
 bit for bit, on the shipped carrier candidate (GBAS, all in view, two pseudolites) and with a channel's carrier
 interrupted by an outage (a new arc: its float ambiguity reset in the copies that measure it, not in the copy that
-leaves it out). Why exact: the reduction drops the lone states (gse, gmp, gio, amb) of channels never measured,
-whose rows and columns of P are exact zeros, and keeps every other sum's order (bankpass module docstring); the
-ambiguity resets zero a kept row and column as on the full layout."""
+leaves it out), and with the sensor fault modes. Why exact: the reduction drops the lone states (gse, gmp, gio, amb)
+of channels never measured, whose rows and columns of P are exact zeros, and keeps every other sum's order (bankpass
+module docstring); the ambiguity resets zero a kept row and column as on the full layout."""
 
 from __future__ import annotations
 
@@ -56,13 +56,16 @@ def _assert_banks_equal(new, old):
 
 
 @pytest.mark.equality
-@pytest.mark.parametrize("kind", ["candidate", "outage"])
+@pytest.mark.parametrize("kind", ["candidate", "outage", "modes"])
 def test_carrier_reduced_pass_equals_the_copies_pass(kind, monkeypatch):
     prof = CARRIER
     truth = _truth(prof)
     arc_channel = None
     if kind == "outage":
         prof, arc_channel = _with_outage(prof, truth)
+    modes = kind == "modes"  # the baro, radar altimeter and pseudolites as fault modes too (no damping loop: the
+    if modes:  # copies without the baro share the INS, so every mode is compiled)
+        prof = replace(prof, nav=replace(prof.nav, baro_loop="none"))
     called, resets = [], []
     orig_pass, orig_arcs = bankpass.bank_pass, bankpass.stacked_new_arcs
 
@@ -78,12 +81,12 @@ def test_carrier_reduced_pass_equals_the_copies_pass(kind, monkeypatch):
     monkeypatch.setattr(bankpass, "bank_pass", spy)
     monkeypatch.setattr(bankpass, "stacked_new_arcs", spy_arcs)
     for run in (0, 1):
-        new, main_new = run_bank(prof, truth, SEED, run)
-        old, main_old = run_bank(prof, truth, SEED, run, compiled=False)
+        new, main_new = run_bank(prof, truth, SEED, run, sensor_modes_on=modes)
+        old, main_old = run_bank(prof, truth, SEED, run, sensor_modes_on=modes, compiled=False)
         assert len(called) == run + 1 and called[-1] is not None  # the compiled pass ran (no fallback)
         bp = called[-1]
         assert bp.layout.has("amb") and bp.layout.n_sv == bp.channels_kept.size  # carrier states, reduced
-        assert new.ek.shape[1] >= 6
+        assert new.ek.shape[1] >= 6 + (4 if modes else 0)  # + baro, radar altimeter, two pseudolites
         _assert_banks_equal(new, old)
         # the main filter's innovations and their variances: the same rows in the same order
         np.testing.assert_array_equal(main_new.status.variance, main_old.status.variance)
