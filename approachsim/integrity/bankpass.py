@@ -25,6 +25,19 @@ so the kept states' estimates and covariances are the same floating-point number
 test_bankpass.py compares them with the full-state pass bit for bit). The bank needs only the navigation states'
 estimates and covariance block: the dropped states never reach it. The cost of an epoch falls with the square
 of the state count: 70 states (24 channels) to 22 + 2 x (channels used), about 32 with best-four selection.
+
+Carrier phase (the layout's gio and amb groups, nav/kernels/carrier.py). A channel's four states (gse, gmp, gio,
+amb) go together (`CHANNEL_GROUPS`): gio is a Gauss-Markov state and amb a random constant, both lone (diagonal
+Phi, Qd: kernels/errormodel.discretize's closed form), and a channel never measured has no carrier phase and no
+arc, so its ambiguity is never reset; the argument above holds for them unchanged. The model adds kernels/carrier.
+dynamics (bank_kernel.carrier_models); each copy's epoch is shared_pass's carrier step (bank_kernel.
+bank_epochs_carrier): the gio states' Qd at the copy's sky, then its ambiguities reset where its carrier arc begins
+(engine.stacked_new_arcs over the copy's arc ids: a copy without channel c has no phase and no arc there,
+bank.bank_records, so it never resets amb_c), the reset zeroing a kept row and column of Phi (a copy) and Qd as on
+the full layout, then class_epoch with the carrier rows after the code rows. The copies start with no arc (the
+converged start is code only: nav/initial.py). The candidate's 121 states (24 channels) to 25 + 4 x (channels used)
+(tests/unit/integrity/test_bankpass_carrier.py: bit for bit against the copies' full-state pass, with an outage
+that opens a new arc).
 """
 
 from __future__ import annotations
@@ -40,11 +53,15 @@ from approachsim.integrity import bank_kernel as bk
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav.base import workspace
-from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer
+from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, stacked_new_arcs
 from approachsim.nav.navigator import NavRun, StatusLog, _stacked_observations, true_error_rows
 from approachsim.nav.observations import Observations
 
 Array = np.ndarray
+
+CHANNEL_GROUPS = ("gse", "gmp", "gio", "amb")
+"""The per-GPS-channel state groups (gio, amb: carrier phase only), each a lone state per channel (module
+docstring)."""
 
 
 @dataclass(frozen=True)
@@ -82,16 +99,13 @@ class BankPass:
 
 def applicable(nav: Any, records: dict[str, Any]) -> bool:
     """Whether `bank_pass` runs the bank of this navigation system on these records (one run, run axis first): the
-    compiled epoch (the optimal filter, tight coupling, constant or no damping loop, no FDE: nav/engine.py) without
-    carrier phase, feed-forward, an IMU record, and each run its own GPS sky (the default "per-run" epoch; a fixed
-    sky takes NavSystem.run's per-epoch path)."""
+    compiled epoch (the optimal filter, tight coupling, constant or no damping loop, no FDE: nav/engine.py), with or
+    without carrier phase, feed-forward, an IMU record, and each run its own GPS sky (the default "per-run" epoch;
+    a fixed sky takes NavSystem.run's per-epoch path)."""
     g = records.get("gnss")
     if g is None or not bool(g.per_run_sky) or "imu" not in records or nav.nav.feedback:
         return False
-    eng = EpochEngine.of(nav)
-    # carrier phase runs compiled in the navigation (nav/engine.py) but the bank's per-group models (bank_kernel.
-    # models) have no ionosphere / ambiguity dynamics nor arc resets: it takes NavSystem.run's path
-    return eng is not None and not eng.carrier
+    return EpochEngine.of(nav) is not None
 
 
 def _kept_channels(lay: em.StateLayout, used: Array, P0: Array) -> Array:
@@ -103,8 +117,10 @@ def _kept_channels(lay: em.StateLayout, used: Array, P0: Array) -> Array:
     off = P0 != 0.0
     np.fill_diagonal(off, False)
     coupled = np.any(off, axis=1)
-    ig, im = lay.i("gse"), lay.i("gmp")
-    keep |= coupled[ig:ig + n_sv] | coupled[im:im + n_sv]
+    for g in CHANNEL_GROUPS:
+        if lay.has(g):
+            i0 = lay.i(g)
+            keep |= coupled[i0:i0 + n_sv]
     return np.flatnonzero(keep)
 
 
@@ -114,7 +130,7 @@ def _reduced(lay: em.StateLayout, kept: Array) -> tuple[em.StateLayout, Array]:
     red = dataclasses.replace(lay, n_sv=int(kept.size))
     idx = []
     for g in red.groups:
-        if g in ("gse", "gmp"):
+        if g in CHANNEL_GROUPS:
             idx.extend(lay.i(g) + kept)
         else:
             sl = lay.index[g]
@@ -153,7 +169,8 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     o = _stacked_observations(records, np.asarray(truth.t_s, dtype=float)[epoch_rows::epoch_rows], tol, True, 1)
     used = np.flatnonzero(np.any(np.asarray(gnss.valid, dtype=bool)[0], axis=0))
     return _core(nav, truth, modes, m, epoch_rows, runs[0].fs.x, np.asarray(runs[0].fs.P, dtype=float),
-                 runs[0].db_error, rows[0, epoch_rows::epoch_rows], None if hb_full is None else hb_full[0], o, used)
+                 runs[0].db_error, rows[0, epoch_rows::epoch_rows], None if hb_full is None else hb_full[0], o, used,
+                 runs[0].arcs)
 
 
 def _baro_held(nav: Any, records: dict[str, Any], truth: Any, m: int) -> Array | None:
@@ -218,10 +235,12 @@ def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Arr
 
 
 def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Array, P_conv: Array,
-          db_error: Any, ins_ep: Array, hb1: Array | None, o: dict[str, Any], used: Array) -> BankPass | None:
+          db_error: Any, ins_ep: Array, hb1: Array | None, o: dict[str, Any], used: Array,
+          arcs0: Array | None = None) -> BankPass | None:
     """The pass from the run's start (x_hat, P_conv, its terrain-database error), its INS states at the epochs
     ins_ep (E, 16), its baro held for the damping loop hb1 (m,) or None, its stacked observations o (one run) and
-    the GNSS channels it measures."""
+    the GNSS channels it measures; carrier phase: arcs0 (k,) the start's carrier arc ids (None: none yet), from
+    which each copy's new arcs (its ambiguity resets) follow as in Navigator.compiled_pass."""
     from approachsim.integrity.bank import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
 
     lay = nav.layout
@@ -260,6 +279,21 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     if not np.all(np.isnan(np.delete(rho_all, kept, axis=2))):
         raise RuntimeError("bank_pass: a measured channel was dropped")
     kr = kept.size
+    carrier = eng.carrier and o.get("cp") is not None
+    if carrier:  # the copies' carrier phases and arc ids (an excluded channel: no phase, no arc: bank_records)
+        cp_all, arc_all = o["cp"], o["arc"]
+        if not (np.all(np.isnan(np.delete(cp_all, kept, axis=2))) and np.all(np.delete(arc_all, kept, axis=2) < 0)):
+            raise RuntimeError("bank_pass: a channel with carrier phase was dropped")
+        cp = np.repeat(cp_all[:, :, kept], C, axis=0)
+        arc = np.repeat(arc_all[:, :, kept], C, axis=0)
+        for k, c in enumerate(np.asarray(modes, dtype=int)):
+            if c >= 0:
+                cp[k + 1, :, col[c]] = np.nan
+                arc[k + 1, :, col[c]] = -1
+        last = np.full(lay.n_sv, -1, dtype=np.int64) if arcs0 is None else np.asarray(arcs0, dtype=np.int64)
+        if np.any(np.delete(last, kept) >= 0):
+            raise RuntimeError("bank_pass: a dropped channel has a carrier arc at the start")
+        new, _ = stacked_new_arcs(np.repeat(last[kept][None], C, axis=0), arc)
     r_sv = np.ascontiguousarray(np.broadcast_to(o["r_sv"][:, :, kept], (C, E, kr, 3)))
     el = o["el"][0][:, kept]
     sig = np.ascontiguousarray(np.broadcast_to(eng._code_sig[kept] if eng.channel_states else o["sig"][0][:, kept],
@@ -270,7 +304,12 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     noise = nav.noise(None)
     q, gse_full, gmp_full = em.kernel_noise(noise, lay.n_sv)
     loop = em.kernel_loop(nav.loop_gains() if lay.has("ac") else None)
-    if red.has("gse") and kr:
+    ch_gio = np.zeros((C, E, 0))
+    if red.has("gse") and kr and carrier:  # the slow state without the ionosphere (gio): Navigator.compiled_pass
+        # (numpy elementwise, on every channel as the navigation's pass, then the kept ones)
+        sky = eng.carrier_channel_sigmas(o["el"][0])
+        ch_gse, ch_gio, ch_gmp = (np.ascontiguousarray(np.broadcast_to(a[:, kept], (C, E, kr))) for a in sky)
+    elif red.has("gse") and kr:
         g1, m1 = eng.channel_sigmas(el)
         ch_gse = np.ascontiguousarray(np.broadcast_to(g1, (C, E, kr)))
         ch_gmp = np.ascontiguousarray(np.broadcast_to(m1, (C, E, kr)))
@@ -284,7 +323,7 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     n = red.n
     X = np.repeat(x_hat[idx][None], C, axis=0)
     P3 = np.repeat(P_conv[np.ix_(idx, idx)][None], C, axis=0)
-    R = 2 + kr + pl_rho.shape[2]
+    R = 2 + (2 if carrier else 1) * kr + pl_rho.shape[2]
     codes, nu, S = np.zeros((C, E, R), dtype=np.int64), np.zeros((C, E, R)), np.zeros((C, E, R))
     n_rows = np.zeros((C, E), dtype=np.int64)
     x_out, pd, pnav = np.zeros((C, E, n)), np.zeros((C, E, n)), np.zeros((C, E, 9, 9))
@@ -293,10 +332,18 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     if model is None:
         return None
     phi, qd = _cut(model, red)
-    bk.bank_epochs(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
-                   o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho,
-                   r_sv, sig, eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, codes, nu, S, n_rows, x_out,
-                   pd, pnav, np.zeros(n), np.zeros(n), workspace(n))
+    if carrier:  # kernels/epoch.shared_pass's carrier step (bank_kernel.bank_epochs_carrier)
+        f_gio = -np.expm1(-2.0 * dt_e / nz.gio_tau_s)
+        bk.bank_epochs_carrier(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
+                               o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x,
+                               db_u, rho, r_sv, sig, eng.channel_states, cp, eng.cp_r, pl_rho, r_pl, pl_sig,
+                               eng.pl_states, ch_gio, f_gio, new, eng.amb_prior, codes, nu, S, n_rows, x_out, pd,
+                               pnav, np.zeros(n), np.zeros(n), workspace(n))
+    else:
+        bk.bank_epochs(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
+                       o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x, db_u,
+                       rho, r_sv, sig, eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, codes, nu, S, n_rows,
+                       x_out, pd, pnav, np.zeros(n), np.zeros(n), workspace(n))
     # the outputs' errors at the epochs: the INS rows - x_hat against the truth rows (Navigator.results)
     xe = x_out[:, :, 0:9].reshape(C * E, 9)
     o_s = ins.perturb(ins.unpack(np.tile(ins_ep, (C, 1))), -xe[:, 0:3], -xe[:, 3:6], -xe[:, 6:9])
@@ -323,22 +370,32 @@ def _models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array,
         if sys_ is nav and tr() is truth and kd == key_dt and kh == key_held:
             return val
     lay = nav.layout
+    carrier = lay.has("amb")
+    if carrier:  # the ionosphere's Gauss-Markov (kernels/carrier.dynamics; the ambiguities are random constants)
+        gio, gio_tau = em.kernel_carrier(nav.noise(None), lay.n_sv)
     if lay.n_sv:  # one channel stands for all: its states' F, Qc depend on the channel only through the sigma, which
         # enters Qc alone (kernels/errormodel.dynamics: a Markov state of the common tau), and each copy's Qd sets it
         lay1, _ = _reduced(lay, np.array([0]))
         gse, gmp = np.ascontiguousarray(gse[:1]), np.ascontiguousarray(gmp[:1])
+        if carrier:
+            gio = np.ascontiguousarray(gio[:1])
     else:
         lay1 = lay
     E, n = dt.shape[0], lay1.n
     phi, qd = np.zeros((E, n, n)), np.zeros((E, n, n))
-    if bk.models(lay1.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, phi, qd) != E:
+    if carrier:
+        done = bk.carrier_models(lay1.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, gio, gio_tau, phi, qd)
+    else:
+        done = bk.models(lay1.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, phi, qd)
+    if done != E:
         return None  # an epoch's model is too large for the compiled discretization
     if lay1.n_sv:  # the channel's states lone: their rows and columns zero off the diagonal
-        ch = np.array([lay1.i("gse"), lay1.i("gmp")])
+        ch = np.array([lay1.i(g) for g in CHANNEL_GROUPS if lay1.has(g)])
         rest = np.setdiff1d(np.arange(n), ch)
+        off = ~np.eye(ch.size, dtype=bool)
         for a in (phi, qd):
-            if (np.any(a[:, ch][:, :, rest]) or np.any(a[:, rest][:, :, ch]) or np.any(a[:, ch[0], ch[1]])
-                    or np.any(a[:, ch[1], ch[0]])):
+            if (np.any(a[:, ch][:, :, rest]) or np.any(a[:, rest][:, :, ch])
+                    or np.any(a[:, ch[:, None], ch[None, :]][:, off])):
                 return None
     val = (phi, qd, lay1)
     _MODELS[:] = [(nav, weakref.ref(truth), key_dt, key_held, val)]
@@ -370,7 +427,7 @@ def _make_cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -
     src, chan = [], []
     for g in red.groups:
         sl = red.index[g]
-        if g in ("gse", "gmp"):
+        if g in CHANNEL_GROUPS:
             src.extend([lay1.i(g)] * (sl.stop - sl.start))
             chan.extend(range(sl.start, sl.stop))
         else:
