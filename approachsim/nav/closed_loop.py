@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from approachsim import geo
 from approachsim.glidepath import GlidePath
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
@@ -39,7 +40,7 @@ from approachsim.nav.system import NavSystem, tuned_records
 from approachsim.records import ApproachErrors, Truth
 from approachsim.seeding import stream
 from approachsim.sensors.baro import Baro, PreparedBaro
-from approachsim.sensors.gnss.receiver import PreparedGnss
+from approachsim.sensors.gnss.receiver import IONO_SHELL_M, PreparedGnss
 from approachsim.sensors.radalt import PreparedRadalt
 from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite
@@ -56,6 +57,8 @@ _AIDING = ("baro", "radalt", "gnss", "pseudolite")
 
 _NAN1 = np.full(1, math.nan)
 _TRUE1 = np.ones(1, dtype=bool)
+_EL_MIN = float(np.radians(2.0))
+"""nav/noise.py's elevation floor, rad."""
 
 
 class _BaroAt:
@@ -147,6 +150,10 @@ class FastEpoch:
     PN: Array
     e: int = 0
     """The next history row."""
+    sig: tuple | None = None
+    """The compiled channel sigmas' scratch and constants (NavInTheLoop._noise_arrays): guarded elevations, the
+    multipath curve's argument, cos, sin, exp, gse, gmp (n_sv,) and channel_sigmas' constants; None: the numpy
+    formulas (GBAS budget, no GPS channels)."""
     direct: bool = False
     """The epoch's sensor inputs come straight from the sensors' kernels (NavInTheLoop._direct_inputs: plain baro,
     radar altimeter and stand-alone code GNSS of one run), not from their records (`_epoch_inputs`, the oracle)."""
@@ -198,6 +205,8 @@ class NavInTheLoop:
         """The last epoch's sensor records (row, records): the baro's is the damping loop's sample at that row."""
         self.fast_epochs = True
         self.direct_inputs = True
+        self.compiled_sigmas = True
+        """The GPS channel sigmas of the compiled epoch partly compiled (FastEpoch.sig); False: numpy's formulas."""
         """The compiled epoch's sensor inputs straight from the sensors' kernels when possible (FastEpoch.direct);
         False: from their records (the direct inputs' test oracle)."""
         """Run the aiding epochs compiled when the configuration allows (`fast_epoch_unavailable`); False: always
@@ -423,7 +432,19 @@ class NavInTheLoop:
             budget=None if g is None else g.budget(), held_possible=lay.has("ac") and self.gains is not None,
             P=np.array(nav.runs[0].fs.P, dtype=float), X=np.zeros((1, n)), f_ned=np.zeros(3),
             XS=np.zeros((n_ep, n)), PP=np.zeros((n_ep, 3, 3)), PC=np.zeros(n_ep), PD=np.zeros((n_ep, n)),
-            PN=np.zeros((n_ep, 9, 9)), direct=self.direct_inputs and self._direct_possible())
+            PN=np.zeros((n_ep, 9, 9)), direct=self.direct_inputs and self._direct_possible(),
+            sig=self._sigma_scratch(None if g is None else g.budget(), lay.n_sv))
+
+    def _sigma_scratch(self, b: Any, n_sv: int) -> tuple | None:
+        """FastEpoch.sig for the budget b (None: no GPS) and n_sv channels: None unless stand-alone with channels
+        (and `compiled_sigmas`)."""
+        if b is None or b.gbas is not None or n_sv == 0 or not self.compiled_sigmas:
+            return None
+        do253 = b.multipath_model == "do253"
+        gmp = np.zeros(n_sv) if do253 else _per_channel(b.multipath_m, n_sv).copy()
+        return (*(np.zeros(n_sv) for _ in range(6)), gmp,
+                (geo.A_WGS84, IONO_SHELL_M, float(b.clock_ephemeris_m**2), float(b.iono_zenith_m),
+                 float(b.tropo_zenith_m), do253))
 
     def _direct_possible(self) -> bool:
         """Whether every aiding sensor's epoch input has its direct form (`_direct_inputs`): a plain (not faulted)
@@ -440,8 +461,25 @@ class NavInTheLoop:
 
     def _noise_arrays(self, el: Array | None) -> tuple[Array, Array, Array]:
         """NoiseModel.kernel_arrays(el) (nav/noise.py) with the elevation-free scalars kept: the GPS channel
-        states' sigmas at el by the receiver budget's numpy formulas (the same operations, the same bits; el is
-        finite or nan)."""
+        states' sigmas at el by the receiver budget's formulas, the same bits (el is finite or nan): a stand-alone
+        budget's with numpy's cos, sin, exp and the rest compiled in numpy's order (closed_loop_epoch
+        channel_guard, channel_sigmas; FastEpoch.sig), else the budget's numpy (`_noise_arrays_numpy`, the
+        oracle)."""
+        fe = self._fast
+        sg = fe.sig
+        if el is None or sg is None or el.shape[0] != sg[0].shape[0]:
+            return self._noise_arrays_numpy(el)
+        g, arg, c, s, ex, gse, gmp, consts = sg
+        ce.channel_guard(el, _EL_MIN, g, arg)
+        np.cos(g, out=c)
+        np.sin(g, out=s)
+        if consts[-1]:  # do253
+            np.exp(arg, out=ex)
+        ce.channel_sigmas(c, s, ex, *consts, gse, gmp)
+        return fe.q, gse, gmp
+
+    def _noise_arrays_numpy(self, el: Array | None) -> tuple[Array, Array, Array]:
+        """`_noise_arrays` by the receiver budget's numpy formulas (receiver.GnssErrorBudget.channel_sigmas_m)."""
         fe = self._fast
         n_sv = self.nav.layout.n_sv
         if el is None or fe.budget is None or n_sv == 0:
