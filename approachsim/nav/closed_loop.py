@@ -24,6 +24,7 @@ import weakref
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+import numba
 import numpy as np
 
 from approachsim import geo
@@ -70,6 +71,18 @@ class _BaroAt:
 
     def __init__(self, h_baro_m: Array) -> None:
         self.h_baro_m = h_baro_m
+
+
+def _entry(dispatcher: Any, args: tuple) -> Any:
+    """The compiled entry point of numba `dispatcher` for these arguments' types, called without numba's per-call
+    type dispatch (flight/run.py `_entry`: loop_epoch's 48 arguments, among them a tuple of arrays whose typing
+    goes through numba's Python typeof, cost more to dispatch than to unbox). Calls through it must pass the same
+    types (every epoch of a run does: the same dtypes, dimensions and C layout); the dispatcher itself when numba's
+    internals (Dispatcher.overloads[signature].entry_point) are not there."""
+    sig = tuple(numba.typeof(a) for a in args)
+    dispatcher.compile(sig)  # loads it from numba's cache when compiled before
+    entry = getattr(dispatcher.overloads.get(sig), "entry_point", None)
+    return dispatcher if entry is None else entry
 
 
 def _per_channel(a: Array | float, n_sv: int) -> Array:
@@ -150,6 +163,8 @@ class FastEpoch:
     PN: Array
     e: int = 0
     """The next history row."""
+    call: Any = None
+    """loop_epoch's compiled entry point for this run's argument types (`_entry`; made at the first epoch)."""
     sig: tuple | None = None
     """The compiled channel sigmas' scratch and constants (NavInTheLoop._noise_arrays): guarded elevations, the
     multipath curve's argument, cos, sin, exp, gse, gmp (n_sv,) and channel_sigmas' constants; None: the numpy
@@ -225,8 +240,9 @@ class NavInTheLoop:
         if getattr(imu.grade, "gyro_quant_rad", 0.0) > 0.0 or getattr(imu.grade, "accel_quant_mps", 0.0) > 0.0:
             return None
         n = self.t_s.shape[0]
-        zeros = {f.name: np.zeros((n,) + (3,) * (f.name in _VEC3) + (4,) * (f.name in ("q_nb", "controls")))
-                 for f in fields(Truth) if f.name != "runway"}
+        shared: dict[tuple, Array] = {}  # one zero array per shape, shared by the fields (read only)
+        zeros = {f.name: shared.setdefault(s, np.zeros(s)) for f in fields(Truth) if f.name != "runway"
+                 for s in [(n,) + (3,) * (f.name in _VEC3) + (4,) * (f.name in ("q_nb", "controls"))]}
         zeros["t_s"] = self.t_s
         zero_truth = Truth(**zeros, runway=self.profile.runway.frame)
         rec = imu.apply(zero_truth, e)
@@ -579,11 +595,14 @@ class NavInTheLoop:
         fe.X[0] = run.fs.x
         db = nav.dbs[0]
         e = fe.e
-        n_rows = ce.loop_epoch(nw, fe.X, fe.P, e, eng.lay, q, gse, gmp, eng.loop, held, t - nav.t_last, fe.f_ned,
-                               eng.F, eng.Qc, eng.phi, eng.qd, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
-                               eng.tx, eng.th, eng.rwy, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig,
-                               eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, eng.codes, eng._nu[:1],
-                               eng.S, eng.h, eng.b, eng.ws, fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic)
+        args = (nw, fe.X, fe.P, e, eng.lay, q, gse, gmp, eng.loop, held, t - nav.t_last, fe.f_ned,
+                eng.F, eng.Qc, eng.phi, eng.qd, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
+                eng.tx, eng.th, eng.rwy, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig,
+                eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, eng.codes, eng._nu[:1],
+                eng.S, eng.h, eng.b, eng.ws, fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic)
+        if fe.call is None:
+            fe.call = _entry(ce.loop_epoch, args)
+        n_rows = fe.call(*args)
         if n_rows < 0:
             return False
         fe.e = e + 1
