@@ -15,6 +15,10 @@ epoch is one compiled call (nav/kernels/closed_loop_epoch.py: the per-run EKF's 
 bookkeeping) on the sensors' one-row records, when the configuration has the compiled epoch
 (`fast_epoch_unavailable`: not with feedback, the online FDE, the robust or U-D filters, loose coupling, an adaptive
 loop, carrier phase); otherwise, and as its test oracle (`fast_epochs = False`), the Navigator's numpy path.
+The compiled epoch's sensor inputs come straight from the baro's, radar altimeter's and GPS receiver's kernels
+(`_direct_inputs`, no records; `direct_inputs = False` or a faulted sensor, GBAS, carrier: from the records) and the
+GPS channel sigmas partly compiled (`_noise_arrays`; `compiled_sigmas = False`: numpy), the same bits either way
+(tests/unit/nav/test_closed_loop_epoch.py; tools/closed_loop_identity.py against a saved reference).
 """
 
 from __future__ import annotations
@@ -219,13 +223,14 @@ class NavInTheLoop:
         self._recs: tuple[int, dict[str, Any]] | None = None
         """The last epoch's sensor records (row, records): the baro's is the damping loop's sample at that row."""
         self.fast_epochs = True
-        self.direct_inputs = True
-        self.compiled_sigmas = True
-        """The GPS channel sigmas of the compiled epoch partly compiled (FastEpoch.sig); False: numpy's formulas."""
-        """The compiled epoch's sensor inputs straight from the sensors' kernels when possible (FastEpoch.direct);
-        False: from their records (the direct inputs' test oracle)."""
         """Run the aiding epochs compiled when the configuration allows (`fast_epoch_unavailable`); False: always
         the Navigator's numpy path (the compiled epoch's test oracle)."""
+        self.direct_inputs = True
+        """The compiled epoch's sensor inputs straight from the sensors' kernels when possible (FastEpoch.direct);
+        False: from their records (the direct inputs' test oracle)."""
+        self.compiled_sigmas = True
+        """The GPS channel sigmas of the compiled epoch partly compiled (FastEpoch.sig); False: numpy's formulas
+        (their test oracle)."""
 
     def _imu_error_terms(self) -> tuple[Array, Array, Array, Array] | None:
         """The IMU error model is affine in the true increments (sensors/imu.py):
