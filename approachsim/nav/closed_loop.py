@@ -15,6 +15,10 @@ epoch is one compiled call (nav/kernels/closed_loop_epoch.py: the per-run EKF's 
 bookkeeping) on the sensors' one-row records, when the configuration has the compiled epoch
 (`fast_epoch_unavailable`: not with feedback, the online FDE, the robust or U-D filters, loose coupling, an adaptive
 loop, carrier phase); otherwise, and as its test oracle (`fast_epochs = False`), the Navigator's numpy path.
+The compiled epoch's sensor inputs come straight from the baro's, radar altimeter's and GPS receiver's kernels
+(`_direct_inputs`, no records; `direct_inputs = False` or a faulted sensor, GBAS, carrier: from the records) and the
+GPS channel sigmas partly compiled (`_noise_arrays`; `compiled_sigmas = False`: numpy), the same bits either way
+(tests/unit/nav/test_closed_loop_epoch.py; tools/closed_loop_identity.py against a saved reference).
 """
 
 from __future__ import annotations
@@ -24,8 +28,10 @@ import weakref
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+import numba
 import numpy as np
 
+from approachsim import geo
 from approachsim.glidepath import GlidePath
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
@@ -38,7 +44,9 @@ from approachsim.nav.observations import Observations
 from approachsim.nav.system import NavSystem, tuned_records
 from approachsim.records import ApproachErrors, Truth
 from approachsim.seeding import stream
-from approachsim.sensors.baro import Baro
+from approachsim.sensors.baro import Baro, PreparedBaro
+from approachsim.sensors.gnss.receiver import IONO_SHELL_M, PreparedGnss
+from approachsim.sensors.radalt import PreparedRadalt
 from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite
 
@@ -53,6 +61,32 @@ _AIDING = ("baro", "radalt", "gnss", "pseudolite")
 """The aiding sensors, in the order the epoch reads them."""
 
 _NAN1 = np.full(1, math.nan)
+_TRUE1 = np.ones(1, dtype=bool)
+_EL_MIN = float(np.radians(2.0))
+"""nav/noise.py's elevation floor, rad."""
+
+
+class _BaroAt:
+    """A plain baro's sample at an epoch row made without its record (NavInTheLoop._direct_inputs): what the
+    damping loop reads of the record (h_baro_m (1,) m, valid (1,): a plain baro's samples are all valid)."""
+
+    __slots__ = ("h_baro_m",)
+    valid = _TRUE1
+
+    def __init__(self, h_baro_m: Array) -> None:
+        self.h_baro_m = h_baro_m
+
+
+def _entry(dispatcher: Any, args: tuple) -> Any:
+    """The compiled entry point of numba `dispatcher` for these arguments' types, called without numba's per-call
+    type dispatch (flight/run.py `_entry`: loop_epoch's 48 arguments, among them a tuple of arrays whose typing
+    goes through numba's Python typeof, cost more to dispatch than to unbox). Calls through it must pass the same
+    types (every epoch of a run does: the same dtypes, dimensions and C layout); the dispatcher itself when numba's
+    internals (Dispatcher.overloads[signature].entry_point) are not there."""
+    sig = tuple(numba.typeof(a) for a in args)
+    dispatcher.compile(sig)  # loads it from numba's cache when compiled before
+    entry = getattr(dispatcher.overloads.get(sig), "entry_point", None)
+    return dispatcher if entry is None else entry
 
 
 def _per_channel(a: Array | float, n_sv: int) -> Array:
@@ -133,6 +167,15 @@ class FastEpoch:
     PN: Array
     e: int = 0
     """The next history row."""
+    call: Any = None
+    """loop_epoch's compiled entry point for this run's argument types (`_entry`; made at the first epoch)."""
+    sig: tuple | None = None
+    """The compiled channel sigmas' scratch and constants (NavInTheLoop._noise_arrays): guarded elevations, the
+    multipath curve's argument, cos, sin, exp, gse, gmp (n_sv,) and channel_sigmas' constants; None: the numpy
+    formulas (GBAS budget, no GPS channels)."""
+    direct: bool = False
+    """The epoch's sensor inputs come straight from the sensors' kernels (NavInTheLoop._direct_inputs: plain baro,
+    radar altimeter and stand-alone code GNSS of one run), not from their records (`_epoch_inputs`, the oracle)."""
 
 
 @dataclass
@@ -182,6 +225,12 @@ class NavInTheLoop:
         self.fast_epochs = True
         """Run the aiding epochs compiled when the configuration allows (`fast_epoch_unavailable`); False: always
         the Navigator's numpy path (the compiled epoch's test oracle)."""
+        self.direct_inputs = True
+        """The compiled epoch's sensor inputs straight from the sensors' kernels when possible (FastEpoch.direct);
+        False: from their records (the direct inputs' test oracle)."""
+        self.compiled_sigmas = True
+        """The GPS channel sigmas of the compiled epoch partly compiled (FastEpoch.sig); False: numpy's formulas
+        (their test oracle)."""
 
     def _imu_error_terms(self) -> tuple[Array, Array, Array, Array] | None:
         """The IMU error model is affine in the true increments (sensors/imu.py):
@@ -196,8 +245,9 @@ class NavInTheLoop:
         if getattr(imu.grade, "gyro_quant_rad", 0.0) > 0.0 or getattr(imu.grade, "accel_quant_mps", 0.0) > 0.0:
             return None
         n = self.t_s.shape[0]
-        zeros = {f.name: np.zeros((n,) + (3,) * (f.name in _VEC3) + (4,) * (f.name in ("q_nb", "controls")))
-                 for f in fields(Truth) if f.name != "runway"}
+        shared: dict[tuple, Array] = {}  # one zero array per shape, shared by the fields (read only)
+        zeros = {f.name: shared.setdefault(s, np.zeros(s)) for f in fields(Truth) if f.name != "runway"
+                 for s in [(n,) + (3,) * (f.name in _VEC3) + (4,) * (f.name in ("q_nb", "controls"))]}
         zeros["t_s"] = self.t_s
         zero_truth = Truth(**zeros, runway=self.profile.runway.frame)
         rec = imu.apply(zero_truth, e)
@@ -342,9 +392,18 @@ class NavInTheLoop:
         run = navigator.runs[0]
         if code & ik.NAV_EPOCH:
             t = float(truth.t_s[k])
-            recs = self._records(k, truth)
-            self._recs = (k, recs)
-            if self._fast is None or not self._fast_epoch(k, t, recs):
+            fe = self._fast
+            recs = None
+            if fe is not None and fe.direct:  # the inputs straight from the sensors' kernels (no records)
+                done = self._fast_epoch(k, t, self._direct_inputs(k, t, truth))
+            else:
+                recs = self._records(k, truth)
+                self._recs = (k, recs)
+                done = fe is not None and self._fast_epoch(k, t, self._epoch_inputs(t, recs))
+            if not done:
+                if recs is None:
+                    recs = self._records(k, truth)
+                    self._recs = (k, recs)
                 obs, _ = self._observations(k, truth, recs)
                 if self.gains is not None:  # the kernel's loop held over the interval (no baro, or excluded)
                     obs = obs.with_loop_held([nw[ik.W_ANY_BARO] == 0.0])
@@ -394,12 +453,54 @@ class NavInTheLoop:
             budget=None if g is None else g.budget(), held_possible=lay.has("ac") and self.gains is not None,
             P=np.array(nav.runs[0].fs.P, dtype=float), X=np.zeros((1, n)), f_ned=np.zeros(3),
             XS=np.zeros((n_ep, n)), PP=np.zeros((n_ep, 3, 3)), PC=np.zeros(n_ep), PD=np.zeros((n_ep, n)),
-            PN=np.zeros((n_ep, 9, 9)))
+            PN=np.zeros((n_ep, 9, 9)), direct=self.direct_inputs and self._direct_possible(),
+            sig=self._sigma_scratch(None if g is None else g.budget(), lay.n_sv))
+
+    def _sigma_scratch(self, b: Any, n_sv: int) -> tuple | None:
+        """FastEpoch.sig for the budget b (None: no GPS) and n_sv channels: None unless stand-alone with channels
+        (and `compiled_sigmas`)."""
+        if b is None or b.gbas is not None or n_sv == 0 or not self.compiled_sigmas:
+            return None
+        do253 = b.multipath_model == "do253"
+        gmp = np.zeros(n_sv) if do253 else _per_channel(b.multipath_m, n_sv).copy()
+        return (*(np.zeros(n_sv) for _ in range(6)), gmp,
+                (geo.A_WGS84, IONO_SHELL_M, float(b.clock_ephemeris_m**2), float(b.iono_zenith_m),
+                 float(b.tropo_zenith_m), do253))
+
+    def _direct_possible(self) -> bool:
+        """Whether every aiding sensor's epoch input has its direct form (`_direct_inputs`): a plain (not faulted)
+        baro and radar altimeter, a one-run, one-sky GPS receiver of code ranging without GBAS or carrier phase;
+        the pseudolite's record is made as before."""
+        ps = self.prepared.sensors
+        for name, kind in (("baro", PreparedBaro), ("radalt", PreparedRadalt), ("gnss", PreparedGnss)):
+            p = ps.get(name)
+            if p is not None and type(p) is not kind:
+                return False
+        g = ps.get("gnss")
+        return g is None or (g.rx.budget.gbas is None and g.rx.carrier is None and not g.per_run
+                             and not g.errors.batched)
 
     def _noise_arrays(self, el: Array | None) -> tuple[Array, Array, Array]:
         """NoiseModel.kernel_arrays(el) (nav/noise.py) with the elevation-free scalars kept: the GPS channel
-        states' sigmas at el by the receiver budget's numpy formulas (the same operations, the same bits; el is
-        finite or nan)."""
+        states' sigmas at el by the receiver budget's formulas, the same bits (el is finite or nan): a stand-alone
+        budget's with numpy's cos, sin, exp and the rest compiled in numpy's order (closed_loop_epoch
+        channel_guard, channel_sigmas; FastEpoch.sig), else the budget's numpy (`_noise_arrays_numpy`, the
+        oracle)."""
+        fe = self._fast
+        sg = fe.sig
+        if el is None or sg is None or el.shape[0] != sg[0].shape[0]:
+            return self._noise_arrays_numpy(el)
+        g, arg, c, s, ex, gse, gmp, consts = sg
+        ce.channel_guard(el, _EL_MIN, g, arg)
+        np.cos(g, out=c)
+        np.sin(g, out=s)
+        if consts[-1]:  # do253
+            np.exp(arg, out=ex)
+        ce.channel_sigmas(c, s, ex, *consts, gse, gmp)
+        return fe.q, gse, gmp
+
+    def _noise_arrays_numpy(self, el: Array | None) -> tuple[Array, Array, Array]:
+        """`_noise_arrays` by the receiver budget's numpy formulas (receiver.GnssErrorBudget.channel_sigmas_m)."""
         fe = self._fast
         n_sv = self.nav.layout.n_sv
         if el is None or fe.budget is None or n_sv == 0:
@@ -407,15 +508,11 @@ class NavInTheLoop:
         el = np.maximum(np.where(np.isnan(el), 0.5, el), np.radians(2.0))  # nav/noise.py's guard
         return (fe.q, *(_per_channel(a, n_sv) for a in fe.budget.channel_sigmas_m(el)))
 
-    def _fast_epoch(self, k: int, t: float, recs: dict[str, Any]) -> bool:
-        """The aiding epoch at truth row k (time t) in one compiled call (closed_loop_epoch.loop_epoch), from the
-        sensors' one-row records recs: Observations.at's values for one run (nan where a record has no sample at
-        t or it is invalid), the per-run EKF's epoch (nav/engine.py own), the Navigator's snapshot and history,
-        the estimate in force. False, with nothing changed, when the model needs the numpy discretization."""
-        fe, nav, lp = self._fast, self.navigator, self._inloop
-        nw = lp.nw
-        run = nav.runs[0]
-        eng = nav.engine
+    def _epoch_inputs(self, t: float, recs: dict[str, Any]) -> tuple:
+        """The compiled epoch's sensor inputs at time t from the sensors' one-row records recs (`_records`):
+        Observations.at's values for one run (nan where a record has no sample at t or it is invalid): (baro_h (1,),
+        baro_r, radalt_h (1,), rho (1, k), r_sv (k, 3), sig (k,), el (k,) or None, pl_rho, r_pl, pl_sig)."""
+        eng = self.navigator.engine
         tol = 0.25 * self.dt
         b = recs.get("baro")
         if b is not None and abs(b.t_s[0] - t) <= tol:
@@ -435,13 +532,67 @@ class NavInTheLoop:
             el = g.elevation_rad[0]
         else:
             rho, r_sv, sig = np.zeros((1, 0)), eng._none3, eng._none1
-        p = recs.get("pseudolite")
-        if p is not None and abs(p.t_s[0] - t) <= tol:
+        return (baro_h, baro_r, radalt_h, rho, r_sv, sig, el, *self._pseudolite_inputs(t, recs.get("pseudolite")))
+
+    def _pseudolite_inputs(self, t: float, p: Any) -> tuple[Array, Array, Array]:
+        """The compiled epoch's pseudolite inputs (pl_rho, r_pl, pl_sig) at time t from its record p (or None)."""
+        eng = self.navigator.engine
+        if p is not None and abs(p.t_s[0] - t) <= 0.25 * self.dt:
             pl_rho = np.where(p.valid[0:1], p.pseudorange_m[0:1], np.nan)
             r_pl = np.ascontiguousarray(p.r_pl_ecef, dtype=float)
             pl_sig = eng._pl_sig if eng.pl_states else np.ascontiguousarray(p.sigma_m[0], dtype=float)
-        else:
-            pl_rho, r_pl, pl_sig = np.zeros((1, 0)), eng._none3, eng._none1
+            return pl_rho, r_pl, pl_sig
+        return np.zeros((1, 0)), eng._none3, eng._none1
+
+    def _direct_inputs(self, k: int, t: float, truth: Truth) -> tuple:
+        """`_epoch_inputs` at truth row k without the records (FastEpoch.direct): the baro's, radar altimeter's and
+        GPS receiver's numbers by their kernels on the same values (sensors' h_one / channels_one), the same bits;
+        the baro's sample is kept for the damping loop (`_recs`)."""
+        ps = self.prepared
+        eng = self.navigator.engine
+        tol = 0.25 * self.dt
+        baro_h, baro_r, radalt_h, el = _NAN1, 0.0, _NAN1, None
+        rho, r_sv, sig = np.zeros((1, 0)), eng._none3, eng._none1
+        recs: dict[str, Any] = {}
+        j = ps.sample("baro", k)
+        if j is not None:
+            p = ps.sensors["baro"]
+            h = p.h_one(truth, j)
+            recs["baro"] = _BaroAt(np.array([h]))
+            if abs(p.errors.t_s[j] - t) <= tol:
+                baro_h, baro_r = np.array([h]), float(p.baro.noise_sigma_m) ** 2
+        j = ps.sample("radalt", k)
+        if j is not None:
+            p = ps.sensors["radalt"]
+            h = p.h_one(truth, j)
+            if abs(p.errors.t_s[j] - t) <= tol:
+                radalt_h = np.array([h])
+        j = ps.sample("gnss", k)
+        if j is not None:
+            p = ps.sensors["gnss"]
+            if abs(p.errors.t_s[j] - t) <= tol:
+                pr, valid, r_sv0, sigma, el = p.channels_one(truth, j)
+                rho = np.where(valid, pr, np.nan)
+                r_sv = np.ascontiguousarray(r_sv0, dtype=float)
+                if not eng.channel_states:
+                    scale = self.nav.nav.gps_sigma_scale  # tuned_records' R tuning
+                    sig = np.ascontiguousarray(sigma if scale == 1.0 else sigma * scale, dtype=float)
+                else:
+                    sig = eng._code_sig
+        self._recs = (k, recs)
+        pl = ps.one("pseudolite", truth, k) if "pseudolite" in ps.sensors else None
+        return (baro_h, baro_r, radalt_h, rho, r_sv, sig, el, *self._pseudolite_inputs(t, pl))
+
+    def _fast_epoch(self, k: int, t: float, inputs: tuple) -> bool:
+        """The aiding epoch at truth row k (time t) in one compiled call (closed_loop_epoch.loop_epoch) on the sensor
+        inputs (`_epoch_inputs` / `_direct_inputs`): the per-run EKF's epoch (nav/engine.py own), the Navigator's
+        snapshot and history, the estimate in force. False, with nothing changed, when the model needs the numpy
+        discretization."""
+        fe, nav, lp = self._fast, self.navigator, self._inloop
+        nw = lp.nw
+        run = nav.runs[0]
+        eng = nav.engine
+        baro_h, baro_r, radalt_h, rho, r_sv, sig, el, pl_rho, r_pl, pl_sig = inputs
         q, gse, gmp = self._noise_arrays(el)
         held = fe.held_possible and nw[ik.W_ANY_BARO] == 0.0
         if run.fs.P is not fe.P:  # the Navigator's path ran an epoch (or the start): its P from now on
@@ -449,11 +600,14 @@ class NavInTheLoop:
         fe.X[0] = run.fs.x
         db = nav.dbs[0]
         e = fe.e
-        n_rows = ce.loop_epoch(nw, fe.X, fe.P, e, eng.lay, q, gse, gmp, eng.loop, held, t - nav.t_last, fe.f_ned,
-                               eng.F, eng.Qc, eng.phi, eng.qd, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
-                               eng.tx, eng.th, eng.rwy, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig,
-                               eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, eng.codes, eng._nu[:1],
-                               eng.S, eng.h, eng.b, eng.ws, fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic)
+        args = (nw, fe.X, fe.P, e, eng.lay, q, gse, gmp, eng.loop, held, t - nav.t_last, fe.f_ned,
+                eng.F, eng.Qc, eng.phi, eng.qd, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
+                eng.tx, eng.th, eng.rwy, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig,
+                eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, eng.codes, eng._nu[:1],
+                eng.S, eng.h, eng.b, eng.ws, fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic)
+        if fe.call is None:
+            fe.call = _entry(ce.loop_epoch, args)
+        n_rows = fe.call(*args)
         if n_rows < 0:
             return False
         fe.e = e + 1

@@ -135,7 +135,7 @@ class StatusBuffer:
                 codes, ts, v, s = p
                 k = len(codes)
                 t.append(np.full(k, ts) if np.ndim(ts) == 0 else np.asarray(ts, dtype=float))
-                name.append(np.array([code_name(int(c)) for c in codes], dtype=object))
+                name.append(codes)  # row codes: named below, all at once
                 nu.append(v)
                 S.append(s)
                 w.append(np.ones(k))
@@ -144,10 +144,22 @@ class StatusBuffer:
         def cat(a: list, dtype: Any) -> Array:
             return np.concatenate(a).astype(dtype) if a else np.zeros(0, dtype=dtype)
 
+        if name and all(n.dtype != object for n in name):  # engine epochs only: their codes named at once
+            name = [_code_names(np.concatenate(name))]
+        else:
+            name = [n if n.dtype == object else np.array([code_name(int(c)) for c in n], dtype=object) for n in name]
+
         nu_a, S_a = cat(nu, float), cat(S, float)
         return {"t_s": cat(t, float), "name": cat(name, str), "innovation": nu_a, "variance": S_a,
                 "test_ratio": nu_a * nu_a / S_a if S_a.size else np.zeros(0), "weight": cat(w, float),
                 "accepted": cat(acc, bool)}
+
+
+def _code_names(codes: Array) -> Array:
+    """The status-log names (code_name) of row codes (k,) as an object array."""
+    u, inv = np.unique(np.asarray(codes, dtype=np.int64), return_inverse=True)
+    return np.array([code_name(int(c)) for c in u], dtype=object)[inv.reshape(-1)] if u.size else \
+        np.zeros(0, dtype=object)
 
 
 @dataclass(frozen=True)

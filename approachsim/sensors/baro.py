@@ -184,9 +184,22 @@ class PreparedBaro:
         self.sf = np.ascontiguousarray(run(np.asarray(errors.constants["scale_factor"], dtype=float)))
         self.bias = np.ascontiguousarray(run(errors.series["bias"]), dtype=float)
         self.noise = np.ascontiguousarray(run(errors.series["noise"]), dtype=float)
+        self._one: tuple | None = None
 
     def at(self, truth: Truth, j: int) -> BaroSamples:
         """The record of sample j alone (one-sample axes)."""
         sl = slice(j, j + 1)
         e = self.errors
         return self.baro.record(truth, e.rows[sl], e.t_s[sl], self.sf, self.bias[:, sl], self.noise[:, sl], e.batched)
+
+    def h_one(self, truth: Truth, j: int) -> float:
+        """The height (m) of sample j of a one-run draw: at(truth, j).h_baro_m[0] (valid: always) by the same kernel
+        on the same values, without the record (the closed loop's compiled aiding epoch reads only this)."""
+        if self._one is None:  # the lag's row offsets and constants (truth.t_s[1] is set once row 1 is flown)
+            w = self.baro.lag_weights(float(truth.t_s[1] - truth.t_s[0])) if self.baro.lag_s > 0.0 else _NO_LAG
+            self._one = (np.arange(max(w.shape[0], 1)), w, self.baro.kernel_constants(), np.empty((1, 1)))
+        lag, w, kc, out = self._one
+        k = int(self.errors.rows[j])
+        p = truth.p_static_pa[np.maximum(k - lag, 0)][None, :]
+        bk.baro_apply(p, *kc, w, self.sf, self.bias[:, j:j + 1], self.noise[:, j:j + 1], out)
+        return float(out[0, 0])

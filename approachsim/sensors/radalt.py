@@ -147,6 +147,7 @@ class PreparedRadalt:
         self.bias = np.ascontiguousarray(run(np.asarray(errors.constants["bias"], dtype=float)))
         self.markov = np.ascontiguousarray(run(errors.series["markov"]), dtype=float)
         self.noise = np.ascontiguousarray(run(errors.series["noise"]), dtype=float)
+        self._out = (np.empty((1, 1)), np.empty((1, 1)), np.empty((1, 1), dtype=bool))
 
     def at(self, truth: Truth, j: int) -> RadaltSamples:
         """The record of sample j alone (one-sample axes)."""
@@ -154,3 +155,15 @@ class PreparedRadalt:
         e = self.errors
         return self.ra.record(truth, e.rows[sl], e.t_s[sl], self.bias, self.markov[:, sl], self.noise[:, sl],
                               e.batched)
+
+    def h_one(self, truth: Truth, j: int) -> float:
+        """The measured height (m) of sample j of a one-run draw, nan when not valid: at(truth, j)'s h_agl_m[0]
+        where valid, by the same kernel on the same values, without the record (the closed loop's compiled epoch)."""
+        k = int(self.errors.rows[j])
+        meas, sig, valid = self._out
+        r = self.ra
+        ra.radalt_apply(truth.h_agl_m[k:k + 1].copy(), truth.euler_rad[k:k + 1, 1].copy(),
+                        truth.euler_rad[k:k + 1, 0].copy(), self.bias, self.markov[:, j:j + 1],
+                        self.noise[:, j:j + 1], float(r.percent_sigma), r.floor_m**2, float(r.max_range_m),
+                        float(r.max_pitch_rad), float(r.max_roll_rad), meas, sig, valid)
+        return float(meas[0, 0]) if valid[0, 0] else math.nan

@@ -21,6 +21,8 @@ that path (NavInTheLoop with the fast epoch off): tests/unit/nav/test_closed_loo
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -71,3 +73,43 @@ def loop_epoch(nw: np.ndarray, X: np.ndarray, P: np.ndarray, e: int, lay: np.nda
         nw[ik.W_XNAV + i] = X[0, i]
     nw[ik.W_ANY_BARO] = 0.0
     return k
+
+
+RAD_TO_DEG = 180.0 / math.pi
+"""numpy's degrees() factor (npy_rad2deg: x * (180 / pi))."""
+
+
+@njit(cache=True)
+def channel_guard(el: np.ndarray, lo: float, g: np.ndarray, mp_arg: np.ndarray) -> None:
+    """The GPS channel states' elevations as the noise model guards them (nav/noise.py): g = max(el, lo) with nan
+    read as 0.5 rad, and mp_arg = -degrees(g) / 10, the argument of DO-253's multipath curve
+    (receiver.do253_multipath_sigma_m). numpy's operations one by one (where, maximum, degrees, negative, divide):
+    exact in IEEE arithmetic, the same bits."""
+    for i in range(el.shape[0]):
+        e = el[i]
+        e = 0.5 if e != e else e
+        e = e if e >= lo else lo
+        g[i] = e
+        mp_arg[i] = -(e * RAD_TO_DEG) / 10.0
+
+
+@njit(cache=True)
+def channel_sigmas(cos_g: np.ndarray, sin_g: np.ndarray, exp_mp: np.ndarray, a_m: float, shell_m: float,
+                   ce2: float, iono_zenith_m: float, tropo_zenith_m: float, do253: bool, gse: np.ndarray,
+                   gmp: np.ndarray) -> None:
+    """A stand-alone budget's channel sigmas (receiver.GnssErrorBudget.channel_sigmas_m, m) from numpy's cos, sin of
+    the guarded elevations and exp of mp_arg (channel_guard): x = a cos / (a + h), F = 1 / sqrt(1 - x^2),
+    M = 1.001 / sqrt(0.002001 + sin^2), gse = sqrt(ce^2 + (I_z F)^2 + (T_z M)^2), gmp = 0.13 + 0.53 exp (do253;
+    else gmp is left as it is). The same operations in numpy's order (no transcendental function here: those stay
+    numpy's, whose last bit numba's may not match), the same bits."""
+    den = a_m + shell_m
+    for i in range(cos_g.shape[0]):
+        x = a_m * cos_g[i] / den
+        f = 1.0 / math.sqrt(1.0 - x * x)
+        s = sin_g[i]
+        m = 1.001 / math.sqrt(0.002001 + s * s)
+        fi = iono_zenith_m * f
+        tm = tropo_zenith_m * m
+        gse[i] = math.sqrt(ce2 + fi * fi + tm * tm)
+        if do253:
+            gmp[i] = 0.13 + 0.53 * exp_mp[i]

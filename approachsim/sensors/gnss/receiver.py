@@ -691,6 +691,8 @@ class PreparedGnss:
         self._plan = np.zeros((self.offsets.shape[0], rx.constellation.prn.shape[0]), dtype=bool)
         self._carrier: tuple | None = None
         """(j, valid, arc, state before j) of the last sample given (carrier phase: the arcs continue from it)."""
+        self._direct: tuple | None = None
+        """channels_one's constants (made at its first call)."""
 
     def plan(self, truth: Truth) -> Array:
         """best4-fixed's plan for this truth's start (kept while row 0 is the same)."""
@@ -724,6 +726,32 @@ class PreparedGnss:
         if carrier is not None:
             self._carrier = carrier_last(j, rec.valid, rec.carrier_arc, carrier)
         return rec
+
+    def channels_one(self, truth: Truth, j: int) -> tuple[Array, Array, Array, Array, Array]:
+        """Sample j of a one-run, one-sky, stand-alone code receiver (no GBAS, no carrier phase) without the record:
+        at(truth, j)'s pseudorange_m (1, 24) m, valid (1, 24), r_sv_ecef[0] (24, 3) m, sigma_m[0] (24,) m and
+        elevation_rad[0] (24,) rad, by the same kernels (gk.sky, gk.pseudoranges) on the same values (the closed
+        loop's compiled aiding epoch reads only these)."""
+        rx, e = self.rx, self.errors
+        if self._direct is None:
+            if rx.budget.gbas is not None or rx.carrier is not None or self.per_run or e.batched:
+                raise ValueError("channels_one: a one-run stand-alone code receiver only")
+            b = rx.budget
+            self._direct = ({"all": gk.MODE_ALL, "best4": gk.MODE_BEST4, "best4-fixed": gk.MODE_PLANNED}[rx.selection],
+                         (IONO_SHELL_M, b.multipath_model == "do253", float(b.multipath_m), b.clock_ephemeris_m**2,
+                          float(b.iono_zenith_m), float(b.tropo_zenith_m), b.code_noise_m**2),
+                         tuple(self.series[n] for n in ("clock_ephemeris", "iono_zenith", "tropo_zenith", "multipath",
+                                                       "noise")))
+        mode, consts, series = self._direct
+        k = int(e.rows[j])
+        sl = slice(j, j + 1)
+        rng, u, el, az, vis, sel, pdop, f_iono, m_tropo, mp_scale, sigma = gk.sky(
+            truth.r_ecef[k:k + 1].copy(), np.ascontiguousarray(self.r_sv[:, sl]), float(rx.mask_rad), mode,
+            self.plan(truth), *consts)
+        pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, *(np.ascontiguousarray(a[:, sl])
+                                                                           for a in series),
+                                    np.ascontiguousarray(self.bias[:, sl]))
+        return pr[0], valid[0], self.r_sv[0, j], sigma[0, 0], el[0, 0]
 
 
 def carrier_gap(last: tuple | None, j: int) -> range:

@@ -70,3 +70,97 @@ def test_configurations_without_the_compiled_epoch_take_the_navigator_path(nav, 
     src, res, run = _fly(prof, True, seconds=3.0)
     assert why in src.fast_epoch_unavailable()
     assert src._fast is None and len(run.t_epoch_s) > 0 and np.all(np.isfinite(run.solution.r_ecef))
+
+
+def _fly_inputs(prof, direct: bool, seconds: float = 8.0):
+    a = Approach(prof)
+    src = NavInTheLoop(prof, seed=3, run=5, max_time_s=a.time_budget_s)
+    src.direct_inputs = direct
+    res = a.fly(seed=3, run=5, nav_source=src, max_time_s=seconds)
+    return src, res, src.result(res.truth)
+
+
+def _eq_inputs(got, want):
+    assert len(got) == len(want)
+    for i, (g, w) in enumerate(zip(got, want, strict=True)):
+        if w is None:
+            assert g is None, i
+        else:
+            np.testing.assert_array_equal(np.asarray(g), np.asarray(w), err_msg=str(i))
+            assert np.shape(g) == np.shape(w) and np.asarray(g).dtype == np.asarray(w).dtype, i
+
+
+@pytest.mark.parametrize("name", ["default.toml", "gray-maybeck.toml", "hot-high-crosswind.toml"])
+def test_direct_epoch_inputs_equal_the_records(name):
+    """The compiled epoch's sensor inputs made straight from the baro's, radar altimeter's and GPS receiver's
+    kernels (NavInTheLoop._direct_inputs) are the inputs made from their one-row records (`_epoch_inputs`, the
+    oracle) at every epoch row of a flown approach and at rows between (no sample there: the empty inputs), and
+    the flight they steer is the same bits."""
+    prof = _profile(name)
+    src, res, nav = _fly_inputs(prof, True)
+    src0, res0, nav0 = _fly_inputs(prof, False)
+    assert src._fast.direct and not src0._fast.direct
+    truth = res.truth
+    rows = list(range(src.epoch_rows, len(truth), src.epoch_rows)) + [src.epoch_rows + 7, 2 * src.epoch_rows - 1]
+    n_gnss = 0
+    for k in rows:
+        t = float(truth.t_s[k])
+        got = src._direct_inputs(k, t, truth)
+        want = src._epoch_inputs(t, src._records(k, truth))
+        _eq_inputs(got, want)
+        n_gnss += got[6] is not None
+        b = src._records(k, truth).get("baro")  # the damping loop's sample at the row (`_recs`)
+        assert (b is None) == ("baro" not in src._recs[1])
+        if b is not None:
+            np.testing.assert_array_equal(src._recs[1]["baro"].h_baro_m, b.h_baro_m)
+            np.testing.assert_array_equal(src._recs[1]["baro"].valid, b.valid)
+    assert n_gnss > 3  # the GPS epochs were compared
+    eq = np.testing.assert_array_equal
+    eq(res.guidance_r_rwy, res0.guidance_r_rwy)
+    eq(res.truth.r_ecef, res0.truth.r_ecef)
+    for f in ("r_ecef", "v_ned", "P_pos_ned"):
+        eq(getattr(nav.solution, f), getattr(nav0.solution, f), err_msg=f)
+    for f in ("t_epoch_s", "x", "P_diag"):
+        eq(getattr(nav, f), getattr(nav0, f), err_msg=f)
+    eq(nav.status.innovation, nav0.status.innovation)
+
+
+@pytest.mark.parametrize(("name", "faults"), [("gbas-cat3-candidate.toml", None),
+                                              ("default.toml", [{"sensor": "baro", "kind": "step", "start_s": 2.0,
+                                                                 "magnitude": 5.0}])])
+def test_configurations_without_direct_inputs_take_the_records(name, faults):
+    """GBAS ranging and a faulted sensor have no direct form: the compiled epoch takes its inputs from the
+    records (FastEpoch.direct False) and flies."""
+    path = PROFILES / name
+    d = tomllib.loads(path.read_text(encoding="utf-8"))
+    if faults is not None:
+        d["faults"] = faults
+    prof = parse_profile(d, source=path.resolve())
+    src, res, nav = _fly_inputs(prof, True, seconds=3.0)
+    assert src._fast is not None and not src._fast.direct
+    assert len(nav.t_epoch_s) > 0 and np.all(np.isfinite(nav.solution.r_ecef))
+
+
+@pytest.mark.parametrize("multipath_model", ["do253", "nrc1995"])
+def test_compiled_channel_sigmas_equal_the_budget_numpy(multipath_model):
+    """The compiled epoch's GPS channel sigmas (numpy's cos, sin, exp, the rest compiled in numpy's order:
+    NavInTheLoop._noise_arrays) are the receiver budget's numpy formulas' (`_noise_arrays_numpy`) bit for bit, at
+    elevations over the whole sky, below the noise model's 2 deg floor and nan (no elevation: 0.5 rad)."""
+    d = tomllib.loads((PROFILES / "default.toml").read_text(encoding="utf-8"))
+    d["sensors"]["gnss"]["multipath_model"] = multipath_model
+    prof = parse_profile(d, source=(PROFILES / "default.toml").resolve())
+    src, _, _ = _fly_inputs(prof, True, seconds=1.5)
+    assert src._fast.sig is not None
+    rng = np.random.default_rng(26)
+    for i in range(400):
+        el = rng.uniform(-0.2, np.pi / 2, 24)
+        el[rng.uniform(size=24) < 0.1] = np.nan
+        if i == 0:
+            el[:4] = [0.0, np.radians(2.0), np.nextafter(np.radians(2.0), 0.0), np.pi / 2]
+        q, gse, gmp = src._noise_arrays(el)
+        q0, gse0, gmp0 = src._noise_arrays_numpy(el)
+        assert q is q0
+        np.testing.assert_array_equal(gse, gse0)
+        np.testing.assert_array_equal(gmp, gmp0)
+    src.compiled_sigmas = False  # the numpy formulas: the fallback the flight takes when asked
+    assert src._sigma_scratch(src.nav.noise_model.sensors.gnss.budget(), 24) is None
