@@ -230,17 +230,21 @@ def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Arr
     hb = _baro_held(nav, one_baro, truth, m)
     used = np.flatnonzero(np.any(np.asarray(recs["gnss"].valid, dtype=bool)[k], axis=0))
     x_hat, P = group.keep["start"][k]
+    main = group.keep["reduced_runs"][k] if "reduced_runs" in group.keep else None
     return _core(nav, truth, modes, m, er, x_hat, P, group.keep["db"][k], group.keep["ins_epoch_rows"][k],
-                 None if hb is None else hb[0], o, used)
+                 None if hb is None else hb[0], o, used, main=main)
 
 
 def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Array, P_conv: Array,
           db_error: Any, ins_ep: Array, hb1: Array | None, o: dict[str, Any], used: Array,
-          arcs0: Array | None = None) -> BankPass | None:
+          arcs0: Array | None = None, main: Any = None) -> BankPass | None:
     """The pass from the run's start (x_hat, P_conv, its terrain-database error), its INS states at the epochs
     ins_ep (E, 16), its baro held for the damping loop hb1 (m,) or None, its stacked observations o (one run) and
     the GNSS channels it measures; carrier phase: arcs0 (k,) the start's carrier arc ids (None: none yet), from
-    which each copy's new arcs (its ambiguity resets) follow as in Navigator.compiled_pass."""
+    which each copy's new arcs (its ambiguity resets) follow as in Navigator.compiled_pass. main: the group pass's
+    own filter of the run on its reduced state (nav/reduced.ReducedRun), which is copy 0 (the same start, INS,
+    observations and models in the same compiled pass): taken as copy 0 when its channels are the copies' (only the
+    sub-filters are run), else None."""
     from approachsim.integrity.bank import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
 
     lay = nav.layout
@@ -339,6 +343,20 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
                                db_u, rho, r_sv, sig, eng.channel_states, cp, eng.cp_r, pl_rho, r_pl, pl_sig,
                                eng.pl_states, ch_gio, f_gio, new, eng.amb_prior, codes, nu, S, n_rows, x_out, pd,
                                pnav, np.zeros(n), np.zeros(n), workspace(n))
+    elif main is not None and C > 1 and np.array_equal(main.kept, kept) and main.x.shape == (E, n):
+        # copy 0 is the group pass's own filter of the run: the sub-filters only
+        c = np.ascontiguousarray
+        s1 = (codes[1:].copy(), nu[1:].copy(), S[1:].copy(), n_rows[1:].copy(), x_out[1:].copy(), pd[1:].copy(),
+              pnav[1:].copy())
+        bk.bank_epochs(X[1:].copy(), P3[1:].copy(), phi, qd, red.packed, c(ch_gse[1:]), c(ch_gmp[1:]), f_gse, f_gmp,
+                       ref, ref_agl, c(ins_y[1:]), c(baro_h[1:]), o["baro_r"], c(radalt_h[1:]), eng.ra_pct,
+                       eng.ra_floor, eng.tx, eng.th, eng.rwy, c(dbp[1:]), db_x, c(db_u[1:]), c(rho[1:]), c(r_sv[1:]),
+                       c(sig[1:]), eng.channel_states, c(pl_rho[1:]), r_pl, pl_sig, eng.pl_states, *s1, np.zeros(n),
+                       np.zeros(n), workspace(n))
+        for a, b, first in zip((codes, nu, S, n_rows, x_out, pd, pnav), s1,
+                               (main.codes, main.nu, main.S, main.n_rows, main.x, main.pd, main.pnav), strict=True):
+            a[0] = first
+            a[1:] = b
     else:
         bk.bank_epochs(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
                        o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x, db_u,

@@ -120,6 +120,16 @@ class RunFilter:
         return self.fde is not None and BARO in self.fde.excluded
 
 
+def _valid_channels(records: Any, n_runs: int) -> Array | None:
+    """(N, k) whether each run's GNSS record has a valid sample of each channel (what the integrity bank takes as
+    the channels it measures), or None when the record has no run axis of n_runs."""
+    g = records.get("gnss")
+    valid = None if g is None else np.asarray(g.valid, dtype=bool)
+    if valid is None or valid.ndim != 3 or valid.shape[0] != n_runs:
+        return None
+    return np.any(valid, axis=1)
+
+
 def true_error_rows(o: ins.InsState, truth: Truth, rows: Array) -> Array:
     """(E, 9) output errors (dp NED, dv, psi) of states o (E,) against truth rows `rows` (E,)."""
     dp = ins.position_error_ned(o.lat_rad, o.lon_rad, o.h_m, truth.lat_rad[rows], truth.lon_rad[rows],
@@ -184,6 +194,8 @@ class Navigator:
         self.t_last = float(t0_s)
         self._ic = self.layout.i("clk") if self.layout.has("clk") else 0
         self.engine = EpochEngine.of(system)
+        self.reduced_runs: list | None = None
+        """compiled_pass on each run's reduced state: each run's nav/reduced.ReducedRun (else None)."""
         """The compiled epoch (nav/engine.py), or None: the generic path."""
         self.dbs = ([RunDatabase.of(system.nav.terrain_database, r.db_error) for r in runs]
                     if self.engine is not None else None)
@@ -461,8 +473,11 @@ class Navigator:
 
             args = (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse,
                     f_gmp, ins_y, baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig)
+            self.reduced_runs = []
             done = reduced_singletons(system, truth, eng, args, (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav),
-                                      self._ic)
+                                      self._ic, self.reduced_runs, _valid_channels(records, N))
+            if done < 0:
+                self.reduced_runs = None
         if done < 0:
             done = ke.shared_pass(X, P3, eng.lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse,
                                   ch_gmp, f_gse, f_gmp, ins_y, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,

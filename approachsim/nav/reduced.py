@@ -13,6 +13,7 @@ x_out, P's diagonal and the final X, P are those of shared_pass bit for bit
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -24,12 +25,31 @@ from approachsim.nav.kernels import kalman as kk
 Array = np.ndarray
 
 
-def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tuple, ic: int) -> int:
+@dataclass(frozen=True)
+class ReducedRun:
+    """One run's pass on its reduced state (the layout with the GPS channels `kept` only), per epoch: estimates x,
+    variances pd (E, n_r), navigation covariance pnav (E, 9, 9), and its rows as kernels/epoch.class_epoch writes
+    them (codes with the reduced channel index, counts, innovations, their variances)."""
+
+    kept: Array
+    x: Array
+    pd: Array
+    pnav: Array
+    codes: Array
+    n_rows: Array
+    nu: Array
+    S: Array
+
+
+def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tuple, ic: int,
+                       runs_out: list | None = None, valid: Array | None = None) -> int:
     """shared_pass for per-run-sky runs, each on its reduced state. args: shared_pass's inputs (X, P3, lay, q, gse,
     gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse, f_gmp, ins_y, baro_h, baro_r,
     radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig) without carrier phase; out: its outputs
-    (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav), filled here; ic the clock state's index. Returns E, or -1
-    with nothing changed when a model cannot be reduced (the caller runs shared_pass)."""
+    (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav), filled here; ic the clock state's index; runs_out: each
+    run's ReducedRun appended (what the integrity bank's copy 0 computes again: integrity/bankpass.py); valid (N, k):
+    the channels each run's record has valid (kept as the bank keeps them, so that its copy 0 is this). Returns E,
+    or -1 with nothing changed when a model cannot be reduced (the caller runs shared_pass)."""
     from approachsim.integrity import bank_kernel as bk
     from approachsim.integrity import bankpass as bp
 
@@ -43,7 +63,9 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
         if model is None:
             return -1
         models.append(model)
-    measured = np.any(np.isfinite(rho), axis=1)  # (N, k)
+    measured = np.any(np.isfinite(rho), axis=1)  # (N, k); any kept superset is exact (the module docstring)
+    if valid is not None and valid.shape == measured.shape:
+        measured = measured | valid
     ig, im = lay.i("gse"), lay.i("gmp")
     ws: dict[int, tuple] = {}
     for i in range(N):
@@ -69,6 +91,8 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
                        np.ascontiguousarray(r_sv[sel]), np.ascontiguousarray(sig[sel]), eng.channel_states,
                        pl_rho[i:i + 1], r_pl, pl_sig, eng.pl_states, c_r, nu_r, S_r, n_r_rows, x_r, pd_r, pnav_r, h,
                        b, w)
+        if runs_out is not None:
+            runs_out.append(ReducedRun(kept, x_r[0], pd_r[0], pnav_r[0], c_r[0], n_r_rows[0], nu_r[0], S_r[0]))
         # the rows: the reduced channel c is the full layout's kept[c]
         gps = (c_r[0] >= ke.CODE_GPS) & (c_r[0] < ke.CODE_PL)
         codes[i, :, :R_r] = np.where(gps, ke.CODE_GPS + kept[np.clip(c_r[0] - ke.CODE_GPS, 0, max(kr - 1, 0))],

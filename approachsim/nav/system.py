@@ -403,6 +403,8 @@ class NavSystem:
         if nav.can_pass() and nav.compiled_pass(records, truth, batched, dth, dvb, dt, hb_full, epoch_rows):
             if keep is not None:
                 keep["ins_epoch_rows"] = nav.rows[:, epoch_rows::epoch_rows].copy()
+                if nav.reduced_runs is not None:
+                    keep["reduced_runs"] = nav.reduced_runs
             results = nav.results(truth, solutions={0} if copies else True)
             return results if batched else results[0]
         # the compiled INS steps every run over the rows between two epochs in one call; a run's numbers do not
