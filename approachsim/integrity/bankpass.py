@@ -9,9 +9,9 @@ apply, `applicable`), with the same arithmetic:
   INS does not depend on the filter), the copies' observations stacked once and copy k + 1 without its mode's
   samples (integrity.bank.bank_records: an invalid sample is no measurement);
 - the model of every epoch (Phi, Qd at the reference: the truth) made once per flight group's truth on the full
-  layout (integrity/bank_kernel.models, kept for the last truth: the group's runs share it), cut to the run's
+  layout (nav/kernels/copies.models, kept for the last truth: the group's runs share it), cut to the run's
   reduced state; then every epoch of every copy, each its own class (per-run GPS sky), in one call of
-  integrity/bank_kernel.bank_epochs (kernels/epoch.shared_pass's loop with the model given), on the *reduced*
+  nav/kernels/copies.bank_epochs (kernels/epoch.shared_pass's loop with the model given), on the *reduced*
   state: the GPS channel states (gse, gmp) of the channels the run never measures are dropped.
 
 Why the reduced state changes no bit. A dropped channel's two states are first-order Gauss-Markov (diagonal
@@ -27,10 +27,10 @@ estimates and covariance block: the dropped states never reach it. The cost of a
 of the state count: 70 states (24 channels) to 22 + 2 x (channels used), about 32 with best-four selection.
 
 Carrier phase (the layout's gio and amb groups, nav/kernels/carrier.py). A channel's four states (gse, gmp, gio,
-amb) go together (`CHANNEL_GROUPS`): gio is a Gauss-Markov state and amb a random constant, both lone (diagonal
+amb) go together (`rd.CHANNEL_GROUPS`): gio is a Gauss-Markov state and amb a random constant, both lone (diagonal
 Phi, Qd: kernels/errormodel.discretize's closed form), and a channel never measured has no carrier phase and no
 arc, so its ambiguity is never reset; the argument above holds for them unchanged. The model adds kernels/carrier.
-dynamics (bank_kernel.carrier_models); each copy's epoch is shared_pass's carrier step (bank_kernel.
+dynamics (nav/kernels/copies.carrier_models); each copy's epoch is shared_pass's carrier step (nav/kernels/copies.
 bank_epochs_carrier): the gio states' Qd at the copy's sky, then its ambiguities reset where its carrier arc begins
 (engine.stacked_new_arcs over the copy's arc ids: a copy without channel c has no phase and no arc there,
 bank.bank_records, so it never resets amb_c), the reset zeroing a kept row and column of Phi (a copy) and Qd as on
@@ -49,19 +49,17 @@ from typing import Any
 
 import numpy as np
 
-from approachsim.integrity import bank_kernel as bk
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
+from approachsim.nav import reduced as rd
 from approachsim.nav.base import workspace
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, stacked_new_arcs
+from approachsim.nav.kernels import copies as kcp
 from approachsim.nav.navigator import NavRun, StatusLog, _stacked_observations, true_error_rows
 from approachsim.nav.observations import Observations
 
 Array = np.ndarray
 
-CHANNEL_GROUPS = ("gse", "gmp", "gio", "amb")
-"""The per-GPS-channel state groups (gio, amb: carrier phase only), each a lone state per channel (module
-docstring)."""
 
 
 @dataclass(frozen=True)
@@ -106,36 +104,6 @@ def applicable(nav: Any, records: dict[str, Any]) -> bool:
     if g is None or not bool(g.per_run_sky) or "imu" not in records or nav.nav.feedback:
         return False
     return EpochEngine.of(nav) is not None
-
-
-def _kept_channels(lay: em.StateLayout, used: Array, P0: Array) -> Array:
-    """The channels whose states stay: those measured, and any whose states are correlated with another state in the
-    start covariance P0 (module docstring: a dropped state must be uncorrelated with all others)."""
-    n_sv = lay.n_sv
-    keep = np.zeros(n_sv, dtype=bool)
-    keep[np.asarray(used, dtype=int)] = True
-    off = P0 != 0.0
-    np.fill_diagonal(off, False)
-    coupled = np.any(off, axis=1)
-    for g in CHANNEL_GROUPS:
-        if lay.has(g):
-            i0 = lay.i(g)
-            keep |= coupled[i0:i0 + n_sv]
-    return np.flatnonzero(keep)
-
-
-def _reduced(lay: em.StateLayout, kept: Array) -> tuple[em.StateLayout, Array]:
-    """The layout with the channel states of `kept` only, and the full-layout index of each of its states (in
-    order)."""
-    red = dataclasses.replace(lay, n_sv=int(kept.size))
-    idx = []
-    for g in red.groups:
-        if g in CHANNEL_GROUPS:
-            idx.extend(lay.i(g) + kept)
-        else:
-            sl = lay.index[g]
-            idx.extend(range(sl.start, sl.stop))
-    return red, np.asarray(idx, dtype=int)
 
 
 def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: np.random.Generator,
@@ -264,9 +232,9 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     radalt_h = np.repeat(o["radalt_h"], C, axis=0)
     rho_all = o["rho"]
     pl_rho = np.repeat(o["pl_rho"], C, axis=0)
-    kept = _kept_channels(lay, used, P_conv) if lay.has("gse") else used
+    kept = rd.kept_channels(lay, used, P_conv) if lay.has("gse") else used
     if lay.has("gse"):
-        red, idx = _reduced(lay, kept)
+        red, idx = rd.reduced_layout(lay, kept)
     else:
         red, idx = lay, np.arange(lay.n)
     col = {int(c): j for j, c in enumerate(kept)}
@@ -332,13 +300,13 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     n_rows = np.zeros((C, E), dtype=np.int64)
     x_out, pd, pnav = np.zeros((C, E, n)), np.zeros((C, E, n)), np.zeros((C, E, 9, 9))
     ins_y = np.ascontiguousarray(np.broadcast_to(ins_ep, (C, E, ins.NX)))
-    model = _models(nav, truth, q, gse_full, gmp_full, loop, dt_e, ref, ref_cbn, f_ref, held1)
+    model = rd.models(nav, truth, q, gse_full, gmp_full, loop, dt_e, ref, ref_cbn, f_ref, held1)
     if model is None:
         return None
-    phi, qd = _cut(model, red)
-    if carrier:  # kernels/epoch.shared_pass's carrier step (bank_kernel.bank_epochs_carrier)
+    phi, qd = rd.cut(model, red)
+    if carrier:  # kernels/epoch.shared_pass's carrier step (nav/kernels/copies.bank_epochs_carrier)
         f_gio = -np.expm1(-2.0 * dt_e / nz.gio_tau_s)
-        bk.bank_epochs_carrier(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
+        kcp.bank_epochs_carrier(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
                                o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x,
                                db_u, rho, r_sv, sig, eng.channel_states, cp, eng.cp_r, pl_rho, r_pl, pl_sig,
                                eng.pl_states, ch_gio, f_gio, new, eng.amb_prior, codes, nu, S, n_rows, x_out, pd,
@@ -348,7 +316,7 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
         c = np.ascontiguousarray
         s1 = (codes[1:].copy(), nu[1:].copy(), S[1:].copy(), n_rows[1:].copy(), x_out[1:].copy(), pd[1:].copy(),
               pnav[1:].copy())
-        bk.bank_epochs(X[1:].copy(), P3[1:].copy(), phi, qd, red.packed, c(ch_gse[1:]), c(ch_gmp[1:]), f_gse, f_gmp,
+        kcp.bank_epochs(X[1:].copy(), P3[1:].copy(), phi, qd, red.packed, c(ch_gse[1:]), c(ch_gmp[1:]), f_gse, f_gmp,
                        ref, ref_agl, c(ins_y[1:]), c(baro_h[1:]), o["baro_r"], c(radalt_h[1:]), eng.ra_pct,
                        eng.ra_floor, eng.tx, eng.th, eng.rwy, c(dbp[1:]), db_x, c(db_u[1:]), c(rho[1:]), c(r_sv[1:]),
                        c(sig[1:]), eng.channel_states, c(pl_rho[1:]), r_pl, pl_sig, eng.pl_states, *s1, np.zeros(n),
@@ -358,7 +326,7 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
             a[0] = first
             a[1:] = b
     else:
-        bk.bank_epochs(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
+        kcp.bank_epochs(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
                        o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x, db_u,
                        rho, r_sv, sig, eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, codes, nu, S, n_rows,
                        x_out, pd, pnav, np.zeros(n), np.zeros(n), workspace(n))
@@ -367,99 +335,6 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     o_s = ins.perturb(ins.unpack(np.tile(ins_ep, (C, 1))), -xe[:, 0:3], -xe[:, 3:6], -xe[:, 6:9])
     err = true_error_rows(o_s, truth, np.tile(e_rows, C)).reshape(C, E, 9)
     return BankPass(t_e, err, pnav, x_out, pd, red, kept, (codes[0], n_rows[0], nu[0], S[0]))
-
-
-_MODELS: list = []
-"""`_models`' last result: (system, weak reference to the truth, dt, held, model) (the runs of a flight group share
-it)."""
-
-
-def _models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array, dt: Array, ref: Array,
-            ref_cbn: Array, f_ref: Array, held: Array) -> tuple[Array, Array, em.StateLayout] | None:
-    """Phi, Qd of every epoch (bank_kernel.models: what shared_pass makes) in compact form, kept for the last (system,
-    truth) objects with the same intervals and damping-loop holds: (E, n1, n1) on the layout with one GPS channel
-    (the channels' states are lone, their rows and columns zero off the diagonal: checked; Phi's diagonal is the
-    same for every channel, the Qd diagonal each copy's own, set in the kernel), and that layout. Discretized on
-    that layout: the same numbers as on the full one (the bankpass docstring's argument: lone states are closed
-    form, the coupled component the same matrix). None when an epoch's model is too large for the compiled
-    discretization or the channels are not lone."""
-    key_dt, key_held = dt.tobytes(), held.tobytes()
-    for sys_, tr, kd, kh, val in _MODELS:
-        if sys_ is nav and tr() is truth and kd == key_dt and kh == key_held:
-            return val
-    lay = nav.layout
-    carrier = lay.has("amb")
-    if carrier:  # the ionosphere's Gauss-Markov (kernels/carrier.dynamics; the ambiguities are random constants)
-        gio, gio_tau = em.kernel_carrier(nav.noise(None), lay.n_sv)
-    if lay.n_sv:  # one channel stands for all: its states' F, Qc depend on the channel only through the sigma, which
-        # enters Qc alone (kernels/errormodel.dynamics: a Markov state of the common tau), and each copy's Qd sets it
-        lay1, _ = _reduced(lay, np.array([0]))
-        gse, gmp = np.ascontiguousarray(gse[:1]), np.ascontiguousarray(gmp[:1])
-        if carrier:
-            gio = np.ascontiguousarray(gio[:1])
-    else:
-        lay1 = lay
-    E, n = dt.shape[0], lay1.n
-    phi, qd = np.zeros((E, n, n)), np.zeros((E, n, n))
-    if carrier:
-        done = bk.carrier_models(lay1.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, gio, gio_tau, phi, qd)
-    else:
-        done = bk.models(lay1.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, phi, qd)
-    if done != E:
-        return None  # an epoch's model is too large for the compiled discretization
-    if lay1.n_sv:  # the channel's states lone: their rows and columns zero off the diagonal
-        ch = np.array([lay1.i(g) for g in CHANNEL_GROUPS if lay1.has(g)])
-        rest = np.setdiff1d(np.arange(n), ch)
-        off = ~np.eye(ch.size, dtype=bool)
-        for a in (phi, qd):
-            if (np.any(a[:, ch][:, :, rest]) or np.any(a[:, rest][:, :, ch])
-                    or np.any(a[:, ch[:, None], ch[None, :]][:, off])):
-                return None
-    val = (phi, qd, lay1)
-    _MODELS[:] = [(nav, weakref.ref(truth), key_dt, key_held, val)]
-    return val
-
-
-_CUTS: list = []
-"""`_cut`'s results for the last model: (model, {reduced layout: (Phi, Qd)}) (the runs of a flight group share the
-model and mostly a few channel counts; the kernel only reads them)."""
-
-
-def _cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -> tuple[Array, Array]:
-    """Phi, Qd (E, n_r, n_r) of the reduced layout `red` from `_models`' compact form: the one channel's lone states
-    repeated on the diagonal of each kept channel's, every other entry as the full model's. Kept per layout for the
-    last model."""
-    if not _CUTS or _CUTS[0][0] is not model:
-        _CUTS[:] = [(model, {})]
-    memo = _CUTS[0][1]
-    key = red.packed.tobytes()
-    if key not in memo:
-        memo[key] = _make_cut(model, red)
-    return memo[key]
-
-
-def _make_cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -> tuple[Array, Array]:
-    phi1, qd1, lay1 = model
-    if not red.has("gse"):
-        return phi1, qd1
-    src, chan = [], []
-    for g in red.groups:
-        sl = red.index[g]
-        if g in CHANNEL_GROUPS:
-            src.extend([lay1.i(g)] * (sl.stop - sl.start))
-            chan.extend(range(sl.start, sl.stop))
-        else:
-            src.extend(range(lay1.index[g].start, lay1.index[g].stop))
-    src_a, chan_a = np.asarray(src), np.asarray(chan, dtype=int)
-    out = []
-    for a in (phi1, qd1):
-        r = a[:, src_a[:, None], src_a[None, :]]
-        d = r[:, chan_a, chan_a].copy()
-        r[:, chan_a, :] = 0.0
-        r[:, :, chan_a] = 0.0
-        r[:, chan_a, chan_a] = d
-        out.append(np.ascontiguousarray(r))
-    return out[0], out[1]
 
 
 _REFERENCES: list = []

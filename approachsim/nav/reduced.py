@@ -4,21 +4,25 @@ Navigator.compiled_pass filters such runs with kernels/epoch.shared_pass on the 
 gmp states, of which a run measures 4-6 with best-four selection. The channels a run never measures are lone
 first-order Gauss-Markov states, uncorrelated with the rest at the start (checked: a correlated one is kept), which
 no row touches: dropping them removes exact zeros from every sum and keeps the others' order, so the kept states
-are the same floating-point numbers (integrity/bankpass.py's module docstring gives the argument; its reduced
-models and the compiled pass integrity/bank_kernel.bank_epochs are the ones used here). The dropped states are
-then carried in closed form exactly as the full pass computes them (x <- 0 + phi x; P <- Qd + phi (0 + phi P)):
-x_out, P's diagonal and the final X, P are those of shared_pass bit for bit
+are the same floating-point numbers (integrity/bankpass.py's module docstring gives the argument; the reduced
+models here, `models` and `cut`, and the compiled pass nav/kernels/copies.bank_epochs serve both). The dropped
+states are then carried in closed form exactly as the full pass computes them (x <- 0 + phi x; P <- Qd + phi (0 +
+phi P)): x_out, P's diagonal and the final X, P are those of shared_pass bit for bit
 (tests/unit/nav/test_reduced_pass.py). The cost of an epoch falls with the square of the state count: 70 -> ~32.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import weakref
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numba import njit
 
+from approachsim.nav import errormodel as em
+from approachsim.nav.kernels import copies as kcp
 from approachsim.nav.kernels import epoch as ke
 from approachsim.nav.kernels import kalman as kk
 
@@ -41,6 +45,136 @@ class ReducedRun:
     S: Array
 
 
+CHANNEL_GROUPS = ("gse", "gmp", "gio", "amb")
+"""The per-GPS-channel state groups (gio, amb: carrier phase only), each a lone state per channel (module
+docstring)."""
+
+
+def kept_channels(lay: em.StateLayout, used: Array, P0: Array) -> Array:
+    """The channels whose states stay: those measured, and any whose states are correlated with another state in the
+    start covariance P0 (a dropped state must be uncorrelated with all others: integrity/bankpass.py's docstring)."""
+    n_sv = lay.n_sv
+    keep = np.zeros(n_sv, dtype=bool)
+    keep[np.asarray(used, dtype=int)] = True
+    off = P0 != 0.0
+    np.fill_diagonal(off, False)
+    coupled = np.any(off, axis=1)
+    for g in CHANNEL_GROUPS:
+        if lay.has(g):
+            i0 = lay.i(g)
+            keep |= coupled[i0:i0 + n_sv]
+    return np.flatnonzero(keep)
+
+
+def reduced_layout(lay: em.StateLayout, kept: Array) -> tuple[em.StateLayout, Array]:
+    """The layout with the channel states of `kept` only, and the full-layout index of each of its states (in
+    order)."""
+    red = dataclasses.replace(lay, n_sv=int(kept.size))
+    idx = []
+    for g in red.groups:
+        if g in CHANNEL_GROUPS:
+            idx.extend(lay.i(g) + kept)
+        else:
+            sl = lay.index[g]
+            idx.extend(range(sl.start, sl.stop))
+    return red, np.asarray(idx, dtype=int)
+
+
+_MODELS: list = []
+"""`models`' last result: (system, weak reference to the truth, dt, held, model) (the runs of a flight group share
+it)."""
+
+
+def models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array, dt: Array, ref: Array,
+            ref_cbn: Array, f_ref: Array, held: Array) -> tuple[Array, Array, em.StateLayout] | None:
+    """Phi, Qd of every epoch (kernels/copies.models: what shared_pass makes) in compact form, kept for the last
+    (system, truth) objects with the same intervals and damping-loop holds: (E, n1, n1) on the layout with one GPS
+    channel (the channels' states are lone, their rows and columns zero off the diagonal: checked; Phi's diagonal is the
+    same for every channel, the Qd diagonal each copy's own, set in the kernel), and that layout. Discretized on
+    that layout: the same numbers as on the full one (the module docstring's argument: lone states are closed
+    form, the coupled component the same matrix). None when an epoch's model is too large for the compiled
+    discretization or the channels are not lone."""
+    key_dt, key_held = dt.tobytes(), held.tobytes()
+    for sys_, tr, kd, kh, val in _MODELS:
+        if sys_ is nav and tr() is truth and kd == key_dt and kh == key_held:
+            return val
+    lay = nav.layout
+    carrier = lay.has("amb")
+    if carrier:  # the ionosphere's Gauss-Markov (kernels/carrier.dynamics; the ambiguities are random constants)
+        gio, gio_tau = em.kernel_carrier(nav.noise(None), lay.n_sv)
+    if lay.n_sv:  # one channel stands for all: its states' F, Qc depend on the channel only through the sigma, which
+        # enters Qc alone (kernels/errormodel.dynamics: a Markov state of the common tau), and each copy's Qd sets it
+        lay1, _ = reduced_layout(lay, np.array([0]))
+        gse, gmp = np.ascontiguousarray(gse[:1]), np.ascontiguousarray(gmp[:1])
+        if carrier:
+            gio = np.ascontiguousarray(gio[:1])
+    else:
+        lay1 = lay
+    E, n = dt.shape[0], lay1.n
+    phi, qd = np.zeros((E, n, n)), np.zeros((E, n, n))
+    if carrier:
+        done = kcp.carrier_models(lay1.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, gio, gio_tau, phi, qd)
+    else:
+        done = kcp.models(lay1.packed, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, phi, qd)
+    if done != E:
+        return None  # an epoch's model is too large for the compiled discretization
+    if lay1.n_sv:  # the channel's states lone: their rows and columns zero off the diagonal
+        ch = np.array([lay1.i(g) for g in CHANNEL_GROUPS if lay1.has(g)])
+        rest = np.setdiff1d(np.arange(n), ch)
+        off = ~np.eye(ch.size, dtype=bool)
+        for a in (phi, qd):
+            if (np.any(a[:, ch][:, :, rest]) or np.any(a[:, rest][:, :, ch])
+                    or np.any(a[:, ch[:, None], ch[None, :]][:, off])):
+                return None
+    val = (phi, qd, lay1)
+    _MODELS[:] = [(nav, weakref.ref(truth), key_dt, key_held, val)]
+    return val
+
+
+_CUTS: list = []
+"""`cut`'s results for the last model: (model, {reduced layout: (Phi, Qd)}) (the runs of a flight group share the
+model and mostly a few channel counts; the kernel only reads them)."""
+
+
+def cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -> tuple[Array, Array]:
+    """Phi, Qd (E, n_r, n_r) of the reduced layout `red` from `models`' compact form: the one channel's lone states
+    repeated on the diagonal of each kept channel's, every other entry as the full model's. Kept per layout for the
+    last model."""
+    if not _CUTS or _CUTS[0][0] is not model:
+        _CUTS[:] = [(model, {})]
+    memo = _CUTS[0][1]
+    key = red.packed.tobytes()
+    if key not in memo:
+        memo[key] = _make_cut(model, red)
+    return memo[key]
+
+
+def _make_cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -> tuple[Array, Array]:
+    phi1, qd1, lay1 = model
+    if not red.has("gse"):
+        return phi1, qd1
+    src, chan = [], []
+    for g in red.groups:
+        sl = red.index[g]
+        if g in CHANNEL_GROUPS:
+            src.extend([lay1.i(g)] * (sl.stop - sl.start))
+            chan.extend(range(sl.start, sl.stop))
+        else:
+            src.extend(range(lay1.index[g].start, lay1.index[g].stop))
+    src_a, chan_a = np.asarray(src), np.asarray(chan, dtype=int)
+    out = []
+    for a in (phi1, qd1):
+        r = a[:, src_a[:, None], src_a[None, :]]
+        d = r[:, chan_a, chan_a].copy()
+        r[:, chan_a, :] = 0.0
+        r[:, :, chan_a] = 0.0
+        r[:, chan_a, chan_a] = d
+        out.append(np.ascontiguousarray(r))
+    return out[0], out[1]
+
+
+
+
 def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tuple, ic: int,
                        runs_out: list | None = None, valid: Array | None = None) -> int:
     """shared_pass for per-run-sky runs, each on its reduced state. args: shared_pass's inputs (X, P3, lay, q, gse,
@@ -50,29 +184,26 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
     run's ReducedRun appended (what the integrity bank's copy 0 computes again: integrity/bankpass.py); valid (N, k):
     the channels each run's record has valid (kept as the bank keeps them, so that its copy 0 is this). Returns E,
     or -1 with nothing changed when a model cannot be reduced (the caller runs shared_pass)."""
-    from approachsim.integrity import bank_kernel as bk
-    from approachsim.integrity import bankpass as bp
-
     (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse, f_gmp, ins_y,
      baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig) = args
     codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav = out
     N, E = held.shape
-    models = []
+    run_models = []
     for i in range(N):  # every run's model first: nothing is changed when one cannot be reduced
-        model = bp._models(system, truth, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, np.ascontiguousarray(held[i]))
+        model = models(system, truth, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, np.ascontiguousarray(held[i]))
         if model is None:
             return -1
-        models.append(model)
+        run_models.append(model)
     measured = np.any(np.isfinite(rho), axis=1)  # (N, k); any kept superset is exact (the module docstring)
     if valid is not None and valid.shape == measured.shape:
         measured = measured | valid
     ig, im = lay.i("gse"), lay.i("gmp")
     ws: dict[int, tuple] = {}
     for i in range(N):
-        phi1, _qd1, lay1 = models[i]
-        kept = bp._kept_channels(lay, np.flatnonzero(measured[i]), P3[i])
-        red, idx = bp._reduced(lay, kept)
-        phi, qd = bp._cut(models[i], red)
+        phi1, _qd1, lay1 = run_models[i]
+        kept = kept_channels(lay, np.flatnonzero(measured[i]), P3[i])
+        red, idx = reduced_layout(lay, kept)
+        phi, qd = cut(run_models[i], red)
         n_r, kr = red.n, kept.size
         Xr = np.ascontiguousarray(X[i:i + 1, idx])
         Pr = np.ascontiguousarray(P3[i][np.ix_(idx, idx)][None])
@@ -84,7 +215,7 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
             ws[n_r] = (np.zeros(n_r), np.zeros(n_r), kk.workspace(n_r))
         h, b, w = ws[n_r]
         sel = (slice(i, i + 1), slice(None), kept)
-        bk.bank_epochs(Xr, Pr, phi, qd, red.packed, np.ascontiguousarray(ch_gse[sel]),
+        kcp.bank_epochs(Xr, Pr, phi, qd, red.packed, np.ascontiguousarray(ch_gse[sel]),
                        np.ascontiguousarray(ch_gmp[sel]), f_gse, f_gmp, ref, ref_agl, ins_y[i:i + 1],
                        baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy,
                        dbp[i:i + 1], db_x, db_u[i:i + 1], np.ascontiguousarray(rho[sel]),

@@ -1,4 +1,4 @@
-"""The integrity bank's compiled reduced-state pass (integrity/bankpass.py, integrity/bank_kernel.py) against the
+"""The integrity bank's compiled reduced-state pass (integrity/bankpass.py, nav/kernels/copies.py) against the
 path it replaces, NavSystem.run's batched copies on the full state (run_bank(..., compiled=False), kernels/epoch.
 shared_pass): the same main and sub-solution errors, variances and identification statistics, to the rounding
 floors of tests/floors.py (measured equal to the last bit on this machine: the reduction drops exact zeros, module
@@ -19,6 +19,7 @@ from approachsim import synthetic
 from approachsim.integrity import bankpass
 from approachsim.integrity.bank import run_bank
 from approachsim.nav import errormodel as em
+from approachsim.nav import reduced
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream
@@ -132,10 +133,10 @@ def test_only_decoupled_channel_states_are_dropped():
     lay = em.StateLayout(n_sv=6, clock=True)
     P0 = np.diag(np.arange(1.0, lay.n + 1.0))
     used = np.array([4, 1])
-    np.testing.assert_array_equal(bankpass._kept_channels(lay, used, P0), [1, 4])
+    np.testing.assert_array_equal(reduced.kept_channels(lay, used, P0), [1, 4])
     P0[lay.i("gmp", 3), lay.i("dp", 0)] = P0[lay.i("dp", 0), lay.i("gmp", 3)] = 1e-3
-    np.testing.assert_array_equal(bankpass._kept_channels(lay, used, P0), [1, 3, 4])
-    red, idx = bankpass._reduced(lay, np.array([1, 3, 4]))
+    np.testing.assert_array_equal(reduced.kept_channels(lay, used, P0), [1, 3, 4])
+    red, idx = reduced.reduced_layout(lay, np.array([1, 3, 4]))
     assert red.n == lay.n - 6 and red.n_sv == 3
     np.testing.assert_array_equal(idx[red.index["gse"]], lay.i("gse") + np.array([1, 3, 4]))
     np.testing.assert_array_equal(idx[red.index["gmp"]], lay.i("gmp") + np.array([1, 3, 4]))

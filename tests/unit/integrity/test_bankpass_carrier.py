@@ -1,5 +1,5 @@
 """The integrity bank's compiled reduced-state pass with GPS carrier phase (integrity/bankpass.py,
-integrity/bank_kernel.bank_epochs_carrier) against the path it replaces, NavSystem.run's batched copies on the full
+nav/kernels/copies.bank_epochs_carrier) against the path it replaces, NavSystem.run's batched copies on the full
 state (run_bank(..., compiled=False): Navigator.compiled_pass, kernels/epoch.shared_pass with the carrier states):
 bit for bit, on the shipped carrier candidate (GBAS, all in view, two pseudolites) and with a channel's carrier
 interrupted by an outage (a new arc: its float ambiguity reset in the copies that measure it, not in the copy that
@@ -18,6 +18,7 @@ import pytest
 from approachsim import synthetic
 from approachsim.integrity import bankpass
 from approachsim.integrity.bank import run_bank
+from approachsim.nav import reduced
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream
@@ -147,10 +148,10 @@ def test_carrier_channel_states_are_dropped_with_their_channel():
     lay = em.StateLayout(n_sv=6, clock=True, carrier=True)
     P0 = np.diag(np.arange(1.0, lay.n + 1.0))
     used = np.array([4, 1])
-    np.testing.assert_array_equal(bankpass._kept_channels(lay, used, P0), [1, 4])
+    np.testing.assert_array_equal(reduced.kept_channels(lay, used, P0), [1, 4])
     P0[lay.i("amb", 2), lay.i("dp", 0)] = P0[lay.i("dp", 0), lay.i("amb", 2)] = 1e-3
-    np.testing.assert_array_equal(bankpass._kept_channels(lay, used, P0), [1, 2, 4])
-    red, idx = bankpass._reduced(lay, np.array([1, 2, 4]))
+    np.testing.assert_array_equal(reduced.kept_channels(lay, used, P0), [1, 2, 4])
+    red, idx = reduced.reduced_layout(lay, np.array([1, 2, 4]))
     assert red.n == lay.n - 12 and red.n_sv == 3 and red.has("gio") and red.has("amb")
     for g in ("gse", "gmp", "gio", "amb"):
         np.testing.assert_array_equal(idx[red.index[g]], lay.i(g) + np.array([1, 2, 4]))

@@ -1,11 +1,12 @@
-"""The integrity bank's compiled pass (numba, cache=True): kernels/epoch.shared_pass with the model given.
+"""Copies of a filter on a given model (numba, cache=True): kernels/epoch.shared_pass with the model given; the
+integrity bank's main and sub-filters, and one run's filter on its reduced state (nav/reduced.py).
 
     bank_epochs(X, P3, phi, qd, lay, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins, <observations>, ...)
 
 shared_pass makes each epoch's model (F, Qc at the reference, Phi, Qd by Van Loan) itself, once per call; the bank
 calls it once per run, so every run of an open-loop flight group made the same models again (they depend on the
 shared truth only). Here Phi and Qd (E, n, n) come in, made once per truth on the full layout and cut to the run's
-reduced state (integrity/bankpass.py `models`); the rest is shared_pass's loop: per epoch and copy, the channel
+reduced state (nav/reduced.py `models`, `cut`); the rest is shared_pass's loop: per epoch and copy, the channel
 states' Qd at the copy's sky, then kernels/epoch.class_epoch in shared mode (the same function, so the same
 arithmetic). tests/unit/integrity/test_bankpass.py: equal to shared_pass bit for bit.
 
