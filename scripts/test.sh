@@ -10,9 +10,11 @@ lint-imports
 python tools/gen_profiles_doc.py --check
 set +e
 # pytest-xdist: one worker per core (the suite is CPU-bound, single-threaded per test); --dist loadfile keeps a
-# module's tests on one worker, so a module's cached flights and campaigns are computed once
+# module's tests on one worker, so a module's cached flights and campaigns are computed once; --no-loadscope-reorder
+# hands the files out in collection order, which tests/conftest.py starts with the longest (xdist's own order, by
+# number of tests, left the 3-minute wheel test, one test, to the end with the other worker idle)
 run_pytest() {
-  python -m pytest -q -n "${PYTEST_WORKERS:-auto}" --dist loadfile "$@"
+  python -m pytest -q -n "${PYTEST_WORKERS:-auto}" --dist loadfile --no-loadscope-reorder "$@"
   status=$?
   if [ "$status" -eq 5 ]; then
     echo "pytest collected no tests: failing" >&2

@@ -1,8 +1,9 @@
 """Packaging: a wheel built from the checkout, installed into a fresh virtual environment, evaluates a profile
 copied out of the package from a directory with no repository at hand (issue 13's acceptance test).
 
-Slow (about a minute and a half on 2 cores: wheel build, dependency install from the package index or the
-machine's wheel cache, 2 closed-loop JSBSim approaches).
+Slow (about three minutes on 2 cores: wheel build, dependency install from the package index or the machine's
+wheel cache, the fresh install's numba kernels compiled, 2 closed-loop JSBSim approaches). One worker process: the
+kernels compile once (about 110 s of CPU here), not once in each of two workers at the same time.
 """
 
 from __future__ import annotations
@@ -48,7 +49,8 @@ def test_wheel_in_fresh_venv_evaluates_a_copied_profile(tmp_path: Path) -> None:
 
     _run([exe, "profiles", "init", "default", "x"], cwd=work, env=env, timeout=60)
     assert (work / "x" / "default.toml").is_file()
-    _run([exe, "evaluate", "x/default.toml", "--runs", "2", "--out", "out"], cwd=work, env=env, timeout=600)
+    _run([exe, "evaluate", "x/default.toml", "--runs", "2", "--workers", "1", "--out", "out"], cwd=work, env=env,
+         timeout=600)
     summary = json.loads((work / "out" / "summary.json").read_text())
     assert summary["runs"] == 2
     assert summary["failed_runs"] == 0  # the aircraft file came from the installed package
