@@ -10,9 +10,10 @@ reduced state (nav/reduced.py `models`, `cut`); the rest is shared_pass's loop: 
 states' Qd at the copy's sky, then kernels/epoch.class_epoch in shared mode (the same function, so the same
 arithmetic). tests/unit/integrity/test_bankpass.py: equal to shared_pass bit for bit.
 
-With carrier phase: carrier_models (`models` plus kernels/carrier.dynamics) and bank_epochs_carrier (shared_pass's
-carrier step: the gio states' Qd at each copy's sky, its ambiguities reset at its new arcs, the carrier rows);
-tests/unit/integrity/test_bankpass_carrier.py.
+One compiled loop, bank_epochs_carrier (shared_pass's carrier step: the gio states' Qd at each copy's sky, its
+ambiguities reset at its new arcs, the carrier rows); bank_epochs calls it with no carrier channels. With carrier
+phase the models are carrier_models (`models` plus kernels/carrier.dynamics); tests/unit/integrity/
+test_bankpass_carrier.py.
 """
 
 from __future__ import annotations
@@ -25,7 +26,6 @@ from approachsim.nav.kernels import epoch as ke
 from approachsim.nav.kernels import errormodel as ek
 
 
-@njit(cache=True)
 def bank_epochs(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.ndarray, lay: np.ndarray,
                 ch_gse: np.ndarray, ch_gmp: np.ndarray, f_gse: np.ndarray, f_gmp: np.ndarray,
                 ref: np.ndarray, ref_agl: np.ndarray, ins: np.ndarray,
@@ -39,36 +39,17 @@ def bank_epochs(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.ndarray, 
                 x_out: np.ndarray, pd_out: np.ndarray, pnav_out: np.ndarray,
                 h: np.ndarray, b: np.ndarray, ws: tuple) -> None:
     """Every epoch of every copy (kernels/epoch.shared_pass's loop) with the epoch's model phi[e], qd[e] (E, n, n)
-    given (the damping loop held or not as the copies' INS: the bank's copies share one). Arguments as shared_pass
-    (ch_gse, ch_gmp (N, E, k), f_gse, f_gmp (E,), ref (E, 16), ref_agl (E,), ins (N, E, 16), the observations
-    indexed [i, e]); out per copy and epoch: codes, nu_out, S_out (N, E, R), n_rows (N, E), x_out (N, E, n),
-    pd_out (N, E, n) and pnav_out (N, E, 9, 9) after the epoch's updates."""
-    N, n = X.shape
-    E = phi.shape[0]
-    qd_tmp = np.empty((n, n))
-    no_cp = np.zeros((1, 0))  # no carrier rows (carrier phase: bank_epochs_carrier)
-    ig, im = lay[ek.L_GSE], lay[ek.L_GMP]
-    for e in range(E):
-        y = ref[e]
-        for i in range(N):
-            qd_tmp[:, :] = qd[e]
-            if ig >= 0:
-                for c in range(ch_gse.shape[2]):
-                    qd_tmp[ig + c, ig + c] = ch_gse[i, e, c] ** 2 * f_gse[e]
-                    qd_tmp[im + c, im + c] = ch_gmp[i, e, c] ** 2 * f_gmp[e]
-            P = P3[i]
-            n_rows[i, e] = ke.class_epoch(X[i:i + 1], P, phi[e], qd_tmp, lay, False, y, ins[i, e:e + 1],
-                                          baro_h[i, e:e + 1], baro_r[e], radalt_h[i, e:e + 1], ra_pct, ra_floor,
-                                          ref_agl[e], tx, th, rwy, dbp[i:i + 1], db_x, db_u[i:i + 1],
-                                          rho[i, e:e + 1], r_sv[i, e], sig[i, e], channel_states, no_cp, 0.0,
-                                          pl_rho[i, e:e + 1], r_pl, pl_sig[e], pl_states, codes[i, e],
-                                          nu_out[i, e:e + 1], S_out[i, e], h, b, ws)
-            for a in range(n):
-                x_out[i, e, a] = X[i, a]
-                pd_out[i, e, a] = P[a, a]
-            for a in range(9):
-                for c in range(9):
-                    pnav_out[i, e, a, c] = P[a, c]
+    given (the damping loop held or not as the copies' INS: the bank's copies share one), without carrier phase:
+    bank_epochs_carrier with no carrier channels (no carrier rows, no ionosphere states, no arcs: the same
+    arithmetic). Arguments as shared_pass (ch_gse, ch_gmp (N, E, k), f_gse, f_gmp (E,), ref (E, 16), ref_agl (E,),
+    ins (N, E, 16), the observations indexed [i, e]); out per copy and epoch: codes, nu_out, S_out (N, E, R),
+    n_rows (N, E), x_out (N, E, n), pd_out (N, E, n) and pnav_out (N, E, 9, 9) after the epoch's updates."""
+    N, E = X.shape[0], phi.shape[0]
+    none = np.zeros((N, E, 0))
+    bank_epochs_carrier(X, P3, phi, qd, lay, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins, baro_h, baro_r,
+                        radalt_h, ra_pct, ra_floor, tx, th, rwy, dbp, db_x, db_u, rho, r_sv, sig, channel_states,
+                        none, 0.0, pl_rho, r_pl, pl_sig, pl_states, none, np.zeros(E), np.zeros((N, E, 0), np.int64),
+                        0.0, codes, nu_out, S_out, n_rows, x_out, pd_out, pnav_out, h, b, ws)
 
 
 @njit(cache=True)
