@@ -1,7 +1,8 @@
 """Issue 26, the second look's cost in continuity under faults: the same faulted bank epochs scored with the
-first-look identification (exclude the first detection's suspect for good) and with the second look
+first-look identification (exclude the first detection's suspect for good), with the second look
 (integrity.bank.second_level: not protected until a mode's exclusion is confirmed, and again when a later detection
-names another mode), per sample and category.
+names another mode) and with the second look `at_once` (a clear first detection excluded at once, only an ambiguous
+one waits), per sample and category.
 
     PYTHONPATH=. python benchmarks/second_look_continuity.py [--profile P] [--mode sat-ramp] [--samples N]
         [--seed S] [--workers K] [--truths T] [--out FILE.json]
@@ -52,10 +53,11 @@ def sample(profile, seed: int, truths: int, mode_name: str, run: int, u: list[fl
     for cat, req in REQUIREMENTS.items():
         win = settled & (ep.height_m >= cfg.dh_m(cat))
         s0 = score_category(ep, req, hz, win, confirm=False)
-        s1 = score_category(ep, req, hz, win, confirm=True)
-        out[CATEGORY_KEYS[cat]] = [s0.epochs, int(np.sum(~s0.available)), int(np.sum(~s1.available)),
-                                   int(np.sum(s0.available & ~s1.available)), int(np.sum(s0.hazardous)),
-                                   int(np.sum(s1.hazardous)), int(np.any(s0.detected))]
+        row = [s0.epochs, int(np.sum(~s0.available)), int(np.sum(s0.hazardous)), int(np.any(s0.detected))]
+        for at_once in (False, True):
+            s1 = score_category(ep, req, hz, win, confirm=True, at_once=at_once)
+            row += [int(np.sum(~s1.available)), int(np.sum(s0.available & ~s1.available)), int(np.sum(s1.hazardous))]
+        out[CATEGORY_KEYS[cat]] = row
     return out
 
 
@@ -101,30 +103,32 @@ def main() -> None:
     res: dict = {"profile": profile.name, "mode": a.mode, "prior_per_approach": prior, "samples": a.samples,
                  "seed": a.seed, "wall_s": wall, "categories": {}}
     print(f"{profile.name}, {a.mode}: {a.samples} samples in {wall:.0f} s; prior {prior:.2g} per approach")
-    print("  category  detected  2nd look alerts where 1st protected (samples, epochs: mean / max)  "
-          "continuous approaches interrupted [one-sided 95 % bounds]  HMI samples 1st / 2nd look")
+    print("  rule: second look (alert until confirmed) or at once (a clear first detection excluded at once)\n"
+          "  category  rule      detected  alerts where the first look protected (samples, epochs: mean / max)  "
+          "continuous approaches interrupted [one-sided 95 % bounds]  HMI samples first look / rule")
     for key in CATEGORY_KEYS.values():
         m = np.array([r[key] for r in rows])
-        epochs, a0, a1, added, h0, h1, det = m.T
+        epochs, a0, h0, det = m[:, :4].T
         cont = a0 == 0
-        lost = cont & (a1 > 0)
-        k, nc = int(lost.sum()), int(cont.sum())
-        lo, hi = rare.clopper_pearson(k, max(nc, 1), 0.95)
-        hit = added > 0
-        res["categories"][key] = {
-            "epochs_per_sample_mean": float(epochs.mean()), "detected": int(det.sum()),
-            "samples_with_added_alerts": int(hit.sum()),
-            "added_alert_epochs_mean_where_added": float(added[hit].mean()) if hit.any() else 0.0,
-            "added_alert_epochs_max": int(added.max()),
-            "continuous_first_look": nc, "interrupted_by_second_look": k,
-            "p_interrupted_given_fault": k / max(nc, 1), "p_interrupted_upper_95": hi,
-            "continuity_risk_per_approach_upper": hi * nc / a.samples * prior,
-            "hmi_samples_first_look": int((h0 > 0).sum()), "hmi_samples_second_look": int((h1 > 0).sum())}
-        c = res["categories"][key]
-        print(f"  {key:8s}  {c['detected']:5d}     {c['samples_with_added_alerts']:5d}, "
-              f"{c['added_alert_epochs_mean_where_added']:.1f} / {c['added_alert_epochs_max']}"
-              f"{'':34s}{k} of {nc} = {k / max(nc, 1):.3g} [{lo:.2g}, {hi:.2g}]"
-              f"{'':10s}{c['hmi_samples_first_look']} / {c['hmi_samples_second_look']}")
+        nc = int(cont.sum())
+        res["categories"][key] = {"epochs_per_sample_mean": float(epochs.mean()), "detected": int(det.sum()),
+                                  "continuous_first_look": nc, "hmi_samples_first_look": int((h0 > 0).sum())}
+        for j, rule in enumerate(("second_look", "at_once")):
+            a1, added, h1 = m[:, 4 + 3 * j:7 + 3 * j].T
+            k = int((cont & (a1 > 0)).sum())
+            lo, hi = rare.clopper_pearson(k, max(nc, 1), 0.95)
+            hit = added > 0
+            c = {"samples_with_added_alerts": int(hit.sum()),
+                 "added_alert_epochs_mean_where_added": float(added[hit].mean()) if hit.any() else 0.0,
+                 "added_alert_epochs_max": int(added.max()), "interrupted": k,
+                 "p_interrupted_given_fault": k / max(nc, 1), "p_interrupted_lower_95": lo,
+                 "p_interrupted_upper_95": hi, "continuity_risk_per_approach_upper": hi * nc / a.samples * prior,
+                 "hmi_samples": int((h1 > 0).sum())}
+            res["categories"][key][rule] = c
+            print(f"  {key:8s}  {rule:11s} {int(det.sum()):5d}     {c['samples_with_added_alerts']:5d}, "
+                  f"{c['added_alert_epochs_mean_where_added']:.1f} / {c['added_alert_epochs_max']}"
+                  f"{'':34s}{k} of {nc} = {k / max(nc, 1):.3g} [{lo:.2g}, {hi:.2g}]"
+                  f"{'':10s}{int((h0 > 0).sum())} / {c['hmi_samples']}")
     if a.out is not None:
         a.out.write_text(json.dumps(res, indent=1) + "\n")
 

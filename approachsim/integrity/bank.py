@@ -231,7 +231,7 @@ SECOND_LEVEL_EPOCHS = 3
 
 
 def second_level(detected: Array, stat: Array, ratio: float = SECOND_LEVEL_RATIO,
-                 epochs: int = SECOND_LEVEL_EPOCHS) -> tuple[Array, Array]:
+                 epochs: int = SECOND_LEVEL_EPOCHS, at_once: bool = False) -> tuple[Array, Array]:
     """Confirmed identification with a second look (issue 26: the misidentified ramp of run 44).
 
     From the first detection on, at each detected epoch the candidate is the mode with the largest identification
@@ -241,7 +241,10 @@ def second_level(detected: Array, stat: Array, ratio: float = SECOND_LEVEL_RATIO
     CAT II, docs/integrity.md). The output is protected (confirmed) only at epochs where the excluded
     mode is not contradicted (a later detected epoch whose clear candidate is another mode contradicts it; an
     ambiguous one does not); elsewhere from the first detection on it is not: the caller raises the alert
-    (PL = inf). Returns (excluded mode per epoch, -1 none; confirmed (epochs,))."""
+    (PL = inf). at_once: a first detection whose candidate is clear excludes it at once (protected, as the first
+    look), so only an ambiguous first detection waits for the confirmation (docs/integrity.md: the confirmation's
+    alerts on every detected ramp cost the continuity allocation). Returns (excluded mode per epoch, -1 none;
+    confirmed (epochs,))."""
     det = np.asarray(detected, bool)
     st = np.asarray(stat, float)
     n = det.size
@@ -253,14 +256,15 @@ def second_level(detected: Array, stat: Array, ratio: float = SECOND_LEVEL_RATIO
     top = order[:, -1]
     second = st[np.arange(n), order[:, -2]] if st.shape[1] > 1 else np.zeros(n)
     clear = st[np.arange(n), top] >= ratio * np.maximum(second, 0.0)
-    current, last, run = -1, -2, 0
+    current, last, run, first = -1, -2, 0, True
     for e in range(int(np.argmax(det)), n):
         if det[e]:
             c = int(top[e]) if clear[e] else -1
             run = run + 1 if (c == last and c >= 0) else (1 if c >= 0 else 0)
             last = c
-            if c >= 0 and current < 0 and run >= epochs:  # a confirmed exclusion is kept: a contradiction alerts
-                current = c
+            if c >= 0 and current < 0 and (run >= epochs or (at_once and first)):  # a confirmed exclusion is
+                current = c  # kept: a contradiction alerts
+            first = False
             ok[e] = current >= 0 and c in (current, -1)  # an ambiguous epoch does not contradict an exclusion
         else:
             ok[e] = current >= 0
@@ -269,11 +273,12 @@ def second_level(detected: Array, stat: Array, ratio: float = SECOND_LEVEL_RATIO
 
 
 def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, window: Array | None = None,
-                   confirm: bool = False) -> CategoryIntegrity:
+                   confirm: bool = False, at_once: bool = False) -> CategoryIntegrity:
     """Protection levels, detection and the per-epoch counts of one category (Annex 10 alert limits at the
     aircraft's distance from the threshold and height above it). confirm: identify with the second look
     (second_level: the output is not protected until a mode's exclusion is confirmed, and again whenever a later
-    detection names another mode); default: exclude the first detection's suspect for good."""
+    detection names another mode; at_once: a clear first detection excluded at once, second_level); default:
+    exclude the first detection's suspect for good."""
     sel = np.ones(ep.t_s.shape, bool) if window is None else np.asarray(window, bool)
     n_modes = max(ep.ek.shape[1], 1)
     r = separation(ep.e0[sel], ep.p0[sel], ep.ek[sel], ep.pk[sel], req.k_ff(), req.k_fa(epoch_hz, 2 * n_modes),
@@ -287,7 +292,7 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
     if r.detected.any() and confirm:
         w = ep.identification()
         stat = w[sel] if w is not None else np.max(r.test_ratio, axis=2)
-        mode, ok = second_level(r.detected, stat)
+        mode, ok = second_level(r.detected, stat, at_once=at_once)
         t_det = float(t[int(np.argmax(r.detected))])
         on = mode >= 0
         kk = np.where(on, mode, 0)

@@ -56,12 +56,33 @@ def test_a_clear_contradiction_alerts_and_keeps_the_exclusion() -> None:
     assert ok[2:5].all() and not ok[5:].any()  # contradicted from epoch 5 on: the alert stays on
 
 
+def test_at_once_excludes_a_clear_first_detection_and_waits_on_an_ambiguous_one() -> None:
+    det = np.r_[np.zeros(3, bool), np.ones(6, bool)]
+    stat = np.ones((9, 3))
+    stat[:, 1] = 50.0  # clear from the first detection on
+    mode, ok = second_level(det, stat, at_once=True)
+    assert np.all(mode[:3] == -1) and np.all(mode[3:] == 1) and ok.all()  # protected throughout: no alert
+    mode2, ok2 = second_level(det, stat)  # the plain second look alerts while it confirms
+    assert not ok2[3:5].any() and np.all(mode2[5:] == 1)
+    stat[3, 2] = 40.0  # the first detection ambiguous (50 / 40 < 2): confirmed as without at_once
+    mode, ok = second_level(det, stat, at_once=True)
+    mode2, ok2 = second_level(det, stat)
+    assert np.array_equal(mode, mode2) and np.array_equal(ok, ok2) and not ok[3]
+    stat[3, 2] = 1.0  # clear first detection again; a later clear contradiction alerts there, the exclusion kept
+    stat[6, 0] = 500.0
+    mode, ok = second_level(det, stat, at_once=True)
+    assert not ok[6] and mode[6] == 1
+
+
 @pytest.mark.parametrize("cat, dh_ft", [("CAT I", 200.0), ("CAT II", 100.0), ("CAT III", 50.0)])
 def test_run44_misidentification_becomes_an_alert(cat: str, dh_ft: float) -> None:
     ep = BankEpochs(**dict(np.load(DATA)))
     win = (ep.t_s >= ep.t_s[0] + 10.0) & (ep.height_m >= dh_ft * FT)
     first = score_category(ep, REQUIREMENTS[cat], 1.0, win)
     second = score_category(ep, REQUIREMENTS[cat], 1.0, win, confirm=True)
+    at_once = score_category(ep, REQUIREMENTS[cat], 1.0, win, confirm=True, at_once=True)
+    # the first detection was ambiguous (764 against 427: a ratio under 2), so at_once waits the same way
+    assert np.array_equal(at_once.alert, second.alert) and np.array_equal(at_once.misleading, second.misleading)
     assert first.excluded_channel == 21 and first.misleading.sum() > 100  # the pinned failure
     assert second.excluded_channel == 18  # PRN 20, the faulted satellite
     assert second.misleading.sum() == 0 and second.hazardous.sum() == 0
