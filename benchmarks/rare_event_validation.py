@@ -4,7 +4,7 @@ real simulation.
 
     PYTHONPATH=. python benchmarks/rare_event_validation.py [--profile P] [--mode baro-step-halfnormal]
         [--thresholds C1,C2] [--brute N] [--samples N] [--seed S] [--workers K] [--truths T] [--pilot N]
-        [--vmax-file F] [--no-nais] [--out FILE.json]
+        [--vmax-file F] [--no-nais] [--method nais|ce] [--out FILE.json]
 
 The event: the protected output's largest vertical error over the CAT I window (integrity.risk.limit_states
 `cat1_vmax_m`: the main solution, after an exclusion the excluded sub-solution) exceeds C metres, given one fault of
@@ -52,6 +52,8 @@ def main() -> None:
                     help="brute-force values, appended as they finish (and read back: a run can be continued)")
     ap.add_argument("--brute-wall-s", type=float, default=None, help="wall time of an earlier brute-force run, s")
     ap.add_argument("--no-nais", action="store_true", help="brute force only")
+    ap.add_argument("--method", default="nais", choices=("nais", "ce"),
+                    help="the importance-sampling estimator (integrity.rare.estimate): NAIS or cross-entropy")
     ap.add_argument("--level-offset", type=int, default=0,
                     help="NAIS run indices and seeds as if the levels came after this many others (a later run's "
                          "levels stay independent of an earlier one's)")
@@ -107,10 +109,11 @@ def main() -> None:
             counter[0] = 0
             t = time.time()
             est, _ = rare.estimate(lambda u, c=c, j=j: sample(u, 6_000_000 + 100_000 * j) - c, mode.dim,
-                                   method="nais", samples=a.samples, seed=a.seed * 31 + 1 + j,
+                                   method=a.method, samples=a.samples, seed=a.seed * 31 + 1 + j,
                                    max_calls=12 * a.samples)
             nais_rows.append({**est.as_dict(), "wall_s": time.time() - t})
-            print(f"C = {c} m: NAIS {est.probability:.3g} CoV {est.cov:.2g} [{est.lower:.3g}, {est.upper:.3g}] hits "
+            print(f"C = {c} m: {a.method.upper()} {est.probability:.3g} CoV {est.cov:.2g} "
+                  f"[{est.lower:.3g}, {est.upper:.3g}] hits "
                   f"{est.hits}/{est.samples} calls {est.calls} ({est.steps} steps, {nais_rows[-1]['wall_s']:.0f} s) "
                   f"{est.note}", flush=True)
     vmax = np.atleast_1d(np.loadtxt(a.vmax_file)) if a.vmax_file.exists() else np.empty(0)
