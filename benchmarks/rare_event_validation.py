@@ -4,7 +4,7 @@ real simulation.
 
     PYTHONPATH=. python benchmarks/rare_event_validation.py [--profile P] [--mode baro-step-halfnormal]
         [--thresholds C1,C2] [--brute N] [--samples N] [--seed S] [--workers K] [--truths T] [--pilot N]
-        [--vmax-file F] [--no-nais] [--method nais|ce] [--out FILE.json]
+        [--vmax-file F] [--no-nais] [--method nais|ce] [--strata E1,E2 --strata-samples N] [--out FILE.json]
 
 The event: the protected output's largest vertical error over the CAT I window (integrity.risk.limit_states
 `cat1_vmax_m`: the main solution, after an exclusion the excluded sub-solution) exceeds C metres, given one fault of
@@ -20,6 +20,14 @@ with every C; they are appended to --vmax-file as chunks finish, so a brute-forc
 NAIS-only run (--brute 0 with the same --vmax-file, read at the end) can go side by side. NAIS runs once per C, each
 on its own run indices (its own noise) and its own OpenTURNS seed. Prints and writes the table: estimate, CoV,
 one-sided bounds, hits, evaluations, wall time, whether the intervals overlap.
+
+--strata E1,E2,...: a second reference, stratified plain Monte Carlo over the magnitude input |u_1| (Cochran,
+*Sampling techniques*, ch. 5): strata [E1, E2), ..., [Ek, inf) of known probability P_j = 2 (Phi(E_j+1) -
+Phi(E_j)), each with --strata-samples plain samples of the conditional law (|u_1| by the inverse CDF within the
+stratum, its sign and the other inputs as drawn), on their own run indices; the stratum below E1 is read from the
+brute force's own samples there (its u re-drawn from the same generator). The estimate p = sum_j P_j k_j / n_j,
+Var = sum_j P_j^2 p_j (1 - p_j) / n_j, one-sided normal bounds at 0.95: no adaptation, no likelihood ratio, so it
+checks the estimators where the brute force's hits are too few (the tail lives in the upper strata).
 """
 
 from __future__ import annotations
@@ -30,6 +38,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy import stats as sps
 
 from approachsim.integrity import rare
 from approachsim.integrity.risk import MODES, VALIDATION_MODES, Simulator, _columns, fault_mode
@@ -57,6 +66,8 @@ def main() -> None:
     ap.add_argument("--level-offset", type=int, default=0,
                     help="NAIS run indices and seeds as if the levels came after this many others (a later run's "
                          "levels stay independent of an earlier one's)")
+    ap.add_argument("--strata", default=None, help="comma-separated |u_1| edges of the stratified reference")
+    ap.add_argument("--strata-samples", type=int, default=3000, help="plain samples per stratum")
     a = ap.parse_args()
     profile = load_profile(a.profile)
     mode = fault_mode(a.mode)
@@ -97,7 +108,12 @@ def main() -> None:
                 print(f"brute force {done}/{a.brute} ({time.time() - t:.0f} s); above the levels:",
                       [int(np.sum(np.loadtxt(a.vmax_file) > c)) for c in levels], flush=True)
         wall_mc = float(a.brute_wall_s) if a.brute_wall_s else (time.time() - t if a.brute else float("nan"))
+        if a.strata:
+            vmax = np.atleast_1d(np.loadtxt(a.vmax_file)) if a.vmax_file.exists() else np.empty(0)
+            res["stratified"] = stratified(sim, a, mode.dim, [float(x) for x in a.strata.split(",")], levels, vmax)
         if a.no_nais:
+            if a.out is not None:
+                a.out.write_text(json.dumps(res, indent=1) + "\n")
             vmax = np.atleast_1d(np.loadtxt(a.vmax_file))
             for c in levels:
                 k = int(np.sum(vmax > c))
@@ -125,12 +141,67 @@ def main() -> None:
         mc = {"method": "mc", "probability": k / max(vmax.size, 1), "lower": lo, "upper": hi, "hits": k,
               "calls": int(vmax.size), "wall_s": wall_mc}
         overlap = bool(lo <= (nais["upper"] or 1.0) and (nais["lower"] or 0.0) <= hi)
-        res["levels"].append({"threshold_m": c, "brute_force": mc, "nais": nais, "overlap": overlap})
+        row = {"threshold_m": c, "brute_force": mc, "nais": nais, "overlap": overlap}
+        extra = ""
+        for st in res.get("stratified", {}).get("levels", []):
+            if st["threshold_m"] == c:
+                row["overlap_stratified"] = bool(st["lower"] <= (nais["upper"] or 1.0)
+                                                 and (nais["lower"] or 0.0) <= st["upper"])
+                extra = (f"; stratified {st['probability']:.3g} [{st['lower']:.3g}, {st['upper']:.3g}], overlap "
+                         f"{row['overlap_stratified']}")
+        res["levels"].append(row)
         print(f"C = {c} m: brute force {k}/{vmax.size} = {mc['probability']:.3g} [{lo:.3g}, {hi:.3g}]; NAIS "
-              f"{nais['probability']} [{nais['lower']}, {nais['upper']}]; overlap {overlap}", flush=True)
+              f"{nais['probability']} [{nais['lower']}, {nais['upper']}]; overlap {overlap}{extra}", flush=True)
     res["wall_s"] = time.time() - t_all
     if a.out is not None:
         a.out.write_text(json.dumps(res, indent=1) + "\n")
+
+
+def stratified(sim: Simulator, a: argparse.Namespace, dim: int, edges: list[float], levels: list[float],
+               vmax_brute: np.ndarray) -> dict:
+    """The stratified reference (module docstring): each stratum's samples and, per level, the estimate."""
+    rng = np.random.default_rng(777 * a.seed)
+    bounds = list(zip(edges, edges[1:] + [np.inf], strict=True))
+    strata = []
+    for j, (lo, hi) in enumerate(bounds):
+        t = time.time()
+        n = a.strata_samples
+        q = sps.norm.cdf(lo) + rng.random(n) * (sps.norm.cdf(hi) - sps.norm.cdf(lo))
+        u = np.empty((n, dim))
+        u[:, 1] = np.where(rng.random(n) < 0.5, -1.0, 1.0) * sps.norm.ppf(q)
+        u[:, [i for i in range(dim) if i != 1]] = rng.standard_normal((n, dim - 1))
+        cols = _columns(sim.run(a.mode, 8_000_000 + 100_000 * j + np.arange(n), u))
+        v = np.where(cols["failed"] > 0, 1e3, cols["cat1_vmax_m"])
+        strata.append({"u1_abs": [lo, hi], "p_stratum": float(2.0 * (sps.norm.cdf(hi) - sps.norm.cdf(lo))),
+                       "samples": n, "vmax_m": v, "wall_s": time.time() - t})
+        print(f"stratum |u_1| in [{lo}, {hi}): {n} samples ({strata[-1]['wall_s']:.0f} s), largest vmax "
+              f"{v.max():.2f} m", flush=True)
+    u_brute = np.random.default_rng(a.seed * 31).standard_normal((vmax_brute.size, dim))  # the brute force's u
+    below = np.abs(u_brute[:, 1]) < edges[0]
+    p_below = float(2.0 * sps.norm.cdf(edges[0]) - 1.0)
+    z = float(sps.norm.ppf(0.95))
+    out = {"strata": [{k: v for k, v in s.items() if k != "vmax_m"} for s in strata],
+           "below": {"u1_abs": [0.0, edges[0]], "p_stratum": p_below, "samples": int(below.sum()),
+                     "largest_vmax_m": float(vmax_brute[below].max()) if below.any() else None}, "levels": []}
+    for c in levels:
+        k0, n0 = int(np.sum(vmax_brute[below] > c)), int(below.sum())
+        p = p_below * k0 / n0 if n0 else 0.0
+        var = p_below**2 * (k0 / n0) * (1 - k0 / n0) / n0 if n0 else 0.0
+        hits = []
+        for s in strata:
+            k = int(np.sum(s["vmax_m"] > c))
+            pj = k / s["samples"]
+            p += s["p_stratum"] * pj
+            var += s["p_stratum"] ** 2 * pj * (1.0 - pj) / s["samples"]
+            hits.append(k)
+        sd = var**0.5
+        row = {"threshold_m": c, "probability": p, "sd": sd, "lower": max(0.0, p - z * sd), "upper": p + z * sd,
+               "hits": hits, "below_hits": k0, "below_upper_cp": p_below * rare.clopper_pearson(k0, n0, 0.95)[1]}
+        out["levels"].append(row)
+        print(f"C = {c} m: stratified {p:.3g} (sd {sd:.2g}) [{row['lower']:.3g}, {row['upper']:.3g}], hits per "
+              f"stratum {hits}; below |u_1| {edges[0]}: {k0} of {n0} (largest {out['below']['largest_vmax_m']:.2f} m)",
+              flush=True)
+    return out
 
 
 if __name__ == "__main__":
