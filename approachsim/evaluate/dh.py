@@ -44,18 +44,36 @@ def runway_errors(truth: Truth, nav: NavSolution) -> RunwayErrors:
     if not np.allclose(nav.t_s[:n], truth.t_s[:n], rtol=0.0, atol=1e-6):
         raise ValueError("navigation solution and truth are not on the same time base")
     dr = nav.r_ecef[:n] - truth.r_ecef[:n]
-    e_ned = ecef_to_ned_vectors(dr, truth.lat_rad[:n], truth.lon_rad[:n])
+    sl, cl, so, co, hat = _truth_terms(truth, n)
+    e_ned = _rotate_ned(dr, sl, cl, so, co)
     e_rwy = dr @ truth.runway.c_ecef_to_rwy.T
-    hat = truth.runway.height_above_threshold(truth.h_m[:n])
     return RunwayErrors(
         t_s=truth.t_s[:n], hat_m=hat, along_m=e_rwy[:, 0], lateral_m=e_rwy[:, 1], vertical_m=-e_ned[:, 2], e_ned=e_ned
     )
 
 
+_TRUTH_TERMS: list = [None, -1, ()]
+"""The last truth's (truth, n, terms) of `_truth_terms`: the runs of an open-loop group share their truth."""
+
+
+def _truth_terms(truth: Truth, n: int) -> tuple[Array, Array, Array, Array, Array]:
+    """sin / cos of the truth's first n latitudes and longitudes and its heights above the threshold, computed once
+    per truth (the memo holds the truth itself, so its identity cannot be reused while it is kept)."""
+    if _TRUTH_TERMS[0] is not truth or _TRUTH_TERMS[1] != n:
+        lat, lon = truth.lat_rad[:n], truth.lon_rad[:n]
+        terms = (np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon),
+                 truth.runway.height_above_threshold(truth.h_m[:n]))
+        _TRUTH_TERMS[:] = [truth, n, terms]
+    return _TRUTH_TERMS[2]
+
+
 def ecef_to_ned_vectors(d_ecef: Array, lat_rad: Array, lon_rad: Array) -> Array:
     """Rotate ECEF vectors (n, 3) into the local NED axes at (lat, lon) per row (geo.c_ecef_to_ned, unrolled)."""
-    sl, cl = np.sin(lat_rad), np.cos(lat_rad)
-    so, co = np.sin(lon_rad), np.cos(lon_rad)
+    return _rotate_ned(d_ecef, np.sin(lat_rad), np.cos(lat_rad), np.sin(lon_rad), np.cos(lon_rad))
+
+
+def _rotate_ned(d_ecef: Array, sl: Array, cl: Array, so: Array, co: Array) -> Array:
+    """ecef_to_ned_vectors with the sines and cosines of latitude (sl, cl) and longitude (so, co) given."""
     x, y, z = d_ecef[:, 0], d_ecef[:, 1], d_ecef[:, 2]
     t = co * x + so * y
     return np.stack([-sl * t + cl * z, -so * x + co * y, -cl * t - sl * z], axis=-1)

@@ -62,6 +62,19 @@ def glidepath_tan(truth: Truth, hat_m: np.ndarray) -> float:
     return float(-np.polyfit(x, y, 1)[0])
 
 
+_GLIDEPATH_TAN: list = [None, -1, 0.0]
+"""The last truth's (truth, n, glidepath_tan): the runs of an open-loop group share their truth."""
+
+
+def _glidepath_tan_of(truth: Truth, hat_m: np.ndarray) -> float:
+    """glidepath_tan(truth, hat_m) for hat_m the truth's own first n heights above the threshold (runway_errors),
+    computed once per truth (the memo holds the truth itself)."""
+    n = hat_m.shape[0]
+    if _GLIDEPATH_TAN[0] is not truth or _GLIDEPATH_TAN[1] != n:
+        _GLIDEPATH_TAN[:] = [truth, n, glidepath_tan(truth, hat_m)]
+    return _GLIDEPATH_TAN[2]
+
+
 def score_run(
     truth: Truth,
     nav: NavSolution,
@@ -76,7 +89,7 @@ def score_run(
     err = runway_errors(truth, nav)
     integ = integrity_series(err.e_ned, nav.P_pos_ned, cfg.k_v, cfg.k_h)
     n = err.t_s.shape[0]
-    tan_gp = glidepath_tan(truth, err.hat_m)
+    tan_gp = _glidepath_tan_of(truth, err.hat_m)
     scalars: dict[str, float] = {}
     for cat in CATEGORIES:
         key = CATEGORY_KEYS[cat]

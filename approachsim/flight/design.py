@@ -31,11 +31,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import control
 import numpy as np
 
 from approachsim import units
+
+if TYPE_CHECKING:  # python-control imports matplotlib.pyplot (~0.5 s): loaded where a loop is analysed
+    import control
 
 Array = np.ndarray
 
@@ -308,6 +311,8 @@ def closed_loop(lin: Linearization, g: AutopilotGains, glidepath_rad: float, eng
 
 def loop_transfer(cl: ClosedLoop) -> control.StateSpace:
     """L(s) of a broken loop, sign chosen for python-control's negative-feedback convention."""
+    import control
+
     return control.ss(cl.A, cl.B, -cl.C, np.zeros((1, 1)))
 
 
@@ -324,6 +329,8 @@ class LoopMargin:
 
 def margins(L: control.StateSpace) -> tuple[float, float, float]:
     """Worst gain margin (dB, up or down), worst phase margin (deg) and the first gain crossover (rad/s)."""
+    import control
+
     with np.errstate(over="ignore", invalid="ignore"):  # polynomial root finding on high-gain test loops
         gm, pm, _sm, wpc, wgc, _wms = control.stability_margins(L, returnall=True)
     gm = np.atleast_1d(np.asarray(gm, dtype=float))

@@ -21,10 +21,12 @@ many Monte Carlo runs at once. The nav core calls `step` once per IMU (or baro) 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
-import control
 import numpy as np
+
+if TYPE_CHECKING:  # python-control imports matplotlib.pyplot (~0.5 s): loaded where a loop is analysed
+    import control
 
 Array = np.ndarray
 
@@ -95,11 +97,15 @@ def error_dynamics(gains: LoopGains, *, g0_mps2: float = G0_MPS2, r0_m: float = 
     B = np.array([[lin.c1, 0.0], [lin.c2, 1.0], [-lin.c3, 0.0]])
     C = np.array([[1.0, 0.0, 0.0]])
     D = np.zeros((1, 2))
+    import control
+
     return control.ss(A, B, C, D)
 
 
 def closed_loop_poles(gains: LoopGains, *, g0_mps2: float = G0_MPS2, r0_m: float = R0_M) -> Array:
     """Poles (1/s) of the linearized loop, from python-control (roots of eq. 4)."""
+    import control
+
     return np.asarray(control.poles(error_dynamics(gains, g0_mps2=g0_mps2, r0_m=r0_m)))
 
 
