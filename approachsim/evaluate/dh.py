@@ -52,19 +52,22 @@ def runway_errors(truth: Truth, nav: NavSolution) -> RunwayErrors:
     )
 
 
-_TRUTH_TERMS: list = [None, -1, ()]
+_TRUTH_TERMS: tuple = (None, -1, ())
 """The last truth's (truth, n, terms) of `_truth_terms`: the runs of an open-loop group share their truth."""
 
 
 def _truth_terms(truth: Truth, n: int) -> tuple[Array, Array, Array, Array, Array]:
     """sin / cos of the truth's first n latitudes and longitudes and its heights above the threshold, computed once
-    per truth (the memo holds the truth itself, so its identity cannot be reused while it is kept)."""
-    if _TRUTH_TERMS[0] is not truth or _TRUTH_TERMS[1] != n:
-        lat, lon = truth.lat_rad[:n], truth.lon_rad[:n]
-        terms = (np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon),
-                 truth.runway.height_above_threshold(truth.h_m[:n]))
-        _TRUTH_TERMS[:] = [truth, n, terms]
-    return _TRUTH_TERMS[2]
+    per truth (the memo holds the truth itself, so its identity cannot be reused while it is kept; one immutable
+    tuple, replaced whole, so a thread reads one truth's memo or another's, never a mix)."""
+    global _TRUTH_TERMS
+    memo = _TRUTH_TERMS
+    if memo[0] is truth and memo[1] == n:
+        return memo[2]
+    lat, lon = truth.lat_rad[:n], truth.lon_rad[:n]
+    terms = (np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon), truth.runway.height_above_threshold(truth.h_m[:n]))
+    _TRUTH_TERMS = (truth, n, terms)
+    return terms
 
 
 def ecef_to_ned_vectors(d_ecef: Array, lat_rad: Array, lon_rad: Array) -> Array:

@@ -62,17 +62,20 @@ def glidepath_tan(truth: Truth, hat_m: np.ndarray) -> float:
     return float(-np.polyfit(x, y, 1)[0])
 
 
-_GLIDEPATH_TAN: list = [None, -1, 0.0]
+_GLIDEPATH_TAN: tuple = (None, -1, 0.0)
 """The last truth's (truth, n, glidepath_tan): the runs of an open-loop group share their truth."""
 
 
 def _glidepath_tan_of(truth: Truth, hat_m: np.ndarray) -> float:
     """glidepath_tan(truth, hat_m) for hat_m the truth's own first n heights above the threshold (runway_errors),
-    computed once per truth (the memo holds the truth itself)."""
-    n = hat_m.shape[0]
-    if _GLIDEPATH_TAN[0] is not truth or _GLIDEPATH_TAN[1] != n:
-        _GLIDEPATH_TAN[:] = [truth, n, glidepath_tan(truth, hat_m)]
-    return _GLIDEPATH_TAN[2]
+    computed once per truth (the memo holds the truth itself; one immutable tuple, replaced whole)."""
+    global _GLIDEPATH_TAN
+    memo, n = _GLIDEPATH_TAN, hat_m.shape[0]
+    if memo[0] is truth and memo[1] == n:
+        return memo[2]
+    tan_gp = glidepath_tan(truth, hat_m)
+    _GLIDEPATH_TAN = (truth, n, tan_gp)
+    return tan_gp
 
 
 def score_run(
