@@ -617,7 +617,7 @@ class NavInTheLoop:
         if flags & ce.GNSS_IN:
             rho, r_sv, el = d.rho, d.r_sv, d.el
             sig = eng._code_sig if eng.channel_states else d.sig
-            d.guarded = d.guard  # the guarded elevations made: `_noise_arrays` goes on from them
+        d.guarded = d.guard and el is not None  # the guarded elevations made: `_noise_arrays` goes on from them
         self._recs = (k, d.recs if flags & ce.HAS_BARO else _NO_RECS)
         pl = ps.one("pseudolite", truth, k) if d.pseudolite else None
         return (baro_h, baro_r, radalt_h, rho, r_sv, sig, el, *self._pseudolite_inputs(t, pl))
