@@ -15,6 +15,9 @@ in order:
         the "baro in the interval" flag W_ANY_BARO <- 0
 
 nw is the closed loop's work vector (nav/kernels/inloop.py W_* offsets): the INS state y at W_X, f_sum at W_FSUM.
+direct_inputs makes that epoch's sensor inputs (baro, radar altimeter, GPS sky + pseudoranges, the channel guard) by
+the sensors' own kernels in one call (closed_loop.py `_direct_inputs`).
+
 Copies only, and one division: the snapshot's numbers are the same bits as the Navigator's numpy path; the oracle is
 that path (NavInTheLoop with the fast epoch off): tests/unit/nav/test_closed_loop_epoch.py flies both.
 """
