@@ -17,7 +17,8 @@ bookkeeping) on the sensors' one-row records, when the configuration has the com
 loop, carrier phase); otherwise, and as its test oracle (`fast_epochs = False`), the Navigator's numpy path.
 The compiled epoch's sensor inputs come straight from the baro's, radar altimeter's and GPS receiver's kernels,
 fused in one compiled call (`_direct_inputs`, closed_loop_epoch.direct_inputs, no records; `direct_inputs = False`
-or a faulted sensor, GBAS, carrier: from the records) and the GPS channel sigmas partly compiled (`_noise_arrays`; `compiled_sigmas = False`: numpy), the same bits either way
+or a faulted sensor, GBAS, carrier: from the records) and the GPS channel sigmas partly compiled (`_noise_arrays`;
+`compiled_sigmas = False`: numpy), the same bits either way
 (tests/unit/nav/test_closed_loop_epoch.py; tools/closed_loop_identity.py against a saved reference).
 """
 
