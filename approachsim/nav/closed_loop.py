@@ -15,9 +15,10 @@ epoch is one compiled call (nav/kernels/closed_loop_epoch.py: the per-run EKF's 
 bookkeeping) on the sensors' one-row records, when the configuration has the compiled epoch
 (`fast_epoch_unavailable`: not with feedback, the online FDE, the robust or U-D filters, loose coupling, an adaptive
 loop, carrier phase); otherwise, and as its test oracle (`fast_epochs = False`), the Navigator's numpy path.
-The compiled epoch's sensor inputs come straight from the baro's, radar altimeter's and GPS receiver's kernels
-(`_direct_inputs`, no records; `direct_inputs = False` or a faulted sensor, GBAS, carrier: from the records) and the
-GPS channel sigmas partly compiled (`_noise_arrays`; `compiled_sigmas = False`: numpy), the same bits either way
+The compiled epoch's sensor inputs come straight from the baro's, radar altimeter's and GPS receiver's kernels,
+fused in one compiled call (`_direct_inputs`, closed_loop_epoch.direct_inputs, no records; `direct_inputs = False`
+or a faulted sensor, GBAS, carrier: from the records) and the GPS channel sigmas partly compiled (`_noise_arrays`;
+`compiled_sigmas = False`: numpy), the same bits either way
 (tests/unit/nav/test_closed_loop_epoch.py; tools/closed_loop_identity.py against a saved reference).
 """
 
@@ -178,6 +179,40 @@ class FastEpoch:
     radar altimeter and stand-alone code GNSS of one run), not from their records (`_epoch_inputs`, the oracle)."""
 
 
+_NO_RECS: dict[str, Any] = {}
+"""`_recs` of an epoch row without a baro sample (read only)."""
+
+
+@dataclass
+class _Direct:
+    """closed_loop_epoch.direct_inputs' argument list for one run (NavInTheLoop._direct_arrays): its sample indices
+    at args[jb], args[jr], args[jg] (-1: none at the row), best4-fixed's plan (PreparedGnss.plan, args[jg + 5]; None
+    for the other selections), and the output buffers the epoch's inputs are read from."""
+
+    args: list
+    jb: int
+    jr: int
+    jg: int
+    plan: Any
+    baro_h: Array
+    baro_r: float
+    radalt_h: Array
+    rho: Array
+    r_sv: Array
+    sig: Array
+    el: Array
+    no_rho: Array
+    guard: bool
+    """direct_inputs guards the GPS elevations for the compiled channel sigmas (FastEpoch.sig fits the channels)."""
+    recs: dict[str, Any]
+    """`_recs` of an epoch row with a baro sample: its height in the kernel's b_hold (1,)."""
+    pseudolite: bool
+    call: Any = None
+    """direct_inputs' compiled entry point for these argument types (`_entry`)."""
+    guarded: bool = False
+    """The last call guarded the elevations (`_noise_arrays` reads them once)."""
+
+
 @dataclass
 class NavInTheLoop:
     """NavigationSource running this profile's navigation system for Monte Carlo run `run` of campaign `seed`.
@@ -220,6 +255,8 @@ class NavInTheLoop:
         self._h_thr = float(self.profile.runway.elevation_m)
         self._inloop: InLoop | None = None
         self._fast: FastEpoch | None = None
+        self._direct: _Direct | None = None
+        """The direct inputs' kernel arguments (`_direct_arrays`, made at the first direct epoch)."""
         self._recs: tuple[int, dict[str, Any]] | None = None
         """The last epoch's sensor records (row, records): the baro's is the damping loop's sample at that row."""
         self.fast_epochs = True
@@ -491,7 +528,11 @@ class NavInTheLoop:
         if el is None or sg is None or el.shape[0] != sg[0].shape[0]:
             return self._noise_arrays_numpy(el)
         g, arg, c, s, ex, gse, gmp, consts = sg
-        ce.channel_guard(el, _EL_MIN, g, arg)
+        d = self._direct
+        if d is not None and d.guarded:  # direct_inputs guarded el into g, arg (`_direct_inputs`)
+            d.guarded = False
+        else:
+            ce.channel_guard(el, _EL_MIN, g, arg)
         np.cos(g, out=c)
         np.sin(g, out=s)
         if consts[-1]:  # do253
@@ -546,42 +587,94 @@ class NavInTheLoop:
 
     def _direct_inputs(self, k: int, t: float, truth: Truth) -> tuple:
         """`_epoch_inputs` at truth row k without the records (FastEpoch.direct): the baro's, radar altimeter's and
-        GPS receiver's numbers by their kernels on the same values (sensors' h_one / channels_one), the same bits;
-        the baro's sample is kept for the damping loop (`_recs`)."""
+        GPS receiver's numbers by their kernels on the same values (sensors' h_one / channels_one) in one compiled
+        call (closed_loop_epoch.direct_inputs, into buffers made at the first epoch: `_direct_arrays`), the same
+        bits; the baro's sample is kept for the damping loop (`_recs`). The GPS channels' guarded elevations are
+        made there too (FastEpoch.sig: `_noise_arrays` finishes them)."""
         ps = self.prepared
         eng = self.navigator.engine
-        tol = 0.25 * self.dt
-        baro_h, baro_r, radalt_h, el = _NAN1, 0.0, _NAN1, None
-        rho, r_sv, sig = np.zeros((1, 0)), eng._none3, eng._none1
-        recs: dict[str, Any] = {}
+        d = self._direct
+        if d is None:
+            d = self._direct = self._direct_arrays(truth)
+        args = d.args
+        args[0], args[1] = k, t
         j = ps.sample("baro", k)
-        if j is not None:
-            p = ps.sensors["baro"]
-            h = p.h_one(truth, j)
-            recs["baro"] = _BaroAt(np.array([h]))
-            if abs(p.errors.t_s[j] - t) <= tol:
-                baro_h, baro_r = np.array([h]), float(p.baro.noise_sigma_m) ** 2
+        args[d.jb] = -1 if j is None else j
         j = ps.sample("radalt", k)
-        if j is not None:
-            p = ps.sensors["radalt"]
-            h = p.h_one(truth, j)
-            if abs(p.errors.t_s[j] - t) <= tol:
-                radalt_h = np.array([h])
+        args[d.jr] = -1 if j is None else j
         j = ps.sample("gnss", k)
-        if j is not None:
-            p = ps.sensors["gnss"]
-            if abs(p.errors.t_s[j] - t) <= tol:
-                pr, valid, r_sv0, sigma, el = p.channels_one(truth, j)
-                rho = np.where(valid, pr, np.nan)
-                r_sv = np.ascontiguousarray(r_sv0, dtype=float)
-                if not eng.channel_states:
-                    scale = self.nav.nav.gps_sigma_scale  # tuned_records' R tuning
-                    sig = np.ascontiguousarray(sigma if scale == 1.0 else sigma * scale, dtype=float)
-                else:
-                    sig = eng._code_sig
-        self._recs = (k, recs)
-        pl = ps.one("pseudolite", truth, k) if "pseudolite" in ps.sensors else None
+        args[d.jg] = -1 if j is None else j
+        if d.plan is not None:
+            args[d.jg + 5] = d.plan(truth)
+        if d.call is None:
+            d.call = _entry(ce.direct_inputs, tuple(args))
+        flags = d.call(*args)
+        baro_h, baro_r, radalt_h, el = _NAN1, 0.0, _NAN1, None
+        rho, r_sv, sig = d.no_rho, eng._none3, eng._none1
+        if flags & ce.BARO_IN:
+            baro_h, baro_r = d.baro_h, d.baro_r
+        if flags & ce.RADALT_IN:
+            radalt_h = d.radalt_h
+        if flags & ce.GNSS_IN:
+            rho, r_sv, el = d.rho, d.r_sv, d.el
+            sig = eng._code_sig if eng.channel_states else d.sig
+        d.guarded = d.guard and el is not None  # the guarded elevations made: `_noise_arrays` goes on from them
+        self._recs = (k, d.recs if flags & ce.HAS_BARO else _NO_RECS)
+        pl = ps.one("pseudolite", truth, k) if d.pseudolite else None
         return (baro_h, baro_r, radalt_h, rho, r_sv, sig, el, *self._pseudolite_inputs(t, pl))
+
+    def _direct_arrays(self, truth: Truth) -> _Direct:
+        """closed_loop_epoch.direct_inputs' arguments (constants, the sensors' drawn errors, scratch and outputs)
+        for this run, the sensors absent given as empty (their sample index stays -1)."""
+        ps = self.prepared.sensors
+        z1, z2 = np.zeros(0), np.zeros((1, 0))
+        b = ps.get("baro")
+        if b is not None:
+            lag, w, kc, _ = b.one_constants(truth)
+            baro = (-1, truth.p_static_pa, w, *kc, b.sf, b.bias, b.noise, b.errors.t_s, np.empty((1, lag.shape[0])),
+                    np.empty((1, 1)))
+            baro_r = float(b.baro.noise_sigma_m) ** 2
+        else:
+            baro = (-1, z1, z1, 0.0, 1.0, 1.0, 0.0, 0.0, z1, z2, z2, z1, np.empty((1, 1)), np.empty((1, 1)))
+            baro_r = 0.0
+        hold, baro_h, radalt_h = np.zeros(1), np.full(1, math.nan), np.full(1, math.nan)
+        r = ps.get("radalt")
+        out = (np.empty((1, 1)), np.empty((1, 1)), np.empty((1, 1), dtype=bool))
+        if r is not None:
+            a = r.ra
+            radalt = (-1, truth.h_agl_m, truth.euler_rad, r.bias, r.markov, r.noise, r.errors.t_s,
+                      float(a.percent_sigma), a.floor_m**2, float(a.max_range_m), float(a.max_pitch_rad),
+                      float(a.max_roll_rad), np.empty((3, 1)), *out, radalt_h)
+        else:
+            radalt = (-1, z1, np.zeros((0, 3)), z1, z2, z2, z1, 0.0, 0.0, 0.0, 0.0, 0.0, np.empty((3, 1)), *out,
+                      radalt_h)
+        g = ps.get("gnss")
+        fe = self._fast
+        sg = fe.sig
+        plan = None
+        if g is not None:
+            mode, consts, series = g.direct_constants()
+            n_ch = g.r_sv.shape[2]
+            guard = sg is not None and sg[0].shape[0] == n_ch
+            gnss = (-1, truth.r_ecef, g.r_sv, float(g.rx.mask_rad), mode, g.plan(truth), *consts, *series, g.bias,
+                    g.errors.t_s, float(self.nav.nav.gps_sigma_scale), np.empty((1, 3)),
+                    np.empty((g.r_sv.shape[0], 1) + g.r_sv.shape[2:]))
+            plan = g.plan if g.rx.selection == "best4-fixed" else None
+        else:
+            n_ch, guard = 0, False
+            s3 = np.zeros((1, 0, 0))
+            gnss = (-1, np.zeros((0, 3)), np.zeros((1, 0, 0, 3)), 0.0, 0, np.zeros((1, 0), dtype=bool), 0.0, False,
+                    0.0, 0.0, 0.0, 0.0, 0.0, s3, s3, s3, s3, s3, z2, z1, 1.0, np.empty((1, 3)), np.zeros((1, 1, 0, 3)))
+        rho, r_sv, sig, el = np.empty((1, n_ch)), np.empty((n_ch, 3)), np.empty(n_ch), np.empty(n_ch)
+        gs = (sg[0], sg[1]) if guard else (z1, z1)
+        args = [0, 0.0, 0.25 * self.dt, *baro, hold, baro_h, *radalt, *gnss, rho, r_sv, sig, el, guard, _EL_MIN,
+                *gs]
+        jb = 3
+        jr = jb + len(baro) + 2
+        jg = jr + len(radalt)
+        return _Direct(args=args, jb=jb, jr=jr, jg=jg, plan=plan, baro_h=baro_h, baro_r=baro_r, radalt_h=radalt_h,
+                       rho=rho, r_sv=r_sv, sig=sig, el=el, no_rho=np.zeros((1, 0)), guard=guard,
+                       recs={"baro": _BaroAt(hold)}, pseudolite="pseudolite" in ps)
 
     def _fast_epoch(self, k: int, t: float, inputs: tuple) -> bool:
         """The aiding epoch at truth row k (time t) in one compiled call (closed_loop_epoch.loop_epoch) on the sensor

@@ -192,13 +192,18 @@ class PreparedBaro:
         e = self.errors
         return self.baro.record(truth, e.rows[sl], e.t_s[sl], self.sf, self.bias[:, sl], self.noise[:, sl], e.batched)
 
+    def one_constants(self, truth: Truth) -> tuple[Array, Array, tuple[float, ...], Array]:
+        """h_one's lag row offsets (L,), lag weights (empty: no lag), kernel_constants and (1, 1) output, made at
+        the first call (truth.t_s[1] is set once row 1 is flown)."""
+        if self._one is None:
+            w = self.baro.lag_weights(float(truth.t_s[1] - truth.t_s[0])) if self.baro.lag_s > 0.0 else _NO_LAG
+            self._one = (np.arange(max(w.shape[0], 1)), w, self.baro.kernel_constants(), np.empty((1, 1)))
+        return self._one
+
     def h_one(self, truth: Truth, j: int) -> float:
         """The height (m) of sample j of a one-run draw: at(truth, j).h_baro_m[0] (valid: always) by the same kernel
         on the same values, without the record (the closed loop's compiled aiding epoch reads only this)."""
-        if self._one is None:  # the lag's row offsets and constants (truth.t_s[1] is set once row 1 is flown)
-            w = self.baro.lag_weights(float(truth.t_s[1] - truth.t_s[0])) if self.baro.lag_s > 0.0 else _NO_LAG
-            self._one = (np.arange(max(w.shape[0], 1)), w, self.baro.kernel_constants(), np.empty((1, 1)))
-        lag, w, kc, out = self._one
+        lag, w, kc, out = self.one_constants(truth)
         k = int(self.errors.rows[j])
         p = truth.p_static_pa[np.maximum(k - lag, 0)][None, :]
         bk.baro_apply(p, *kc, w, self.sf, self.bias[:, j:j + 1], self.noise[:, j:j + 1], out)

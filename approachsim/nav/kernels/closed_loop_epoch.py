@@ -15,6 +15,9 @@ in order:
         the "baro in the interval" flag W_ANY_BARO <- 0
 
 nw is the closed loop's work vector (nav/kernels/inloop.py W_* offsets): the INS state y at W_X, f_sum at W_FSUM.
+direct_inputs makes that epoch's sensor inputs (baro, radar altimeter, GPS sky + pseudoranges, the channel guard) by
+the sensors' own kernels in one call (closed_loop.py `_direct_inputs`).
+
 Copies only, and one division: the snapshot's numbers are the same bits as the Navigator's numpy path; the oracle is
 that path (NavInTheLoop with the fast epoch off): tests/unit/nav/test_closed_loop_epoch.py flies both.
 """
@@ -28,6 +31,9 @@ from numba import njit
 
 from approachsim.nav.kernels import epoch as ke
 from approachsim.nav.kernels import inloop as ik
+from approachsim.sensors.kernels import baro as bk
+from approachsim.sensors.kernels import gnss as gk
+from approachsim.sensors.kernels import radalt as rk
 
 
 @njit(cache=True)
@@ -113,3 +119,87 @@ def channel_sigmas(cos_g: np.ndarray, sin_g: np.ndarray, exp_mp: np.ndarray, a_m
         gse[i] = math.sqrt(ce2 + fi * fi + tm * tm)
         if do253:
             gmp[i] = 0.13 + 0.53 * exp_mp[i]
+
+
+HAS_BARO = 1
+"""direct_inputs' flag: the baro has a sample at the row (its height in b_hold)."""
+BARO_IN = 2
+"""... and it is the epoch's (its time within tol of t): baro_h = that height."""
+RADALT_IN = 4
+"""The radar altimeter's sample is the epoch's: radalt_h = its height (nan when not valid)."""
+GNSS_IN = 8
+"""The GPS sample is the epoch's: rho, r_sv_out, sig_out, el_out (and g, mp_arg when guarded) are set."""
+
+
+@njit(cache=True)
+def direct_inputs(k: int, t: float, tol: float,
+                  jb: int, p_static: np.ndarray, b_w: np.ndarray, b_set: float, b_t0l: float, b_exp: float,
+                  b_fld: float, b_cm1: float, b_sf: np.ndarray, b_bias: np.ndarray, b_noise: np.ndarray,
+                  b_ts: np.ndarray, b_p: np.ndarray, b_out: np.ndarray, b_hold: np.ndarray, baro_h: np.ndarray,
+                  jr: int, h_agl: np.ndarray, euler: np.ndarray, r_bias: np.ndarray, r_markov: np.ndarray,
+                  r_noise: np.ndarray, r_ts: np.ndarray, r_pct: float, r_floor2: float, r_max: float,
+                  r_pitch_max: float, r_roll_max: float, r_in: np.ndarray, r_meas: np.ndarray, r_sig: np.ndarray,
+                  r_valid: np.ndarray, radalt_h: np.ndarray,
+                  jg: int, r_ecef: np.ndarray, r_sv_all: np.ndarray, mask: float, mode: int, plan: np.ndarray,
+                  shell: float, do253: bool, mp_m: float, ce2: float, iono_z: float, tropo_z: float, cn2: float,
+                  s_ce: np.ndarray, s_iono: np.ndarray, s_tropo: np.ndarray, s_mp: np.ndarray, s_noise: np.ndarray,
+                  clk: np.ndarray, g_ts: np.ndarray, scale: float, g_rx: np.ndarray, g_sv: np.ndarray,
+                  rho: np.ndarray, r_sv_out: np.ndarray, sig_out: np.ndarray, el_out: np.ndarray,
+                  guard: bool, lo: float, g: np.ndarray, mp_arg: np.ndarray) -> int:
+    """The closed loop's direct epoch inputs at truth row k (time t) in one call (nav/closed_loop.py
+    `_direct_inputs`): the sensors' one-row kernels on the values their h_one / channels_one give them, the same
+    kernels in the same order, so the same bits:
+
+        baro sample jb (-1: none): p[0, q] = p_static[max(k - q, 0)] (q < len b_p), baro_apply -> b_hold[0]; when
+            |b_ts[jb] - t| <= tol: baro_h[0] = that height (else nan)                       (PreparedBaro.h_one)
+        radar altimeter sample jr: radalt_apply on row k; radalt_h[0] = the height where valid and in time, else
+            nan                                                                             (PreparedRadalt.h_one)
+        GPS sample jg in time: sky on (r_ecef[k], r_sv_all[:, jg]) (copied to g_rx, g_sv), pseudoranges on the
+            series' sample jg: rho (1, 24) (nan where not selected), r_sv_out = r_sv_all[0, jg], sig_out = sigma
+            (times scale when scale != 1), el_out = elevations; guard: channel_guard(el_out, lo, g, mp_arg)
+                                                                                            (PreparedGnss.channels_one)
+
+    Returns the flags HAS_BARO | BARO_IN | RADALT_IN | GNSS_IN of what was set."""
+    flags = 0
+    baro_h[0] = math.nan
+    radalt_h[0] = math.nan
+    if jb >= 0:
+        for q in range(b_p.shape[1]):
+            i = k - q
+            b_p[0, q] = p_static[i if i > 0 else 0]
+        bk.baro_apply(b_p, b_set, b_t0l, b_exp, b_fld, b_cm1, b_w, b_sf, b_bias[:, jb:jb + 1],
+                      b_noise[:, jb:jb + 1], b_out)
+        b_hold[0] = b_out[0, 0]
+        flags |= HAS_BARO
+        if abs(b_ts[jb] - t) <= tol:
+            baro_h[0] = b_out[0, 0]
+            flags |= BARO_IN
+    if jr >= 0:
+        r_in[0, 0] = h_agl[k]
+        r_in[1, 0] = euler[k, 1]
+        r_in[2, 0] = euler[k, 0]
+        rk.radalt_apply(r_in[0], r_in[1], r_in[2], r_bias, r_markov[:, jr:jr + 1], r_noise[:, jr:jr + 1], r_pct,
+                        r_floor2, r_max, r_pitch_max, r_roll_max, r_meas, r_sig, r_valid)
+        if abs(r_ts[jr] - t) <= tol:
+            radalt_h[0] = r_meas[0, 0] if r_valid[0, 0] else math.nan
+            flags |= RADALT_IN
+    if jg >= 0 and abs(g_ts[jg] - t) <= tol:
+        for c in range(3):
+            g_rx[0, c] = r_ecef[k, c]
+        g_sv[:, 0] = r_sv_all[:, jg]
+        rng, u, el, az, vis, sel, pdop, f_iono, m_tropo, mp_scale, sigma = gk.sky(
+            g_rx, g_sv, mask, mode, plan, shell, do253, mp_m, ce2, iono_z, tropo_z, cn2)
+        pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, s_ce[:, jg:jg + 1], s_iono[:, jg:jg + 1],
+                                    s_tropo[:, jg:jg + 1], s_mp[:, jg:jg + 1], s_noise[:, jg:jg + 1],
+                                    clk[:, jg:jg + 1])
+        n = pr.shape[2]
+        for i in range(n):
+            rho[0, i] = pr[0, 0, i] if valid[0, 0, i] else math.nan
+            for c in range(3):
+                r_sv_out[i, c] = r_sv_all[0, jg, i, c]
+            sig_out[i] = sigma[0, 0, i] if scale == 1.0 else sigma[0, 0, i] * scale
+            el_out[i] = el[0, 0, i]
+        if guard:
+            channel_guard(el_out, lo, g, mp_arg)
+        flags |= GNSS_IN
+    return flags

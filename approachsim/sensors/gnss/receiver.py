@@ -727,13 +727,12 @@ class PreparedGnss:
             self._carrier = carrier_last(j, rec.valid, rec.carrier_arc, carrier)
         return rec
 
-    def channels_one(self, truth: Truth, j: int) -> tuple[Array, Array, Array, Array, Array]:
-        """Sample j of a one-run, one-sky, stand-alone code receiver (no GBAS, no carrier phase) without the record:
-        at(truth, j)'s pseudorange_m (1, 24) m, valid (1, 24), r_sv_ecef[0] (24, 3) m, sigma_m[0] (24,) m and
-        elevation_rad[0] (24,) rad, by the same kernels (gk.sky, gk.pseudoranges) on the same values (the closed
-        loop's compiled aiding epoch reads only these)."""
-        rx, e = self.rx, self.errors
+    def direct_constants(self) -> tuple[int, tuple, tuple[Array, ...]]:
+        """channels_one's selection mode, sky constants (shell m, do253, multipath m, ce^2, I_z, T_z, code noise^2)
+        and error series (clock_ephemeris, iono_zenith, tropo_zenith, multipath, noise), made at the first call;
+        ValueError unless a one-run, one-sky, stand-alone code receiver."""
         if self._direct is None:
+            rx, e = self.rx, self.errors
             if rx.budget.gbas is not None or rx.carrier is not None or self.per_run or e.batched:
                 raise ValueError("channels_one: a one-run stand-alone code receiver only")
             b = rx.budget
@@ -742,7 +741,15 @@ class PreparedGnss:
                           float(b.iono_zenith_m), float(b.tropo_zenith_m), b.code_noise_m**2),
                          tuple(self.series[n] for n in ("clock_ephemeris", "iono_zenith", "tropo_zenith", "multipath",
                                                        "noise")))
-        mode, consts, series = self._direct
+        return self._direct
+
+    def channels_one(self, truth: Truth, j: int) -> tuple[Array, Array, Array, Array, Array]:
+        """Sample j of a one-run, one-sky, stand-alone code receiver (no GBAS, no carrier phase) without the record:
+        at(truth, j)'s pseudorange_m (1, 24) m, valid (1, 24), r_sv_ecef[0] (24, 3) m, sigma_m[0] (24,) m and
+        elevation_rad[0] (24,) rad, by the same kernels (gk.sky, gk.pseudoranges) on the same values (the closed
+        loop's compiled aiding epoch reads only these)."""
+        rx, e = self.rx, self.errors
+        mode, consts, series = self.direct_constants()
         k = int(e.rows[j])
         sl = slice(j, j + 1)
         rng, u, el, az, vis, sel, pdop, f_iono, m_tropo, mp_scale, sigma = gk.sky(

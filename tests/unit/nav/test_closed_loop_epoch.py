@@ -90,13 +90,16 @@ def _eq_inputs(got, want):
             assert np.shape(g) == np.shape(w) and np.asarray(g).dtype == np.asarray(w).dtype, i
 
 
-@pytest.mark.parametrize("name", ["default.toml", "gray-maybeck.toml", "hot-high-crosswind.toml"])
-def test_direct_epoch_inputs_equal_the_records(name):
+@pytest.mark.parametrize(("name", "nav"), [
+    ("default.toml", {}), ("gray-maybeck.toml", {}), ("hot-high-crosswind.toml", {}),
+    # no channel states: the pseudorange sigmas scaled in the fused kernel
+    ("default.toml", {"channel_states": False, "gps_sigma_scale": 1.5})])
+def test_direct_epoch_inputs_equal_the_records(name, nav):
     """The compiled epoch's sensor inputs made straight from the baro's, radar altimeter's and GPS receiver's
-    kernels (NavInTheLoop._direct_inputs) are the inputs made from their one-row records (`_epoch_inputs`, the
-    oracle) at every epoch row of a flown approach and at rows between (no sample there: the empty inputs), and
-    the flight they steer is the same bits."""
-    prof = _profile(name)
+    kernels in one compiled call (NavInTheLoop._direct_inputs, closed_loop_epoch.direct_inputs) are the inputs made
+    from their one-row records (`_epoch_inputs`, the oracle) at every epoch row of a flown approach and at rows
+    between (no sample there: the empty inputs), and the flight they steer is the same bits."""
+    prof = _profile(name, **nav)
     src, res, nav = _fly_inputs(prof, True)
     src0, res0, nav0 = _fly_inputs(prof, False)
     assert src._fast.direct and not src0._fast.direct
