@@ -105,12 +105,13 @@ class Baro:
                            run(errors.series["noise"]), errors.batched)
 
     def record(self, truth: Truth, rows: Array, t_s: Array, sf: Array, bias: Array, noise: Array,
-               batched: bool) -> BaroSamples:
+               batched: bool, truth_dt_s: float | None = None) -> BaroSamples:
         """The record of the samples at truth `rows` (times t_s) of R runs: scale factors sf (R,), bias and noise
-        (R, m) m; batched: the run axis is kept."""
+        (R, m) m; batched: the run axis is kept; truth_dt_s: the truth's step for the lag (default: its first
+        interval)."""
         rows = np.asarray(rows)
         if self.lag_s > 0.0:
-            w = self.lag_weights(float(truth.t_s[1] - truth.t_s[0]))
+            w = self.lag_weights(float(truth.t_s[1] - truth.t_s[0]) if truth_dt_s is None else truth_dt_s)
             p = truth.p_static_pa[np.maximum(rows[:, None] - np.arange(w.shape[0])[None, :], 0)]
         else:
             w = _NO_LAG
@@ -185,18 +186,35 @@ class PreparedBaro:
         self.bias = np.ascontiguousarray(run(errors.series["bias"]), dtype=float)
         self.noise = np.ascontiguousarray(run(errors.series["noise"]), dtype=float)
         self._one: tuple | None = None
+        self._truth_dt_s: float | None = None
+
+    def truth_step_s(self, truth: Truth) -> float:
+        """The truth's step (s) for the lag weights, fixed at the first call: its first interval, or, while row 1 is
+        not flown yet (the closed loop's start reads the baro at row 0), the step of the draw's own grid (the errors
+        were drawn on the planned truth rows): every sample of the run then uses the same weights."""
+        if self._truth_dt_s is None:
+            dt = float(truth.t_s[1] - truth.t_s[0]) if len(truth.t_s) > 1 else math.nan
+            if not math.isfinite(dt):
+                e = self.errors
+                if e.rows.shape[0] < 2:
+                    raise ValueError("lagged baro: the truth's step is unknown (row 1 not flown, one sample drawn)")
+                dt = float(e.t_s[1] - e.t_s[0]) / float(e.rows[1] - e.rows[0])
+            self._truth_dt_s = dt
+        return self._truth_dt_s
 
     def at(self, truth: Truth, j: int) -> BaroSamples:
         """The record of sample j alone (one-sample axes)."""
         sl = slice(j, j + 1)
         e = self.errors
-        return self.baro.record(truth, e.rows[sl], e.t_s[sl], self.sf, self.bias[:, sl], self.noise[:, sl], e.batched)
+        dt = self.truth_step_s(truth) if self.baro.lag_s > 0.0 else None
+        return self.baro.record(truth, e.rows[sl], e.t_s[sl], self.sf, self.bias[:, sl], self.noise[:, sl], e.batched,
+                                dt)
 
     def one_constants(self, truth: Truth) -> tuple[Array, Array, tuple[float, ...], Array]:
         """h_one's lag row offsets (L,), lag weights (empty: no lag), kernel_constants and (1, 1) output, made at
         the first call (truth.t_s[1] is set once row 1 is flown)."""
         if self._one is None:
-            w = self.baro.lag_weights(float(truth.t_s[1] - truth.t_s[0])) if self.baro.lag_s > 0.0 else _NO_LAG
+            w = self.baro.lag_weights(self.truth_step_s(truth)) if self.baro.lag_s > 0.0 else _NO_LAG
             self._one = (np.arange(max(w.shape[0], 1)), w, self.baro.kernel_constants(), np.empty((1, 1)))
         return self._one
 

@@ -24,10 +24,12 @@ pytestmark = pytest.mark.equality
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 
 
-def _profile(name: str, **nav):
+def _profile(name: str, baro: dict | None = None, **nav):
     path = PROFILES / name
     d = tomllib.loads(path.read_text(encoding="utf-8"))
     d.setdefault("nav", {}).update(nav)
+    if baro:
+        d["sensors"]["baro"].update(baro)
     return parse_profile(d, source=path.resolve())
 
 
@@ -90,16 +92,18 @@ def _eq_inputs(got, want):
             assert np.shape(g) == np.shape(w) and np.asarray(g).dtype == np.asarray(w).dtype, i
 
 
-@pytest.mark.parametrize(("name", "nav"), [
-    ("default.toml", {}), ("gray-maybeck.toml", {}), ("hot-high-crosswind.toml", {}),
+@pytest.mark.parametrize(("name", "nav", "baro"), [
+    ("default.toml", {}, None), ("gray-maybeck.toml", {}, None), ("hot-high-crosswind.toml", {}, None),
     # no channel states: the pseudorange sigmas scaled in the fused kernel
-    ("default.toml", {"channel_states": False, "gps_sigma_scale": 1.5})])
-def test_direct_epoch_inputs_equal_the_records(name, nav):
+    ("default.toml", {"channel_states": False, "gps_sigma_scale": 1.5}, None),
+    # a lagged static system: its weights at the start, before the truth's row 1 is flown (the draw's grid step)
+    ("default.toml", {}, {"lag_s": 1.0})])
+def test_direct_epoch_inputs_equal_the_records(name, nav, baro):
     """The compiled epoch's sensor inputs made straight from the baro's, radar altimeter's and GPS receiver's
     kernels in one compiled call (NavInTheLoop._direct_inputs, closed_loop_epoch.direct_inputs) are the inputs made
     from their one-row records (`_epoch_inputs`, the oracle) at every epoch row of a flown approach and at rows
     between (no sample there: the empty inputs), and the flight they steer is the same bits."""
-    prof = _profile(name, **nav)
+    prof = _profile(name, baro, **nav)
     src, res, nav = _fly_inputs(prof, True)
     src0, res0, nav0 = _fly_inputs(prof, False)
     assert src._fast.direct and not src0._fast.direct
