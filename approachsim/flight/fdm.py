@@ -23,7 +23,8 @@ atmosphere/turb-*-fps do not stick in 1.3.3 when its own model is off).
 
 The flight loop's per-step reads and writes go through one LoopIO, bound once per run. Exception to the SI rule
 above: they stay in JSBSim's units, and the loop's compiled step (flight/kernels.py) converts them, so that no
-Python arithmetic runs per step.
+Python arithmetic runs per step. LoopIO.direct gives the same reads and writes to compiled code (the C++ functions
+behind the nodes, flight/jsbsim_direct.py), so the whole loop can run compiled (flight/direct_kernels.py).
 """
 
 from __future__ import annotations
@@ -40,6 +41,8 @@ import jsbsim
 import numpy as np
 
 from approachsim import units
+from approachsim.flight import direct_kernels as dk
+from approachsim.flight import jsbsim_direct
 from approachsim.flight.design import Linearization
 
 INTEGRATOR_RECT_EULER = 1
@@ -146,6 +149,20 @@ class FDM:
         """Seed this instance's random generator (simulation/randomseed), for any JSBSim-side randomness."""
         self._fdm["simulation/randomseed"] = int(seed)
 
+    def direct_addresses(self, written: Sequence[str], read: Sequence[str]) -> np.ndarray | None:
+        """The uint64 vector flight/direct_kernels.py flies on: the C++ entry points, this FGFDMExec, the nodes
+        `written` then `read` (each checked, flight/jsbsim_direct.py); None when any of them is unavailable."""
+        if len(written) != dk.N_WRITE:
+            raise ValueError(f"direct_addresses: {dk.N_WRITE} written properties, got {len(written)}")
+        lib = jsbsim_direct.library(jsbsim._jsbsim.__file__)
+        if lib is None:
+            return None
+        exe = lib.exec_pointer(self._fdm)
+        nodes = [lib.node_pointer(self.node(name)) for name in [*written, *read]]
+        if exe is None or None in nodes:
+            return None
+        return np.array([lib.get_fn, lib.set_fn, lib.run_fn, exe, *nodes], dtype=np.uint64)
+
     def loop_io(self, reads: Sequence[str], near_reads: Sequence[str], near_stand_in: Sequence[float]) -> LoopIO:
         """The flight loop's property traffic, bound once per run (LoopIO)."""
         return LoopIO(self, reads, near_reads, near_stand_in)
@@ -243,6 +260,12 @@ class LoopIO:
                                   for c in ("north", "east", "down"))
         self.set_terrain_ft = fdm.node("position/terrain-elevation-asl-ft").set_double_value
         self._fdm = fdm
+        written = ["fcs/elevator-cmd-norm", "fcs/aileron-cmd-norm", "fcs/rudder-cmd-norm", "fcs/throttle-cmd-norm[0]",
+                   "fcs/throttle-cmd-norm[1]", "atmosphere/gust-north-fps", "atmosphere/gust-east-fps",
+                   "atmosphere/gust-down-fps", "position/terrain-elevation-asl-ft"]
+        self.direct = fdm.direct_addresses(written, [*reads, *near_reads])
+        """The address vector of flight/direct_kernels.py (D_* layout) for the same reads and writes, or None when
+        the C++ entry points cannot be used here (flight/jsbsim_direct.py): then only the Python loop flies."""
 
     def gust_on(self) -> None:
         """Switch JSBSim's own turbulence off: the run writes its turbulence through set_gust_fps

@@ -52,6 +52,7 @@ from approachsim import units
 from approachsim.config import ProfileError
 from approachsim.evaluate.touchdown import touchdown_scalars
 from approachsim.flight import closed_loop_kernels as ck
+from approachsim.flight import direct_kernels as dk
 from approachsim.flight import kernels as fk
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
@@ -309,7 +310,14 @@ class Approach:
         code = fk.TERM_NONE
         near = True
         k = 0
-        for k in range(n_max):
+        direct = io.direct if (guided or fused is not None) else None
+        if direct is not None:  # the same loop compiled, JSBSim called from it (flight/direct_kernels.py)
+            raw = np.zeros(dk.N_READ)
+            if guided:
+                k, code = _entry(dk.fly_guided, direct, raw, buf, nu, par, st)(direct, raw, buf, nu, par, st)
+            else:
+                k, code = self._fly_closed_direct(direct, raw, buf, nu, par, st, fused, truth)
+        for k in range(n_max if direct is None else 0):
             raw = read_near() if near else read()
             if fused is not None:
                 code, ncode, de, da, dr, thr, gn, ge, gd, terr_ft, near = step_nav(k, raw, buf, nu, par, st,
@@ -368,6 +376,31 @@ class Approach:
             run=run,
             turbulence_seed=turb_seed,
         )
+
+    @staticmethod
+    def _fly_closed_direct(direct: Array, raw: Array, buf: Array, nu: Array, par: Array, st: Array, fused: Any,
+                           truth: Truth) -> tuple[int, int]:
+        """The closed loop on direct_kernels.fly_closed: compiled between the rows where the navigation needs
+        Python (fused.act), where the loop below does what the Python loop does at such a row. Returns (the last
+        row k, its TERM_* code)."""
+        nav_args = (fused.nw, fused.fa, fused.ia)
+        cmd = np.zeros(8)
+        n_max = buf.shape[0]
+        seg = _entry(dk.fly_closed, 0, False, cmd, True, direct, raw, buf, nu, par, st, *nav_args)
+        control_nav = _entry(ck.fly_control_closed, 0, buf, par, st, *nav_args)
+        act = fused.act
+        k, pending, near = 0, False, True
+        while True:
+            k, code, ncode, near = seg(k, pending, cmd, near, direct, raw, buf, nu, par, st, *nav_args)
+            if k == n_max:  # every row flown (and the step after the last one taken)
+                return n_max - 1, code
+            if not ncode:  # a termination at a row that needed nothing of Python
+                return k, code
+            act(k, truth, ncode)
+            cmd[0], cmd[1], cmd[2], cmd[3] = control_nav(k, buf, par, st, *nav_args)
+            if code:
+                return k, code
+            k, pending = k + 1, True
 
     def _kernel_vectors(self, fdm: FDM, ic: InitialCondition, seed: int, run: int,
                         n_max: int) -> tuple[Array, Array, Array]:
