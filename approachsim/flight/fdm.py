@@ -158,7 +158,7 @@ class FDM:
         if lib is None:
             return None
         exe = lib.exec_pointer(self._fdm)
-        nodes = [lib.node_pointer(self.node(name)) for name in [*written, *read]]
+        nodes = lib.node_pointers([self.node(name) for name in [*written, *read]])
         if exe is None or None in nodes:
             return None
         return np.array([lib.get_fn, lib.set_fn, lib.run_fn, exe, *nodes], dtype=np.uint64)

@@ -32,7 +32,7 @@ import os
 import platform
 import struct
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -63,18 +63,22 @@ class Library:
 
     def exec_pointer(self, wrapper: Any) -> int | None:
         """The FGFDMExec* held by the Python FGFDMExec `wrapper`, or None when no field checks out."""
-        return _checked_field(wrapper, self.vptr_exec)
+        return _checked_fields([wrapper], self.vptr_exec)[0]
 
     def node_pointer(self, wrapper: Any) -> int | None:
         """The SGPropertyNode* held by the Python FGPropertyNode `wrapper`, or None when no field checks out or
         its value read through the pointer differs (in bits) from wrapper.get_double_value()."""
-        p = _checked_field(wrapper, self.vptr_node)
-        if p is None:
-            return None
-        direct = ctypes.CFUNCTYPE(ctypes.c_double, ctypes.c_void_p)(self.get_fn)(p)
-        if struct.pack("<d", direct) != struct.pack("<d", wrapper.get_double_value()):
-            return None
-        return p
+        return self.node_pointers([wrapper])[0]
+
+    def node_pointers(self, wrappers: Sequence[Any]) -> list[int | None]:
+        """node_pointer of each of `wrappers` (their fields read in one pass over /proc/self/mem)."""
+        get = _getter(self.get_fn)
+        out: list[int | None] = []
+        for w, p in zip(wrappers, _checked_fields(wrappers, self.vptr_node), strict=True):
+            if p is not None and struct.pack("<d", get(p)) != struct.pack("<d", w.get_double_value()):
+                p = None
+            out.append(p)
+        return out
 
 
 def library(extension_path: str) -> Library | None:
@@ -101,15 +105,29 @@ def _library(extension_path: str) -> Library | None:
     return Library(fns[0], fns[1], fns[2], tables[0] + _VPTR_OFFSET, tables[1] + _VPTR_OFFSET)
 
 
-def _checked_field(wrapper: Any, vptr: int) -> int | None:
-    """The one pointer among `wrapper`'s fields whose object starts with `vptr`; None when none or several
-    different ones do."""
-    size = type(wrapper).__basicsize__
-    fields = [struct.unpack("<Q", ctypes.string_at(id(wrapper) + offset, _WORD))[0]
-              for offset in range(_OBJECT_HEAD, size - _WORD + 1, _WORD)]
-    fields = [p for p in fields if p]
-    found = {p for p, word in zip(fields, _read_words(fields), strict=True) if word == vptr}
-    return found.pop() if len(found) == 1 else None
+@functools.cache
+def _getter(address: int) -> Callable[[int], float]:
+    """double f(void*) at `address`, callable from Python (the check of a node's pointer)."""
+    return ctypes.CFUNCTYPE(ctypes.c_double, ctypes.c_void_p)(address)
+
+
+def _checked_fields(wrappers: Sequence[Any], vptr: int) -> list[int | None]:
+    """For each wrapper, the one pointer among its fields whose object starts with `vptr`; None when none or
+    several different ones do."""
+    fields = []
+    for w in wrappers:
+        size = type(w).__basicsize__
+        words = [struct.unpack("<Q", ctypes.string_at(id(w) + offset, _WORD))[0]
+                 for offset in range(_OBJECT_HEAD, size - _WORD + 1, _WORD)]
+        fields.append([p for p in words if p])
+    heads = _read_words([p for f in fields for p in f])  # the first word of each field's object, one pass
+    out: list[int | None] = []
+    start = 0
+    for f in fields:
+        found = {p for p, head in zip(f, heads[start:start + len(f)], strict=True) if head == vptr}
+        start += len(f)
+        out.append(found.pop() if len(found) == 1 else None)
+    return out
 
 
 def _read_words(addresses: Sequence[int]) -> list[int | None]:
