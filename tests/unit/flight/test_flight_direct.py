@@ -100,21 +100,28 @@ def test_the_compiled_loop_flies_the_python_loops_bits(case, direct_available, m
 
 
 @pytest.mark.slow
-def test_the_compiled_closed_loop_flies_the_python_loops_bits(direct_available, monkeypatch):
-    """Navigation in the loop to touchdown: the compiled stretches hand over to Python at every aiding epoch and
-    baro sample (NavInTheLoop.act), and the result is the Python loop's, navigation included."""
+@pytest.mark.parametrize("case", ["landing", "time-budget"])
+def test_the_compiled_closed_loop_flies_the_python_loops_bits(case, direct_available, monkeypatch):
+    """Navigation in the loop to touchdown, and cut by the time budget (the rows run out: the compiled loop's other
+    exit): the compiled stretches hand over to Python at every aiding epoch and baro sample (NavInTheLoop.act), and
+    the result is the Python loop's, navigation included."""
     from approachsim.nav.closed_loop import NavInTheLoop
 
-    prof = _profile("hot-high-crosswind")
-    approach = Approach(prof, land=True)
+    if case == "landing":
+        prof, land, max_time_s, ends = _profile("hot-high-crosswind"), True, None, "touchdown"
+    else:
+        prof, land, max_time_s, ends = _profile("default", start_distance_nmi=3.0), False, 20.0, "timeout"
+    approach = Approach(prof, land=land)
 
     def fly():
         src = NavInTheLoop(prof, seed=2, run=0, max_time_s=approach.time_budget_s)
-        res = approach.fly(seed=2, run=0, nav_source=src)
+        res = approach.fly(seed=2, run=0, nav_source=src, max_time_s=max_time_s)
         return res, src.result(res.truth)
 
     (res_d, nav_d), (res_p, nav_p) = _fly_both(monkeypatch, fly)
-    assert res_d.termination == "touchdown"
+    assert res_d.termination.startswith(ends)
+    if max_time_s is not None:
+        assert len(res_d.truth.t_s) == int(math.ceil(max_time_s * 120.0)) + 1
     assert _assert_same(res_d, res_p) >= 15
     assert _assert_same(nav_d, nav_p) >= 5
 
