@@ -119,8 +119,10 @@ def bank_epochs_carrier(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.n
     ig, im, io = lay[ek.L_GSE], lay[ek.L_GMP], lay[ek.L_GIO]
     for e in range(E):
         y = ref[e]
+        same = False  # qd_tmp and ws hold epoch e's model, no resets since (kernels/epoch.py, model reuse)
         for i in range(N):
-            qd_tmp[:, :] = qd[e]
+            if not same:
+                qd_tmp[:, :] = qd[e]
             if ig >= 0:
                 for c in range(ch_gse.shape[2]):
                     qd_tmp[ig + c, ig + c] = ch_gse[i, e, c] ** 2 * f_gse[e]
@@ -128,6 +130,8 @@ def bank_epochs_carrier(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.n
             if io >= 0:
                 for c in range(ch_gio.shape[2]):
                     qd_tmp[io + c, io + c] = ch_gio[i, e, c] ** 2 * f_gio[e]
+            reset = ke._any_new(new[i, e])
+            ready = same and not reset
             phi_e = ke._with_resets(phi[e], qd_tmp, lay, new[i, e], amb_prior, phi_tmp)
             P = P3[i]
             n_rows[i, e] = ke.class_epoch(X[i:i + 1], P, phi_e, qd_tmp, lay, False, y, ins[i, e:e + 1],
@@ -135,7 +139,8 @@ def bank_epochs_carrier(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.n
                                           ref_agl[e], tx, th, rwy, dbp[i:i + 1], db_x, db_u[i:i + 1],
                                           rho[i, e:e + 1], r_sv[i, e], sig[i, e], channel_states, cp[i, e:e + 1],
                                           cp_r, pl_rho[i, e:e + 1], r_pl, pl_sig[e], pl_states, codes[i, e],
-                                          nu_out[i, e:e + 1], S_out[i, e], h, b, ws)
+                                          nu_out[i, e:e + 1], S_out[i, e], h, b, ws, ready)
+            same = not reset
             for a in range(n):
                 x_out[i, e, a] = X[i, a]
                 pd_out[i, e, a] = P[a, a]

@@ -83,7 +83,7 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
                 cp: np.ndarray, cp_r: float,
                 pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
                 codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray,
-                h: np.ndarray, b: np.ndarray, ws: tuple) -> int:
+                h: np.ndarray, b: np.ndarray, ws: tuple, csr_ready: bool = False) -> int:
     """Predict and update the M members of a class in place (module docstring); returns the number of rows.
 
     X (M, n) estimates; P (n, n) the class covariance; phi, qd (n, n) the epoch's model; lay the state layout
@@ -94,14 +94,17 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
     db_x (k,), db_u (M, k) (kernels.measurements); rho (M, s) pseudoranges m (nan: none), r_sv (s, 3) ECEF m,
     sig (s,) their 1-sigma, channel_states: the rows carry the gse / gmp states; cp (M, s) carrier phases m (nan:
     none; (M, 0) without carrier phase) with noise variance cp_r m^2; pl_rho (M, p), r_pl (p, 3), pl_sig (p,),
-    pl_states. Out: codes (R,), nu_out (M, R), S_out (R,); scratch h, b (n,), ws (kalman.workspace).
+    pl_states. Out: codes (R,), nu_out (M, R), S_out (R,); scratch h, b (n,), ws (kalman.workspace); csr_ready:
+    ws already holds phi's nonzeros (kalman.csr; the caller's previous class_epoch had this same phi), so they are
+    not collected again (the same numbers either way).
     """
     M = X.shape[0]
     n = X.shape[1]
     W, v, val, ptr, col = ws
     kc = v
     # predict: x_m <- Phi x_m ; P <- Phi P Phi' + Qd
-    kk.csr(phi, ptr, col, val)
+    if not csr_ready:
+        kk.csr(phi, ptr, col, val)
     for m in range(M):
         for i in range(n):
             acc = 0.0
@@ -279,9 +282,11 @@ def singleton_epochs(X: np.ndarray, P3: np.ndarray, phi2: np.ndarray, qd2: np.nd
     n_rows[i]."""
     N = X.shape[0]
     ig, im, io = lay[ek.L_GSE], lay[ek.L_GMP], lay[ek.L_GIO]
+    last = -1  # the model (held) whose Qd is in qd_tmp and whose Phi's nonzeros are in ws (model reuse)
     for i in range(N):
         hd = held[i]
-        qd_tmp[:, :] = qd2[hd]
+        if last != hd:
+            qd_tmp[:, :] = qd2[hd]
         if ig >= 0:
             for c in range(ch_gse.shape[1]):
                 qd_tmp[ig + c, ig + c] = ch_gse[i, c] ** 2 * f_gse
@@ -289,12 +294,32 @@ def singleton_epochs(X: np.ndarray, P3: np.ndarray, phi2: np.ndarray, qd2: np.nd
         if io >= 0:
             for c in range(ch_gio.shape[1]):
                 qd_tmp[io + c, io + c] = ch_gio[i, c] ** 2 * f_gio
+        reset = _any_new(new[i])
+        ready = last == hd and not reset
         phi = _with_resets(phi2[hd], qd_tmp, lay, new[i], amb_prior, phi_tmp)
         n_rows[i] = class_epoch(X[i:i + 1], P3[i], phi, qd_tmp, lay, False, ref, ins[i:i + 1],
                                 baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], ra_pct, ra_floor, ref_agl, tx, th, rwy,
                                 dbp[i:i + 1], db_x, db_u[i:i + 1], rho[i:i + 1], r_sv[i], sig[i], channel_states,
                                 cp[i:i + 1], cp_r, pl_rho[i:i + 1], r_pl, pl_sig, pl_states, codes[i],
-                                nu_out[i:i + 1], S_out[i], h, b, ws)
+                                nu_out[i:i + 1], S_out[i], h, b, ws, ready)
+        last = -1 if reset else hd
+
+
+@njit(cache=True)
+def _any_new(new: np.ndarray) -> bool:
+    """Whether any channel of new (k,) begins a carrier arc (_with_resets then changes Phi and Qd)."""
+    for c in range(new.shape[0]):
+        if new[c] != 0:
+            return True
+    return False
+
+
+# Model reuse. The copies' loops (singleton_epochs, shared_pass, copies.bank_epochs_carrier) give class_epoch one
+# model after another, mostly the same: a copy's Qd differs from the model's only on the channel states' diagonal,
+# which every copy writes, and its Phi is the model's unless its carrier arcs reset ambiguities. So qd_tmp is copied
+# from the model, and Phi's nonzeros collected (class_epoch's csr_ready), only when the model changed or the
+# previous copy reset (its resets changed qd_tmp, and ws holds the reset Phi's nonzeros): the same arrays as a fresh
+# copy each time, so the same numbers.
 
 
 @njit(cache=True)
@@ -387,9 +412,11 @@ def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, g
             kcar.dynamics(lay, gio, gio_tau, F, Qc)
             if not ek.discretize(F, Qc, dt[e], phi2[hd], qd2[hd]):
                 return -1 - e
+        last = -1  # model reuse (above _with_resets), within the epoch: its models are new
         for i in range(N):
             hd = held[i, e]
-            qd_tmp[:, :] = qd2[hd]
+            if last != hd:
+                qd_tmp[:, :] = qd2[hd]
             if ig >= 0:
                 for c in range(ch_gse.shape[2]):
                     qd_tmp[ig + c, ig + c] = ch_gse[i, e, c] ** 2 * f_gse[e]
@@ -397,6 +424,8 @@ def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, g
             if io >= 0:
                 for c in range(ch_gio.shape[2]):
                     qd_tmp[io + c, io + c] = ch_gio[i, e, c] ** 2 * f_gio[e]
+            reset = _any_new(new[i, e])
+            ready = last == hd and not reset
             phi = _with_resets(phi2[hd], qd_tmp, lay, new[i, e], amb_prior, phi_tmp)
             P = P3[i]
             n_rows[i, e] = class_epoch(X[i:i + 1], P, phi, qd_tmp, lay, False, y, ins[i, e:e + 1],
@@ -404,7 +433,8 @@ def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, g
                                        ref_agl[e], tx, th, rwy, dbp[i:i + 1], db_x, db_u[i:i + 1], rho[i, e:e + 1],
                                        r_sv[i, e], sig[i, e], channel_states, cp[i, e:e + 1], cp_r,
                                        pl_rho[i, e:e + 1], r_pl, pl_sig[e], pl_states, codes[i, e],
-                                       nu_out[i, e:e + 1], S_out[i, e], h, b, ws)
+                                       nu_out[i, e:e + 1], S_out[i, e], h, b, ws, ready)
+            last = -1 if reset else hd
             for a in range(n):
                 x_out[i, e, a] = X[i, a]
                 pd_out[i, e, a] = P[a, a]
