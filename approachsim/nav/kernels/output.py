@@ -29,9 +29,16 @@ _TWO_PI = 2.0 * math.pi
 def corrected_rows(rows: np.ndarray, X: np.ndarray, snap: np.ndarray, r_ecef: np.ndarray, v_ned: np.ndarray,
                    euler: np.ndarray) -> None:
     """Fill r_ecef, v_ned, euler (m, 3) (m, m/s, rad) from the raw INS rows (m, 16) and the estimates X (s, >= 9)
-    in force at each row (snap (m,) int, indices into X): the module docstring's equations."""
+    in force at each row (snap (m,) int, indices into X): the module docstring's equations. Exp([psi x]) is made
+    once per estimate (a run of rows shares one: an epoch's ~120 rows), the same numbers as once per row."""
+    last = -1
+    rot = rotation_exp(0.0, 0.0, 0.0)
     for j in range(rows.shape[0]):
-        x = X[snap[j]]
+        s = snap[j]
+        x = X[s]
+        if s != last:
+            rot = rotation_exp(x[6], x[7], x[8])
+            last = s
         lat, lon, h = rows[j, 0], rows[j, 1], rows[j, 2]
         r_n, r_e = gk.radii(lat)
         lat_c = lat - x[0] / (r_n + h)
@@ -42,7 +49,7 @@ def corrected_rows(rows: np.ndarray, X: np.ndarray, snap: np.ndarray, r_ecef: np
         v_ned[j, 0], v_ned[j, 1], v_ned[j, 2] = rows[j, 3] - x[3], rows[j, 4] - x[4], rows[j, 5] - x[5]
         c0 = (rows[j, 6], rows[j, 7], rows[j, 8], rows[j, 9], rows[j, 10], rows[j, 11], rows[j, 12], rows[j, 13],
               rows[j, 14])
-        c = _mm(rotation_exp(x[6], x[7], x[8]), c0)
+        c = _mm(rot, c0)
         euler[j, 0] = math.atan2(c[7], c[8])
         euler[j, 1] = -math.asin(min(max(c[6], -1.0), 1.0))
         euler[j, 2] = math.atan2(c[3], c[0]) % _TWO_PI
