@@ -226,6 +226,12 @@ class FDM:
         )
 
 
+WRITTEN = ("fcs/elevator-cmd-norm", "fcs/aileron-cmd-norm", "fcs/rudder-cmd-norm", "fcs/throttle-cmd-norm[0]",
+           "fcs/throttle-cmd-norm[1]", "atmosphere/gust-north-fps", "atmosphere/gust-east-fps",
+           "atmosphere/gust-down-fps", "position/terrain-elevation-asl-ft")
+"""The flight loop's written properties, in LoopIO's setters' order and flight/direct_kernels.py's D_WRITE order."""
+
+
 class LoopIO:
     """The flight loop's JSBSim property traffic of one run, bound once: one call reads a step's inputs, bound
     setters write the commands. Values are in JSBSim's units (the compiled step converts them, flight/kernels.py).
@@ -252,18 +258,13 @@ class LoopIO:
         self.read = _tuple_reader(getters, tuple(float(v) for v in near_stand_in))
         self.read_near = _tuple_reader(getters + near, ())
         self.run = fdm.run
-        self.set_elevator = fdm.node("fcs/elevator-cmd-norm").set_double_value
-        self.set_aileron = fdm.node("fcs/aileron-cmd-norm").set_double_value
-        self.set_rudder = fdm.node("fcs/rudder-cmd-norm").set_double_value
-        self.set_throttle = tuple(fdm.node(f"fcs/throttle-cmd-norm[{i}]").set_double_value for i in range(2))
-        self.set_gust_fps = tuple(fdm.node(f"atmosphere/gust-{c}-fps").set_double_value
-                                  for c in ("north", "east", "down"))
-        self.set_terrain_ft = fdm.node("position/terrain-elevation-asl-ft").set_double_value
+        de, da, dr, thr0, thr1, gn, ge, gd, terr = (fdm.node(name).set_double_value for name in WRITTEN)
+        self.set_elevator, self.set_aileron, self.set_rudder = de, da, dr
+        self.set_throttle = (thr0, thr1)
+        self.set_gust_fps = (gn, ge, gd)
+        self.set_terrain_ft = terr
         self._fdm = fdm
-        written = ["fcs/elevator-cmd-norm", "fcs/aileron-cmd-norm", "fcs/rudder-cmd-norm", "fcs/throttle-cmd-norm[0]",
-                   "fcs/throttle-cmd-norm[1]", "atmosphere/gust-north-fps", "atmosphere/gust-east-fps",
-                   "atmosphere/gust-down-fps", "position/terrain-elevation-asl-ft"]
-        self.direct = fdm.direct_addresses(written, [*reads, *near_reads])
+        self.direct = fdm.direct_addresses(WRITTEN, [*reads, *near_reads])
         """The address vector of flight/direct_kernels.py (D_* layout) for the same reads and writes, or None when
         the C++ entry points cannot be used here (flight/jsbsim_direct.py): then only the Python loop flies."""
 
