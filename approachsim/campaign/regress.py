@@ -21,12 +21,12 @@ however significant (numerics, small refinements); a significant larger one must
 * Power. Common random numbers make SE small when a change acts on the existing draws: scaling one error
   source moves every run's error the same way. Default profile, open loop, 20 runs, seed 7
   (tests/integration/test_regress_power.py): the radio-altimetry budget (radar altimeter white + correlated
-  error and the terrain-database error, which make the vertical error) x1.1 moves the vertical 1-sigma +4.0 /
-  +4.9 / +5.1 % and is flagged at CAT II and III (p = 6.6e-6, 1.8e-6), missed at CAT I (p = 0.0013); x2 is flagged
-  at CAT III (+30.8 %, p = 0.0008), while at CAT I and II the filter re-weights the doubled altimetry against GPS
-  and baro run by run, the change is not uniform across runs (+21.5 %, p = 0.038; +31.4 %, p = 0.0025) and is
-  missed at alpha = 1e-3 (the baseline flown on the straight glide-path cone; on the earlier curved path x1.1 was
-  flagged at all three heights and x2 at CAT II and III). With
+  error and the terrain-database error, which make the vertical error) x1.1 moves the vertical 1-sigma +5.4 /
+  +5.4 / +5.2 % and is flagged at all three heights (p = 0.0007, 8.8e-5, 3.9e-6; CAT I is near alpha: missed,
+  p = 0.0013, with the baseline before the baro loop's held-sample fix); x2 is flagged at CAT III (+33.0 %,
+  p = 0.00075), while at CAT I and II the filter re-weights the doubled altimetry against GPS and baro run by run,
+  the change is not uniform across runs (+32.9 %, p = 0.004; +36.8 %, p = 0.0016) and is missed at alpha = 1e-3
+  (on the earlier curved path x1.1 was flagged at all three heights and x2 at CAT II and III). With
   the earlier white-noise-only altimeter: x1.1 moved the vertical 1-sigma +7.6 / +7.4 / +8.9 % (p = 3e-6, 1e-4,
   3e-9), x2 +69..89 % (p <= 3e-6); baro noise x1.1 (+0.2..0.4 %, inside the margin) is not flagged. With 8 runs
   the same x1.1 is missed (p = 0.005-0.1) and x2 caught at one height only: hence 20. On constructed errors
@@ -37,7 +37,10 @@ however significant (numerics, small refinements); a significant larger one must
   the test holds at about alpha per field. The t reference is approximate (squared errors are skewed):
   measured on independent Gaussian samples 0.56 % per field with 8 runs and 0.31 % with 20 (nominal
   0.1 %, 20000 trials). On the pipeline, seed 8 against the seed-7 baseline (1-sigma figures moved by
-  -15..+53 %) flags nothing (smallest p = 0.04).
+  -15..+53 %) flags no 1-sigma figure (smallest p = 0.04 then; 0.28 at CAT II and III against the baseline of the
+  baro loop's held-sample fix). A verdict is compared as it is, not by a test: against that baseline seed 8 turns
+  CAT II's "fails" into "indeterminate" (its bound straddles the limit at 20 runs), which is reported as a
+  regression.
 * What it does not see: a change below the margin, and with few runs a change of an error source that
   carries a small share of the figure.
 

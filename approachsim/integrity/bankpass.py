@@ -127,12 +127,13 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     el0 = np.asarray(gnss.elevation_rad)[:, 0]
     s, runs = nav.start(truth, [rng], elevation_rad=el0[0], obs=obs0, states=states, elevation_per_run=el0)
     # the INS once (Navigator.propagate: feed-forward, no bias feedback), with the damping loop's baro
-    hb_full = _baro_held(nav, records, truth, m)
+    held = _baro_held(nav, records, truth, m)
+    hb_full, age = (None, None) if held is None else held
     x = ins.pack(s)
     rows = np.full((1, m + 1, ins.NX), np.nan)
     rows[:, 0] = x
     z3 = np.zeros((1, 3))
-    ins.propagate(x, dth, dvb, dt, bias_g=z3, bias_a=z3, h_baro_m=hb_full, loop=nav.loop_gains(),
+    ins.propagate(x, dth, dvb, dt, bias_g=z3, bias_a=z3, h_baro_m=hb_full, baro_age_s=age, loop=nav.loop_gains(),
                   f_sum=np.zeros((1, 3)), out=rows, row0=0)
     o = _stacked_observations(records, np.asarray(truth.t_s, dtype=float)[epoch_rows::epoch_rows], tol, True, 1)
     used = np.flatnonzero(np.any(np.asarray(gnss.valid, dtype=bool)[0], axis=0))
@@ -141,15 +142,13 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
                  runs[0].arcs)
 
 
-def _baro_held(nav: Any, records: dict[str, Any], truth: Any, m: int) -> Array | None:
-    """(N, m) the baro height held at each IMU interval start for the damping loop (nan: none), as NavSystem.run;
-    None without a loop or a baro."""
+def _baro_held(nav: Any, records: dict[str, Any], truth: Any, m: int) -> tuple[Array, Array] | None:
+    """(N, m) the baro height held at each IMU interval start for the damping loop (nan: none) and (m,) its age
+    (s), as NavSystem.run (ins.held_baro); None without a loop or a baro."""
     baro = records.get("baro")
     if nav.loop_gains() is None or baro is None:
         return None
-    hb = np.where(baro.valid, baro.h_baro_m, np.nan)
-    idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
-    return hb[:, idx]
+    return ins.held_baro(baro.valid, baro.h_baro_m, baro.t_s, truth.t_s[:m])
 
 
 class GroupInputs:
@@ -195,7 +194,8 @@ def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Arr
     baro = recs.get("baro")
     one_baro = {} if baro is None else {"baro": dataclasses.replace(baro, valid=np.asarray(baro.valid)[k:k + 1],
                                                                     h_baro_m=np.asarray(baro.h_baro_m)[k:k + 1])}
-    hb = _baro_held(nav, one_baro, truth, m)
+    held = _baro_held(nav, one_baro, truth, m)
+    hb = None if held is None else held[0]
     used = np.flatnonzero(np.any(np.asarray(recs["gnss"].valid, dtype=bool)[k], axis=0))
     x_hat, P = group.keep["start"][k]
     main = group.keep["reduced_runs"][k] if "reduced_runs" in group.keep else None

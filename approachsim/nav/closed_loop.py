@@ -243,9 +243,12 @@ class NavInTheLoop:
         self.navigator: Navigator | None = None
         """The navigation step object (nav/navigator.py), made at row 0."""
         self.h_baro_hold = math.nan
+        self.h_baro_t = math.nan
+        """The held baro sample and its time (s): the damping loop takes the INS height back to that time."""
         # the kernels' inputs and outputs, allocated once (kernels/strapdown.py inloop_step, guidance)
         self._dth, self._dv = np.zeros((1, 1, 3)), np.zeros((1, 1, 3))
         self._bg, self._ba, self._hb = np.zeros((1, 3)), np.zeros((1, 3)), np.full((1, 1), math.nan)
+        self._hb_age = np.zeros(1)
         self._hb_interval = np.full(self.epoch_rows, math.nan)  # the baro the kernel got over the epoch interval
         self._loop = ins.loop_vector(self.gains)
         self._guide = np.zeros(6)
@@ -338,9 +341,11 @@ class NavInTheLoop:
             if nav.nav.feedback:
                 self._bg[0], self._ba[0] = run.bg_fb, run.ba_fb
             self._hb[0, 0] = self.h_baro_hold
+            self._hb_age[0] = truth.t_s[k - 1] - self.h_baro_t
             self._hb_interval[(k - 1) % self.epoch_rows] = self.h_baro_hold
             sk.inloop_step(k, truth.w_ib_body, truth.f_body, affine, m_g, m_a, c_g, c_a, self._dth, self._dv,
-                           self.dt, self._bg, self._ba, self._hb, self._loop, navigator.x, navigator.f_sum)
+                           self.dt, self._bg, self._ba, self._hb, self._hb_age, self._loop, navigator.x,
+                           navigator.f_sum)
             if k % self.epoch_rows == 0:
                 obs, _ = self._observations(k, truth)
                 if self.gains is not None:  # the kernel's loop held over the interval (no baro, or excluded)
@@ -352,6 +357,7 @@ class NavInTheLoop:
             # nan (an outage, or the baro excluded by FDE): the INS kernel's damping loop holds
             held = run.baro_excluded() or not bool(np.ravel(b.valid)[0])
             self.h_baro_hold = math.nan if held else float(np.ravel(b.h_baro_m)[0])
+            self.h_baro_t = float(truth.t_s[k])
             if k == 0 and nav.nav.initial_error.start == "prior" and math.isfinite(self.h_baro_hold):
                 # the converged start's height error stands
                 navigator.x[0, 2] = self.h_baro_hold
@@ -372,7 +378,7 @@ class NavInTheLoop:
             n = self.t_s.shape[0]
             nw = np.zeros(ik.NW)
             nw[ik.W_LOOP:ik.W_LOOP + 6] = self._loop
-            nw[ik.W_HB] = math.nan
+            nw[ik.W_HB] = nw[ik.W_HB_T] = math.nan
             nw[ik.W_DT] = self.dt
             nw[ik.W_MG:ik.W_MG + 9] = m_g.reshape(9)
             nw[ik.W_MA:ik.W_MA + 9] = m_a.reshape(9)
@@ -455,6 +461,7 @@ class NavInTheLoop:
                 # nan (an outage, or the baro excluded by FDE): the INS kernel's damping loop holds
                 held = run.baro_excluded() or not bool(np.ravel(b.valid)[0])
                 nw[ik.W_HB] = math.nan if held else float(np.ravel(b.h_baro_m)[0])
+                nw[ik.W_HB_T] = truth.t_s[k]
                 if k == 0 and nav.nav.initial_error.start == "prior" and math.isfinite(nw[ik.W_HB]):
                     nw[ik.W_X + 2] = nw[ik.W_HB]  # the converged start's height error stands
         navigator.record_row(k)

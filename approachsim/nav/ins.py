@@ -234,27 +234,45 @@ _NO_OUT = np.empty((0, 0, NX))
 
 
 def propagate(x: Array, dtheta_body: Array, dv_body: Array, dt_s: float, *, bias_g: Array | None = None,
-              bias_a: Array | None = None, h_baro_m: Array | None = None, loop: vl.LoopGains | None = None,
-              f_sum: Array | None = None, out: Array | None = None, row0: int = 0) -> Array:
+              bias_a: Array | None = None, h_baro_m: Array | None = None, baro_age_s: Array | None = None,
+              loop: vl.LoopGains | None = None, f_sum: Array | None = None, out: Array | None = None,
+              row0: int = 0) -> Array:
     """Step packed states x (N, 16) in place over m IMU intervals with the compiled mechanization
     (kernels.strapdown.strapdown: the equations of `step_reference`); returns x.
 
     dtheta_body, dv_body (N, m, 3) rad, m/s; bias_g, bias_a (N, 3) rad/s, m/s^2 subtracted from the rates
-    (feedback); h_baro_m (N, m) the baro height held at each interval start (with `loop`); f_sum (N, 3)
-    accumulates C_bn dv (NED, m/s) when given; out (N, rows, 16) receives the state after interval j at
-    row row0 + j + 1 when given.
+    (feedback); h_baro_m (N, m) the baro height held at each interval start (with `loop`), baro_age_s (m,) the
+    held sample's age there (s; None: fresh samples, age 0; `held_baro`); f_sum (N, 3) accumulates C_bn dv (NED,
+    m/s) when given; out (N, rows, 16) receives the state after interval j at row row0 + j + 1 when given.
     """
     n = x.shape[0]
     dth = np.ascontiguousarray(dtheta_body, dtype=float).reshape(n, -1, 3)
     dvb = np.ascontiguousarray(dv_body, dtype=float).reshape(n, -1, 3)
     zeros = np.zeros((n, 3))
-    hb = np.zeros((n, 0)) if h_baro_m is None or loop is None else np.ascontiguousarray(h_baro_m, dtype=float
-                                                                                         ).reshape(n, -1)
+    if h_baro_m is None or loop is None:
+        hb, age = np.zeros((n, 0)), np.zeros(0)
+    else:
+        hb = np.ascontiguousarray(h_baro_m, dtype=float).reshape(n, -1)
+        age = np.zeros(hb.shape[1]) if baro_age_s is None else np.ascontiguousarray(baro_age_s, dtype=float)
+        if age.shape != (hb.shape[1],):
+            raise ValueError(f"baro_age_s has shape {age.shape}, the held baro {hb.shape[1]} intervals")
     lv = loop_vector(loop if h_baro_m is not None else None)
     sk.strapdown(x, dth, dvb, float(dt_s), zeros if bias_g is None else np.ascontiguousarray(bias_g, dtype=float),
-                 zeros if bias_a is None else np.ascontiguousarray(bias_a, dtype=float), hb, lv,
+                 zeros if bias_a is None else np.ascontiguousarray(bias_a, dtype=float), hb, age, lv,
                  np.zeros((n, 3)) if f_sum is None else f_sum, _NO_OUT if out is None else out, int(row0))
     return x
+
+
+def held_baro(valid: Array, h_baro_m: Array, t_baro_s: Array, t_start_s: Array) -> tuple[Array, Array]:
+    """The damping loop's zero-order hold of the baro: (N, m) the latest sample at or before each IMU interval
+    start t_start_s (m,) (nan where that sample is invalid: an outage, a lost sensor; the loop holds), and (m,) its
+    age there, t_start - t_sample (s), with which the INS takes the INS height back to the sample's time
+    (kernels/strapdown.py). valid, h_baro_m (N, n_baro) or (n_baro,) the baro records at times t_baro_s (n_baro,)."""
+    t_b = np.asarray(t_baro_s, dtype=float)
+    t0 = np.asarray(t_start_s, dtype=float)
+    idx = np.clip(np.searchsorted(t_b, t0 + 1e-9, side="right") - 1, 0, None)
+    hb = np.where(np.asarray(valid, dtype=bool), np.asarray(h_baro_m, dtype=float), np.nan).reshape(-1, t_b.shape[0])
+    return hb[:, idx], t0 - t_b[idx]
 
 
 def step(
@@ -264,19 +282,21 @@ def step(
     dt_s: float,
     *,
     h_baro_m: Array | None = None,
+    baro_age_s: float = 0.0,
     loop: vl.LoopGains | None = None,
 ) -> InsState:
     """Advance the INS by one IMU interval dt_s (s) with increments dtheta (rad) and dv (m/s), body axes (N, 3):
     the compiled kernel (`propagate`) on the state; the same result as `step_reference` to 1e-12 relative.
 
     With `loop` and `h_baro_m` (N,) given, the 3rd-order baro damping loop (seed 003 eq. 3 / 7) corrects
-    height, vertical velocity and its compensator from the loop error e = h_ins - h_baro at the interval start.
+    height, vertical velocity and its compensator from the loop error e = h_ins - h_baro, the INS height taken back
+    to the sample's time, baro_age_s (s) before the interval start: h_ins = h + v_D baro_age_s.
     """
     x = pack(s)
     n = x.shape[0]
     propagate(x, np.reshape(dtheta_body, (n, 1, 3)), np.reshape(dv_body, (n, 1, 3)), dt_s,
               h_baro_m=None if h_baro_m is None else np.reshape(np.asarray(h_baro_m, dtype=float), (n, 1)),
-              loop=loop)
+              baro_age_s=np.array([baro_age_s], dtype=float), loop=loop)
     return unpack(x)
 
 
@@ -287,6 +307,7 @@ def step_reference(
     dt_s: float,
     *,
     h_baro_m: Array | None = None,
+    baro_age_s: float = 0.0,
     loop: vl.LoopGains | None = None,
 ) -> InsState:
     """`step` in numpy (the readable version and the compiled kernel's test oracle): one IMU interval dt_s (s)
@@ -312,7 +333,8 @@ def step_reference(
     a_comp = s.a_comp_mps2
     dh_loop = 0.0
     if loop is not None and h_baro_m is not None:
-        e = h0 - np.asarray(h_baro_m, dtype=float)  # loop error e = h_ins - h_baro (seed 003 eq. 3)
+        # loop error e = h_ins - h_baro (seed 003 eq. 3), both at the sample's time (kernels/strapdown.py)
+        e = (h0 + v0[:, 2] * baro_age_s) - np.asarray(h_baro_m, dtype=float)
         k1, k2 = vl.branch_corrections(loop, e)
         v1 = v1.copy()
         v1[:, 2] += (k2 + a_comp) * dt_s  # v_up' = ... - k2(e) - a_c  (v_D = -v_up)

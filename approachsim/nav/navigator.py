@@ -239,13 +239,14 @@ class Navigator:
             return z, z
         return np.stack([r.bg_fb for r in self.runs]), np.stack([r.ba_fb for r in self.runs])
 
-    def propagate(self, dtheta: Array, dv: Array, dt_s: float, h_baro: Array | None, row0: int) -> None:
+    def propagate(self, dtheta: Array, dv: Array, dt_s: float, h_baro: Array | None, row0: int,
+                  baro_age_s: Array | None = None) -> None:
         """Step every INS over the m IMU intervals of dtheta, dv (M, m, 3) from row row0 (the compiled
         mechanization: all over all rows in one call), recording rows row0 + 1 .. row0 + m; h_baro (M, m) the baro
-        held at each interval start (with the damping loop)."""
+        held at each interval start (with the damping loop), baro_age_s (m,) its age there (s; ins.held_baro)."""
         m = dtheta.shape[1]
         bg, ba = self.bias_feedback()
-        ins.propagate(self.x, dtheta, dv, dt_s, bias_g=bg, bias_a=ba, h_baro_m=h_baro,
+        ins.propagate(self.x, dtheta, dv, dt_s, bias_g=bg, bias_a=ba, h_baro_m=h_baro, baro_age_s=baro_age_s,
                       loop=self.system.loop_gains(), f_sum=self.f_sum, out=self.rows, row0=row0)
         self.snap[row0 + 1:row0 + m + 1] = len(self._snaps) - 1
 
@@ -401,7 +402,7 @@ class Navigator:
                 and self.shared.singletons and not self.system.nav.feedback)
 
     def compiled_pass(self, records: Any, truth: Truth, batched: bool, dtheta: Array, dv: Array, dt_s: float,
-                      h_baro: Array | None, epoch_rows: int) -> bool:
+                      h_baro: Array | None, epoch_rows: int, baro_age_s: Array | None = None) -> bool:
         """The whole open-loop pass in two compiled calls (`can_pass`): the INS over every row, then every epoch of
         every run (kernels/epoch.shared_pass: the per-epoch path's arithmetic, nav/shared.py's singletons). Fills
         the state `results` reads. False, with nothing changed but the INS rows, when an epoch's model is too
@@ -409,7 +410,8 @@ class Navigator:
         system, lay, sh, eng = self.system, self.layout, self.shared, self.engine
         m = dtheta.shape[1]
         x0 = self.x.copy()
-        self.propagate(dtheta, dv, dt_s, h_baro, 0)  # the INS over every row (feed-forward: the filter never acts)
+        # the INS over every row (feed-forward: the filter never acts)
+        self.propagate(dtheta, dv, dt_s, h_baro, 0, baro_age_s)
         e_rows = np.arange(epoch_rows, m + 1, epoch_rows)
         N, E = self.n_runs, e_rows.shape[0]
         t_e = np.asarray(truth.t_s, dtype=float)[e_rows]

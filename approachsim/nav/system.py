@@ -388,19 +388,16 @@ class NavSystem:
             keep["feed_forward"] = not self.nav.feedback
             keep["epoch_rows"] = epoch_rows
         baro = records.get("baro")
-        hb_full = None
+        hb_full = age = None
         if self.loop_gains() is not None and baro is not None:
             # an invalid sample (outage, a lost sensor) is no baro: nan, and the loop holds (kernels.strapdown)
-            hb = np.where(baro.valid, baro.h_baro_m, np.nan)
-            hb = hb if batched else hb[None]
-            # zero-order hold of the latest baro sample at each IMU interval start (truth rows 0 .. m-1)
-            idx = np.clip(np.searchsorted(baro.t_s, truth.t_s[:m] + 1e-9, side="right") - 1, 0, None)
-            hb_full = hb[:, idx]
+            # zero-order hold of the latest baro sample at each IMU interval start (truth rows 0 .. m-1), and its age
+            hb_full, age = ins.held_baro(baro.valid, baro.h_baro_m, baro.t_s, truth.t_s[:m])
             if copies:
                 if not np.all((hb_full == hb_full[:1]) | (np.isnan(hb_full) & np.isnan(hb_full[:1]))):
                     raise ValueError("run(copies=True): the copies' baro records differ")
                 hb_full = hb_full[:1]
-        if nav.can_pass() and nav.compiled_pass(records, truth, batched, dth, dvb, dt, hb_full, epoch_rows):
+        if nav.can_pass() and nav.compiled_pass(records, truth, batched, dth, dvb, dt, hb_full, epoch_rows, age):
             if keep is not None:
                 keep["ins_epoch_rows"] = nav.rows[:, epoch_rows::epoch_rows].copy()
                 if nav.reduced_runs is not None:
@@ -412,7 +409,8 @@ class NavSystem:
         j0 = 0
         while j0 < m:
             j1 = min(m, (j0 // epoch_rows + 1) * epoch_rows)  # rows j0 + 1 .. j1; j1 an epoch unless the end
-            nav.propagate(dth[:, j0:j1], dvb[:, j0:j1], dt, None if hb_full is None else hb_full[:, j0:j1], j0)
+            nav.propagate(dth[:, j0:j1], dvb[:, j0:j1], dt, None if hb_full is None else hb_full[:, j0:j1], j0,
+                          None if age is None else age[j0:j1])
             if j1 % epoch_rows == 0:
                 obs = Observations.at(records, float(truth.t_s[j1]), tol, batched)
                 if hb_full is not None:  # the loop held where the kernel had no baro over the whole interval

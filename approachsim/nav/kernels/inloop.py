@@ -7,7 +7,8 @@ Per truth row k (k > 0), with the flight's row buffer buf (flight/run.py columns
 
     IMU increment of (k-1, k]: d = dt w(k-1) (rate or specific force of truth sample k-1 held, sensors/imu.py),
                                dtheta = d + M_g d + c_g[k-1],  dv = d + M_a d + c_a[k-1]  (pre-drawn, affine)
-    INS step (kernels/strapdown.py) with the baro held in the work vector (nan: the damping loop holds)
+    INS step (kernels/strapdown.py) with the baro held in the work vector (nan: the damping loop holds) and its age
+                               t(k-1) - t(sample)
     rows[k] = the INS state; snap[k] = the filter snapshot in force
     guidance = INS - x_hat (feed-forward) in the runway frame and NED (kernels/strapdown.guidance)
 
@@ -61,7 +62,9 @@ W_BFLD, W_BCM1 = 80, 81
 """The baro's temperature correction: field geopotential elevation H_f (m) and c - 1 (sensors/baro.py)."""
 W_N, W_M, W_NBE, W_NLAG = 82, 83, 84, 85
 """Sizes of the packed arrays (`views`): truth rows n, IMU samples m, baro samples, lag weights."""
-NW = 86
+W_HB_T, W_HB_AGE = 86, 87
+"""The held baro sample's time (s, truth row time) and its age at the interval start being stepped (s)."""
+NW = 88
 
 NAV_START, NAV_BARO, NAV_EPOCH = 1, 2, 4
 """Bits of nav_row's code: the rows at which Python must act."""
@@ -111,9 +114,10 @@ def nav_row(k: int, buf: np.ndarray, nw: np.ndarray, cg: np.ndarray, ca: np.ndar
         hb = nw[W_HB:W_HB + 1].reshape(1, 1)
         if hb[0, 0] == hb[0, 0]:
             nw[W_ANY_BARO] = 1.0
+        nw[W_HB_AGE] = buf[k - 1, 0] - nw[W_HB_T]
         sk.strapdown(nw[W_X:W_X + 16].reshape(1, 16), dth, dv, dt, nw[W_BG:W_BG + 3].reshape(1, 3),
-                     nw[W_BA:W_BA + 3].reshape(1, 3), hb, nw[W_LOOP:W_LOOP + 6], nw[W_FSUM:W_FSUM + 3].reshape(1, 3),
-                     np.empty((1, 0, 16)), 0)
+                     nw[W_BA:W_BA + 3].reshape(1, 3), hb, nw[W_HB_AGE:W_HB_AGE + 1], nw[W_LOOP:W_LOOP + 6],
+                     nw[W_FSUM:W_FSUM + 3].reshape(1, 3), np.empty((1, 0, 16)), 0)
         if k % int(nw[W_EPOCH_ROWS]) == 0:
             code |= NAV_EPOCH
     j = baro_j[k]
@@ -121,6 +125,7 @@ def nav_row(k: int, buf: np.ndarray, nw: np.ndarray, cg: np.ndarray, ca: np.ndar
         if nw[W_BARO_KERNEL] != 0.0 and code == 0:  # the held baro for the next intervals (nan: excluded)
             nw[W_HB] = np.nan if nw[W_BARO_EXCL] != 0.0 else baro_sample(k, buf, nw, lag_w, baro_e[j, 0],
                                                                           baro_e[j, 1])
+            nw[W_HB_T] = buf[k, 0]
         else:
             code |= NAV_BARO
     for q in range(16):

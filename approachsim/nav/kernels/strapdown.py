@@ -11,9 +11,13 @@ Per interval j (increments dtheta, dv over (t_j, t_j + dt], body axes):
     attitude  C(+) = Exp(-w_in(mid) dt) C(-) Exp(dtheta)
     velocity  v(+) = v(-) + C(-) (dv + 1/2 dtheta x dv) - 1/2 dt w_in x C(-) dv + (g(mid) - (2 w_ie + w_en) x v_mid) dt
     position  trapezoid of v(-), v(+), radii at the midpoint
-    baro loop (optional, seed 003 eq. 3 / 7): e = h(-) - h_baro, vD += (k2(e) + a_c) dt, a_c += C3 e dt,
-              h += -k1(e) dt
+    baro loop (optional, seed 003 eq. 3 / 7): e = h(-) + vD(-) a - h_baro, vD += (k2(e) + a_c) dt,
+              a_c += C3 e dt, h += -k1(e) dt
     with h_baro nan (no baro: an outage, or the baro excluded by FDE) the loop holds: vD += a_c dt only
+
+h_baro is the last baro sample, held; a (s) is its age at the interval start. The loop compares it with the INS
+height at the sample's time, h(-) + vD(-) a (first order), not with the height now: on a descent the held sample is
+vD a above the aircraft, and closing the loop on it biased the height high (docs/baro-loop-hold-bias.md).
 
 Each run is stepped on its own (the run loop is outside the time loop, so the 16 state numbers stay in
 registers): a run's numbers are the same in any batch, which the campaign's bit-identity needs. Vectorizing the
@@ -88,13 +92,14 @@ def _branch(form: float, c: float, b: float, e: float) -> float:
 
 @njit(cache=True)
 def strapdown(x: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, dt: float, bias_g: np.ndarray,
-              bias_a: np.ndarray, h_baro: np.ndarray, loop: np.ndarray, f_sum: np.ndarray, out: np.ndarray,
-              row0: int) -> None:
+              bias_a: np.ndarray, h_baro: np.ndarray, baro_age: np.ndarray, loop: np.ndarray, f_sum: np.ndarray,
+              out: np.ndarray, row0: int) -> None:
     """Step N runs over m IMU intervals, in place.
 
     x (N, 16) packed states; dtheta, dv (N, m, 3) raw increments (rad, m/s); bias_g, bias_a (N, 3) rate and
     specific-force corrections (rad/s, m/s^2; the increments used are dtheta - bias_g dt, dv - bias_a dt);
-    h_baro (N, m) the baro height held at each interval start (m; read only with a loop); loop (6,) as
+    h_baro (N, m) the baro height held at each interval start (m; read only with a loop), baro_age (m,) the held
+    sample's age there (s: interval start - sample time; read with h_baro); loop (6,) as
     LOOP_*; f_sum (N, 3) accumulates C(-) dv of every interval (NED, m/s); out (N, rows, 16): when rows > 0,
     the state after interval j is written to out[:, row0 + j + 1].
     """
@@ -153,7 +158,8 @@ def strapdown(x: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, dt: float, bias
             if form != LOOP_NONE:
                 hb = h_baro[i, j]
                 if hb == hb:
-                    e = h0 - hb  # loop error e = h_ins - h_baro (seed 003 eq. 3)
+                    # loop error e = h_ins - h_baro (seed 003 eq. 3), both at the sample's time
+                    e = (h0 + vd * baro_age[j]) - hb
                     k1 = _branch(form, loop[1], loop[4], e)
                     k2 = _branch(form, loop[2], loop[5], e)
                     v1d += (k2 + a_comp) * dt  # v_up' = ... - k2(e) - a_c  (v_D = -v_up)
@@ -203,15 +209,15 @@ def imu_increment(m_err: np.ndarray, true_row: np.ndarray, dt: float, c: np.ndar
 @njit(cache=True)
 def inloop_step(k: int, w_ib: np.ndarray, f_body: np.ndarray, affine: bool, m_g: np.ndarray, m_a: np.ndarray,
                 c_g: np.ndarray, c_a: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, dt: float,
-                bias_g: np.ndarray, bias_a: np.ndarray, h_baro: np.ndarray, loop: np.ndarray, x: np.ndarray,
-                f_sum: np.ndarray) -> None:
+                bias_g: np.ndarray, bias_a: np.ndarray, h_baro: np.ndarray, baro_age: np.ndarray, loop: np.ndarray,
+                x: np.ndarray, f_sum: np.ndarray) -> None:
     """The closed loop's INS step into truth row k for one run: with `affine`, the IMU increments of interval
     (k-1, k] from truth rows w_ib, f_body (n, 3) and the pre-drawn error terms (imu_increment; M m_g, m_a and
     c_g, c_a (m, 3) indexed by sample k-1), else the given dtheta, dv (1, 1, 3); then `strapdown` on x (1, 16)."""
     if affine:
         imu_increment(m_g, w_ib[k - 1], dt, c_g[k - 1], dtheta[0, 0])
         imu_increment(m_a, f_body[k - 1], dt, c_a[k - 1], dv[0, 0])
-    strapdown(x, dtheta, dv, dt, bias_g, bias_a, h_baro, loop, f_sum, np.empty((1, 0, NX)), 0)
+    strapdown(x, dtheta, dv, dt, bias_g, bias_a, h_baro, baro_age, loop, f_sum, np.empty((1, 0, NX)), 0)
 
 
 @njit(cache=True)

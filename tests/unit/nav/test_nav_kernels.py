@@ -54,10 +54,11 @@ def test_strapdown_kernel_equals_numpy_reference(form):
     dth, dv = _increments(n, m, rng, dt)
     loop = None if form == "none" else vl.LoopGains(0.3, 0.03, 0.001, form=form, b1_per_m=0.05, b2_per_m=0.08)
     hb = s0.h_m[:, None] + rng.normal(0.0, 5.0, (n, m))
+    age = rng.uniform(0.0, 0.5, m)  # the held sample's age (s)
     a = b = s0
     for j in range(m):
-        a = ins.step(a, dth[:, j], dv[:, j], dt, h_baro_m=hb[:, j], loop=loop)
-        b = ins.step_reference(b, dth[:, j], dv[:, j], dt, h_baro_m=hb[:, j], loop=loop)
+        a = ins.step(a, dth[:, j], dv[:, j], dt, h_baro_m=hb[:, j], baro_age_s=age[j], loop=loop)
+        b = ins.step_reference(b, dth[:, j], dv[:, j], dt, h_baro_m=hb[:, j], baro_age_s=age[j], loop=loop)
     for f in ("lat_rad", "lon_rad", "h_m", "v_ned", "c_bn", "a_comp_mps2"):
         if form == "none" and f == "a_comp_mps2":
             np.testing.assert_array_equal(getattr(a, f), 0.0)
@@ -102,10 +103,29 @@ def test_a_run_has_the_same_bits_in_any_batch():
     dth, dv = _increments(n, m, rng, dt)
     loop = vl.LoopGains(0.3, 0.03, 0.001)
     hb = rng.normal(1000.0, 5.0, (n, m))
-    x_all = ins.propagate(ins.pack(s0), dth, dv, dt, h_baro_m=hb, loop=loop)
+    age = rng.uniform(0.0, 0.1, m)
+    x_all = ins.propagate(ins.pack(s0), dth, dv, dt, h_baro_m=hb, baro_age_s=age, loop=loop)
     for i in (0, 3, 6):
-        x_one = ins.propagate(ins.pack(s0)[i:i + 1], dth[i:i + 1], dv[i:i + 1], dt, h_baro_m=hb[i:i + 1], loop=loop)
+        x_one = ins.propagate(ins.pack(s0)[i:i + 1], dth[i:i + 1], dv[i:i + 1], dt, h_baro_m=hb[i:i + 1],
+                              baro_age_s=age, loop=loop)
         np.testing.assert_array_equal(x_one[0], x_all[i])
+
+
+def test_the_loop_compares_a_held_sample_with_the_ins_height_at_the_samples_time():
+    """On a descent at v_D = 4 m/s, a baro sample taken a = 0.05 s before the interval start reads h + v_D a. Taken
+    back to its time, the INS agrees with it: no loop error, so the compensator does not move (exactly: the same
+    products). Compared with the height now, as a zero-order hold does, the loop sees the INS v_D a = 0.2 m low and
+    drives the compensator by C3 e dt, the lag that biased the height high (docs/baro-loop-hold-bias.md)."""
+    loop = vl.LoopGains(0.3, 0.03, 0.001)
+    s = ins.init_state(np.array([0.6]), np.array([-2.1]), np.array([300.0]), np.array([[70.0, 0.0, 4.0]]),
+                       np.eye(3)[None])
+    a, dt = 0.05, 1.0 / 120.0
+    hb = s.h_m + s.v_ned[:, 2] * a
+    dth, dv = np.zeros((1, 3)), np.array([[0.0, 0.0, -9.80 * dt]])
+    aligned = ins.step(s, dth, dv, dt, h_baro_m=hb, baro_age_s=a, loop=loop)
+    held = ins.step(s, dth, dv, dt, h_baro_m=hb, loop=loop)
+    assert aligned.a_comp_mps2[0] == 0.0
+    assert held.a_comp_mps2[0] == pytest.approx(loop.c3 * (-4.0 * a) * dt, rel=1e-12)
 
 
 def test_geodesy_kernels_equal_geo():
