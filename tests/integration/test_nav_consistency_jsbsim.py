@@ -96,7 +96,10 @@ def normalized_errors(runs) -> np.ndarray:
                    "e^2/P of v_N 0.79, v_E 0.70 over the approach; 52 % and 72 % of epochs below their 95 % bounds), "
                    "so the 9-state NEES (8.4 of 9) is below its bounds at 22-26 % of epochs. Until the baro loop's "
                    "held-sample fix (docs/baro-loop-hold-bias.md) the vertical velocity's optimism (1.19, 33 % of "
-                   "epochs above) offset it and this passed")
+                   "epochs above) offset it and this passed. Cause (measured, 60 runs): the filter lumps the slow "
+                   "range errors (clock/ephemeris tau 7200 s, iono 1800 s, tropo 3600 s) into one Gauss-Markov state "
+                   "at the shortest tau (nav/noise.py), so it expects them to drift faster than they do; with the "
+                   "truth's three at 1800 s, v_N / v_E give 1.41 / 1.07 (0.82 / 0.63 as they are)")
 def test_average_nees_inside_95_percent_bounds(runs):
     nees = average_nees(runs)
     assert len(nees) >= 250  # 1 s epochs over the ~260 s approach
