@@ -125,3 +125,22 @@ def test_perturb_and_error_functions_invert():
     np.testing.assert_allclose(
         ins.position_error_ned(p.lat_rad, p.lon_rad, p.h_m, s.lat_rad, s.lon_rad, s.h_m), dp, atol=1e-6)
     np.testing.assert_allclose(ins.attitude_error(p.c_bn, s.c_bn), psi, atol=1e-10)
+
+
+def test_held_baro_is_the_latest_sample_and_its_age():
+    """The damping loop's hold (ins.held_baro): at each IMU interval start the latest baro sample at or before it
+    (a sample at the same instant counts, to 1e-9 s), nan where that sample is invalid, and its age
+    t_start - t_sample, which the INS uses to take its height back to the sample's time."""
+    t_baro = np.array([0.0, 0.1, 0.2, 0.3])
+    h = np.array([[100.0, 99.5, 99.0, 98.5], [200.0, 199.0, 198.0, 197.0]])
+    valid = np.array([[True, True, False, True], [True, True, True, True]])
+    t_start = np.arange(0.0, 0.35, 1.0 / 40.0)  # 14 starts, 4 per sample interval
+    hb, age = ins.held_baro(valid, h, t_baro, t_start)
+    idx = np.array([0] * 4 + [1] * 4 + [2] * 4 + [3] * 2)
+    np.testing.assert_array_equal(hb[1], h[1, idx])
+    np.testing.assert_array_equal(np.isnan(hb[0]), idx == 2)  # run 0's third sample is invalid: the loop holds
+    np.testing.assert_allclose(age, t_start - t_baro[idx], rtol=0, atol=0)
+    assert age.min() >= -1e-15 and age.max() < 0.1  # a start on a sample: age 0 to the rounding of t_start
+    one_h, one_age = ins.held_baro(valid[1], h[1], t_baro, t_start)  # a single run's records: one row
+    np.testing.assert_array_equal(one_h, hb[1:2])
+    np.testing.assert_array_equal(one_age, age)
