@@ -108,7 +108,7 @@ def deviation_and_rate(x: float, y: float, z: float, x_dot: float, y_dot: float,
                        x_gpi: float, a: float, b: float, c: float) -> tuple[float, float]:
     """Glidepath deviation from the cone (m, + above) and its rate (m/s) of one runway-frame point (x, y, z) moving
     at (x', y', z'), constants as GlidePath.constants(): the scalar form the autopilot and the stabilized-approach
-    monitor use (flight/kernels.cone_deviation compiles the same lines). Past the GPI the straight line goes on."""
+    monitor use (core/loop/flight_step.cone_deviation compiles these lines). Past the GPI the straight line goes on."""
     dx = x - x_gpi
     rr = math.sqrt(dx * dx + y * y)
     s = 1.0 if dx <= 0.0 else -1.0

@@ -137,7 +137,7 @@ class NavigationSource(Protocol):
     along, cross, height above threshold, m) and NED velocity (m/s) that guidance should fly on.
 
     A source may also offer `inloop()`, returning None or an object whose arrays the flight loop's compiled step
-    steps the navigation with (nav/kernels/inloop.py: nw, cg, ca, rows, snap, baro_j, baro_e, lag_w, dth, dv) and whose
+    steps the navigation with (core/loop/nav_row.py: nw, cg, ca, rows, snap, baro_j, baro_e, lag_w, dth, dv) and whose
     act(k, truth, code) it calls at the rows the step asks for; step() is then not called (nav/closed_loop.py).
     """
 

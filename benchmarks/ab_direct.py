@@ -1,4 +1,4 @@
-"""In-process A/B of the flight loop: compiled with JSBSim called from it (flight/direct_kernels.py) against the
+"""In-process A/B of the flight loop: compiled with JSBSim called from it (core/loop/direct.py) against the
 Python loop (APPROACHSIM_JSBSIM_DIRECT=0), interleaved in one warm process, with raw JSBSim stepping (trim + run()
 from Python) as the floor. CPU time (time.process_time), min and median over the repeats, of the truth flight
 (Approach.fly) and of the closed loop (Approach.fly with NavInTheLoop); every pair's results are compared bit for bit.
@@ -18,7 +18,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from approachsim.flight import jsbsim_direct  # noqa: E402
+from approachsim.core.loop import jsbsim_abi  # noqa: E402
 from approachsim.flight.fdm import FDM  # noqa: E402
 from approachsim.flight.run import Approach  # noqa: E402
 from approachsim.flight.trim import start_condition  # noqa: E402
@@ -63,13 +63,13 @@ def main() -> None:
         return time.process_time() - t
 
     def truth(flag: str, k: int):
-        os.environ[jsbsim_direct.ENV_SWITCH] = flag
+        os.environ[jsbsim_abi.ENV_SWITCH] = flag
         t = time.process_time()
         res = approach.fly(seed=1, run=k)
         return time.process_time() - t, res
 
     def closed(flag: str, k: int):
-        os.environ[jsbsim_direct.ENV_SWITCH] = flag
+        os.environ[jsbsim_abi.ENV_SWITCH] = flag
         t = time.process_time()
         src = NavInTheLoop(prof, seed=1, run=k, max_time_s=approach.time_budget_s)
         res = approach.fly(seed=1, run=k, nav_source=src)
@@ -90,7 +90,7 @@ def main() -> None:
             if name == "truth":
                 steps = len(r1.truth.t_s)
                 times["raw"].append(raw(steps))
-    os.environ.pop(jsbsim_direct.ENV_SWITCH, None)
+    os.environ.pop(jsbsim_abi.ENV_SWITCH, None)
     print(f"ab_direct: {args.profile}, {args.repeat} interleaved repeats, ~{steps} steps; CPU s, min / median; "
           f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     r = min(times["raw"])

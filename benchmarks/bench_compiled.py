@@ -50,7 +50,7 @@ import time, numpy as np
 t0 = time.perf_counter()
 from approachsim.nav import ins
 from approachsim.nav.closed_loop import NavInTheLoop  # noqa: F401 (imports every nav and sensor kernel module)
-from approachsim.flight import kernels as fk
+from approachsim.core.loop import flight_step as fk
 t1 = time.perf_counter()
 s = ins.init_state(0.6, -2.1, 100.0, [60.0, 0.0, 3.0], np.eye(3))
 ins.propagate(ins.pack(s), np.zeros((1, 2, 3)), np.zeros((1, 2, 3)), 1 / 120)

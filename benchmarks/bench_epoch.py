@@ -27,14 +27,14 @@ from pathlib import Path
 import numpy as np
 
 from approachsim import geo, synthetic
+from approachsim.core.nav import errormodel as ek
+from approachsim.core.nav import kalman as kk
+from approachsim.core.nav import measurements as mk
 from approachsim.nav import errormodel as em
 from approachsim.nav import initial, ins
 from approachsim.nav import measurements as meas
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import KalmanFilter, ScalarMeasurement, joseph_reference, predict_reference, workspace
-from approachsim.nav.kernels import errormodel as ek
-from approachsim.nav.kernels import kalman as kk
-from approachsim.nav.kernels import measurements as mk
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.sensors.states import measure_with_states

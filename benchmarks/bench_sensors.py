@@ -9,7 +9,7 @@ same length). --pseudolite adds one pseudolite unit near the threshold to the pr
 
 1. draw + apply per run, for 1 run and for a chunk of runs sharing the truth (each its own GPS sky when the
    profile's epoch is per-run), "reference" (numpy: scipy lfilter Gauss-Markov recursions, the apply_reference of
-   the GNSS receiver (best_pdop_four_reference), baro, radar altimeter, pseudolite) vs "compiled" (sensors/kernels/);
+   the GNSS receiver (best_pdop_four_reference), baro, radar altimeter, pseudolite) vs "compiled" (core/sensors/);
 2. the best-PDOP selection alone on those skies: best_pdop_four_reference vs the kernel (and that they agree);
 3. one truth row at a time: the closed loop's aiding epochs (baro + radalt + gnss [+ pseudolite]) and all its sensor
    calls over an approach (the epochs and every baro sample): the generic path with the numpy GNSS (before), the

@@ -1,5 +1,5 @@
 """Converged-start benchmark: the 600 s covariance recursion of nav/initial.py at the default profile's start, by
-the compiled Riccati kernel (kernels/kalman.riccati: the filter's sequential scalar Joseph updates, the states never
+the compiled Riccati kernel (core/nav/kalman.riccati: the filter's sequential scalar Joseph updates, the states never
 measured and not coupled reduced exactly; what the code does) against the same recursion in numpy (the reference,
 initial.converged_covariance_reference), and their largest difference in units of the sigmas.
 

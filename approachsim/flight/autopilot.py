@@ -64,7 +64,7 @@ Landing runs (h_gear: main-gear height above the terrain, the radio altitude) ad
   (0 when |eta| <= b_max: the full decrab); the bank command adds k_pb beta, the aileron k_da_align beta.
 
 Sign conventions of the 737 FCS: + elevator = nose down, + aileron = roll right, + rudder = nose left.
-This class is the readable oracle; the flight loop runs its compiled twin (flight/kernels.py autopilot_step, equal
+This class is the readable oracle; the flight loop runs its compiled twin (core/loop/flight_step.autopilot_step, equal
 to it bit for bit: tests/unit/flight/test_flight_loop_kernels.py).
 """
 

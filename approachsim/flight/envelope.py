@@ -42,6 +42,19 @@ from dataclasses import dataclass
 
 from approachsim import units
 from approachsim.config import ProfileError
+from approachsim.core.loop.flight_step import (  # the criteria the compiled monitor applies, defined there once
+    LOC_ANTENNA_PAST_THRESHOLD_M,
+    MON_GLIDEPATH,
+    MON_LOCALIZER,
+    MON_OK,
+    MON_SINK,
+    MON_SPEED,
+    SINK_LIMIT_MPS,
+    SINK_TOLERANCE_MPS,
+    SPEED_HIGH_MPS,
+    SPEED_LOW_MPS,
+    STABILIZATION_HEIGHT_M,
+)
 from approachsim.glidepath import deviation_and_rate
 
 GS_DOT_PER_GLIDEPATH = 0.12
@@ -50,19 +63,7 @@ GS_DOT_PER_GLIDEPATH = 0.12
 LOC_DOT_AT_THRESHOLD_M = 0.0775 / 0.00145
 """Localizer: 1 dot (0.0775 DDM) over the nominal 0.00145 DDM/m displacement sensitivity at the threshold
 (ICAO Annex 10 Vol I 3.1.3.7.1): 53.4 m at the threshold, growing linearly with distance from the antenna."""
-LOC_ANTENNA_PAST_THRESHOLD_M = 3300.0
-"""Assumed localizer antenna position past the threshold: a 3000 m runway plus 300 m (no runway length is in
-a profile); only the localizer dot's size depends on it."""
-STABILIZATION_HEIGHT_M = 1000.0 * units.FT
-"""FSF ALAR BN 7.1: stabilized by 1000 ft above the airport in IMC, and stay so below it."""
-WATCH_HEIGHT_M = 1400.0 * units.FT
-"""The monitor is fed from this height down (its 10 s means are full by 1000 ft at any sink rate below
-2400 ft/min); above it the run loop skips it."""
 GS_DOT_FLOOR_HEIGHT_M = 200.0 * units.FT
-SPEED_HIGH_MPS = 10.0 * units.KT
-SPEED_LOW_MPS = 5.0 * units.KT
-SINK_LIMIT_MPS = 1000.0 * units.FT / 60.0
-SINK_TOLERANCE_MPS = 300.0 * units.FT / 60.0
 PLANNING_SPEED_MARGIN_MPS = 10.0 * units.KT
 MEAN_WINDOW_S = 3.0
 SINK_WINDOW_S = 10.0
@@ -135,9 +136,7 @@ def check_envelope(profile, limits: ApproachLimits, aircraft_name: str, approach
         )
 
 
-MON_OK, MON_GLIDEPATH, MON_LOCALIZER, MON_SPEED, MON_SINK = range(5)
-"""Results of one monitor step: stabilized, or which criterion failed (the compiled monitor in flight/kernels.py
-returns these with two figures, `unstabilized_reason` words them)."""
+
 
 
 def unstabilized_reason(result: int, z_m: float, a: float, b: float) -> str:
@@ -161,7 +160,7 @@ class StabilityMonitor:
     """The stabilized-approach criterion of one run (module docstring), fed every step with the true IMU state.
 
     step() returns None while stabilized, else the named reason, e.g. "unstabilized at 420 ft: glidepath
-    deviation 1.3 dots". Re-create per run. The readable oracle of the compiled monitor (flight/kernels.py
+    deviation 1.3 dots". Re-create per run. The readable oracle of the compiled monitor (core/loop/flight_step.py
     monitor_step); check() is its step with the result as (MON_* code, figures)."""
 
     def __init__(self, glidepath_rad: float, tch_m: float, target_cas_mps: float, dt_s: float,

@@ -22,9 +22,9 @@ JSBSim's user gust atmosphere/gust-{north,east,down}-fps, which JSBSim adds to t
 atmosphere/turb-*-fps do not stick in 1.3.3 when its own model is off).
 
 The flight loop's per-step reads and writes go through one LoopIO, bound once per run. Exception to the SI rule
-above: they stay in JSBSim's units, and the loop's compiled step (flight/kernels.py) converts them, so that no
+above: they stay in JSBSim's units, and the loop's compiled step (core/loop/flight_step.py) converts them, so that no
 Python arithmetic runs per step. LoopIO.direct gives the same reads and writes to compiled code (the C++ functions
-behind the nodes, flight/jsbsim_direct.py), so the whole loop can run compiled (flight/direct_kernels.py).
+behind the nodes, flight/jsbsim_abi.py), so the whole loop can run compiled (core/loop/direct.py).
 """
 
 from __future__ import annotations
@@ -41,8 +41,8 @@ import jsbsim
 import numpy as np
 
 from approachsim import units
-from approachsim.flight import direct_kernels as dk
-from approachsim.flight import jsbsim_direct
+from approachsim.core.loop import direct as dk
+from approachsim.core.loop import jsbsim_abi
 from approachsim.flight.design import Linearization
 
 INTEGRATOR_RECT_EULER = 1
@@ -150,11 +150,11 @@ class FDM:
         self._fdm["simulation/randomseed"] = int(seed)
 
     def direct_addresses(self, written: Sequence[str], read: Sequence[str]) -> np.ndarray | None:
-        """The uint64 vector flight/direct_kernels.py flies on: the C++ entry points, this FGFDMExec, the nodes
-        `written` then `read` (each checked, flight/jsbsim_direct.py); None when any of them is unavailable."""
+        """The uint64 vector core/loop/direct.py flies on: the C++ entry points, this FGFDMExec, the nodes
+        `written` then `read` (each checked, flight/jsbsim_abi.py); None when any of them is unavailable."""
         if len(written) != dk.N_WRITE:
             raise ValueError(f"direct_addresses: {dk.N_WRITE} written properties, got {len(written)}")
-        lib = jsbsim_direct.library(jsbsim._jsbsim.__file__)
+        lib = jsbsim_abi.library(jsbsim._jsbsim.__file__)
         if lib is None:
             return None
         exe = lib.exec_pointer(self._fdm)
@@ -229,12 +229,12 @@ class FDM:
 WRITTEN = ("fcs/elevator-cmd-norm", "fcs/aileron-cmd-norm", "fcs/rudder-cmd-norm", "fcs/throttle-cmd-norm[0]",
            "fcs/throttle-cmd-norm[1]", "atmosphere/gust-north-fps", "atmosphere/gust-east-fps",
            "atmosphere/gust-down-fps", "position/terrain-elevation-asl-ft")
-"""The flight loop's written properties, in LoopIO's setters' order and flight/direct_kernels.py's D_WRITE order."""
+"""The flight loop's written properties, in LoopIO's setters' order and core/loop/direct.py's D_WRITE order."""
 
 
 class LoopIO:
     """The flight loop's JSBSim property traffic of one run, bound once: one call reads a step's inputs, bound
-    setters write the commands. Values are in JSBSim's units (the compiled step converts them, flight/kernels.py).
+    setters write the commands. Values are in JSBSim's units (the compiled step converts them: core/loop/flight_step).
 
         read()       -> (*reads, *near_stand_in)   the properties `reads`, the near-ground ones stood in for
         read_near()  -> (*reads, *near_reads)      the same with the near-ground properties read
@@ -265,8 +265,8 @@ class LoopIO:
         self.set_terrain_ft = terr
         self._fdm = fdm
         self.direct = fdm.direct_addresses(WRITTEN, [*reads, *near_reads])
-        """The address vector of flight/direct_kernels.py (D_* layout) for the same reads and writes, or None when
-        the C++ entry points cannot be used here (flight/jsbsim_direct.py): then only the Python loop flies."""
+        """The address vector of core/loop/direct.py (D_* layout) for the same reads and writes, or None when
+        the C++ entry points cannot be used here (flight/jsbsim_abi.py): then only the Python loop flies."""
 
     def gust_on(self) -> None:
         """Switch JSBSim's own turbulence off: the run writes its turbulence through set_gust_fps

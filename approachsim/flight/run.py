@@ -22,7 +22,7 @@ timeout (`FlightResult.ok` / `failure`). The Truth arrays are preallocated for t
 until written) and trimmed at the end; a navigation source sees that record and may read rows <= k only.
 
 One loop serves both: per step JSBSim's reads (one LoopIO of flight/fdm.py, bound per run), one compiled call
-(flight/kernels.fly_step: the Truth row, the Dryden turbulence, the termination checks with the stabilized-approach
+(core/loop/flight_step.fly_step: Truth row, the Dryden turbulence, the termination checks with the stabilized-approach
 monitor and, when the truth guides, the autopilot), the writes (controls, gusts, terrain) and JSBSim's next step.
 With a navigation source, fly_step stops after the termination checks, the source steps on row k, and
 kernels.fly_control runs the autopilot on its guidance. The autopilot, turbulence and monitor are compiled twins of
@@ -30,7 +30,7 @@ flight/autopilot.py, flight/turbulence.py and flight/envelope.py, which stay the
 bit, tests/unit/flight/test_flight_loop_kernels.py) and fill the kernels' parameter and state vectors. Why a run
 ended is a code during the loop, worded after it (termination_reason).
 
-Truth is of the IMU point (aircraft file [imu]), one row per step from the compiled kernel of flight/kernels.py:
+Truth is of the IMU point (aircraft file [imu]), one row per step from the compiled kernel of core/loop/flight_step.py:
 position, velocity and specific force are moved from the CG with the rigid-body lever-arm terms (f_imu = f_cg +
 w_ib' x l + w_ib x (w_ib x l), in the exact form of JSBSim's Euler step, plus the gravitation gradient; v_imu =
 v_cg + C_nb (w_eb x l), resolved on the IMU's own NED axes), and the static pressure is moved hydrostatically to
@@ -41,25 +41,24 @@ docs/truth.md says why each term is there.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numba
 import numpy as np
 
 from approachsim import units
 from approachsim.config import ProfileError
+from approachsim.core.entry import entry_point
+from approachsim.core.loop import closed_step as ck
+from approachsim.core.loop import direct as dk
+from approachsim.core.loop import flight_step as fk
 from approachsim.evaluate.touchdown import touchdown_scalars
-from approachsim.flight import closed_loop_kernels as ck
-from approachsim.flight import direct_kernels as dk
-from approachsim.flight import kernels as fk
+from approachsim.flight import vectors as fv
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import Linearization
 from approachsim.flight.envelope import StabilityMonitor, check_envelope, unstabilized_reason
 from approachsim.flight.fdm import FDM, InitialCondition, TrimError
-from approachsim.flight.kernels import imu_point_constants
 from approachsim.flight.trim import (
     CAS_TOLERANCE_MPS,
     PATH_TOLERANCE_RAD,
@@ -68,6 +67,7 @@ from approachsim.flight.trim import (
     start_condition,
 )
 from approachsim.flight.turbulence import DrydenTurbulence
+from approachsim.flight.vectors import imu_point_constants
 from approachsim.profile import Profile
 from approachsim.records import NavigationSource, Truth
 from approachsim.seeding import stream, stream_int
@@ -284,7 +284,7 @@ class Approach:
         # the truth, the autopilot), the writes, JSBSim's step; a navigation source sees row k between fly_step
         # and the autopilot (fly_control)
         # A source whose navigation runs compiled (`inloop()`, nav/closed_loop.py) is stepped inside the same call
-        # (flight/closed_loop_kernels.py fly_step_closed, on the navigation's packed arrays nw, fa, ia): Python acts
+        # (core/loop/closed_step.py fly_step_closed, on the navigation's packed arrays nw, fa, ia): Python acts
         # only at the rows it asks for (start, baro samples, aiding epochs)
         guided = src is None
         fused = None if src is None else getattr(src, "inloop", lambda: None)()
@@ -297,12 +297,12 @@ class Approach:
             guidance = None if src is None else np.full((n_max, 6), np.nan)
         read, read_near, run_step = io.read, io.read_near, io.run
         raw0 = (0.0,) * (fk.N_RAW + len(fk.GEAR_FIELDS))
-        step = _entry(fk.fly_step, 0, raw0, buf, nu, par, st, guided)
-        control = None if guided else _entry(fk.fly_control, 0, guidance, buf, par, st)
+        step = entry_point(fk.fly_step, 0, raw0, buf, nu, par, st, guided)
+        control = None if guided else entry_point(fk.fly_control, 0, guidance, buf, par, st)
         if fused is not None:
             nav_args = (fused.nw, fused.fa, fused.ia)
-            step_nav = _entry(ck.fly_step_closed, 0, raw0, buf, nu, par, st, *nav_args)
-            control_nav = _entry(ck.fly_control_closed, 0, buf, par, st, *nav_args)
+            step_nav = entry_point(ck.fly_step_closed, 0, raw0, buf, nu, par, st, *nav_args)
+            control_nav = entry_point(ck.fly_control_closed, 0, buf, par, st, *nav_args)
             act = fused.act
         set_de, set_da, set_dr, (set_thr0, set_thr1) = io.set_elevator, io.set_aileron, io.set_rudder, io.set_throttle
         set_gn, set_ge, set_gd = io.set_gust_fps
@@ -311,10 +311,10 @@ class Approach:
         near = True
         k = 0
         direct = io.direct if (guided or fused is not None) else None
-        if direct is not None:  # the same loop compiled, JSBSim called from it (flight/direct_kernels.py)
+        if direct is not None:  # the same loop compiled, JSBSim called from it (core/loop/direct.py)
             raw = np.zeros(dk.N_READ)
             if guided:
-                k, code = _entry(dk.fly_guided, direct, raw, buf, nu, par, st)(direct, raw, buf, nu, par, st)
+                k, code = entry_point(dk.fly_guided, direct, raw, buf, nu, par, st)(direct, raw, buf, nu, par, st)
             else:
                 k, code = self._fly_closed_direct(direct, raw, buf, nu, par, st, fused, truth)
         for k in range(n_max if direct is None else 0):
@@ -380,14 +380,14 @@ class Approach:
     @staticmethod
     def _fly_closed_direct(direct: Array, raw: Array, buf: Array, nu: Array, par: Array, st: Array, fused: Any,
                            truth: Truth) -> tuple[int, int]:
-        """The closed loop on direct_kernels.fly_closed: compiled between the rows where the navigation needs
+        """The closed loop on core/loop/direct.fly_closed: compiled between the rows where the navigation needs
         Python (fused.act), where the loop below does what the Python loop does at such a row. Returns (the last
         row k, its TERM_* code)."""
         nav_args = (fused.nw, fused.fa, fused.ia)
         cmd = np.zeros(8)
         n_max = buf.shape[0]
-        seg = _entry(dk.fly_closed, 0, False, cmd, True, direct, raw, buf, nu, par, st, *nav_args)
-        control_nav = _entry(ck.fly_control_closed, 0, buf, par, st, *nav_args)
+        seg = entry_point(dk.fly_closed, 0, False, cmd, True, direct, raw, buf, nu, par, st, *nav_args)
+        control_nav = entry_point(ck.fly_control_closed, 0, buf, par, st, *nav_args)
         act = fused.act
         k, pending, near = 0, False, True
         while True:
@@ -426,7 +426,7 @@ class Approach:
             turb = DrydenTurbulence(env.turbulence, stream(seed, run, "turbulence"), n_max, dt,
                                     env.wind_from_rad + math.pi)
             nu = turb.nu
-        par, st = fk.flight_vectors(
+        par, st = fv.flight_vectors(
             const, ap, monitor, turb, np.asarray(prof.terrain.along_m, dtype=float),
             np.asarray(prof.terrain.height_m, dtype=float),
             pitch_trim=fdm["fcs/pitch-trim-cmd-norm"],
@@ -440,19 +440,10 @@ class Approach:
         return par, st, nu
 
 
-def _entry(dispatcher: Any, *args: Any) -> Callable:
-    """The compiled code's Python entry point of numba `dispatcher` for these arguments' types, called without
-    numba's per-call type dispatch (which costs ~0.35 us of a ~1.4 us fly_step call; the loop makes 31,000 a
-    flight). Calls through it must pass exactly these types (it does not check them). Numba internals
-    (Dispatcher.overloads[signature].entry_point): when they are not there, the dispatcher itself."""
-    sig = tuple(numba.typeof(a) for a in args)
-    dispatcher.compile(sig)  # loads it from numba's cache when compiled before
-    entry = getattr(dispatcher.overloads.get(sig), "entry_point", None)
-    return dispatcher if entry is None else entry
 
 
 def termination_reason(code: int, fs: Array) -> str:
-    """FlightResult.termination in words from fly_step's termination code (flight/kernels.py TERM_*) and the
+    """FlightResult.termination in words from fly_step's termination code (core/loop/flight_step.py TERM_*) and the
     figures its state fs (FS_*) keeps; TERM_NONE after the last permitted step is a timeout."""
     if code == fk.TERM_STOP:
         return "reached stop height"

@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from approachsim import units
+from approachsim.core.loop.flight_step import COEFF_EVERY, POE_ALT_FT, POE_SIGMA_FPS  # the kernel's table, once
 
 LEVELS = {
     "none": None,
@@ -37,19 +38,6 @@ LEVELS = {
 }
 """Profile turbulence level -> (MIL-F-8785C wind speed at 20 ft, ft/s; probability-of-exceedance index)."""
 
-POE_ALT_FT = (500.0, 1750.0, 3750.0, 7500.0, 15000.0, 25000.0, 35000.0, 45000.0, 55000.0, 65000.0, 75000.0,
-              80000.0)
-"""Altitudes of the high-altitude intensity table, ft (MIL-F-8785C fig. 7)."""
-POE_SIGMA_FPS = (
-    (3.2, 2.2, 1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-    (4.2, 3.6, 3.3, 1.6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-    (6.6, 6.9, 7.4, 6.7, 4.6, 2.7, 0.4, 0.0, 0.0, 0.0, 0.0, 0.0),
-    (8.6, 9.6, 10.6, 10.1, 8.0, 6.6, 5.0, 4.2, 2.7, 0.0, 0.0, 0.0),
-    (11.8, 13.0, 16.0, 15.1, 11.6, 9.7, 8.1, 8.2, 7.9, 4.9, 3.2, 2.1),
-    (15.6, 17.6, 23.0, 23.6, 22.1, 20.0, 16.0, 15.1, 12.1, 7.9, 6.2, 5.1),
-    (18.7, 21.5, 28.4, 30.2, 30.7, 31.0, 25.2, 23.1, 17.5, 10.7, 8.4, 7.2),
-)
-"""High-altitude turbulence intensity sigma (ft/s) by probability-of-exceedance index 1..7 (rows) and altitude."""
 
 
 def scales(h_ft: float, w20_fps: float, index: int) -> tuple[float, float, float, float]:
@@ -83,8 +71,6 @@ def _interp(x: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> float:
     return ys[i - 1] + (x - x0) / (x1 - x0) * (ys[i] - ys[i - 1])
 
 
-COEFF_EVERY = 12
-"""Steps between re-evaluations of the scale lengths and intensities."""
 
 
 class DrydenTurbulence:
@@ -92,7 +78,7 @@ class DrydenTurbulence:
 
     The white-noise sequence is drawn up front from `rng` (the run's "turbulence" stream), so a run's
     turbulence depends on nothing but its seed. The readable oracle of the compiled step the flight loop runs
-    (flight/kernels.py dryden_step, equal to it bit for bit).
+    (core/loop/flight_step.py dryden_step, equal to it bit for bit).
     """
 
     def __init__(self, level: str, rng: np.random.Generator, n_steps: int, dt_s: float, wind_to_rad: float) -> None:
@@ -136,6 +122,6 @@ class DrydenTurbulence:
 
     def state(self) -> tuple[float, ...]:
         """(xi_u, xi_v, xi_w, coefficients valid, a_u, b_u, a_v, b_v, a_w, b_w): the compiled turbulence's TBS_*
-        state vector (flight/kernels.py dryden_step)."""
+        state vector (core/loop/flight_step.py dryden_step)."""
         coef = self._coef if self._coef is not None else (0.0,) * 6
         return (self.xi_u, self.xi_v, self.xi_w, float(self._coef is not None), *coef)

@@ -9,9 +9,9 @@ apply, `applicable`), with the same arithmetic:
   INS does not depend on the filter), the copies' observations stacked once and copy k + 1 without its mode's
   samples (integrity.bank.bank_records: an invalid sample is no measurement);
 - the model of every epoch (Phi, Qd at the reference: the truth) made once per flight group's truth on the full
-  layout (nav/kernels/copies.models, kept for the last truth: the group's runs share it), cut to the run's
+  layout (core/nav/copies.models, kept for the last truth: the group's runs share it), cut to the run's
   reduced state; then every epoch of every copy, each its own class (per-run GPS sky), in one call of
-  nav/kernels/copies.bank_epochs (kernels/epoch.shared_pass's loop with the model given), on the *reduced*
+  core/nav/copies.bank_epochs (core/nav/epoch.shared_pass's loop with the model given), on the *reduced*
   state: the GPS channel states (gse, gmp) of the channels the run never measures are dropped.
 
 Why the reduced state changes no bit. A dropped channel's two states are first-order Gauss-Markov (diagonal
@@ -19,18 +19,18 @@ Phi, Qd: kernels/errormodel.py makes them lone states, closed form) that no meas
 start they are uncorrelated with every other state (nav/initial.py: a channel not updated in the converged
 segment keeps its prior row exactly; checked here, else the channel is kept). So their rows and columns of P stay
 exactly zero off the diagonal: in the prediction W = Phi P, Phi W' + Qd their terms are exact zeros, and the
-scalar updates (kernels/kalman.gain and _joseph_cov) skip the rows where P h is zero and add exact zeros in the
+scalar updates (core/nav/kalman.gain and _joseph_cov) skip the rows where P h is zero and add exact zeros in the
 other rows' dropped columns. Every remaining term is summed in the same order (the kept states keep their order),
 so the kept states' estimates and covariances are the same floating-point numbers (tests/unit/integrity/
 test_bankpass.py compares them with the full-state pass bit for bit). The bank needs only the navigation states'
 estimates and covariance block: the dropped states never reach it. The cost of an epoch falls with the square
 of the state count: 70 states (24 channels) to 22 + 2 x (channels used), about 32 with best-four selection.
 
-Carrier phase (the layout's gio and amb groups, nav/kernels/carrier.py). A channel's four states (gse, gmp, gio,
+Carrier phase (the layout's gio and amb groups, core/nav/carrier.py). A channel's four states (gse, gmp, gio,
 amb) go together (`rd.CHANNEL_GROUPS`): gio is a Gauss-Markov state and amb a random constant, both lone (diagonal
 Phi, Qd: kernels/errormodel.discretize's closed form), and a channel never measured has no carrier phase and no
 arc, so its ambiguity is never reset; the argument above holds for them unchanged. The model adds kernels/carrier.
-dynamics (nav/kernels/copies.carrier_models); each copy's epoch is shared_pass's carrier step (nav/kernels/copies.
+dynamics (core/nav/copies.carrier_models); each copy's epoch is shared_pass's carrier step (core/nav/copies.
 bank_epochs_carrier): the gio states' Qd at the copy's sky, then its ambiguities reset where its carrier arc begins
 (engine.stacked_new_arcs over the copy's arc ids: a copy without channel c has no phase and no arc there,
 bank.bank_records, so it never resets amb_c), the reset zeroing a kept row and column of Phi (a copy) and Qd as on
@@ -49,12 +49,12 @@ from typing import Any
 
 import numpy as np
 
+from approachsim.core.nav import copies as kcp
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import reduced as rd
 from approachsim.nav.base import workspace
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, stacked_new_arcs
-from approachsim.nav.kernels import copies as kcp
 from approachsim.nav.navigator import NavRun, StatusLog, _stacked_observations, true_error_rows
 from approachsim.nav.observations import Observations
 
@@ -82,7 +82,7 @@ class BankPass:
     """(k_r,) the GPS channels whose error states the pass carries."""
     main_rows: tuple[Array, Array, Array, Array]
     """The main filter's measurement rows: codes, their counts per epoch, innovations, their variances (E, R)
-    (kernels/epoch.shared_pass)."""
+    (core/nav/epoch.shared_pass)."""
 
     def main_run(self) -> NavRun:
         """The main filter's NavRun without its solution (None: the bank needs the epoch history only), on the
@@ -304,7 +304,7 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     if model is None:
         return None
     phi, qd = rd.cut(model, red)
-    if carrier:  # kernels/epoch.shared_pass's carrier step (nav/kernels/copies.bank_epochs_carrier)
+    if carrier:  # core/nav/epoch.shared_pass's carrier step (core/nav/copies.bank_epochs_carrier)
         f_gio = -np.expm1(-2.0 * dt_e / nz.gio_tau_s)
         kcp.bank_epochs_carrier(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
                                o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x,

@@ -11,7 +11,7 @@ mutate themselves). The interface, in textbook symbols:
 Variants override one hook: a robust filter changes how the gain is weighted (`GainPolicy`); the U-D
 filter changes how the covariance is stored. The registry in nav/registry.py picks one by name.
 
-KalmanFilter's predict and update run the compiled kernels of nav/kernels/kalman.py (sparse Phi, O(n^2) scalar
+KalmanFilter's predict and update run the compiled kernels of core/nav/kalman.py (sparse Phi, O(n^2) scalar
 update); `predict_reference` and `joseph_reference` are the dense numpy forms, kept as their test oracle and for
 the pinned ill-conditioned case of the Joseph product form (tests/unit/nav/test_ud.py).
 """
@@ -25,7 +25,7 @@ from typing import Protocol
 
 import numpy as np
 
-from approachsim.nav.kernels import kalman as kk
+from approachsim.core.nav import kalman as kk
 
 Array = np.ndarray
 

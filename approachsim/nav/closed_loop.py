@@ -10,8 +10,8 @@ errors to the increment (k-1, k], steps the INS, and at aiding epochs applies th
 errors to row k and runs the filter (system.NavSystem.aid). Guidance gets the navigation output
 (feed-forward INS - estimated error, or the fed-back INS) in the runway frame.
 
-Flown by JSBSim (`inloop`), the row runs inside the flight's compiled step (nav/kernels/inloop.py) and an aiding
-epoch is one compiled call (nav/kernels/closed_loop_epoch.py: the per-run EKF's epoch and the Navigator's
+Flown by JSBSim (`inloop`), the row runs inside the flight's compiled step (core/loop/nav_row.py) and an aiding
+epoch is one compiled call (core/loop/aiding.py: the per-run EKF's epoch and the Navigator's
 bookkeeping) on the sensors' one-row records, when the configuration has the compiled epoch
 (`fast_epoch_unavailable`: not with feedback, the online FDE, the robust or U-D filters, loose coupling, an adaptive
 loop, carrier phase); otherwise, and as its test oracle (`fast_epochs = False`), the Navigator's numpy path.
@@ -29,17 +29,17 @@ import weakref
 from dataclasses import dataclass, field, fields
 from typing import Any
 
-import numba
 import numpy as np
 
 from approachsim import geo
+from approachsim.core.entry import entry_point
+from approachsim.core.loop import aiding as ce
+from approachsim.core.loop import nav_row as ik
+from approachsim.core.nav import strapdown as sk
 from approachsim.glidepath import GlidePath
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav.base import FilterState
-from approachsim.nav.kernels import closed_loop_epoch as ce
-from approachsim.nav.kernels import inloop as ik
-from approachsim.nav.kernels import strapdown as sk
 from approachsim.nav.navigator import Navigator, NavRun
 from approachsim.nav.observations import Observations
 from approachsim.nav.system import NavSystem, tuned_records
@@ -78,16 +78,6 @@ class _BaroAt:
         self.h_baro_m = h_baro_m
 
 
-def _entry(dispatcher: Any, args: tuple) -> Any:
-    """The compiled entry point of numba `dispatcher` for these arguments' types, called without numba's per-call
-    type dispatch (flight/run.py `_entry`: loop_epoch's 48 arguments, among them a tuple of arrays whose typing
-    goes through numba's Python typeof, cost more to dispatch than to unbox). Calls through it must pass the same
-    types (every epoch of a run does: the same dtypes, dimensions and C layout); the dispatcher itself when numba's
-    internals (Dispatcher.overloads[signature].entry_point) are not there."""
-    sig = tuple(numba.typeof(a) for a in args)
-    dispatcher.compile(sig)  # loads it from numba's cache when compiled before
-    entry = getattr(dispatcher.overloads.get(sig), "entry_point", None)
-    return dispatcher if entry is None else entry
 
 
 def _per_channel(a: Array | float, n_sv: int) -> Array:
@@ -100,7 +90,7 @@ def _per_channel(a: Array | float, n_sv: int) -> Array:
 
 @dataclass(frozen=True)
 class InLoop:
-    """The compiled per-row navigation of one closed-loop run (nav/kernels/inloop.py): the work vector nw (NW,),
+    """The compiled per-row navigation of one closed-loop run (core/loop/nav_row.py): the work vector nw (NW,),
     the packed arrays fa (float64) and ia (int64) and, as views of them (inloop.views), the IMU error terms cg, ca
     (m, 3) by sample, the INS rows (1, n, 16), the guidance rows (n, 6), the snapshot index per row (n,), the baro
     sample per row, its errors and lag weights, scratch increments dth, dv (1, 1, 3); and act(k, truth, code): the
@@ -144,7 +134,7 @@ class _Act:
 
 @dataclass
 class FastEpoch:
-    """The closed loop's compiled aiding epoch (nav/kernels/closed_loop_epoch.py loop_epoch): its constant
+    """The closed loop's compiled aiding epoch (core/loop/aiding.py loop_epoch): its constant
     arguments, scratch and the epoch history it writes (XS, PP, PC, PD, PN: one row per epoch, the Navigator's
     snapshots are views of them), made once at the start (NavInTheLoop.fast_epoch_unavailable says when not)."""
 
@@ -366,7 +356,7 @@ class NavInTheLoop:
         sk.guidance(navigator.x, self.x_nav, self._c_rwy, self._o_rwy, self._h_thr, g)  # feed-forward INS - x_hat
         return g[0:3].copy(), g[3:6].copy()  # copies: the kernel's buffer is rewritten at the next step
 
-    # --- the compiled row (nav/kernels/inloop.py): the flight loop steps the navigation in its own compiled call
+    # --- the compiled row (core/loop/nav_row.py): the flight loop steps the navigation in its own compiled call
 
     def inloop(self) -> InLoop | None:
         """The arrays of the compiled per-row navigation (records.NavigationSource), or None when the IMU errors
@@ -466,7 +456,7 @@ class NavInTheLoop:
                     nw[ik.W_X + 2] = nw[ik.W_HB]  # the converged start's height error stands
         navigator.record_row(k)
 
-    # --- the compiled aiding epoch (nav/kernels/closed_loop_epoch.py) -------------------------------------------
+    # --- the compiled aiding epoch (core/loop/aiding.py) -------------------------------------------
 
     def fast_epoch_unavailable(self) -> str | None:
         """Why the aiding epochs cannot run compiled (None: they can): they need the compiled per-run EKF epoch
@@ -614,7 +604,7 @@ class NavInTheLoop:
         if d.plan is not None:
             args[d.jg + 5] = d.plan(truth)
         if d.call is None:
-            d.call = _entry(ce.direct_inputs, tuple(args))
+            d.call = entry_point(ce.direct_inputs, *args)
         flags = d.call(*args)
         baro_h, baro_r, radalt_h, el = _NAN1, 0.0, _NAN1, None
         rho, r_sv, sig = d.no_rho, eng._none3, eng._none1
@@ -706,7 +696,7 @@ class NavInTheLoop:
                 eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, eng.codes, eng._nu[:1],
                 eng.S, eng.h, eng.b, eng.ws, fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic)
         if fe.call is None:
-            fe.call = _entry(ce.loop_epoch, args)
+            fe.call = entry_point(ce.loop_epoch, *args)
         n_rows = fe.call(*args)
         if n_rows < 0:
             return False

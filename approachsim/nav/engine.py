@@ -1,5 +1,5 @@
 """The compiled epoch engine: the optimal filter's epoch of one run, or of a shared-covariance class, as one call of
-kernels/epoch.py, with the arrays it needs built once per navigation system and per run.
+core/nav/epoch.py, with the arrays it needs built once per navigation system and per run.
 
     eng = EpochEngine.of(system)                     # None when the configuration needs the generic path
     eng.epoch(X, P, phi, qd, own, ref_y, ins_y, obs, members, t_s, statuses, db)
@@ -26,11 +26,11 @@ from typing import Any
 import numpy as np
 
 from approachsim import geo
+from approachsim.core.nav import epoch as ke
 from approachsim.nav import errormodel as em
 from approachsim.nav import measurements as meas
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import KalmanFilter, UpdateStatus, optimal_policy, workspace
-from approachsim.nav.kernels import epoch as ke
 from approachsim.nav.observations import Observations
 from approachsim.sensors.gnss.receiver import IONO_SHELL_M
 
@@ -42,7 +42,7 @@ _MAX_ROWS = 2 + 2 * 64 + 16
 
 @lru_cache(maxsize=512)
 def code_name(code: int) -> str:
-    """The status-log name of a row code (kernels/epoch.py): "baro", "radalt", "gps07", "cp07", "pl0"."""
+    """The status-log name of a row code (core/nav/epoch.py): "baro", "radalt", "gps07", "cp07", "pl0"."""
     if code == ke.CODE_BARO:
         return "baro"
     if code == ke.CODE_RADALT:
@@ -180,7 +180,7 @@ class RunDatabase:
 
 
 class EpochEngine:
-    """The constants of one navigation system for kernels/epoch.class_epoch, and its scratch space."""
+    """The constants of one navigation system for core/nav/epoch.class_epoch, and its scratch space."""
 
     def __init__(self, system: Any) -> None:
         lay = system.layout
@@ -230,15 +230,15 @@ class EpochEngine:
     def channel_sigmas(self, el: Array) -> tuple[Array, Array]:
         """The GPS channel states' slow and fast 1-sigma (m) at elevations el (N, k) rad, each element on its own:
         the receiver budget's channel_sigmas_m with nav/noise.py's elevation guard, compiled. Stand-alone:
-        kernels/epoch.channel_sigmas; GBAS corrections: sensors/kernels/gnss.gbas_channel_sigmas at
+        core/nav/epoch.channel_sigmas; GBAS corrections: core/sensors/gnss.gbas_channel_sigmas at
         gbas.REFERENCE_GEOMETRY (the filter's elevation-only channel noise, as nav/noise.py builds it)."""
         el = np.ascontiguousarray(el, dtype=float)
         gse, gmp = np.empty(el.shape), np.empty(el.shape)
         if self._gbas is None:
             ke.channel_sigmas(el, *self._sky_budget, gse, gmp)
         else:
+            from approachsim.core.sensors.gnss import gbas_channel_sigmas
             from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
-            from approachsim.sensors.kernels.gnss import gbas_channel_sigmas
 
             x, dh, v = (np.full(el.shape[0], g) for g in REFERENCE_GEOMETRY)
             gbas_channel_sigmas(el, x, dh, v, *self._gbas, gse, gmp)
@@ -268,7 +268,7 @@ class EpochEngine:
         return cls(system)
 
     def _obs_args(self, obs: Observations, members: list[int], dbs: list[RunDatabase]) -> tuple:
-        """class_epoch's observation arguments of the members (kernels/epoch.py)."""
+        """class_epoch's observation arguments of the members (core/nav/epoch.py)."""
         M = len(members)
         if M == 1:
             i = members[0]
@@ -308,7 +308,7 @@ class EpochEngine:
               obs: Observations, members: list[int], t_s: float, statuses: list[StatusBuffer],
               dbs: list[RunDatabase], ref_agl_m: float = 0.0) -> None:
         """One epoch of the members (indices into obs's runs) with estimates X (M, n) and covariance P, in place
-        (kernels/epoch.class_epoch); each member's status records go to its buffer."""
+        (core/nav/epoch.class_epoch); each member's status records go to its buffer."""
         M = len(members)
         first, rest = self._obs_args(obs, members, dbs)
         if self._nu.shape[0] < M:
@@ -322,7 +322,7 @@ class EpochEngine:
     def own(self, X: Array, P: Array, y: Array, f_ned: Array, elevation_rad: Array | None, held: bool, dt: float,
             obs: Observations, i: int, t_s: float, statuses: StatusBuffer, db: RunDatabase,
             new: Array | None = None) -> bool:
-        """The per-run EKF's whole epoch of run i (kernels/epoch.own_epoch: its error model about its INS state y
+        """The per-run EKF's whole epoch of run i (core/nav/epoch.own_epoch: its error model about its INS state y
         (16,) with the mean specific force f_ned (3,), discretized over dt, then every update), in place on X (1, n)
         and P. False when the model needs the numpy discretization (nothing changed: take the generic path). new (k,):
         carrier phase, the channels whose arc begins here (`new_arcs`; their ambiguities reset)."""
@@ -345,7 +345,7 @@ class EpochEngine:
     def singletons(self, X: Array, P3: Array, phi2: Array, qd2: Array, held: Array, obs: Observations, t_s: float,
                    dt: float, ins_y: Array, ref_y: Array, ref_agl_m: float, statuses: list[StatusBuffer],
                    db_stack: tuple[Array, Array, Array], new: Array | None = None) -> None:
-        """The shared-mode epoch of N runs each its own class (kernels/epoch.singleton_epochs), in place on X (N, n)
+        """The shared-mode epoch of N runs each its own class (core/nav/epoch.singleton_epochs), in place on X (N, n)
         and P3 (N, n, n); phi2, qd2 (2, n, n) the model without / with the damping loop held, held (N,) int; the
         GPS channel states' Qd at each run's own elevations; db_stack: the runs' databases (`stack`); new (N, k):
         carrier phase, the channels whose arc begins here in each run (`new_arcs`)."""

@@ -42,7 +42,7 @@ and the baro white noise v_b enters the process noise through the gains.
 
 Discretization over the aiding interval: Phi = expm(F dt) and Qd from Van Loan's method (scipy.linalg.expm).
 
-`dynamics` and `discretize` run the compiled kernels of nav/kernels/errormodel.py on plain arrays (the layout and
+`dynamics` and `discretize` run the compiled kernels of core/nav/errormodel.py on plain arrays (the layout and
 the noise packed once per frozen object: `StateLayout.packed`, `kernel_noise`); `dynamics_reference` and
 `discretize_reference` are the readable numpy versions, kept as the kernels' test oracle
 (tests/unit/nav/test_epoch_kernels.py: F, Qc equal, Phi, Qd to 1e-12 relative).
@@ -57,9 +57,9 @@ import numpy as np
 from scipy.linalg import expm
 
 from approachsim import geo
+from approachsim.core.nav import errormodel as ek
 from approachsim.nav import ins
 from approachsim.nav import vertical_loop as vl
-from approachsim.nav.kernels import errormodel as ek
 
 Array = np.ndarray
 

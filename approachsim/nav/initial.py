@@ -63,9 +63,9 @@ from typing import Any
 
 import numpy as np
 
+from approachsim.core.nav import kalman as kk
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
-from approachsim.nav.kernels import kalman as kk
 from approachsim.nav.observations import Observations
 from approachsim.sensors.states import STATE_GROUPS, SensorStates
 
@@ -109,7 +109,7 @@ def converged_covariance(system: Any, truth: Any, obs: Observations, row: int, P
     """P_conv (n, n): the optimal filter's covariance after converge_s (s) of aiding at truth row `row` from P0,
     with the measurements available in obs (NavSystem.observations at the row; the first run's schedule).
 
-    The filter's own recursion, one scalar Joseph update per row, compiled (kernels/kalman.riccati: the states
+    The filter's own recursion, one scalar Joseph update per row, compiled (core/nav/kalman.riccati: the states
     never measured and not coupled evolve alone, an exact reduction); converged_covariance_reference is the same
     recursion in numpy (the test oracle)."""
     phi, qd, rows = _segment(system, truth, obs, row, P0)

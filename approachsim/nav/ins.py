@@ -17,7 +17,7 @@ the integral over [t_{k-1}, t_k] of the body rate / specific force (sensors/imu.
 samples k-1, k form increment k).
 
 Every function is a plain array function over a leading run axis: a state holds (N,) / (N, 3) / (N, 3, 3)
-arrays, so many Monte Carlo runs step together. The mechanization runs compiled (nav/kernels/strapdown.py,
+arrays, so many Monte Carlo runs step together. The mechanization runs compiled (core/nav/strapdown.py,
 numba): `propagate` steps packed (N, 16) states over many intervals in one call, `step` is one interval of it
 on an InsState, and `step_reference` is the same equations in numpy, kept as the kernel's test oracle. An
 optional 3rd-order baro damping loop (nav/vertical_loop.py, seed 003 eq. 3, 7) stabilizes the vertical channel.
@@ -30,8 +30,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from approachsim import geo
+from approachsim.core.nav import strapdown as sk
 from approachsim.nav import vertical_loop as vl
-from approachsim.nav.kernels import strapdown as sk
 
 Array = np.ndarray
 

@@ -17,7 +17,7 @@ Rows (index names from errormodel.StateLayout):
               the code's geometry, clock and slow error, the ionosphere with the opposite sign, the arc's ambiguity)
     position  z = p_ins - p_gps (NED, per axis)  (loosely-coupled option)
 
-The baro, radalt and range rows have compiled versions in nav/kernels/measurements.py that write h into a buffer
+The baro, radalt and range rows have compiled versions in core/nav/measurements.py that write h into a buffer
 and return the innovation nu = z - g(x_hat) (for a per-run loop, and over runs for the shared covariance); the
 functions here are their test oracle. `terrain_arrays` and `database_arrays` give the kernels the terrain
 database as arrays.

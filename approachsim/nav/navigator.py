@@ -26,14 +26,14 @@ from typing import Any
 import numpy as np
 
 from approachsim import geo
+from approachsim.core.nav import epoch as ke
+from approachsim.core.nav import output as ko
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import FilterState, UpdateStatus
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, new_arcs, reset_arcs, stacked_new_arcs
 from approachsim.nav.fde import FdeState
-from approachsim.nav.kernels import epoch as ke
-from approachsim.nav.kernels import output as ko
 from approachsim.nav.observations import BARO, Observations
 from approachsim.records import NavSolution, Truth
 
@@ -217,7 +217,7 @@ class Navigator:
     def bind(self, x: Array, f_sum: Array, rows: Array, snap: Array) -> None:
         """Keep the INS state (M, 16), the specific-force sum (M, 3), the rows (M, n_rows, 16) and the snapshot
         index per row (n_rows,) in the caller's arrays from now on (their current values copied in): the closed
-        loop's compiled row (nav/kernels/inloop.py) steps them in place."""
+        loop's compiled row (core/loop/nav_row.py) steps them in place."""
         x[...] = self.x
         f_sum[...] = self.f_sum
         if rows is not self.rows:  # (the Navigator made with the caller's rows: nothing to copy)
@@ -282,7 +282,7 @@ class Navigator:
     def epoch_done(self, row: int, t_s: float, x: Array, p_pos: Array, p_clk: Array, p_diag: Array,
                    p_nav: Array) -> None:
         """What `epoch` keeps after an epoch its caller ran itself (the closed loop's compiled epoch,
-        nav/kernels/closed_loop_epoch.py, which has reset f_sum): the snapshot x (N, n), P's position block
+        core/loop/aiding.py, which has reset f_sum): the snapshot x (N, n), P's position block
         (N, 3, 3), clock variance (N,), diagonal (N, n) and navigation block (N, 9, 9), and the epoch's history
         entry (the caller records row `row` itself)."""
         self.t_last = t_s
@@ -404,7 +404,7 @@ class Navigator:
     def compiled_pass(self, records: Any, truth: Truth, batched: bool, dtheta: Array, dv: Array, dt_s: float,
                       h_baro: Array | None, epoch_rows: int, baro_age_s: Array | None = None) -> bool:
         """The whole open-loop pass in two compiled calls (`can_pass`): the INS over every row, then every epoch of
-        every run (kernels/epoch.shared_pass: the per-epoch path's arithmetic, nav/shared.py's singletons). Fills
+        every run (core/nav/epoch.shared_pass: the per-epoch path's arithmetic, nav/shared.py's singletons). Fills
         the state `results` reads. False, with nothing changed but the INS rows, when an epoch's model is too
         large for the compiled discretization (the caller then takes the per-epoch path from the start)."""
         system, lay, sh, eng = self.system, self.layout, self.shared, self.engine
@@ -509,7 +509,7 @@ class Navigator:
         return True
 
     def _stacked_carrier(self, o: dict, noise: em.ErrorNoise, nz: em.ErrorNoise, dt: Array) -> tuple:
-        """compiled_pass's carrier-phase arguments of kernels/epoch.shared_pass: (cp (N, E, k), new (N, E, k),
+        """compiled_pass's carrier-phase arguments of core/nav/epoch.shared_pass: (cp (N, E, k), new (N, E, k),
         gio (n_sv,), gio_tau, f_gio (E,), the runs' arc ids after the pass (N, k)); empty arrays and None without
         carrier phase. noise: the model's noise, nz the elevation-free one (the taus)."""
         N, E = self.n_runs, dt.shape[0]

@@ -1,11 +1,11 @@
 """The open-loop pass of runs that are each their own class (per-run GPS skies) on each run's reduced state.
 
-Navigator.compiled_pass filters such runs with kernels/epoch.shared_pass on the full layout: 24 GPS channels' gse /
+Navigator.compiled_pass filters such runs with core/nav/epoch.shared_pass on the full layout: 24 GPS channels' gse /
 gmp states, of which a run measures 4-6 with best-four selection. The channels a run never measures are lone
 first-order Gauss-Markov states, uncorrelated with the rest at the start (checked: a correlated one is kept), which
 no row touches: dropping them removes exact zeros from every sum and keeps the others' order, so the kept states
 are the same floating-point numbers (integrity/bankpass.py's module docstring gives the argument; the reduced
-models here, `models` and `cut`, and the compiled pass nav/kernels/copies.bank_epochs serve both). The dropped
+models here, `models` and `cut`, and the compiled pass core/nav/copies.bank_epochs serve both). The dropped
 states are then carried in closed form exactly as the full pass computes them (x <- 0 + phi x; P <- Qd + phi (0 +
 phi P)): x_out, P's diagonal and the final X, P are those of shared_pass bit for bit
 (tests/unit/nav/test_reduced_pass.py). The cost of an epoch falls with the square of the state count: 70 -> ~32.
@@ -19,12 +19,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from approachsim.core.nav import copies as kcp
+from approachsim.core.nav import epoch as ke
+from approachsim.core.nav import kalman as kk
+from approachsim.core.nav import reduced as kred
 from approachsim.nav import errormodel as em
-from approachsim.nav.kernels import copies as kcp
-from approachsim.nav.kernels import epoch as ke
-from approachsim.nav.kernels import kalman as kk
 
 Array = np.ndarray
 
@@ -32,7 +32,7 @@ Array = np.ndarray
 @dataclass(frozen=True)
 class ReducedRun:
     """One run's pass on its reduced state (the layout with the GPS channels `kept` only), per epoch: estimates x,
-    variances pd (E, n_r), navigation covariance pnav (E, 9, 9), and its rows as kernels/epoch.class_epoch writes
+    variances pd (E, n_r), navigation covariance pnav (E, 9, 9), and its rows as core/nav/epoch.class_epoch writes
     them (codes with the reduced channel index, counts, innovations, their variances)."""
 
     kept: Array
@@ -239,7 +239,7 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
         drop = np.setdiff1d(np.arange(lay.n_sv), kept)
         xg, xm = X[i, ig + drop].copy(), X[i, im + drop].copy()
         pg, pm = P3[i, ig + drop, ig + drop].copy(), P3[i, im + drop, im + drop].copy()
-        lone_states(np.ascontiguousarray(phi1[:, lay1.i("gse"), lay1.i("gse")]),
+        kred.lone_states(np.ascontiguousarray(phi1[:, lay1.i("gse"), lay1.i("gse")]),
                     np.ascontiguousarray(phi1[:, lay1.i("gmp"), lay1.i("gmp")]), ch_gse[i], ch_gmp[i], f_gse, f_gmp,
                     drop, ig, im, xg, xm, pg, pm, x_out[i], pd[i])
         # the final state and covariance (the dropped states' rows and columns stay zero off the diagonal)
@@ -248,24 +248,3 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
         P3[i][np.ix_(idx, idx)] = Pr[0]
         P3[i, ig + drop, ig + drop], P3[i, im + drop, im + drop] = pg, pm
     return E
-
-
-
-@njit(cache=True)
-def lone_states(f_g: Array, f_m: Array, ch_gse: Array, ch_gmp: Array, f_gse: Array, f_gmp: Array, drop: Array,
-                ig: int, im: int, xg: Array, xm: Array, pg: Array, pm: Array, x_out: Array, pd_out: Array) -> None:
-    """The dropped channels' gse / gmp states over the E epochs, in place from their start xg, xm, pg, pm (k_d,):
-    each epoch x <- 0 + phi x and P <- Qd + phi (0 + phi P) (kernels/kalman._predict_cov's sums for a lone state,
-    Qd = sigma^2 f as kernels/epoch.singleton_epochs sets it; phi f_g, f_m (E,), the sigmas ch_gse, ch_gmp (E, k)
-    of the run, factors f_gse, f_gmp (E,)); written to x_out, pd_out (E, n) at ig + drop, im + drop."""
-    for e in range(f_g.shape[0]):
-        for a in range(drop.shape[0]):
-            c = drop[a]
-            xg[a] = 0.0 + f_g[e] * xg[a]
-            xm[a] = 0.0 + f_m[e] * xm[a]
-            pg[a] = ch_gse[e, c] ** 2 * f_gse[e] + f_g[e] * (0.0 + f_g[e] * pg[a])
-            pm[a] = ch_gmp[e, c] ** 2 * f_gmp[e] + f_m[e] * (0.0 + f_m[e] * pm[a])
-            x_out[e, ig + c] = xg[a]
-            x_out[e, im + c] = xm[a]
-            pd_out[e, ig + c] = pg[a]
-            pd_out[e, im + c] = pm[a]

@@ -158,7 +158,7 @@ class SharedCovariance:
 
     def _aid_engine(self, nav: Any, ref: ins.InsState, t: float, dt_epoch: float, obs: Observations, held: list,
                     models: dict, new: Array) -> None:
-        """`aid`'s predict and updates by kernels/epoch.class_epoch in shared mode (rows at the truth), one call
+        """`aid`'s predict and updates by core/nav/epoch.class_epoch in shared mode (rows at the truth), one call
         per class; the classes are already split."""
         system = nav.system
         runs = nav.runs
@@ -180,7 +180,7 @@ class SharedCovariance:
 
     def _aid_singletons(self, nav: Any, ref: ins.InsState, t: float, dt_epoch: float, obs: Observations,
                         held: list, models: dict, new: Array) -> None:
-        """`_aid_engine` when every run is its own class: all runs in one kernels/epoch.singleton_epochs call (each
+        """`_aid_engine` when every run is its own class: all runs in one core/nav/epoch.singleton_epochs call (each
         its own covariance, the channel Qd at its own sky)."""
         system = nav.system
         runs = nav.runs

@@ -33,9 +33,9 @@ from typing import ClassVar
 import numpy as np
 
 from approachsim import units
+from approachsim.core.sensors import baro as bk
 from approachsim.records import BaroSamples, Truth
 from approachsim.sensors import atmosphere, base
-from approachsim.sensors.kernels import baro as bk
 
 Array = np.ndarray
 _T0_OVER_LAPSE_M = atmosphere.T0_K / atmosphere.LAPSE_K_PER_M
@@ -80,7 +80,7 @@ class Baro:
 
     def kernel_constants(self) -> tuple[float, float, float, float, float]:
         """(setting Pa, ISA T0 / L m, exponent R L / g0, field H_f m, c - 1): the indicated-altitude constants of the
-        compiled sample (sensors/kernels/baro.py; nav/kernels/inloop.py makes a closed loop's samples with them)."""
+        compiled sample (core/sensors/baro.py; core/loop/nav_row.py makes a closed loop's samples with them)."""
         return (float(self.setting_pa), _T0_OVER_LAPSE_M, _EXPONENT_INV, float(self.field_m),
                 float(self.temperature_ratio) - 1.0)
 
@@ -97,7 +97,7 @@ class Baro:
         return w / w.sum()
 
     def apply(self, truth: Truth, errors: base.SensorErrors) -> BaroSamples:
-        """Measurements at the truth rows of `errors`; compiled (sensors/kernels/baro.py), equal to apply_reference to
+        """Measurements at the truth rows of `errors`; compiled (core/sensors/baro.py), equal to apply_reference to
         1e-12 of the ISA scale T0 / L (4.4e-8 m; the kernel module says why not 1e-12 of the height)."""
         sf = np.asarray(errors.constants["scale_factor"], dtype=float)
         run = (lambda a: a) if errors.batched else (lambda a: a[None])

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from scipy.signal import lfilter
 
-from approachsim.sensors.kernels import noise as noise_kernels
+from approachsim.core.sensors import noise as noise_kernels
 
 Array = np.ndarray
 RngLike = np.random.Generator | Sequence[np.random.Generator]
@@ -69,7 +69,7 @@ def gauss_markov(z: Array, sigma: float | Array, tau_s: float | Array, dt_s: flo
     x_0 = sigma z_0;  x_k = a x_{k-1} + sigma sqrt(1 - a^2) z_k,  a = exp(-dt / tau)
     (the exact discretization of dx/dt = -x / tau + w; seed 000 eq. 5 and seed 001 eq. 2 are its Euler
     form a = 1 - dt beta). sigma and tau broadcast over the trailing axes of z; tau = inf gives a random
-    constant, sigma = 0 gives zeros. The recursion is compiled (sensors/kernels/noise.py first_order), bit-identical
+    constant, sigma = 0 gives zeros. The recursion is compiled (core/sensors/noise.py first_order), bit-identical
     to gauss_markov_reference.
     """
     z = np.asarray(z, dtype=float)

@@ -33,9 +33,9 @@ from typing import ClassVar
 
 import numpy as np
 
+from approachsim.core.sensors import imu as sk
 from approachsim.records import ImuSamples, Truth
 from approachsim.sensors import base
-from approachsim.sensors import kernels as sk
 from approachsim.sensors.presets import ImuGrade
 
 Array = np.ndarray
@@ -95,7 +95,7 @@ class Imu:
 
     def apply(self, truth: Truth, errors: base.SensorErrors) -> ImuSamples:
         """Increments for the samples in `errors` (truth rows errors.rows and the rows before them); computed by
-        the compiled kernel (sensors/kernels/imu.py imu_apply), equal to `apply_reference` to 1e-12 relative."""
+        the compiled kernel (core/sensors/imu.py imu_apply), equal to `apply_reference` to 1e-12 relative."""
         return self.record(truth, errors.rows, errors.t_s, _run_axis(errors), errors.batched)
 
     def record(self, truth: Truth, rows: Array, t_s: Array, e: dict[str, Array], batched: bool) -> ImuSamples:

@@ -22,10 +22,10 @@ from typing import ClassVar
 import numpy as np
 
 from approachsim import geo
+from approachsim.core.sensors import pseudolite as plk
 from approachsim.records import PseudoliteSamples, Truth
 from approachsim.sensors import base
 from approachsim.sensors.gnss.clock import ClockModel
-from approachsim.sensors.kernels import pseudolite as plk
 
 Array = np.ndarray
 
@@ -94,7 +94,7 @@ class Pseudolite:
         self, truth: Truth, errors: base.SensorErrors, clock: base.SensorErrors | None = None
     ) -> PseudoliteSamples:
         """Pseudoranges at the truth rows of `errors`; `clock` the receiver clock (None: zero). Compiled
-        (sensors/kernels/pseudolite.py), equal to apply_reference to 1e-12 relative."""
+        (core/sensors/pseudolite.py), equal to apply_reference to 1e-12 relative."""
         pub = self.r_published_ecef
         e = _run_axis(errors, clock)
         c_down = np.ascontiguousarray(self.c_ecef_to_ned(pub)[:, 2, :])

@@ -38,10 +38,10 @@ from typing import ClassVar
 import numpy as np
 
 from approachsim import units
+from approachsim.core.sensors import radalt as ra
 from approachsim.records import RadaltSamples, Truth
 from approachsim.seeding import substream
 from approachsim.sensors import base
-from approachsim.sensors.kernels import radalt as ra
 
 Array = np.ndarray
 
@@ -83,7 +83,7 @@ class RadarAltimeter:
 
     def apply(self, truth: Truth, errors: base.SensorErrors) -> RadaltSamples:
         """Measurements at the truth rows of `errors`; nan and valid=False out of range or attitude limits. Compiled
-        (sensors/kernels/radalt.py), bit-identical to apply_reference."""
+        (core/sensors/radalt.py), bit-identical to apply_reference."""
         bias = np.asarray(errors.constants["bias"], dtype=float)
         run = (lambda a: a) if errors.batched else (lambda a: a[None])
         return self.record(truth, errors.rows, errors.t_s, run(bias), run(errors.series["markov"]),

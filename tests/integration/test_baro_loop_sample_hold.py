@@ -5,7 +5,7 @@ the IMU intervals until the next one. On a descent at V m/s the held sample is, 
 the aircraft (0.22-0.24 s of staleness at 2 Hz). Until 2026-12-04 the loop compared it with the INS height now,
 and the navigation read high by a deterministic amount its covariance did not cover: +1.4 m at the CAT I decision
 height with a 2 Hz baro, against a sd of 0.68 m over the runs. The INS now takes its height back to the sample's
-time, h + v_D a (nav/kernels/strapdown.py); the same case gives -0.06 m. Measured before the fix, this test failed.
+time, h + v_D a (core/nav/strapdown.py); the same case gives -0.06 m. Measured before the fix, this test failed.
 
 Open loop, one flown truth, 25 runs, integrity bank off; the runs share the truth, so the lag's part of the
 error is the same in every run and the mean over the runs carries it, with a standard error of about

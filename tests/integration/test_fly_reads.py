@@ -1,4 +1,4 @@
-"""What the flight loop reads from JSBSim and what it derives instead (flight/kernels.py, flight/fdm.LoopIO).
+"""What the flight loop reads from JSBSim and what it derives instead (core/loop/flight_step.py, flight/fdm.LoopIO).
 
 JSBSim's Earth-relative body rates (velocities/p-rad_sec, ...) are not read: the loop derives them from the inertial
 rates and the attitude, w_eb = w_ib - C_nb' w_ie at the geodetic latitude (kernels.earth_rates_reference). JSBSim
@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from approachsim import geo
-from approachsim.flight import kernels as fk
+from approachsim.core.loop import flight_step as fk
+from approachsim.flight import vectors as fv
 from approachsim.flight.fdm import FDM
 from approachsim.flight.run import Approach
 from approachsim.profile import load_profile
@@ -53,7 +54,7 @@ def manoeuvre():
 def test_earth_relative_rates_are_derived_within_jsbsims_quaternion_drift(manoeuvre):
     raw, _, pqr, gc, _ = manoeuvre
     assert np.abs(pqr).max() > 0.05  # the inputs made it roll and pitch
-    derived = fk.earth_rates_reference(raw[:, :fk.N_RAW])
+    derived = fv.earth_rates_reference(raw[:, :fk.N_RAW])
     assert np.abs(derived - pqr).max() <= RATE_BOUND
     # the compiled truth row derives the same rates (its velocity lever-arm term w_eb x l uses them)
     const = np.zeros(fk.N_CONST)
@@ -65,7 +66,7 @@ def test_earth_relative_rates_are_derived_within_jsbsims_quaternion_drift(manoeu
     # the latitude matters: JSBSim's local frame is geodetic (with the geocentric one the rates miss by ~1e-7)
     wrong = raw[:, :fk.N_RAW].copy()
     wrong[:, 0] = gc
-    assert np.abs(fk.earth_rates_reference(wrong) - pqr).max() > 1e-8
+    assert np.abs(fv.earth_rates_reference(wrong) - pqr).max() > 1e-8
 
 
 def test_loop_io_reads_the_fields_in_order_with_the_gear_stood_in_for(manoeuvre):

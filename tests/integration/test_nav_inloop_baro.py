@@ -1,4 +1,4 @@
-"""The compiled closed loop's own baro samples (nav/kernels/inloop.baro_sample, which feed the damping loop while
+"""The compiled closed loop's own baro samples (core/loop/nav_row.baro_sample, which feed the damping loop while
 JSBSim flies) equal the sensor model's (sensors/baro.py), with the aerodrome-temperature correction on a cold day at
 a high field: the navigation of a flown closed-loop approach is recomputed row by row through NavInTheLoop.step (the
 Python path, samples from Baro.record) over the flown truth, and must agree to rounding."""

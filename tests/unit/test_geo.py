@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from approachsim import geo
-from approachsim.nav.kernels import geodesy as gk
+from approachsim.core import geodesy as gk
 
 lat_s = st.floats(-89.9, 89.9).map(math.radians)
 lon_s = st.floats(-180.0, 180.0).map(math.radians)

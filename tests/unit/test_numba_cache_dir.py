@@ -1,5 +1,6 @@
-"""Numba's file cache is keyed by the sources of every numba module (approachsim/__init__.py): a kernel that calls
-another module's kernel (flight/kernels.py -> nav/kernels/inloop.py) never runs a stale cached callee."""
+"""Numba's file cache is keyed by the sources of the compiled floor (approachsim/core/__init__.py): a kernel that
+calls another module's kernel (core/loop/closed_step.py -> core/loop/nav_row.py) never runs a stale cached callee,
+and editing a module outside core keeps the cache (no recompilation)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import sys
 
 
 def _cache_dir(env: dict[str, str]) -> str:
-    code = "import os, approachsim; print(os.environ.get('NUMBA_CACHE_DIR', ''))"
+    code = "import os, approachsim.core; print(os.environ.get('NUMBA_CACHE_DIR', ''))"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     return out.stdout.strip()
 
@@ -32,7 +33,7 @@ def test_cache_dir_is_keyed_by_the_cpu_target(tmp_path):
     another cache directory: a home directory shared between CPU models never loads another model's kernels."""
     from pathlib import Path
 
-    import approachsim
+    import approachsim.core
 
     env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CPU")} | {"XDG_CACHE_HOME": str(tmp_path)}
     env.pop("NUMBA_CACHE_DIR", None)
@@ -41,9 +42,9 @@ def test_cache_dir_is_keyed_by_the_cpu_target(tmp_path):
     other = _cache_dir(env | {"NUMBA_CPU_NAME": "skylake", "NUMBA_CPU_FEATURES": "+sse2,+avx2,+fma"})
     assert len({host, generic, other}) == 3
     assert _cache_dir(env | {"NUMBA_CPU_NAME": "generic"}) == generic  # and stable for one target
-    pkg = Path(approachsim.__file__).resolve().parent
-    a = approachsim._numba_cache_key(pkg, "x86_64-unknown-linux-gnu|haswell|+avx2,+fma")
-    b = approachsim._numba_cache_key(pkg, "x86_64-unknown-linux-gnu|haswell|+avx2,-fma")
+    pkg = Path(approachsim.core.__file__).resolve().parents[1]
+    a = approachsim.core._numba_cache_key(pkg, "x86_64-unknown-linux-gnu|haswell|+avx2,+fma")
+    b = approachsim.core._numba_cache_key(pkg, "x86_64-unknown-linux-gnu|haswell|+avx2,-fma")
     assert a != b  # one feature differs: another key
 
 
@@ -76,3 +77,30 @@ def test_numba_does_not_load_a_kernel_cached_for_another_cpu(tmp_path):
     assert _cache_hits(tmp_path, generic) == 1  # loaded for the same target
     assert _cache_hits(tmp_path, env) == 0  # this CPU: not the generic kernel, compiled anew
     assert _cache_hits(tmp_path, env) == 1
+
+
+def test_editing_a_stage_keeps_the_cache_and_editing_core_starts_a_fresh_one(tmp_path):
+    """The cache key covers core/ (and the units and geo constants the kernels freeze) alone: a copy of the package
+    with a stage module edited (nav/closed_loop.py, flight/run.py: the loop's wiring) has the same key, so the
+    first evaluate after such an edit loads every kernel from the cache; an edited kernel module gets a new key."""
+    import shutil
+    from pathlib import Path
+
+    import approachsim.core
+
+    src = Path(approachsim.core.__file__).resolve().parents[1]
+    pkg = tmp_path / "approachsim"
+    shutil.copytree(src, pkg, ignore=shutil.ignore_patterns("__pycache__", "data"))
+    target = "x86_64-unknown-linux-gnu|haswell|+avx2,+fma"
+    key = approachsim.core._numba_cache_key(pkg, target)
+    assert key == approachsim.core._numba_cache_key(src, target)
+    for stage in ("nav/closed_loop.py", "flight/run.py", "sensors/baro.py", "integrity/bank.py"):
+        with (pkg / stage).open("a", encoding="utf-8") as f:
+            f.write("\n# edited\n")
+        assert approachsim.core._numba_cache_key(pkg, target) == key, stage
+    numba_users = [p.relative_to(pkg).as_posix() for p in pkg.rglob("*.py")
+                   if "import numba" in p.read_text(encoding="utf-8") or "from numba" in p.read_text(encoding="utf-8")]
+    assert numba_users and all(p.startswith("core/") for p in numba_users), numba_users
+    with (pkg / "core/nav/kalman.py").open("a", encoding="utf-8") as f:
+        f.write("\n# edited\n")
+    assert approachsim.core._numba_cache_key(pkg, target) != key

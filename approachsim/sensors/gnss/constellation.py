@@ -18,7 +18,7 @@ from datetime import UTC, datetime
 import numpy as np
 
 from approachsim import geo
-from approachsim.sensors.kernels import gnss as gk
+from approachsim.core.sensors import gnss as gk
 
 Array = np.ndarray
 
@@ -91,7 +91,7 @@ class Constellation:
         """Positions (S, m, 24, 3), ECEF, m, at run times t_s (m,) of the S skies offsets_s (S,) s after the epoch,
         and with_velocity their velocities relative to the rotating Earth (same shape), m/s (else None).
 
-        The compiled kernel (sensors/kernels/gnss.py sv_orbits) of positions_ecef / velocities_ecef (the numpy
+        The compiled kernel (core/sensors/gnss.py sv_orbits) of positions_ecef / velocities_ecef (the numpy
         oracles, equal to 1e-12 relative): one sky's values do not depend on the others or on the times asked."""
         t = np.ascontiguousarray(t_s, dtype=float)
         offs = np.atleast_1d(np.asarray(offsets_s, dtype=float))

@@ -101,7 +101,7 @@ The iono and tropo terms depend on where the aircraft is; `channel_sigmas_m` tak
 on a 3 deg path at 140 kt: the largest residual such an approach sees (conservative closer in).
 
 `GbasModel` holds the configuration and the numpy formulas, the oracle of the compiled kernels
-(sensors/kernels/gnss.py gbas_scales, pseudoranges_gbas, and gbas_channel_sigmas: the filter's channel sigmas for a
+(core/sensors/gnss.py gbas_scales, pseudoranges_gbas, and gbas_channel_sigmas: the filter's channel sigmas for a
 compiled navigation epoch, called with channel_kernel_args()).
 """
 
@@ -272,7 +272,7 @@ class GbasModel:
         return np.array([a0, a1, math.radians(th0)])
 
     def channel_kernel_args(self) -> tuple:
-        """The constant arguments of sensors/kernels/gnss.gbas_channel_sigmas between the geometry and the outputs:
+        """The constant arguments of core/sensors/gnss.gbas_channel_sigmas between the geometry and the outputs:
         gbas_channel_sigmas(el, x_air, dh, v_air, *model.channel_kernel_args(), gse, gmp)."""
         from approachsim.sensors.gnss.receiver import IONO_SHELL_M
 

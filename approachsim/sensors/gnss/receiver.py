@@ -72,7 +72,7 @@ it keep their draws bit for bit: they come from the child stream "carrier" of th
 Selection: "all" (every SV above the mask) or "best4" (the four of lowest PDOP, seed 002, chosen afresh at
 each epoch). Channels are the 24 slots, in SLOTS order; invisible or unselected channels are nan and invalid.
 
-Computation: `apply` runs the compiled kernels of sensors/kernels/gnss.py (orbits, look angles, selection, PDOP,
+Computation: `apply` runs the compiled kernels of core/sensors/gnss.py (orbits, look angles, selection, PDOP,
 pseudoranges) over every sky and sample at once; `apply_reference` (with `geometry`, `best_pdop_four_reference`)
 is the readable numpy version and the kernels' test oracle (values to 1e-12 relative, selections identical).
 `prepare(errors, clock)` lays one run's (or batch's) errors out for sample-at-a-time application in a closed
@@ -92,6 +92,7 @@ from typing import ClassVar
 import numpy as np
 
 from approachsim import geo
+from approachsim.core.sensors import gnss as gk
 from approachsim.records import GnssSamples, Truth
 from approachsim.seeding import substream
 from approachsim.sensors import base
@@ -99,7 +100,6 @@ from approachsim.sensors.gnss.carrier import CarrierModel, ambiguities, carrier_
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
 from approachsim.sensors.gnss.gbas import CARRIER_NOISE_M, SMOOTHING_TAU_S, GbasModel, station_geometry
-from approachsim.sensors.kernels import gnss as gk
 
 Array = np.ndarray
 
@@ -248,7 +248,7 @@ def tropo_mapping(el_rad: Array) -> Array:
 
 def best_pdop_four(u_los: Array, visible: Array) -> Array:
     """Selection mask (n, k): per epoch the four visible channels of lowest PDOP (all visible if < 4); compiled
-    (sensors/kernels/gnss.py best_four), the same selection as best_pdop_four_reference."""
+    (core/sensors/gnss.py best_four), the same selection as best_pdop_four_reference."""
     sel = np.zeros(np.shape(visible), dtype=bool)
     gk.best_four_epochs(np.ascontiguousarray(u_los, dtype=float), np.ascontiguousarray(visible, dtype=bool), sel)
     return sel
@@ -318,7 +318,7 @@ class GnssReceiver:
             h = float(geo.ecef_to_geodetic(np.asarray(self.station_ecef, dtype=float))[2])
         object.__setattr__(self, "_station_h_m", h)
         g = self.budget.gbas
-        # gbas_scales' constant arguments after the truth's (sensors/kernels/gnss.py), made once
+        # gbas_scales' constant arguments after the truth's (core/sensors/gnss.py), made once
         object.__setattr__(self, "_gbas_args", None if g is None else (
             np.asarray(self.station_ecef, dtype=float), h, g.gad_params(), float(g.reference_receivers),
             g.aad_params(), float(g.sigma_vig_per_m), SMOOTHING_TAU_S, float(g.refractivity_sigma),
@@ -513,7 +513,7 @@ class GnssReceiver:
         self, truth: Truth, errors: base.SensorErrors, clock: base.SensorErrors | None = None
     ) -> GnssSamples:
         """Pseudoranges at the truth rows of `errors`; `clock` from draw_clock (None: a zero receiver clock).
-        Compiled (sensors/kernels/gnss.py); equal to apply_reference to 1e-12 relative, the same selections."""
+        Compiled (core/sensors/gnss.py); equal to apply_reference to 1e-12 relative, the same selections."""
         offs, per_run = self.skies(errors)
         r_sv, v_sv = self.constellation.orbits(errors.t_s, offs, self.doppler)
         series = _run_axis(errors)

@@ -1,4 +1,4 @@
-"""The flight loop compiled with JSBSim's C++ called from it (flight/direct_kernels.py, flight/jsbsim_direct.py)
+"""The flight loop compiled with JSBSim's C++ called from it (core/loop/direct.py, flight/jsbsim_abi.py)
 flies the Python loop's flight bit for bit: guided by the truth (turbulence writes), over terrain (terrain
 writes), to touchdown (the gear reads near the ground), and with the navigation in the loop (Python acting between
 compiled stretches). The pointer checks refuse what is not a JSBSim object, unreadable memory reads as None, and
@@ -17,9 +17,9 @@ import jsbsim
 import numpy as np
 import pytest
 
-from approachsim.flight import direct_kernels as dk
-from approachsim.flight import jsbsim_direct
-from approachsim.flight import kernels as fk
+from approachsim.core.loop import direct as dk
+from approachsim.core.loop import flight_step as fk
+from approachsim.core.loop import jsbsim_abi
 from approachsim.flight.fdm import FDM
 from approachsim.flight.run import Approach
 from approachsim.flight.trim import start_condition
@@ -74,9 +74,9 @@ def direct_available():
 
 
 def _fly_both(monkeypatch, fly) -> tuple[object, object]:
-    monkeypatch.setenv(jsbsim_direct.ENV_SWITCH, "1")
+    monkeypatch.setenv(jsbsim_abi.ENV_SWITCH, "1")
     direct = fly()
-    monkeypatch.setenv(jsbsim_direct.ENV_SWITCH, "0")
+    monkeypatch.setenv(jsbsim_abi.ENV_SWITCH, "0")
     python = fly()
     return direct, python
 
@@ -169,7 +169,7 @@ def test_direct_writes_are_the_wrappers_writes(direct_available):
 
 
 def test_what_is_not_a_jsbsim_object_gives_no_pointer():
-    lib = jsbsim_direct.library(jsbsim._jsbsim.__file__)
+    lib = jsbsim_abi.library(jsbsim._jsbsim.__file__)
     if lib is None:
         assert not SUPPORTED
         pytest.skip("the direct JSBSim path needs CPython on x86-64 Linux")
@@ -184,13 +184,13 @@ def test_what_is_not_a_jsbsim_object_gives_no_pointer():
 
 
 def test_unreadable_memory_reads_as_none():
-    assert jsbsim_direct._read_words([0, 8, 2**63 + 8]) == [None, None, None]
-    word = jsbsim_direct._read_words([id(None)])[0]  # the reference count of None: some positive count
+    assert jsbsim_abi._read_words([0, 8, 2**63 + 8]) == [None, None, None]
+    word = jsbsim_abi._read_words([id(None)])[0]  # the reference count of None: some positive count
     assert word is None or word > 0
 
 
 def test_the_switch_keeps_the_python_loop(monkeypatch):
-    monkeypatch.setenv(jsbsim_direct.ENV_SWITCH, "0")
-    assert jsbsim_direct.library(jsbsim._jsbsim.__file__) is None
+    monkeypatch.setenv(jsbsim_abi.ENV_SWITCH, "0")
+    assert jsbsim_abi.library(jsbsim._jsbsim.__file__) is None
     _, io = _trimmed_io(_profile("default"))
     assert io.direct is None

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from approachsim import geo, units
-from approachsim.flight import kernels as fk
+from approachsim.core.loop import flight_step as fk
+from approachsim.flight import vectors as fv
 from approachsim.nav import ins
 
 pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
@@ -65,11 +66,11 @@ COLS = {"t": [0], "lat": [1], "lon": [2], "h": [3], "r_ecef": [4, 5, 6], "v_ned"
 def test_kernel_equals_numpy_reference():
     rng = np.random.default_rng(12)
     raw = _raw(300, rng)
-    const = fk.imu_point_constants([10.0, 0.4, -1.2], RWY.threshold_lat_rad, RWY, DT)
+    const = fv.imu_point_constants([10.0, 0.4, -1.2], RWY.threshold_lat_rad, RWY, DT)
     along, height = np.array([-20000.0, 0.0, 5000.0]), np.array([30.0, 4.0, 2.0])
     t = np.arange(300) * DT
     got, terr = _kernel_rows(raw, const, along, height, t)
-    ref = fk.imu_point_rows_reference(raw, const, along, height, t)
+    ref = fv.imu_point_rows_reference(raw, const, along, height, t)
     for name, c in COLS.items():
         _close(got[:, c], ref[:, c], name)
     assert np.isnan(got[:, 31:35]).all()  # the controls stay the caller's
@@ -81,7 +82,7 @@ def test_kernel_equals_numpy_reference():
 def test_zero_lever_arm_keeps_the_cg_state_and_the_quaternion_is_the_attitude():
     rng = np.random.default_rng(3)
     raw = _raw(50, rng)
-    const = fk.imu_point_constants([0.0, 0.0, 0.0], RWY.threshold_lat_rad, RWY, DT)
+    const = fv.imu_point_constants([0.0, 0.0, 0.0], RWY.threshold_lat_rad, RWY, DT)
     got, _ = _kernel_rows(raw, const, np.array([0.0]), np.array([4.0]), np.zeros(50))
     np.testing.assert_array_equal(got[:, 1:3], raw[:, 0:2])
     np.testing.assert_allclose(got[:, 3], raw[:, 2] * units.FT, rtol=0, atol=1e-9)
@@ -104,7 +105,7 @@ def test_lever_arm_on_a_steady_rotation_gives_the_centripetal_acceleration():
     raw[:, 9:12] = [0.0, 0.0, w]
     raw[:, 12:15] = 0.0
     raw[:, 15:18] = 0.0
-    const = fk.imu_point_constants([10.0, 0.0, 0.0], RWY.threshold_lat_rad, RWY, 1e-4)
+    const = fv.imu_point_constants([10.0, 0.0, 0.0], RWY.threshold_lat_rad, RWY, 1e-4)
     got, _ = _kernel_rows(raw, const, np.array([0.0]), np.array([4.0]), np.zeros(1))
     np.testing.assert_allclose(got[0, 20:23], [-w * w * 10.0, 0.0, 0.0], rtol=0, atol=2e-4)
     np.testing.assert_allclose(got[0, 7:10], [0.0, w * 10.0, 0.0], rtol=0, atol=1e-4)  # w x l, east
@@ -150,7 +151,7 @@ def test_kernel_reproduces_the_flight_loop_rows(monkeypatch):
     cg = (fdm["inertia/cg-x-in"], fdm["inertia/cg-y-in"], fdm["inertia/cg-z-in"])
     imu = approach.aircraft.imu_location_struct_m
     lever = [cg[0] * 0.0254 - imu[0], imu[1] - cg[1] * 0.0254, cg[2] * 0.0254 - imu[2]]
-    const = fk.imu_point_constants(lever, ic.lat_rad, prof.runway, approach.dt_s)
+    const = fv.imu_point_constants(lever, ic.lat_rad, prof.runway, approach.dt_s)
     got, _ = _kernel_rows(raw, const, np.asarray(prof.terrain.along_m, float), np.asarray(prof.terrain.height_m,
                                                                                           float),
                           np.arange(len(truth)) * approach.dt_s)
@@ -177,7 +178,7 @@ def test_every_glidepath_formula_is_the_cone():
     tol = 16 * np.finfo(float).eps * 2000.0
     rng = np.random.default_rng(21)
     raw = _raw(50, rng)
-    const = fk.imu_point_constants([10.0, 0.4, -1.2], RWY.threshold_lat_rad, RWY, DT)
+    const = fv.imu_point_constants([10.0, 0.4, -1.2], RWY.threshold_lat_rad, RWY, DT)
     got, _ = _kernel_rows(raw, const, np.array([0.0]), np.array([4.0]), np.arange(50) * DT)
     cone = GlidePath.of(RWY)
     np.testing.assert_allclose(got[:, 29], cone.deviation_m(got[:, 26], got[:, 27], got[:, 28]), rtol=0, atol=tol)

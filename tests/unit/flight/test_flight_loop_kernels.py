@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 
 from approachsim import geo, units
-from approachsim.flight import kernels as fk
+from approachsim.core.entry import entry_point
+from approachsim.core.loop import flight_step as fk
+from approachsim.flight import vectors as fv
 from approachsim.flight.aircraft import load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import AutopilotGains
@@ -25,11 +27,10 @@ from approachsim.flight.envelope import (
     MON_OK,
     MON_SINK,
     MON_SPEED,
-    WATCH_HEIGHT_M,
     StabilityMonitor,
     unstabilized_reason,
 )
-from approachsim.flight.run import _entry, termination_reason
+from approachsim.flight.run import termination_reason
 from approachsim.flight.turbulence import DrydenTurbulence, scales
 from approachsim.glidepath import GlidePath
 from approachsim.profile import load_profile
@@ -96,7 +97,7 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
     n = 600
     x, y, z, v, att, cas, h_gear, tas, psi = _autopilot_inputs(rng, n, flare=flare)
     ap = _autopilot(gains)
-    par, st = fk.autopilot_arrays(ap)
+    par, st = fv.autopilot_arrays(ap)
     seen = {"pitch limited": 0, "bank limited": 0, "throttle 1": 0, "throttle 0": 0, "flaring": 0, "idle": 0,
             "aligning": 0, "sideslip limited": 0, "full decrab": 0}
     sq = ap.trim.cas_mps / gains.align_cas_mps
@@ -138,7 +139,7 @@ def test_dryden_scales_equal_the_oracle_across_the_regimes():
                               np.random.default_rng(2).uniform(0.0, 90000.0, 400)])
     for level, (w20, index) in (("light", (25.0, 3)), ("moderate", (50.0, 4)), ("severe", (75.0, 6))):
         turb = DrydenTurbulence(level, np.random.default_rng(0), 1, DT, 0.0)
-        par, _ = fk.dryden_arrays(turb)
+        par, _ = fv.dryden_arrays(turb)
         alt, sig = par[fk.TB_ALT:fk.TB_ALT + fk.N_POE], par[fk.TB_SIGMA:fk.TB_SIGMA + fk.N_POE]
         for h in heights:
             assert fk.dryden_scales(h, w20, alt, sig) == scales(h, w20, index), (level, h)
@@ -151,7 +152,7 @@ def test_dryden_kernel_equals_the_oracle_bit_for_bit(level):
     n = 700
     rng = np.random.default_rng(11)
     turb = DrydenTurbulence(level, np.random.default_rng(3), n + 5, DT, wind_to_rad=2.2)
-    par, st = fk.dryden_arrays(turb)
+    par, st = fv.dryden_arrays(turb)
     nu = turb.nu.copy()
     h = np.linspace(3000.0, -3.0, n) * units.FT + rng.normal(0.0, 2.0, n)
     vt = 70.0 + rng.normal(0.0, 3.0, n)
@@ -165,8 +166,8 @@ def test_dryden_kernel_equals_the_oracle_bit_for_bit(level):
 
 
 def _monitor_inputs(rng, n, reason):
-    """n steps descending from WATCH_HEIGHT_M on the path at the target speed, disturbed so that `reason` fires."""
-    z = np.linspace(WATCH_HEIGHT_M, 100.0, n)
+    """n steps descending from fk.WATCH_HEIGHT_M on the path at the target speed, disturbed so that `reason` fires."""
+    z = np.linspace(fk.WATCH_HEIGHT_M, 100.0, n)
     x = (TCH - z) / math.tan(GP)
     y = rng.normal(0.0, 2.0, n)
     cas = 72.0 + rng.normal(0.0, 0.5, n)
@@ -190,7 +191,7 @@ def test_monitor_kernel_equals_the_oracle_and_each_reason_fires(reason):
     x, y, z, cas, vd, gs = _monitor_inputs(np.random.default_rng(reason), n, reason)
     mon = StabilityMonitor(GP, TCH, 72.0, DT)
     ref = StabilityMonitor(GP, TCH, 72.0, DT)
-    par, st, ring = fk.monitor_arrays(mon)
+    par, st, ring = fv.monitor_arrays(mon)
     for k in range(n):
         want = mon.check(x[k], y[k], z[k], cas[k], vd[k], gs[k])
         words = ref.step(x[k], y[k], z[k], cas[k], vd[k], gs[k])
@@ -213,8 +214,8 @@ def _step_vectors(gains, *, land=False, turbulent=True, stop_h=-math.inf, n_step
     frame = geo.RunwayFrame(math.radians(39.8), math.radians(-104.7), 1600.0, 0.4)
     rw = SimpleNamespace(frame=frame, elevation_m=1600.0, glidepath_rad=GP, tch_m=TCH, heading_rad=0.4,
                          threshold_lat_rad=frame.threshold_lat_rad)
-    const = fk.imu_point_constants(np.array([9.0, 0.3, -1.1]), frame.threshold_lat_rad, rw, DT)
-    par, st = fk.flight_vectors(const, ap, mon, turb, np.array([-20000.0, 0.0]), np.array([1650.0, 1600.0]),
+    const = fv.imu_point_constants(np.array([9.0, 0.3, -1.1]), frame.threshold_lat_rad, rw, DT)
+    par, st = fv.flight_vectors(const, ap, mon, turb, np.array([-20000.0, 0.0]), np.array([1650.0, 1600.0]),
                                 pitch_trim=-0.1, stop_height_m=stop_h, land=land,
                                 monitor_floor_m=(monitor_floor if monitor_floor is not None
                                                  else gains.flare_height_m if land else -math.inf),
@@ -299,8 +300,8 @@ def test_fly_step_is_the_composition_of_its_pieces(gains):
     par, st, ap, mon, turb, const, rw = _step_vectors(gains, n_steps=n)
     raw = _synthetic_raw(np.random.default_rng(8), n)
     along, height = np.array([-20000.0, 0.0]), np.array([1650.0, 1600.0])
-    rows = fk.imu_point_rows_reference(raw, const, along, height, np.arange(n) * DT)
-    pqr = fk.earth_rates_reference(raw)
+    rows = fv.imu_point_rows_reference(raw, const, along, height, np.arange(n) * DT)
+    pqr = fv.earth_rates_reference(raw)
     buf = np.full((n, 36), np.nan)
     nu = turb.nu.copy()
     de, da, dr, thr = 0.0, 0.0, 0.0, ap.trim.throttle
@@ -375,7 +376,7 @@ def test_entry_point_calls_the_same_compiled_step(gains):
     buf = np.full((n, 36), np.nan)
     nu = np.zeros((n, 3))
     reads = (*raw[0], *fk.GEAR_AIRBORNE)
-    entry = _entry(fk.fly_step, 0, reads, buf, nu, par, st, True)
+    entry = entry_point(fk.fly_step, 0, reads, buf, nu, par, st, True)
     assert entry is not fk.fly_step  # numba still exposes it (else the loop falls back on the dispatcher)
     st2, buf2 = st.copy(), buf.copy()
     assert entry(0, reads, buf, nu, par, st, True) == fk.fly_step(0, reads, buf2, nu, par, st2, True)

@@ -1,5 +1,5 @@
-"""The integrity bank's compiled reduced-state pass (integrity/bankpass.py, nav/kernels/copies.py) against the
-path it replaces, NavSystem.run's batched copies on the full state (run_bank(..., compiled=False), kernels/epoch.
+"""The integrity bank's compiled reduced-state pass (integrity/bankpass.py, core/nav/copies.py) against the
+path it replaces, NavSystem.run's batched copies on the full state (run_bank(..., compiled=False), core/nav/epoch.
 shared_pass): the same main and sub-solution errors, variances and identification statistics, to the rounding
 floors of tests/floors.py (measured equal to the last bit on this machine: the reduction drops exact zeros, module
 docstring of bankpass), with per-run skies, pseudolites with their states, a baro outage that holds the damping

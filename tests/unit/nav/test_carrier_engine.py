@@ -1,4 +1,4 @@
-"""The compiled engine with GPS carrier phase (nav/engine.py, kernels/carrier.py, kernels/epoch.py) against the
+"""The compiled engine with GPS carrier phase (nav/engine.py, kernels/carrier.py, core/nav/epoch.py) against the
 generic path it replaces (nav/navigator.py's per-run filters with nav/rows.py and nav/measurements.carrier_phase,
 nav/shared.py's numpy shared covariance, both with the arc resets of engine.new_arcs / reset_arcs): the same
 solutions, status logs and filter histories to the rounding floors of test_epoch_engine.py (P's with the float
@@ -20,10 +20,10 @@ from floors import R_EARTH_M, R_GPS_MAX_M, assert_within, floor
 from test_epoch_engine import K_CHAIN, _floors
 
 from approachsim import geo, synthetic
+from approachsim.core.nav import carrier as kcar
 from approachsim.nav import engine
 from approachsim.nav import errormodel as em
 from approachsim.nav import measurements as meas
-from approachsim.nav.kernels import carrier as kcar
 from approachsim.nav.navigator import Navigator
 from approachsim.nav.system import NavSystem
 from approachsim.profile import parse_profile
@@ -72,7 +72,7 @@ def _navigate(prof, shared: bool, generic: bool, monkeypatch, new_arc: bool = Fa
 @pytest.mark.parametrize("sky", ["per-run", "fixed"])
 @pytest.mark.parametrize("shared", [False, True])
 def test_carrier_engine_equals_the_generic_path(sky, shared, monkeypatch):
-    """Per-run skies with the shared covariance take the whole compiled pass (kernels/epoch.shared_pass); one sky the
+    """Per-run skies with the shared covariance take the whole compiled pass (core/nav/epoch.shared_pass); one sky the
     compiled class epoch; per run the compiled own epoch. Each against the numpy path, with run 1's new arc."""
     prof = _profile(epoch=sky)
     fast = _navigate(prof, shared, False, monkeypatch, new_arc=True)

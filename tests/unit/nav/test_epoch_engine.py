@@ -1,4 +1,4 @@
-"""The compiled epoch engine (nav/engine.py, kernels/epoch.py) against the generic path it replaces for the optimal
+"""The compiled epoch engine (nav/engine.py, core/nav/epoch.py) against the generic path it replaces for the optimal
 filter (nav/navigator.py's per-run filters with nav/rows.py, nav/shared.py's shared covariance): the same solutions,
 status logs and filter histories to rounding, per run and shared, with per-run skies, one sky with a fault that
 splits a class, a pseudolite with its states, terrain, the radar altimeter's database error and the damping loop."""
@@ -34,7 +34,7 @@ def _profile(kind: str):
     if kind == "fixed-sky-fault":
         p = replace(p, sensors=replace(p.sensors, gnss=replace(p.sensors.gnss, epoch="fixed", selection="all")),
                     faults=(FaultSpec(sensor="baro", kind="outage", start_s=12.0, end_s=20.0),))
-    if kind == "gbas":  # GBAS corrections: the channel noise from its budget (sensors/kernels/gnss.gbas_channel_sigmas)
+    if kind == "gbas":  # GBAS corrections: the channel noise from its budget (core/sensors/gnss.gbas_channel_sigmas)
         p = replace(p, sensors=replace(p.sensors, gnss=replace(p.sensors.gnss, corrections="gbas", gbas=GbasModel(),
                                                                selection="all")))
     if kind == "pseudolite":

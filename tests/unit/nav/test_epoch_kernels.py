@@ -1,4 +1,4 @@
-"""The compiled filter-epoch kernels (nav/kernels/errormodel.py, kalman.py, measurements.py) against their numpy
+"""The compiled filter-epoch kernels (core/nav/errormodel.py, kalman.py, measurements.py) against their numpy
 oracles on the same inputs: the error model F, Qc (equal to 1e-12 relative, entry by entry) and Phi, Qd (1e-12
 relative, norm-wise per matrix) over random linearization points and layouts; the filter's predict and scalar
 Joseph update (max|dP| <= 1e-12 max|P|, x to 1e-12 relative), the shared-covariance update (a run's numbers
@@ -16,15 +16,15 @@ import pytest
 from floors import assert_within, floor
 
 from approachsim import geo, synthetic
+from approachsim.core.nav import errormodel as ek
+from approachsim.core.nav import kalman as kk
+from approachsim.core.nav import measurements as mk
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import measurements as meas
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav import vertical_loop as vl
 from approachsim.nav.base import KalmanFilter, ScalarMeasurement, joseph_reference, predict_reference, workspace
-from approachsim.nav.kernels import errormodel as ek
-from approachsim.nav.kernels import kalman as kk
-from approachsim.nav.kernels import measurements as mk
 from approachsim.nav.robust import AdaptivePolicy
 from approachsim.profile import load_profile
 

@@ -8,9 +8,9 @@ import pytest
 from floors import assert_within, floor
 
 from approachsim import geo
+from approachsim.core import geodesy as gk
 from approachsim.nav import ins
 from approachsim.nav import vertical_loop as vl
-from approachsim.nav.kernels import geodesy as gk
 
 pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
 
@@ -200,7 +200,7 @@ def test_output_kernel_equals_perturb_ecef_and_euler():
                         rng.normal(0.0, 1e-3, (40, 3)), rng.normal(0.0, 1.0, (40, 4))], axis=1)
     X[0, 6:9] = 1e-9  # tiny attitude correction: the Rodrigues series branch
     snap = rng.integers(0, 40, 500)
-    from approachsim.nav.kernels import output as ko
+    from approachsim.core.nav import output as ko
 
     r, v, e = ko.corrected(rows, X, snap)
     xs = X[snap]

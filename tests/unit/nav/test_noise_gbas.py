@@ -106,10 +106,10 @@ def test_the_budget_takes_the_aircraft_geometry_when_given(navs):
 
 
 def test_compiled_channel_sigmas_equal_the_budget(navs):
-    """sensors/kernels/gnss.gbas_channel_sigmas (for a compiled navigation epoch: per-run elevations and geometry)
+    """core/sensors/gnss.gbas_channel_sigmas (for a compiled navigation epoch: per-run elevations and geometry)
     equals the budget's numpy channel_sigmas_m behind nav/noise.py's elevation guard (nan -> 0.5 rad, >= 2 deg), to
     1e-12 relative, each row independent of the others."""
-    from approachsim.sensors.kernels import gnss as gk
+    from approachsim.core.sensors import gnss as gk
 
     _, nav = navs
     bud = nav.sensors.gnss.budget()

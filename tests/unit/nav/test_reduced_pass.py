@@ -1,5 +1,5 @@
 """The open-loop pass of per-run-sky runs on each run's reduced state (nav/reduced.py) against the full-layout pass
-it replaces (kernels/epoch.shared_pass, what Navigator.compiled_pass runs when the reduction does not apply): the
+it replaces (core/nav/epoch.shared_pass, what Navigator.compiled_pass runs when the reduction does not apply): the
 same estimates, covariances, measurement rows and solutions, with a baro outage that holds the damping loop and
 with pseudolites. The reduction drops exact zeros and keeps every other sum's order (the module docstring): measured
 equal to the last bit on this machine; asserted to the floors of tests/unit/integrity/test_bankpass.py (the same

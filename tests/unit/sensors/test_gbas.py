@@ -21,6 +21,7 @@ from gnss_floors import assert_fields_within, record_floors
 
 from approachsim import synthetic
 from approachsim.config import ProfileError
+from approachsim.core.sensors import gnss as gk
 from approachsim.profile import load_profile, parse_profile
 from approachsim.seeding import stream
 from approachsim.sensors.gnss import gbas as gb
@@ -30,7 +31,6 @@ from approachsim.sensors.gnss.receiver import (
     draw_receiver_clock,
     make_budget,
 )
-from approachsim.sensors.kernels import gnss as gk
 from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite, SuiteErrors
 

@@ -1,4 +1,4 @@
-"""The compiled GPS kernels (sensors/kernels/gnss.py) against their numpy oracles: the best-PDOP selection identical
+"""The compiled GPS kernels (core/sensors/gnss.py) against their numpy oracles: the best-PDOP selection identical
 on the default approach's skies over a sidereal day and on random geometries (fewer than four, exactly four and many
 visible); orbits, look angles and whole records (every selection, Doppler, both multipath models, one sky / per-run
 skies / one run) equal to their rounding floors (gnss_floors.py: from the orbit's phase angles and the ECEF operands
@@ -16,6 +16,7 @@ from floors import assert_within, floor
 from gnss_floors import PHASE_RAD, assert_fields_within, look_floors, orbit_floor, record_floors, v_sv_max
 
 from approachsim import synthetic
+from approachsim.core.sensors import gnss as gk
 from approachsim.profile import load_profile
 from approachsim.seeding import stream
 from approachsim.sensors.gnss.constellation import Constellation, look_angles
@@ -27,7 +28,6 @@ from approachsim.sensors.gnss.receiver import (
     draw_receiver_clock,
     make_budget,
 )
-from approachsim.sensors.kernels import gnss as gk
 from approachsim.sensors.suite import SensorSuite
 
 pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)

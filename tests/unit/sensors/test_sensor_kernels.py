@@ -1,11 +1,11 @@
-"""The compiled IMU error application (sensors/kernels/imu.py) against the numpy `Imu.apply_reference`: equal to the
+"""The compiled IMU error application (core/sensors/imu.py) against the numpy `Imu.apply_reference`: equal to the
 rounding floor of the error model's sum (tests/floors.py: k eps times the sizes of its terms) for one run and a batch,
 with and without quantization (then equal, or one step apart where a tie rounded the other way); a run's bits
-independent of its batch. The compiled Gauss-Markov recursion (sensors/kernels/noise.py) against scipy's lfilter, and
-the compiled radar altimeter (sensors/kernels/radalt.py) against `RadarAltimeter.apply_reference`: bit for bit (the
-same operations in the same order, a contract of the kernels). The compiled baro (sensors/kernels/baro.py) against
+independent of its batch. The compiled Gauss-Markov recursion (core/sensors/noise.py) against scipy's lfilter, and
+the compiled radar altimeter (core/sensors/radalt.py) against `RadarAltimeter.apply_reference`: bit for bit (the
+same operations in the same order, a contract of the kernels). The compiled baro (core/sensors/baro.py) against
 `Baro.apply_reference`: to 1e-12 of the ISA scale T0 / L (4.4e-8 m, far above its floor), with and without the
-static-system lag. The compiled pseudolites (sensors/kernels/pseudolite.py) against `Pseudolite.apply_reference`:
+static-system lag. The compiled pseudolites (core/sensors/pseudolite.py) against `Pseudolite.apply_reference`:
 ranges and elevations to the floor of a difference of two ECEF positions, validity identical."""
 
 from __future__ import annotations
@@ -90,7 +90,7 @@ def test_gauss_markov_kernel_equals_lfilter_bit_for_bit(shape, sigma, tau_s):
     a = base.gauss_markov(z, sigma, tau_s, 1.0 / 120.0)
     b = base.gauss_markov_reference(z, sigma, tau_s, 1.0 / 120.0)
     assert a.shape == b.shape == z.shape
-    # bit-identical by contract: one multiply-add per step in the same order as lfilter (sensors/kernels/noise.py),
+    # bit-identical by contract: one multiply-add per step in the same order as lfilter (core/sensors/noise.py),
     # no reassociation; a draw's bits must not depend on the path
     np.testing.assert_array_equal(a, b)
     assert np.any(a != 0.0)

@@ -1,5 +1,5 @@
 """The closed loop's aiding epoch as one compiled call (numba, cache=True): the per-run EKF's whole epoch
-(kernels/epoch.own_epoch) with what the Navigator does around it at an epoch of a feed-forward run, so that an
+(core/nav/epoch.own_epoch) with what the Navigator does around it at an epoch of a feed-forward run, so that an
 epoch of the closed loop costs one kernel call plus the sensors' one-row records (nav/closed_loop.py `_fast_epoch`).
 
     k = loop_epoch(nw, X, P, e, <own_epoch's model and observation arguments>, XS, PP, PC, PD, PN, ic)
@@ -7,14 +7,14 @@ epoch of the closed loop costs one kernel call plus the sensors' one-row records
 in order:
 
     f_ned = f_sum / dt                      the interval's mean specific force (Navigator.epoch: (f_sum / dt))
-    k = own_epoch(X, P, ..., y = INS state) predict + every scalar update (kernels/epoch.py), X (1, n), P (n, n)
+    k = own_epoch(X, P, ..., y = INS state) predict + every scalar update (core/nav/epoch.py), X (1, n), P (n, n)
     when k >= 0 (the model fitted the compiled discretization):
         XS[e] = x, PP[e] = P[0:3, 0:3], PC[e] = P[ic, ic], PD[e] = diag P, PN[e] = P[0:9, 0:9]
                                             the filter snapshot and epoch history (Navigator._snapshot(epoch=True))
-        f_sum <- 0;  the estimate in force x[0:9] -> the row's work vector (nav/kernels/inloop.py W_XNAV);
+        f_sum <- 0;  the estimate in force x[0:9] -> the row's work vector (core/loop/nav_row.py W_XNAV);
         the "baro in the interval" flag W_ANY_BARO <- 0
 
-nw is the closed loop's work vector (nav/kernels/inloop.py W_* offsets): the INS state y at W_X, f_sum at W_FSUM.
+nw is the closed loop's work vector (core/loop/nav_row.py W_* offsets): the INS state y at W_X, f_sum at W_FSUM.
 direct_inputs makes that epoch's sensor inputs (baro, radar altimeter, GPS sky + pseudoranges, the channel guard) by
 the sensors' own kernels in one call (closed_loop.py `_direct_inputs`).
 
@@ -29,11 +29,11 @@ import math
 import numpy as np
 from numba import njit
 
-from approachsim.nav.kernels import epoch as ke
-from approachsim.nav.kernels import inloop as ik
-from approachsim.sensors.kernels import baro as bk
-from approachsim.sensors.kernels import gnss as gk
-from approachsim.sensors.kernels import radalt as rk
+from approachsim.core.loop import nav_row as ik
+from approachsim.core.nav import epoch as ke
+from approachsim.core.sensors import baro as bk
+from approachsim.core.sensors import gnss as gk
+from approachsim.core.sensors import radalt as rk
 
 
 @njit(cache=True)

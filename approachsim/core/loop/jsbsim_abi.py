@@ -10,7 +10,7 @@ They are the very functions the wheel's FGPropertyNode.get_double_value / set_do
 (JSBSim's python/jsbsim.pyx.in). Called on the C++ objects the Python wrappers hold, they do exactly what those
 calls do, so a flight flown through them is bit-identical to one flown through the Python loop (flight/run.py;
 tests/unit/flight/test_flight_direct.py). A non-static member function takes `this` as its first argument
-(Itanium C++ ABI, the x86-64 Linux one), so compiled code calls them as plain functions (flight/direct_kernels.py).
+(Itanium C++ ABI, the x86-64 Linux one), so compiled code calls them as plain functions (core/loop/direct.py).
 
 The C++ objects are found in the Cython wrappers' fields (`thisptr`): a field counts when the object it points to
 starts with its class's virtual-table pointer (Itanium ABI: the address of _ZTV<class> plus 16, past the

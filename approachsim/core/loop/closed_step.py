@@ -1,5 +1,5 @@
 """The flight loop's compiled step with the closed loop's navigation row, on the packed navigation arrays
-(nav/kernels/inloop.py `views`): flight/kernels.py fly_step, then the navigation's row (inloop.nav_row), the
+(core/loop/nav_row.py `views`): core/loop/flight_step.py fly_step, then the navigation's row (inloop.nav_row), the
 guidance and fly_control, with three navigation arguments (the work vector nw and the packed fa, ia) instead of the
 twelve arrays of the earlier fly_step_nav it replaced. The flight makes one such call per JSBSim step, and numba
 unboxes every array argument of every call (~0.13 us each): nine fewer arrays save ~1.2 us a step, ~35 ms of a
@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from approachsim.flight import kernels as fk
-from approachsim.nav.kernels import inloop as ik
+from approachsim.core.loop import flight_step as fk
+from approachsim.core.loop import nav_row as ik
 
 Array = np.ndarray
 

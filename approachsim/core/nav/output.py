@@ -19,8 +19,8 @@ import math
 import numpy as np
 from numba import njit
 
-from approachsim.nav.kernels import geodesy as gk
-from approachsim.nav.kernels.strapdown import _mm, rotation_exp
+from approachsim.core import geodesy as gk
+from approachsim.core.nav.strapdown import _mm, rotation_exp
 
 _TWO_PI = 2.0 * math.pi
 

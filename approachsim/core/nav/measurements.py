@@ -27,8 +27,8 @@ import math
 import numpy as np
 from numba import njit
 
-from approachsim.nav.kernels import errormodel as ek
-from approachsim.nav.kernels import geodesy as gk
+from approachsim.core import geodesy as gk
+from approachsim.core.nav import errormodel as ek
 
 
 @njit(cache=True)

@@ -1,5 +1,5 @@
 """The closed loop's per-row navigation as a compiled kernel (numba, cache=True), called by the flight loop's
-compiled step (flight/closed_loop_kernels.py) so that a closed-loop row costs no Python beyond JSBSim's reads and
+compiled step (core/loop/closed_step.py) so that a closed-loop row costs no Python beyond JSBSim's reads and
 writes; Python runs only at the rows where the navigation needs it (the start, a baro sample of the damping loop,
 an aiding epoch: nav/closed_loop.py).
 
@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from approachsim.nav.kernels import strapdown as sk
+from approachsim.core.nav import strapdown as sk
 
 W_X = 0
 """Packed INS state (16,), kernels/strapdown.py layout."""
@@ -72,7 +72,7 @@ NAV_START, NAV_BARO, NAV_EPOCH = 1, 2, 4
 
 @njit(cache=True)
 def baro_sample(k: int, buf: np.ndarray, nw: np.ndarray, lag_w: np.ndarray, bias: float, noise: float) -> float:
-    """The barometric altimeter's sample at truth row k (sensors/kernels/baro.baro_apply for one run, the same
+    """The barometric altimeter's sample at truth row k (core/sensors/baro.baro_apply for one run, the same
     operations in order): h_ind = (T0 / L)(1 - (p / p_set)^(R L / g0)) of the static pressure at the IMU (buf column
     23; with a lag, the weights lag_w over rows k, k - 1, ..., clipped at 0), h_c = h_ind + (h_ind - H_f)(c - 1),
     h = h_c (1 + S) + bias + noise."""

@@ -3,8 +3,8 @@
 The Python loop of flight/run.py makes ~38 calls into JSBSim's Python wrapper a step (24-29 reads, 5-9 writes, the
 step) and one compiled call; at 31,000 steps an approach that is ~4 us a step on top of JSBSim's own ~7 us. Here the
 same loop runs in compiled code: the reads and writes call SGPropertyNode::getDoubleValue / setDoubleValue and the
-step FGFDMExec::Run directly (the wheel's exported C++ functions, found and checked by flight/jsbsim_direct.py), and
-the per-step arithmetic is the same kernels in the same order (flight/kernels.py fly_step, flight/closed_loop_kernels.py
+step FGFDMExec::Run directly (the wheel's exported C++ functions, found and checked by flight/jsbsim_abi.py), and
+the per-step arithmetic is the same kernels in the same order (flight_step.py fly_step, closed_step.py
 fly_step_closed), so the flight is bit-identical to the Python loop's.
 
 `d`, the uint64 vector of addresses every kernel here takes (flight/fdm.py LoopIO.direct builds it):
@@ -22,8 +22,8 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-from approachsim.flight import closed_loop_kernels as ck
-from approachsim.flight import kernels as fk
+from approachsim.core.loop import closed_step as ck
+from approachsim.core.loop import flight_step as fk
 
 Array = np.ndarray
 

@@ -1,5 +1,5 @@
 """Compiled carrier-phase parts of the filter epoch (numba, cache=True): the carrier states' dynamics, the float
-ambiguities' reset at a new arc and the carrier-phase row, for kernels/epoch.py (nav/errormodel.py,
+ambiguities' reset at a new arc and the carrier-phase row, for core/nav/epoch.py (nav/errormodel.py,
 nav/navigator.py and nav/measurements.py give the equations; their numpy versions are the test oracle,
 tests/unit/nav/test_carrier_engine.py).
 
@@ -11,7 +11,7 @@ tests/unit/nav/test_carrier_engine.py).
         nu = z - g(x_hat) ; h: e' at dp, -1 at clk, gse and amb, +1 at gio (into h when `row`)
 
 The code pseudorange row under carrier phase has -1 at gio as well (its ionosphere has the code's sign):
-kernels/epoch.class_epoch adds it to kernels/measurements.pseudorange's row.
+core/nav/epoch.class_epoch adds it to kernels/measurements.pseudorange's row.
 
 Layout: lay[kernels.errormodel.L_GIO], lay[L_AMB] the groups' first index (-1: no carrier phase), lay[L_NSV] the
 channels; gio, amb of channel c at index + c.
@@ -24,7 +24,7 @@ import math
 import numpy as np
 from numba import njit
 
-from approachsim.nav.kernels import errormodel as ek
+from approachsim.core.nav import errormodel as ek
 
 
 @njit(cache=True)

@@ -1,4 +1,4 @@
-"""Copies of a filter on a given model (numba, cache=True): kernels/epoch.shared_pass with the model given; the
+"""Copies of a filter on a given model (numba, cache=True): core/nav/epoch.shared_pass with the model given; the
 integrity bank's main and sub-filters, and one run's filter on its reduced state (nav/reduced.py).
 
     bank_epochs(X, P3, phi, qd, lay, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins, <observations>, ...)
@@ -7,7 +7,7 @@ shared_pass makes each epoch's model (F, Qc at the reference, Phi, Qd by Van Loa
 calls it once per run, so every run of an open-loop flight group made the same models again (they depend on the
 shared truth only). Here Phi and Qd (E, n, n) come in, made once per truth on the full layout and cut to the run's
 reduced state (nav/reduced.py `models`, `cut`); the rest is shared_pass's loop: per epoch and copy, the channel
-states' Qd at the copy's sky, then kernels/epoch.class_epoch in shared mode (the same function, so the same
+states' Qd at the copy's sky, then core/nav/epoch.class_epoch in shared mode (the same function, so the same
 arithmetic). tests/unit/integrity/test_bankpass.py: equal to shared_pass bit for bit.
 
 One compiled loop, bank_epochs_carrier (shared_pass's carrier step: the gio states' Qd at each copy's sky, its
@@ -21,9 +21,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from approachsim.nav.kernels import carrier as kcar
-from approachsim.nav.kernels import epoch as ke
-from approachsim.nav.kernels import errormodel as ek
+from approachsim.core.nav import carrier as kcar
+from approachsim.core.nav import epoch as ke
+from approachsim.core.nav import errormodel as ek
 
 
 def bank_epochs(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.ndarray, lay: np.ndarray,
@@ -38,7 +38,7 @@ def bank_epochs(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.ndarray, 
                 codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray, n_rows: np.ndarray,
                 x_out: np.ndarray, pd_out: np.ndarray, pnav_out: np.ndarray,
                 h: np.ndarray, b: np.ndarray, ws: tuple) -> None:
-    """Every epoch of every copy (kernels/epoch.shared_pass's loop) with the epoch's model phi[e], qd[e] (E, n, n)
+    """Every epoch of every copy (core/nav/epoch.shared_pass's loop) with the epoch's model phi[e], qd[e] (E, n, n)
     given (the damping loop held or not as the copies' INS: the bank's copies share one), without carrier phase:
     bank_epochs_carrier with no carrier channels (no carrier rows, no ionosphere states, no arcs: the same
     arithmetic). Arguments as shared_pass (ch_gse, ch_gmp (N, E, k), f_gse, f_gmp (E,), ref (E, 16), ref_agl (E,),
@@ -75,7 +75,7 @@ def models(lay: np.ndarray, q: np.ndarray, gse: np.ndarray, gmp: np.ndarray, loo
 def carrier_models(lay: np.ndarray, q: np.ndarray, gse: np.ndarray, gmp: np.ndarray, loop: np.ndarray,
                    dt: np.ndarray, ref: np.ndarray, ref_cbn: np.ndarray, f_ref: np.ndarray, held: np.ndarray,
                    gio: np.ndarray, gio_tau: float, phi: np.ndarray, qd: np.ndarray) -> int:
-    """`models` with the carrier states (kernels/epoch.shared_pass's model under carrier phase): after kernels.
+    """`models` with the carrier states (core/nav/epoch.shared_pass's model under carrier phase): after kernels.
     errormodel.dynamics, kernels.carrier.dynamics (gio Gauss-Markov of 1-sigma gio (n_sv,) m and correlation time
     gio_tau s; amb random constants), then discretize over dt[e]. Returns E, or -1 - e as `models`."""
     E = dt.shape[0]
@@ -106,7 +106,7 @@ def bank_epochs_carrier(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.n
                         codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray, n_rows: np.ndarray,
                         x_out: np.ndarray, pd_out: np.ndarray, pnav_out: np.ndarray,
                         h: np.ndarray, b: np.ndarray, ws: tuple) -> None:
-    """`bank_epochs` under carrier phase: kernels/epoch.shared_pass's per-copy step with the carrier states, in its
+    """`bank_epochs` under carrier phase: core/nav/epoch.shared_pass's per-copy step with the carrier states, in its
     order. Per epoch e and copy i: Qd = qd[e] with the channel states' entries at the copy's sky (ch_gse, ch_gmp,
     then the ionosphere's ch_gio (N, E, k) m times f_gio[e] = 1 - exp(-2 dt / tau_gio)), the ambiguities of the
     channels with new[i, e, c] != 0 (a new carrier arc: engine.stacked_new_arcs) reset to amb_prior m^2 in Phi
@@ -119,7 +119,7 @@ def bank_epochs_carrier(X: np.ndarray, P3: np.ndarray, phi: np.ndarray, qd: np.n
     ig, im, io = lay[ek.L_GSE], lay[ek.L_GMP], lay[ek.L_GIO]
     for e in range(E):
         y = ref[e]
-        same = False  # qd_tmp and ws hold epoch e's model, no resets since (kernels/epoch.py, model reuse)
+        same = False  # qd_tmp and ws hold epoch e's model, no resets since (core/nav/epoch.py, model reuse)
         for i in range(N):
             if not same:
                 qd_tmp[:, :] = qd[e]

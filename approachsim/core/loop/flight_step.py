@@ -39,23 +39,7 @@ import numpy as np
 from numba import njit
 
 from approachsim import geo, units
-from approachsim.flight.envelope import (
-    LOC_ANTENNA_PAST_THRESHOLD_M,
-    MON_GLIDEPATH,
-    MON_LOCALIZER,
-    MON_OK,
-    MON_SINK,
-    MON_SPEED,
-    SINK_LIMIT_MPS,
-    SINK_TOLERANCE_MPS,
-    SPEED_HIGH_MPS,
-    SPEED_LOW_MPS,
-    STABILIZATION_HEIGHT_M,
-    WATCH_HEIGHT_M,
-)
-from approachsim.flight.turbulence import COEFF_EVERY, POE_ALT_FT, POE_SIGMA_FPS
-from approachsim.glidepath import GlidePath, cone_height
-from approachsim.nav.kernels import geodesy as gk
+from approachsim.core import geodesy as gk
 
 Array = np.ndarray
 
@@ -76,35 +60,54 @@ R_AIR = 287.05287
 """Specific gas constant of dry air, J/(kg K) (US Standard Atmosphere 1976, JSBSim's Rdry)."""
 
 _FT, _FPS, _KT, _PSF = units.FT, units.FPS, units.KT, units.PSF
-_LBF_PER_SLUG = units.LBF / units.SLUG
+LBF_PER_SLUG = units.LBF / units.SLUG
 _G0 = units.G0
-_G0_OVER_R = units.G0 / R_AIR
-_GM = geo.GM_JSBSIM
-_OMEGA = geo.OMEGA_JSBSIM
-_RANKINE = 1.8
+G0_OVER_R_AIR = units.G0 / R_AIR
+GM_JSBSIM = geo.GM_JSBSIM
+OMEGA_JSBSIM = geo.OMEGA_JSBSIM
+RANKINE_PER_K = 1.8
 _TWO_PI = 2.0 * math.pi
 
 N_CONST = 22
 
+# --- the stabilized-approach criteria (flight/envelope.py's monitor and its profile checks import them) ---
+LOC_ANTENNA_PAST_THRESHOLD_M = 3300.0
+"""Assumed localizer antenna position past the threshold: a 3000 m runway plus 300 m (no runway length is in
+a profile); only the localizer dot's size depends on it."""
+STABILIZATION_HEIGHT_M = 1000.0 * units.FT
+"""FSF ALAR BN 7.1: stabilized by 1000 ft above the airport in IMC, and stay so below it."""
+WATCH_HEIGHT_M = 1400.0 * units.FT
+"""The monitor is fed from this height down (its 10 s means are full by 1000 ft at any sink rate below
+2400 ft/min); above it the run loop skips it."""
+SPEED_HIGH_MPS = 10.0 * units.KT
+SPEED_LOW_MPS = 5.0 * units.KT
+SINK_LIMIT_MPS = 1000.0 * units.FT / 60.0
+SINK_TOLERANCE_MPS = 300.0 * units.FT / 60.0
+
+MON_OK, MON_GLIDEPATH, MON_LOCALIZER, MON_SPEED, MON_SINK = range(5)
+"""Results of one monitor step: stabilized, or which criterion failed (`monitor_step` returns these with two
+figures, flight/envelope.py `unstabilized_reason` words them)."""
+
+# --- MIL-F-8785C turbulence intensity table (flight/turbulence.py's oracle imports it) ---
+POE_ALT_FT = (500.0, 1750.0, 3750.0, 7500.0, 15000.0, 25000.0, 35000.0, 45000.0, 55000.0, 65000.0, 75000.0,
+              80000.0)
+"""Altitudes of the high-altitude intensity table, ft (MIL-F-8785C fig. 7)."""
+POE_SIGMA_FPS = (
+    (3.2, 2.2, 1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    (4.2, 3.6, 3.3, 1.6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    (6.6, 6.9, 7.4, 6.7, 4.6, 2.7, 0.4, 0.0, 0.0, 0.0, 0.0, 0.0),
+    (8.6, 9.6, 10.6, 10.1, 8.0, 6.6, 5.0, 4.2, 2.7, 0.0, 0.0, 0.0),
+    (11.8, 13.0, 16.0, 15.1, 11.6, 9.7, 8.1, 8.2, 7.9, 4.9, 3.2, 2.1),
+    (15.6, 17.6, 23.0, 23.6, 22.1, 20.0, 16.0, 15.1, 12.1, 7.9, 6.2, 5.1),
+    (18.7, 21.5, 28.4, 30.2, 30.7, 31.0, 25.2, 23.1, 17.5, 10.7, 8.4, 7.2),
+)
+"""High-altitude turbulence intensity sigma (ft/s) by probability-of-exceedance index 1..7 (rows) and altitude."""
+COEFF_EVERY = 12
+"""Steps between re-evaluations of the scale lengths and intensities."""
+
+
 # positions in RAW_FIELDS of the reads the loop uses besides the truth row
 _R_H_FT, _R_VN, _R_PHI, _R_VC, _R_BETA, _R_VT = 2, 3, 6, 21, 22, 23
-
-
-def imu_point_constants(lever_arm_m: Array, lat0_rad: float, runway: Any, dt_s: float) -> Array:
-    """The kernel's constants (22,): lever arm l (body axes, m; CG to IMU), the radii R_N, R_E (m) at lat0_rad
-    (held over the approach, as flight/run.py does), the runway frame's ECEF origin (m) and the first two rows
-    of its ECEF-to-runway matrix, threshold height (m), tan(glidepath), TCH (m), the glide path cone's GPI (m)
-    and curvature coefficients a, b, c (1/m; approachsim.glidepath.GlidePath.constants) and the step dt_s (s).
-
-    runway: the profile's runway (profile.Runway: .frame, .elevation_m, .glidepath_rad, .tch_m, .heading_rad,
-    .threshold_lat_rad)."""
-    r_n, r_e = geo.radii(lat0_rad)
-    frame = runway.frame
-    c = frame.c_ecef_to_rwy
-    _, x_gpi, ca, cb, cc = GlidePath.of(runway).constants()
-    return np.array([*np.asarray(lever_arm_m, dtype=float), float(r_n), float(r_e), *frame.origin_ecef,
-                     *c[0], *c[1], runway.elevation_m, math.tan(runway.glidepath_rad), runway.tch_m,
-                     x_gpi, ca, cb, cc, dt_s], dtype=float)
 
 
 @njit(cache=True)
@@ -158,12 +161,12 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     n20, n21, n22 = -st, sf * ct, cf * ct
     # Earth-relative body rates w_eb = w_ib - C_nb' w_ie (earth_rates)
     s_lat, c_lat = math.sin(lat), math.cos(lat)
-    wn_e, wd_e = _OMEGA * c_lat, -_OMEGA * s_lat
+    wn_e, wd_e = OMEGA_JSBSIM * c_lat, -OMEGA_JSBSIM * s_lat
     p, q, r = pi_ - (n00 * wn_e + n20 * wd_e), qi - (n01 * wn_e + n21 * wd_e), ri - (n02 * wn_e + n22 * wd_e)
     # lever-arm terms: w_eb x l (velocity); w x l with the inertial rate (specific force)
     ux, uy, uz = q * lz - r * ly, r * lx - p * lz, p * ly - q * lx
     wx, wy, wz = qi * lz - ri * ly, ri * lx - pi_ * lz, pi_ * ly - qi * lx
-    s = _LBF_PER_SLUG / m
+    s = LBF_PER_SLUG / m
     # (R (w1 x l) - w x l) / dt, w1 = w + dt w', R the step's body rotation (q(+) = normalize(q (1, dt w / 2)))
     ex, ey, ez = hdt * pi_, hdt * qi, hdt * ri
     ux1, uy1, uz1 = pi_ + dt * pid, qi + dt * qid, ri + dt * rid
@@ -186,13 +189,13 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     x_e, y_e, z_e = gk.geodetic_to_ecef(lat_i, lon_i, h_i)
     # gravitation gradient over the lever arm, GM/r^3 (l - 3 d_D C_nb' e_D) (J2 part < 1e-8 m/s^2)
     r2 = x_e * x_e + y_e * y_e + z_e * z_e
-    kg = _GM / (r2 * math.sqrt(r2))
+    kg = GM_JSBSIM / (r2 * math.sqrt(r2))
     fbx += kg * (lx - 3.0 * dd * n20)
     fby += kg * (ly - 3.0 * dd * n21)
     fbz += kg * (lz - 3.0 * dd * n22)
     # gravitation of the step start vs its midpoint along the inertial velocity v_i = v + W x r
     kv = kg * hdt
-    gn_, ge_, gd_ = kv * vn, kv * (ve + _OMEGA * math.sqrt(x_e * x_e + y_e * y_e)), -2.0 * kv * vd
+    gn_, ge_, gd_ = kv * vn, kv * (ve + OMEGA_JSBSIM * math.sqrt(x_e * x_e + y_e * y_e)), -2.0 * kv * vd
     fbx += n00 * gn_ + n10 * ge_ + n20 * gd_
     fby += n01 * gn_ + n11 * ge_ + n21 * gd_
     fbz += n02 * gn_ + n12 * ge_ + n22 * gd_
@@ -213,7 +216,7 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     dpsi = math.atan2(m10, m00) - psi
     psi_i = psi + (dpsi - _TWO_PI * np.rint(dpsi / _TWO_PI))  # psi + remainder(dpsi, 2 pi)
     # static pressure at the IMU point, hydrostatic over the CG-to-IMU height difference
-    p_imu = p_psf * _PSF * math.exp(dd * _G0_OVER_R / (t_r / _RANKINE))
+    p_imu = p_psf * _PSF * math.exp(dd * G0_OVER_R_AIR / (t_r / RANKINE_PER_K))
     dx, dy, dz = x_e - ox, y_e - oy, z_e - oz
     xr = c00 * dx + c01 * dy + c02 * dz
     yr = c10 * dx + c11 * dy + c12 * dz
@@ -233,108 +236,12 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     out[14], out[15], out[16] = phi_i, th_i, psi_i
     out[17], out[18], out[19] = pi_, qi, ri
     out[20], out[21], out[22] = fbx, fby, fbz
-    out[23], out[24], out[25] = p_imu, t_r / _RANKINE, h_i - terr
+    out[23], out[24], out[25] = p_imu, t_r / RANKINE_PER_K, h_i - terr
     out[26], out[27], out[28] = xr, yr, zr
     out[29] = cone_deviation(xr, yr, zr, 0.0, 0.0, 0.0, tan_gp, const[17], const[18], const[19], const[20])[0]
     out[30] = yr
     out[35] = vc_kt * _KT
     return terr, p, q, r
-
-
-def _cross(a: Array, b: Array) -> Array:
-    return np.cross(a, b)
-
-
-def earth_rates_reference(raw: Array) -> Array:
-    """JSBSim's Earth-relative body rates p, q, r (velocities/p-rad_sec, ...) from reads in RAW_FIELDS order, (n, 3)
-    rad/s: w_eb = w_ib - C_nb' w_ie, w_ie = Omega (cos L, 0, -sin L) in JSBSim's local NED, whose latitude is the
-    geodetic one (FGLocation's local frame), Omega = geo.OMEGA_JSBSIM; C_nb from the Euler angles.
-
-    JSBSim computes vPQR = vPQRi - Ti2b (0, 0, Omega) (FGPropagate::Run) with Ti2b from its ECI quaternion, which
-    it renormalizes only when |1 - |q|| reaches 1e-10 (FGQuaternion::Normalize): its Ti2b is scaled by |q|^2, so
-    its p, q, r differ from these by up to 2e-10 Omega = 1.5e-14 rad/s (tests/integration/test_flight_reads.py)."""
-    raw = np.atleast_2d(np.asarray(raw, dtype=float))
-    lat, phi, th, psi = raw[:, 0], raw[:, 6], raw[:, 7], raw[:, 8]
-    w_ie = _OMEGA * np.stack([np.cos(lat), np.zeros_like(lat), -np.sin(lat)], axis=1)
-    cr, sr, cp, sp, cy, sy = np.cos(phi), np.sin(phi), np.cos(th), np.sin(th), np.cos(psi), np.sin(psi)
-    c_nb = np.stack([np.stack([cp * cy, sr * sp * cy - cr * sy, cr * sp * cy + sr * sy], -1),
-                     np.stack([cp * sy, sr * sp * sy + cr * cy, cr * sp * sy - sr * cy], -1),
-                     np.stack([-sp, sr * cp, cr * cp], -1)], -2)
-    return raw[:, 9:12] - np.einsum("nji,nj->ni", c_nb, w_ie)
-
-
-def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m: Array, t_s: Array) -> Array:
-    """`imu_point_row` for many steps at once in vectorized numpy (the kernel's test oracle): raw (n, 24) in
-    RAW_FIELDS order, t_s (n,); returns (n, 36) rows with columns 0-30 and 35 filled (NaN elsewhere).
-
-    Written with matrices and np.cross rather than the kernel's scalar expressions, so that it checks them."""
-    raw = np.atleast_2d(np.asarray(raw, dtype=float))
-    n = raw.shape[0]
-    lev = const[0:3]
-    r_n, r_e = const[3], const[4]
-    origin = const[5:8]
-    c_rwy2 = np.stack([const[8:11], const[11:14]])
-    h_thr, dt = const[14], const[21]
-    lat, lon, h = raw[:, 0], raw[:, 1], raw[:, 2] * _FT
-    v_cg = raw[:, 3:6] * _FPS
-    eul = raw[:, 6:9]
-    w_ib, w_dot = raw[:, 9:12], raw[:, 12:15]
-    f_cg = raw[:, 15:18] * (_LBF_PER_SLUG / raw[:, 18:19])
-    cr, sr = np.cos(eul[:, 0]), np.sin(eul[:, 0])
-    cp, sp = np.cos(eul[:, 1]), np.sin(eul[:, 1])
-    cy, sy = np.cos(eul[:, 2]), np.sin(eul[:, 2])
-    c_nb = np.stack([np.stack([cp * cy, sr * sp * cy - cr * sy, cr * sp * cy + sr * sy], -1),
-                     np.stack([cp * sy, sr * sp * sy + cr * cy, cr * sp * sy - sr * cy], -1),
-                     np.stack([-sp, sr * cp, cr * cp], -1)], -2)  # body -> NED, (n, 3, 3)
-    l_b = np.broadcast_to(lev, (n, 3))
-    w_eb = earth_rates_reference(raw)
-    e = 0.5 * dt * w_ib
-    a = _cross(w_ib + dt * w_dot, l_b)  # w1 x l
-    b = _cross(e, a)
-    k2 = 2.0 / (1.0 + np.sum(e * e, axis=1))
-    rot_a = a + k2[:, None] * (b + _cross(e, b))  # R (w1 x l), R = rotation by the quaternion (1, e)
-    f = f_cg + (rot_a - _cross(w_ib, l_b)) / dt
-    v = v_cg + np.einsum("nij,nj->ni", c_nb, _cross(w_eb, l_b))
-    d = np.einsum("nij,j->ni", c_nb, lev)  # C_nb l, NED
-    lat_i = lat + d[:, 0] / (r_n + h)
-    lon_i = lon + d[:, 1] / ((r_e + h) * np.cos(lat))
-    h_i = h - d[:, 2]
-    r = geo.geodetic_to_ecef(lat_i, lon_i, h_i)
-    kg = _GM / np.sum(r * r, axis=1) ** 1.5
-    f = f + kg[:, None] * (l_b - 3.0 * d[:, 2:3] * c_nb[:, 2, :])
-    g_ned = (kg * 0.5 * dt)[:, None] * np.stack(
-        [v[:, 0], v[:, 1] + _OMEGA * np.hypot(r[:, 0], r[:, 1]), -2.0 * v[:, 2]], axis=1)
-    f = f + np.einsum("nji,nj->ni", c_nb, g_ned)  # C_nb' g
-    phi_v = 2.0 * e
-    a2 = np.sum(phi_v * phi_v, axis=1)[:, None]
-    pf = _cross(phi_v, f)
-    f = f - (0.5 - a2 / 24.0) * pf + (1.0 / 6.0 - a2 / 120.0) * _cross(phi_v, pf)
-    t = np.stack([d[:, 1] / (r_e + h), -d[:, 0] / (r_n + h), -d[:, 1] * np.tan(lat) / (r_e + h)], axis=1)
-    v = v - _cross(t, v)  # (I - [t x]) v
-    m_nb = c_nb - _cross(t[:, None, :], c_nb.transpose(0, 2, 1)).transpose(0, 2, 1)  # (I - [t x]) C_nb by column
-    roll = np.arctan2(m_nb[:, 2, 1], m_nb[:, 2, 2])
-    pitch = -np.arcsin(m_nb[:, 2, 0])
-    yaw = eul[:, 2] + np.remainder(np.arctan2(m_nb[:, 1, 0], m_nb[:, 0, 0]) - eul[:, 2] + np.pi, 2.0 * np.pi) - np.pi
-    p_imu = raw[:, 19] * _PSF * np.exp(d[:, 2] * _G0_OVER_R / (raw[:, 20] / _RANKINE))
-    xy = (r - origin) @ c_rwy2.T
-    zr = h_i - h_thr
-    terr = np.full(n, height_m[0]) if len(height_m) == 1 else np.interp(xy[:, 0], along_m, height_m)
-    hr, hp, hy = 0.5 * roll, 0.5 * pitch, 0.5 * yaw
-    q = np.stack([np.cos(hr) * np.cos(hp) * np.cos(hy) + np.sin(hr) * np.sin(hp) * np.sin(hy),
-                  np.sin(hr) * np.cos(hp) * np.cos(hy) - np.cos(hr) * np.sin(hp) * np.sin(hy),
-                  np.cos(hr) * np.sin(hp) * np.cos(hy) + np.sin(hr) * np.cos(hp) * np.sin(hy),
-                  np.cos(hr) * np.cos(hp) * np.sin(hy) - np.sin(hr) * np.sin(hp) * np.cos(hy)], axis=1)
-    out = np.full((n, 36), np.nan)
-    out[:, 0], out[:, 1], out[:, 2], out[:, 3] = t_s, lat_i, lon_i, h_i
-    out[:, 4:7], out[:, 7:10], out[:, 10:14] = r, v, q
-    out[:, 14], out[:, 15], out[:, 16] = roll, pitch, yaw
-    out[:, 17:20], out[:, 20:23] = w_ib, f
-    out[:, 23], out[:, 24], out[:, 25] = p_imu, raw[:, 20] / _RANKINE, h_i - terr
-    out[:, 26], out[:, 27], out[:, 28] = xy[:, 0], xy[:, 1], zr
-    out[:, 29] = zr - cone_height(xy[:, 0], xy[:, 1], const[15], *const[17:21])
-    out[:, 30] = xy[:, 1]
-    out[:, 35] = raw[:, 21] * _KT
-    return out
 
 
 # --- the flight loop's per-step kernel: turbulence, autopilot, stabilized-approach monitor, termination -----------
@@ -765,60 +672,6 @@ def fly_control(k: int, guidance: Array, buf: Array, par: Array, st: Array) -> t
     s = st[S_STEP:S_STEP + N_F_STATE]
     return _control(par, st, buf[k], g[0], g[1], g[2], g[3], g[4], g[5], s[FS_PHI], s[FS_THETA], s[FS_P], s[FS_Q],
                     s[FS_BETA], s[FS_CAS], s[FS_H_GEAR], s[FS_TAS], s[FS_PSI], s[FS_R])
-
-
-def autopilot_arrays(ap: Any) -> tuple[Array, Array]:
-    """(parameters, state) of the compiled autopilot (AP_*, APS_*) from its oracle (flight/autopilot.Autopilot)."""
-    par = [getattr(ap.g, name) for name in AP_GAINS]
-    par += [ap.trim.theta_rad, ap.trim.throttle, ap.trim.cas_mps, ap.ch, ap.sh, ap.heading_rad, ap.tan_gp,
-            ap.x_gpi_m, ap.cone_a, ap.cone_b, ap.cone_c, ap.conv_per_east_m, ap.dt]
-    return np.array(par, dtype=float), np.array(ap.state(), dtype=float)
-
-
-def dryden_arrays(turb: Any) -> tuple[Array, Array]:
-    """(parameters, state) of the compiled turbulence (TB_*, TBS_*) from its oracle
-    (flight/turbulence.DrydenTurbulence); its noise is turb.nu."""
-    par = [turb.w20_fps, turb.dt, turb.cos_fps, turb.sin_fps, *POE_ALT_FT, *POE_SIGMA_FPS[turb.index - 1]]
-    return np.array(par, dtype=float), np.array(turb.state(), dtype=float)
-
-
-def monitor_arrays(mon: Any) -> tuple[Array, Array, Array]:
-    """(parameters, state, windows) of the compiled stabilized-approach monitor (MN_*, MNS_*, the ring buffer)
-    from its oracle (flight/envelope.StabilityMonitor)."""
-    par = [mon.tan_gp, math.tan(mon.gs_dot_rad), mon.x_gp_m, mon.x_floor_m, math.tan(mon.loc_dot_rad), mon.tch_m,
-           mon.target_mps, float(mon.n), float(mon.m), *mon.curvature]
-    return np.array(par, dtype=float), np.array(mon.state(), dtype=float), np.array(mon.windows(), dtype=float)
-
-
-def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, terrain_along_m: Array,
-                   terrain_height_m: Array, *, pitch_trim: float, stop_height_m: float, land: bool,
-                   monitor_floor_m: float, wind_ned_mps: tuple[float, float]) -> tuple[Array, Array]:
-    """fly_step's (par, st) for one flight: the IMU-point constants (imu_point_constants), the autopilot, monitor
-    and turbulence (None: calm air) of the run (their oracles, fresh), the terrain profile (along-track distances
-    and heights, m), the trimmed pitch trim (the elevator column of the Truth controls adds it), the stop height
-    above the threshold (m; -inf: none), landing run (flare, touchdown), the height above the threshold the
-    monitor stops at (m) and the steady wind (north, east, m/s; the air moves with it)."""
-    ap_par, ap_st = autopilot_arrays(ap)
-    mn_par, mn_st, ring = monitor_arrays(mon)
-    if turb is not None:
-        tb_par, tb_st = dryden_arrays(turb)
-    else:
-        tb_par, tb_st = np.zeros(N_TB_PAR), np.zeros(N_TB_STATE)
-    fpar = np.zeros(N_F_PAR)
-    fpar[F_PITCH_TRIM], fpar[F_STOP_H], fpar[F_LAND] = pitch_trim, stop_height_m, float(land)
-    fpar[F_TAN_GP], fpar[F_TCH] = ap.tan_gp, ap.tch_m
-    fpar[F_X_GPI], fpar[F_CA], fpar[F_CB], fpar[F_CC] = ap.x_gpi_m, ap.cone_a, ap.cone_b, ap.cone_c
-    fpar[F_MON_FLOOR], fpar[F_WIND_N], fpar[F_WIND_E] = monitor_floor_m, wind_ned_mps[0], wind_ned_mps[1]
-    fpar[F_TURBULENT] = float(turb is not None)
-    fpar[F_N_TERRAIN] = len(terrain_along_m)
-    fst = np.zeros(N_F_STATE)
-    fst[FS_THR] = ap.trim.throttle  # the trimmed controls are in force at row 0
-    fst[FS_LOWEST] = math.inf
-    fst[FS_TD_X] = fst[FS_TD_SINK] = math.nan
-    par = np.concatenate([np.asarray(const, dtype=float), fpar, ap_par, tb_par, mn_par,
-                          np.asarray(terrain_along_m, dtype=float), np.asarray(terrain_height_m, dtype=float)])
-    st = np.concatenate([fst, ap_st, tb_st, mn_st, ring])
-    return par, st
 
 
 @njit(cache=True)

@@ -33,7 +33,7 @@ import math
 import numpy as np
 from numba import njit
 
-from approachsim.nav.kernels import geodesy as gk
+from approachsim.core import geodesy as gk
 
 NX = 16
 """Columns of the packed INS state."""

@@ -32,7 +32,7 @@ import math
 import numpy as np
 from numba import njit
 
-from approachsim.nav.kernels import geodesy as gk
+from approachsim.core import geodesy as gk
 
 L_N, L_DP, L_DV, L_PSI, L_BG, L_BA, L_BB, L_SB, L_CLK, L_AC = range(10)
 L_GSE, L_GMP, L_PMP, L_PTR, L_PCLK, L_RAB, L_RAM, L_TDB, L_NSV, L_NPL = range(10, 20)

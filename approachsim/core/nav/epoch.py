@@ -7,12 +7,12 @@ Order of the rows (nav/rows.py): baro, radar altimeter, each GNSS channel in cha
 carrier phase (carrier phase only), each pseudolite in unit order; a row exists when member 0's value is finite
 (a class shares one schedule: nav/shared.py).
 
-    predict    x_m <- Phi x_m (each member),  P <- Phi P Phi' + Qd                      (kernels/kalman.py)
+    predict    x_m <- Phi x_m (each member),  P <- Phi P Phi' + Qd                      (core/nav/kalman.py)
     each row   own (one run, the per-run EKF): h and nu = z - g(x_hat) at the run's own INS and current x_hat
                (sequential relinearization, as nav/navigator.py's per-run filters);
                shared (M runs): h and r at the reference trajectory `ref` with x_hat = 0 (the truth: nav/shared.py),
                nu_m of each member at its own INS and current x_hat_m
-               S = h' P h + r ; K = P h / S ; x_m <- x_m + K nu_m ; P Joseph (O(n^2), kernels/kalman.py)
+               S = h' P h + r ; K = P h / S ; x_m <- x_m + K nu_m ; P Joseph (O(n^2), core/nav/kalman.py)
 
 Rows and innovations are kernels/measurements.py's. The numpy paths (nav/navigator.py with nav/rows.py, and
 nav/shared.py) are the test oracle (tests/unit/nav/test_epoch_engine.py: equal to 1e-12 relative norm-wise).
@@ -33,11 +33,11 @@ import math
 import numpy as np
 from numba import njit
 
-from approachsim.nav.kernels import carrier as kcar
-from approachsim.nav.kernels import errormodel as ek
-from approachsim.nav.kernels import geodesy as gk
-from approachsim.nav.kernels import kalman as kk
-from approachsim.nav.kernels import measurements as km
+from approachsim.core import geodesy as gk
+from approachsim.core.nav import carrier as kcar
+from approachsim.core.nav import errormodel as ek
+from approachsim.core.nav import kalman as kk
+from approachsim.core.nav import measurements as km
 
 CODE_BARO, CODE_RADALT, CODE_GPS, CODE_PL, CODE_CP = 0, 1, 100, 200, 300
 """Row codes (module docstring)."""
