@@ -42,13 +42,9 @@ from dataclasses import dataclass
 
 from approachsim import units
 from approachsim.config import ProfileError
-from approachsim.core.loop.flight_step import (  # the criteria the compiled monitor applies, defined there once
+from approachsim.core.loop.flight_step import MON_GLIDEPATH, MON_LOCALIZER, MON_OK, MON_SINK, MON_SPEED
+from approachsim.core.tables import (  # the criteria the compiled monitor applies, defined there once
     LOC_ANTENNA_PAST_THRESHOLD_M,
-    MON_GLIDEPATH,
-    MON_LOCALIZER,
-    MON_OK,
-    MON_SINK,
-    MON_SPEED,
     SINK_LIMIT_MPS,
     SINK_TOLERANCE_MPS,
     SPEED_HIGH_MPS,

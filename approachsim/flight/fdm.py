@@ -41,7 +41,7 @@ import jsbsim
 import numpy as np
 
 from approachsim import units
-from approachsim.core.loop import direct as dk
+from approachsim.core import layouts
 from approachsim.core.loop import jsbsim_abi
 from approachsim.flight.design import Linearization
 
@@ -152,8 +152,8 @@ class FDM:
     def direct_addresses(self, written: Sequence[str], read: Sequence[str]) -> np.ndarray | None:
         """The uint64 vector core/loop/direct.py flies on: the C++ entry points, this FGFDMExec, the nodes
         `written` then `read` (each checked, flight/jsbsim_abi.py); None when any of them is unavailable."""
-        if len(written) != dk.N_WRITE:
-            raise ValueError(f"direct_addresses: {dk.N_WRITE} written properties, got {len(written)}")
+        if len(written) != layouts.N_WRITE:
+            raise ValueError(f"direct_addresses: {layouts.N_WRITE} written properties, got {len(written)}")
         lib = jsbsim_abi.library(jsbsim._jsbsim.__file__)
         if lib is None:
             return None
@@ -226,12 +226,6 @@ class FDM:
         )
 
 
-WRITTEN = ("fcs/elevator-cmd-norm", "fcs/aileron-cmd-norm", "fcs/rudder-cmd-norm", "fcs/throttle-cmd-norm[0]",
-           "fcs/throttle-cmd-norm[1]", "atmosphere/gust-north-fps", "atmosphere/gust-east-fps",
-           "atmosphere/gust-down-fps", "position/terrain-elevation-asl-ft")
-"""The flight loop's written properties, in LoopIO's setters' order and core/loop/direct.py's D_WRITE order."""
-
-
 class LoopIO:
     """The flight loop's JSBSim property traffic of one run, bound once: one call reads a step's inputs, bound
     setters write the commands. Values are in JSBSim's units (the compiled step converts them: core/loop/flight_step).
@@ -258,13 +252,13 @@ class LoopIO:
         self.read = _tuple_reader(getters, tuple(float(v) for v in near_stand_in))
         self.read_near = _tuple_reader(getters + near, ())
         self.run = fdm.run
-        de, da, dr, thr0, thr1, gn, ge, gd, terr = (fdm.node(name).set_double_value for name in WRITTEN)
+        de, da, dr, thr0, thr1, gn, ge, gd, terr = (fdm.node(name).set_double_value for name in layouts.WRITTEN)
         self.set_elevator, self.set_aileron, self.set_rudder = de, da, dr
         self.set_throttle = (thr0, thr1)
         self.set_gust_fps = (gn, ge, gd)
         self.set_terrain_ft = terr
         self._fdm = fdm
-        self.direct = fdm.direct_addresses(WRITTEN, [*reads, *near_reads])
+        self.direct = fdm.direct_addresses(layouts.WRITTEN, [*reads, *near_reads])
         """The address vector of core/loop/direct.py (D_* layout) for the same reads and writes, or None when
         the C++ entry points cannot be used here (flight/jsbsim_abi.py): then only the Python loop flies."""
 

@@ -48,6 +48,7 @@ import numpy as np
 
 from approachsim import units
 from approachsim.config import ProfileError
+from approachsim.core import layouts
 from approachsim.core.entry import entry_point
 from approachsim.core.loop import closed_step as ck
 from approachsim.core.loop import direct as dk
@@ -88,13 +89,9 @@ LINEARIZATION_HEIGHT_M = 1000.0 * units.FT
 """Height above the threshold of the design linearization (the top of the 1000-200 ft scored segment)."""
 
 # column layout of the one (n, 36) buffer the Truth arrays are views of while flying
-_COLS = {
-    "t_s": (0, 1), "lat_rad": (1, 1), "lon_rad": (2, 1), "h_m": (3, 1), "r_ecef": (4, 3), "v_ned": (7, 3),
-    "q_nb": (10, 4), "euler_rad": (14, 3), "w_ib_body": (17, 3), "f_body": (20, 3), "p_static_pa": (23, 1),
-    "t_air_k": (24, 1), "h_agl_m": (25, 1), "r_rwy": (26, 3), "gs_dev_m": (29, 1), "loc_dev_m": (30, 1),
-    "controls": (fk.CONTROLS_COL, 4), "airspeed_mps": (35, 1),
-}
-_NCOL = 36
+_COLS = {name: (layouts.TRUTH_ROW.start(name), layouts.TRUTH_ROW.width(name)) for name in layouts.TRUTH_ROW.names}
+"""The row buffer's Truth fields: (first column, width), from core/layouts.py TRUTH_ROW."""
+_NCOL = layouts.N_ROW
 _COL_STARTS = np.array([c for c, _ in _COLS.values()], dtype=np.int64)
 
 
@@ -271,12 +268,12 @@ class Approach:
         if max_time_s is None:
             max_time_s = self.time_budget_s
         n_max = int(math.ceil(max_time_s / dt)) + 1
-        io = fdm.loop_io(fk.RAW_FIELDS, fk.GEAR_FIELDS, fk.GEAR_AIRBORNE)
+        io = fdm.loop_io(layouts.RAW_FIELDS, layouts.GEAR_FIELDS, layouts.GEAR_AIRBORNE)
         par, st, nu = self._kernel_vectors(fdm, ic, seed, run, n_max)
-        turbulent = par[fk.P_STEP + fk.F_TURBULENT] != 0.0
+        turbulent = par[layouts.P_STEP + layouts.F_TURBULENT] != 0.0
         if turbulent:
             io.gust_on()
-        hilly = par[fk.P_STEP + fk.F_N_TERRAIN] > 1
+        hilly = par[layouts.P_STEP + layouts.F_N_TERRAIN] > 1
         buf = np.full((n_max, _NCOL), np.nan)
         truth = _truth_views(buf, rw.frame)
 
@@ -296,7 +293,7 @@ class Approach:
         else:
             guidance = None if src is None else np.full((n_max, 6), np.nan)
         read, read_near, run_step = io.read, io.read_near, io.run
-        raw0 = (0.0,) * (fk.N_RAW + len(fk.GEAR_FIELDS))
+        raw0 = (0.0,) * (layouts.N_RAW + len(layouts.GEAR_FIELDS))
         step = entry_point(fk.fly_step, 0, raw0, buf, nu, par, st, guided)
         control = None if guided else entry_point(fk.fly_control, 0, guidance, buf, par, st)
         if fused is not None:
@@ -312,7 +309,7 @@ class Approach:
         k = 0
         direct = io.direct if (guided or fused is not None) else None
         if direct is not None:  # the same loop compiled, JSBSim called from it (core/loop/direct.py)
-            raw = np.zeros(dk.N_READ)
+            raw = np.zeros(layouts.N_READ)
             if guided:
                 k, code = entry_point(dk.fly_guided, direct, raw, buf, nu, par, st)(direct, raw, buf, nu, par, st)
             else:
@@ -356,21 +353,21 @@ class Approach:
             g_r, g_v = final.r_rwy.copy(), final.v_ned.copy()
         else:
             g_r, g_v = np.ascontiguousarray(guidance[:n, 0:3]), np.ascontiguousarray(guidance[:n, 3:6])
-        fs = st[fk.S_STEP:fk.S_STEP + fk.N_F_STATE]
+        fs = st[layouts.S_STEP:layouts.S_STEP + layouts.N_F_STATE]
         td = {}
         if code in (fk.TERM_TOUCHDOWN, fk.TERM_SHORT):  # scored at the main gear, not the IMU point
             sc = touchdown_scalars(final, self.main_gear_lever_arms_m)
             td = {"touchdown_x_m": sc["td_x_m"], "touchdown_sink_mps": sc["td_sink_mps"],
                   "touchdown_y_m": sc["td_y_m"], "touchdown_drift_rad": sc["td_gear_slip_rad"],
                   "touchdown_crab_rad": sc["td_crab_rad"]}
-            fs[fk.FS_TD_X] = sc["td_x_m"]
+            fs[layouts.FS_TD_X] = sc["td_x_m"]
             code = fk.TERM_TOUCHDOWN if sc["td_x_m"] >= 0.0 else fk.TERM_SHORT
         return FlightResult(
             truth=final,
             guidance_r_rwy=g_r,
             guidance_v_ned=g_v,
             termination=termination_reason(code, fs),
-            lowest_height_ft=float(fs[fk.FS_LOWEST]) / units.FT,
+            lowest_height_ft=float(fs[layouts.FS_LOWEST]) / units.FT,
             **td,
             seed=seed,
             run=run,
@@ -450,13 +447,14 @@ def termination_reason(code: int, fs: Array) -> str:
     if code == fk.TERM_TOUCHDOWN:
         return "touchdown"
     if code == fk.TERM_SHORT:
-        return f"touchdown short of the threshold ({-fs[fk.FS_TD_X] / units.FT:.0f} ft)"
+        return f"touchdown short of the threshold ({-fs[layouts.FS_TD_X] / units.FT:.0f} ft)"
     if code == fk.TERM_GROUND:
         return "ground contact"
     if code == fk.TERM_DIVERGED:
         return "diverged"
     if code == fk.TERM_UNSTABLE:
-        return unstabilized_reason(int(fs[fk.FS_MON]), fs[fk.FS_MON_Z], fs[fk.FS_MON_A], fs[fk.FS_MON_B])
+        return unstabilized_reason(int(fs[layouts.FS_MON]), fs[layouts.FS_MON_Z], fs[layouts.FS_MON_A],
+                                   fs[layouts.FS_MON_B])
     return "timeout"
 
 

@@ -28,7 +28,7 @@ import math
 import numpy as np
 
 from approachsim import units
-from approachsim.core.loop.flight_step import COEFF_EVERY, POE_ALT_FT, POE_SIGMA_FPS  # the kernel's table, once
+from approachsim.core.tables import COEFF_EVERY, POE_ALT_FT, POE_SIGMA_FPS  # the kernel's table, once
 
 LEVELS = {
     "none": None,

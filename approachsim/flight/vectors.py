@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from approachsim import geo, units
+from approachsim.core import layouts, tables
 from approachsim.core.loop import flight_step as fk
 from approachsim.glidepath import GlidePath, cone_height
 
@@ -135,7 +136,7 @@ def imu_point_rows_reference(raw: Array, const: Array, along_m: Array, height_m:
 
 def autopilot_arrays(ap: Any) -> tuple[Array, Array]:
     """(parameters, state) of the compiled autopilot (AP_*, APS_*) from its oracle (flight/autopilot.Autopilot)."""
-    par = [getattr(ap.g, name) for name in fk.AP_GAINS]
+    par = [getattr(ap.g, name) for name in layouts.AP_GAINS]
     par += [ap.trim.theta_rad, ap.trim.throttle, ap.trim.cas_mps, ap.ch, ap.sh, ap.heading_rad, ap.tan_gp,
             ap.x_gpi_m, ap.cone_a, ap.cone_b, ap.cone_c, ap.conv_per_east_m, ap.dt]
     return np.array(par, dtype=float), np.array(ap.state(), dtype=float)
@@ -144,7 +145,7 @@ def autopilot_arrays(ap: Any) -> tuple[Array, Array]:
 def dryden_arrays(turb: Any) -> tuple[Array, Array]:
     """(parameters, state) of the compiled turbulence (TB_*, TBS_*) from its oracle
     (flight/turbulence.DrydenTurbulence); its noise is turb.nu."""
-    par = [turb.w20_fps, turb.dt, turb.cos_fps, turb.sin_fps, *fk.POE_ALT_FT, *fk.POE_SIGMA_FPS[turb.index - 1]]
+    par = [turb.w20_fps, turb.dt, turb.cos_fps, turb.sin_fps, *tables.POE_ALT_FT, *tables.POE_SIGMA_FPS[turb.index - 1]]
     return np.array(par, dtype=float), np.array(turb.state(), dtype=float)
 
 
@@ -169,18 +170,20 @@ def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, terrain_al
     if turb is not None:
         tb_par, tb_st = dryden_arrays(turb)
     else:
-        tb_par, tb_st = np.zeros(fk.N_TB_PAR), np.zeros(fk.N_TB_STATE)
-    fpar = np.zeros(fk.N_F_PAR)
-    fpar[fk.F_PITCH_TRIM], fpar[fk.F_STOP_H], fpar[fk.F_LAND] = pitch_trim, stop_height_m, float(land)
-    fpar[fk.F_TAN_GP], fpar[fk.F_TCH] = ap.tan_gp, ap.tch_m
-    fpar[fk.F_X_GPI], fpar[fk.F_CA], fpar[fk.F_CB], fpar[fk.F_CC] = ap.x_gpi_m, ap.cone_a, ap.cone_b, ap.cone_c
-    fpar[fk.F_MON_FLOOR], fpar[fk.F_WIND_N], fpar[fk.F_WIND_E] = monitor_floor_m, wind_ned_mps[0], wind_ned_mps[1]
-    fpar[fk.F_TURBULENT] = float(turb is not None)
-    fpar[fk.F_N_TERRAIN] = len(terrain_along_m)
-    fst = np.zeros(fk.N_F_STATE)
-    fst[fk.FS_THR] = ap.trim.throttle  # the trimmed controls are in force at row 0
-    fst[fk.FS_LOWEST] = math.inf
-    fst[fk.FS_TD_X] = fst[fk.FS_TD_SINK] = math.nan
+        tb_par, tb_st = np.zeros(layouts.N_TB_PAR), np.zeros(layouts.N_TB_STATE)
+    fpar = np.zeros(layouts.N_F_PAR)
+    fpar[layouts.F_PITCH_TRIM], fpar[layouts.F_STOP_H], fpar[layouts.F_LAND] = pitch_trim, stop_height_m, float(land)
+    fpar[layouts.F_TAN_GP], fpar[layouts.F_TCH] = ap.tan_gp, ap.tch_m
+    fpar[layouts.F_X_GPI], fpar[layouts.F_CA] = ap.x_gpi_m, ap.cone_a
+    fpar[layouts.F_CB], fpar[layouts.F_CC] = ap.cone_b, ap.cone_c
+    fpar[layouts.F_MON_FLOOR] = monitor_floor_m
+    fpar[layouts.F_WIND_N], fpar[layouts.F_WIND_E] = wind_ned_mps[0], wind_ned_mps[1]
+    fpar[layouts.F_TURBULENT] = float(turb is not None)
+    fpar[layouts.F_N_TERRAIN] = len(terrain_along_m)
+    fst = np.zeros(layouts.N_F_STATE)
+    fst[layouts.FS_THR] = ap.trim.throttle  # the trimmed controls are in force at row 0
+    fst[layouts.FS_LOWEST] = math.inf
+    fst[layouts.FS_TD_X] = fst[layouts.FS_TD_SINK] = math.nan
     par = np.concatenate([np.asarray(const, dtype=float), fpar, ap_par, tb_par, mn_par,
                           np.asarray(terrain_along_m, dtype=float), np.asarray(terrain_height_m, dtype=float)])
     st = np.concatenate([fst, ap_st, tb_st, mn_st, ring])

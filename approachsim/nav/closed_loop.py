@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from approachsim import geo
+from approachsim.core import layouts
 from approachsim.core.entry import entry_point
 from approachsim.core.loop import aiding as ce
 from approachsim.core.loop import nav_row as ik
@@ -366,17 +367,17 @@ class NavInTheLoop:
         if self._inloop is None:
             m_g, m_a, c_g, c_a = self._imu_affine
             n = self.t_s.shape[0]
-            nw = np.zeros(ik.NW)
-            nw[ik.W_LOOP:ik.W_LOOP + 6] = self._loop
-            nw[ik.W_HB] = nw[ik.W_HB_T] = math.nan
-            nw[ik.W_DT] = self.dt
-            nw[ik.W_MG:ik.W_MG + 9] = m_g.reshape(9)
-            nw[ik.W_MA:ik.W_MA + 9] = m_a.reshape(9)
-            nw[ik.W_CRWY:ik.W_CRWY + 6] = self._c_rwy[0:2].reshape(6)
-            nw[ik.W_ORWY:ik.W_ORWY + 3] = self._o_rwy
-            nw[ik.W_HTHR] = self._h_thr
-            nw[ik.W_EPOCH_ROWS] = self.epoch_rows
-            nw[ik.W_BARO_LOOP] = 1.0 if self.gains is not None else 0.0
+            nw = np.zeros(layouts.NW)
+            nw[layouts.W_LOOP:layouts.W_LOOP + 6] = self._loop
+            nw[layouts.W_HB] = nw[layouts.W_HB_T] = math.nan
+            nw[layouts.W_DT] = self.dt
+            nw[layouts.W_MG:layouts.W_MG + 9] = m_g.reshape(9)
+            nw[layouts.W_MA:layouts.W_MA + 9] = m_a.reshape(9)
+            nw[layouts.W_CRWY:layouts.W_CRWY + 6] = self._c_rwy[0:2].reshape(6)
+            nw[layouts.W_ORWY:layouts.W_ORWY + 3] = self._o_rwy
+            nw[layouts.W_HTHR] = self._h_thr
+            nw[layouts.W_EPOCH_ROWS] = self.epoch_rows
+            nw[layouts.W_BARO_LOOP] = 1.0 if self.gains is not None else 0.0
             baro_j = np.full(n, -1, dtype=np.int64)
             baro_e, lag_w = np.zeros((0, 2)), np.zeros(0)
             e = self.errors.sensors.get("baro")
@@ -386,14 +387,15 @@ class NavInTheLoop:
                 baro_j[rows[keep]] = np.flatnonzero(keep)
                 baro = self.suite.sensors["baro"]
                 if type(baro) is Baro:  # a plain altimeter: its samples made in the kernel (a faulted one: Python)
-                    nw[ik.W_BARO_KERNEL] = 1.0
-                    (nw[ik.W_BSET], nw[ik.W_BT0L], nw[ik.W_BEXP], nw[ik.W_BFLD],
-                     nw[ik.W_BCM1]) = baro.kernel_constants()
-                    nw[ik.W_BSF] = float(np.ravel(e.constants["scale_factor"])[0])
+                    nw[layouts.W_BARO_KERNEL] = 1.0
+                    (nw[layouts.W_BSET], nw[layouts.W_BT0L], nw[layouts.W_BEXP], nw[layouts.W_BFLD],
+                     nw[layouts.W_BCM1]) = baro.kernel_constants()
+                    nw[layouts.W_BSF] = float(np.ravel(e.constants["scale_factor"])[0])
                     baro_e = np.ascontiguousarray(np.column_stack([e.series["bias"], e.series["noise"]]))
                     lag_w = np.ascontiguousarray(baro.lag_weights(self.dt), dtype=float)
             m = c_g.shape[0]
-            nw[ik.W_N], nw[ik.W_M], nw[ik.W_NBE], nw[ik.W_NLAG] = n, m, baro_e.shape[0], lag_w.shape[0]
+            nw[layouts.W_N], nw[layouts.W_M] = n, m
+            nw[layouts.W_NBE], nw[layouts.W_NLAG] = baro_e.shape[0], lag_w.shape[0]
             n_f, n_i = ik.packed_sizes(n, m, baro_e.shape[0], lag_w.shape[0])
             fa, ia = np.empty(n_f), np.empty(n_i, dtype=np.int64)
             cg, ca, rows, snap, bj, be, lw, dth, dv, guidance = ik.views(nw, fa, ia)
@@ -415,7 +417,8 @@ class NavInTheLoop:
             s, runs = nav.start(truth, [stream(self.seed, self.run, "nav")], 0, elevation_rad=el, obs=obs,
                                 states=start_states(self.suite, truth, self.errors))
             self.navigator = Navigator(nav, s, runs, float(truth.t_s[0]), self.t_s.shape[0], rows=lp.rows3)
-            self.navigator.bind(nw[ik.W_X:ik.W_X + 16].reshape(1, 16), nw[ik.W_FSUM:ik.W_FSUM + 3].reshape(1, 3),
+            self.navigator.bind(nw[layouts.W_X:layouts.W_X + layouts.NX].reshape(1, layouts.NX),
+                                nw[layouts.W_FSUM:layouts.W_FSUM + 3].reshape(1, 3),
                                 lp.rows3, lp.snap)
             self._estimate_in_force()
             self._recs = (0, recs)
@@ -439,8 +442,8 @@ class NavInTheLoop:
                     self._recs = (k, recs)
                 obs, _ = self._observations(k, truth, recs)
                 if self.gains is not None:  # the kernel's loop held over the interval (no baro, or excluded)
-                    obs = obs.with_loop_held([nw[ik.W_ANY_BARO] == 0.0])
-                    nw[ik.W_ANY_BARO] = 0.0
+                    obs = obs.with_loop_held([nw[layouts.W_ANY_BARO] == 0.0])
+                    nw[layouts.W_ANY_BARO] = 0.0
                 navigator.epoch(k, t, obs, truth)
                 self._estimate_in_force()
         if code & ik.NAV_BARO:
@@ -450,10 +453,10 @@ class NavInTheLoop:
             if b is not None:
                 # nan (an outage, or the baro excluded by FDE): the INS kernel's damping loop holds
                 held = run.baro_excluded() or not bool(np.ravel(b.valid)[0])
-                nw[ik.W_HB] = math.nan if held else float(np.ravel(b.h_baro_m)[0])
-                nw[ik.W_HB_T] = truth.t_s[k]
-                if k == 0 and nav.nav.initial_error.start == "prior" and math.isfinite(nw[ik.W_HB]):
-                    nw[ik.W_X + 2] = nw[ik.W_HB]  # the converged start's height error stands
+                nw[layouts.W_HB] = math.nan if held else float(np.ravel(b.h_baro_m)[0])
+                nw[layouts.W_HB_T] = truth.t_s[k]
+                if k == 0 and nav.nav.initial_error.start == "prior" and math.isfinite(nw[layouts.W_HB]):
+                    nw[layouts.W_X + 2] = nw[layouts.W_HB]  # the converged start's height error stands
         navigator.record_row(k)
 
     # --- the compiled aiding epoch (core/loop/aiding.py) -------------------------------------------
@@ -684,7 +687,7 @@ class NavInTheLoop:
         eng = nav.engine
         baro_h, baro_r, radalt_h, rho, r_sv, sig, el, pl_rho, r_pl, pl_sig = inputs
         q, gse, gmp = self._noise_arrays(el)
-        held = fe.held_possible and nw[ik.W_ANY_BARO] == 0.0
+        held = fe.held_possible and nw[layouts.W_ANY_BARO] == 0.0
         if run.fs.P is not fe.P:  # the Navigator's path ran an epoch (or the start): its P from now on
             fe.P = np.array(run.fs.P, dtype=float)
         fe.X[0] = run.fs.x
@@ -704,7 +707,7 @@ class NavInTheLoop:
         run.statuses.add_epoch(eng.codes[:n_rows], t, eng._nu[0, :n_rows], eng.S[:n_rows])
         run.fs = FilterState(x=fe.XS[e].copy(), P=fe.P, memory=run.fs.memory)
         nav.epoch_done(k, t, fe.XS[e:e + 1], fe.PP[e:e + 1], fe.PC[e:e + 1], fe.PD[e:e + 1], fe.PN[e:e + 1])
-        nw[ik.W_SNAP] = nav.snap_index
+        nw[layouts.W_SNAP] = nav.snap_index
         return True
 
     def _estimate_in_force(self) -> None:
@@ -712,12 +715,12 @@ class NavInTheLoop:
         snapshot index."""
         nw = self._inloop.nw
         run = self.navigator.runs[0]
-        nw[ik.W_XNAV:ik.W_XNAV + 9] = run.fs.x[0:9]
+        nw[layouts.W_XNAV:layouts.W_XNAV + 9] = run.fs.x[0:9]
         if self.nav.nav.feedback:
-            nw[ik.W_BG:ik.W_BG + 3] = run.bg_fb
-            nw[ik.W_BA:ik.W_BA + 3] = run.ba_fb
-        nw[ik.W_SNAP] = self.navigator.snap_index
-        nw[ik.W_BARO_EXCL] = 1.0 if run.baro_excluded() else 0.0
+            nw[layouts.W_BG:layouts.W_BG + 3] = run.bg_fb
+            nw[layouts.W_BA:layouts.W_BA + 3] = run.ba_fb
+        nw[layouts.W_SNAP] = self.navigator.snap_index
+        nw[layouts.W_BARO_EXCL] = 1.0 if run.baro_excluded() else 0.0
 
     def result(self, truth: Truth) -> NavRun:
         """The navigation run over the flown truth (call after the flight)."""

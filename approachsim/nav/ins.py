@@ -30,6 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from approachsim import geo
+from approachsim.core import layouts as L
 from approachsim.core.nav import strapdown as sk
 from approachsim.nav import vertical_loop as vl
 
@@ -201,22 +202,23 @@ def perturb(state: InsState, dp_ned_m: Array, dv_ned_mps: Array, psi_rad: Array)
 
 
 def pack(s: InsState) -> Array:
-    """The packed (N, 16) form of a state for the compiled kernel (kernels/strapdown.py: lat, lon, h, v_ned,
+    """The packed (N, NX) form of a state for the compiled kernel (core/layouts.py INS: lat, lon, h, v_ned,
     C_bn row-major, a_comp)."""
     n = s.lat_rad.shape[0]
-    x = np.empty((n, sk.NX))
-    x[:, 0], x[:, 1], x[:, 2] = s.lat_rad, s.lon_rad, s.h_m
-    x[:, 3:6] = s.v_ned
-    x[:, 6:15] = np.asarray(s.c_bn, dtype=float).reshape(n, 9)
-    x[:, 15] = s.a_comp_mps2
+    x = np.empty((n, NX))
+    x[:, L.X_LAT], x[:, L.X_LON], x[:, L.X_H] = s.lat_rad, s.lon_rad, s.h_m
+    x[:, L.INS.slice("v_ned")] = s.v_ned
+    x[:, L.INS.slice("c_bn")] = np.asarray(s.c_bn, dtype=float).reshape(n, 9)
+    x[:, L.X_A_COMP] = s.a_comp_mps2
     return x
 
 
 def unpack(x: Array) -> InsState:
-    """An InsState (copies) from packed rows (..., 16); a leading run axis stays the run axis."""
+    """An InsState (copies) from packed rows (..., NX); a leading run axis stays the run axis."""
     x = np.asarray(x, dtype=float)
-    return InsState(x[..., 0].copy(), x[..., 1].copy(), x[..., 2].copy(), x[..., 3:6].copy(),
-                    x[..., 6:15].reshape(x.shape[:-1] + (3, 3)).copy(), x[..., 15].copy())
+    return InsState(x[..., L.X_LAT].copy(), x[..., L.X_LON].copy(), x[..., L.X_H].copy(),
+                    x[..., L.INS.slice("v_ned")].copy(),
+                    x[..., L.INS.slice("c_bn")].reshape(x.shape[:-1] + (3, 3)).copy(), x[..., L.X_A_COMP].copy())
 
 
 def loop_vector(loop: vl.LoopGains | None) -> Array:
@@ -227,8 +229,8 @@ def loop_vector(loop: vl.LoopGains | None) -> Array:
     return np.array([code, loop.c1, loop.c2, loop.c3, loop.b1_per_m, loop.b2_per_m], dtype=float)
 
 
-NX = sk.NX
-"""Columns of a packed state (pack / unpack)."""
+NX = L.NX
+"""Columns of a packed state (pack / unpack; core/layouts.py INS)."""
 
 _NO_OUT = np.empty((0, 0, NX))
 

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from approachsim import geo
+from approachsim.core import layouts
 from approachsim.core.loop import flight_step as fk
 from approachsim.flight import vectors as fv
 from approachsim.flight.fdm import FDM
@@ -36,7 +37,7 @@ def manoeuvre():
     approach = Approach(load_profile(DEFAULT))
     fdm = FDM(approach.aircraft.jsbsim_model, approach.dt_s)
     approach._trim(fdm, approach.start())
-    io = fdm.loop_io(fk.RAW_FIELDS, fk.GEAR_FIELDS, fk.GEAR_AIRBORNE)
+    io = fdm.loop_io(layouts.RAW_FIELDS, layouts.GEAR_FIELDS, layouts.GEAR_AIRBORNE)
     own = [fdm.node(f"velocities/{c}-rad_sec").get_double_value for c in "pqr"]
     lat_gc = fdm.node("position/lat-gc-rad").get_double_value
     raw, pqr, gc, near = [], [], [], []
@@ -54,28 +55,28 @@ def manoeuvre():
 def test_earth_relative_rates_are_derived_within_jsbsims_quaternion_drift(manoeuvre):
     raw, _, pqr, gc, _ = manoeuvre
     assert np.abs(pqr).max() > 0.05  # the inputs made it roll and pitch
-    derived = fv.earth_rates_reference(raw[:, :fk.N_RAW])
+    derived = fv.earth_rates_reference(raw[:, :layouts.N_RAW])
     assert np.abs(derived - pqr).max() <= RATE_BOUND
     # the compiled truth row derives the same rates (its velocity lever-arm term w_eb x l uses them)
-    const = np.zeros(fk.N_CONST)
-    const[fk.N_CONST - 1] = 1.0 / 120.0  # the step dt ends the constants
+    const = np.zeros(layouts.N_CONST)
+    const[layouts.N_CONST - 1] = 1.0 / 120.0  # the step dt ends the constants
     for k in range(0, len(raw), 97):
         out = np.full(36, np.nan)
         _, p, q, _ = fk._imu_point(raw[k], const, np.array([0.0]), np.array([0.0]), 0.0, out)
         assert (p, q) == pytest.approx(tuple(derived[k, :2]), rel=0, abs=1e-17)
     # the latitude matters: JSBSim's local frame is geodetic (with the geocentric one the rates miss by ~1e-7)
-    wrong = raw[:, :fk.N_RAW].copy()
+    wrong = raw[:, :layouts.N_RAW].copy()
     wrong[:, 0] = gc
     assert np.abs(fv.earth_rates_reference(wrong) - pqr).max() > 1e-8
 
 
 def test_loop_io_reads_the_fields_in_order_with_the_gear_stood_in_for(manoeuvre):
     raw, near, _, _, fdm = manoeuvre
-    assert raw.shape == near.shape == (3000, fk.N_RAW + len(fk.GEAR_FIELDS))
-    np.testing.assert_array_equal(raw[:, fk.N_RAW:], np.broadcast_to(fk.GEAR_AIRBORNE, (3000, 5)))
-    np.testing.assert_array_equal(raw[:, :fk.N_RAW], near[:, :fk.N_RAW])
-    io = fdm.loop_io(fk.RAW_FIELDS, fk.GEAR_FIELDS, fk.GEAR_AIRBORNE)
-    assert io.read_near() == tuple(fdm[name] for name in (*fk.RAW_FIELDS, *fk.GEAR_FIELDS))
-    assert near[-1, fk.N_RAW + 3] > 1000.0  # the gear's height above the ground, ft: the reads are real
+    assert raw.shape == near.shape == (3000, layouts.N_RAW + len(layouts.GEAR_FIELDS))
+    np.testing.assert_array_equal(raw[:, layouts.N_RAW:], np.broadcast_to(layouts.GEAR_AIRBORNE, (3000, 5)))
+    np.testing.assert_array_equal(raw[:, :layouts.N_RAW], near[:, :layouts.N_RAW])
+    io = fdm.loop_io(layouts.RAW_FIELDS, layouts.GEAR_FIELDS, layouts.GEAR_AIRBORNE)
+    assert io.read_near() == tuple(fdm[name] for name in (*layouts.RAW_FIELDS, *layouts.GEAR_FIELDS))
+    assert near[-1, layouts.N_RAW + 3] > 1000.0  # the gear's height above the ground, ft: the reads are real
     with pytest.raises(ValueError, match="one value per"):
-        fdm.loop_io(fk.RAW_FIELDS, fk.GEAR_FIELDS, (0.0,))
+        fdm.loop_io(layouts.RAW_FIELDS, layouts.GEAR_FIELDS, (0.0,))

@@ -29,7 +29,7 @@ import math
 import numpy as np
 from numba import njit
 
-from approachsim.core.loop import nav_row as ik
+from approachsim.core import layouts
 from approachsim.core.nav import epoch as ke
 from approachsim.core.sensors import baro as bk
 from approachsim.core.sensors import gnss as gk
@@ -52,8 +52,8 @@ def loop_epoch(nw: np.ndarray, X: np.ndarray, P: np.ndarray, e: int, lay: np.nda
     """The closed loop's epoch e (module docstring); returns own_epoch's number of rows, or -1 (nothing changed:
     the model needs the numpy discretization, the caller takes the Navigator's path). f_ned (3,) scratch."""
     for c in range(3):
-        f_ned[c] = nw[ik.W_FSUM + c] / dt
-    y = nw[ik.W_X:ik.W_X + 16]
+        f_ned[c] = nw[layouts.W_FSUM + c] / dt
+    y = nw[layouts.W_X:layouts.W_X + 16]
     # no carrier phase on this path (closed_loop.fast_epoch_unavailable sends it to the Navigator's): no carrier
     # rows, no ionosphere states, no new arcs (the engine's own empties, nav/engine.py)
     k = ke.own_epoch(X, P, lay, q, gse, gmp, loop, held, dt, f_ned, y, F, Qc, phi, qd, baro_h, baro_r, radalt_h,
@@ -74,10 +74,10 @@ def loop_epoch(nw: np.ndarray, X: np.ndarray, P: np.ndarray, e: int, lay: np.nda
             PN[e, i, j] = P[i, j]
     PC[e] = P[ic, ic]
     for c in range(3):
-        nw[ik.W_FSUM + c] = 0.0
+        nw[layouts.W_FSUM + c] = 0.0
     for i in range(9):
-        nw[ik.W_XNAV + i] = X[0, i]
-    nw[ik.W_ANY_BARO] = 0.0
+        nw[layouts.W_XNAV + i] = X[0, i]
+    nw[layouts.W_ANY_BARO] = 0.0
     return k
 
 

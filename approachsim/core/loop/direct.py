@@ -22,20 +22,35 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
+from approachsim.core import layouts
+from approachsim.core.layouts import (
+    D_EXEC,
+    D_GET,
+    D_READ,
+    D_RUN,
+    D_SET,
+    D_WRITE,
+    GEAR_AIRBORNE,
+    GEAR_FIELDS,
+    N_RAW,
+    N_READ,
+    WRITE_DA,
+    WRITE_DE,
+    WRITE_DR,
+    WRITE_GD,
+    WRITE_GE,
+    WRITE_GN,
+    WRITE_TERRAIN,
+    WRITE_THR0,
+    WRITE_THR1,
+)
 from approachsim.core.loop import closed_step as ck
 from approachsim.core.loop import flight_step as fk
 
 Array = np.ndarray
 
-D_GET, D_SET, D_RUN, D_EXEC, D_WRITE = 0, 1, 2, 3, 4
-N_WRITE = 9
-D_READ = D_WRITE + N_WRITE
-N_READ = fk.N_RAW + len(fk.GEAR_FIELDS)
-N_D = D_READ + N_READ
-WRITE_DE, WRITE_DA, WRITE_DR, WRITE_THR0, WRITE_THR1, WRITE_GN, WRITE_GE, WRITE_GD, WRITE_TERRAIN = range(N_WRITE)
-
-_GEAR_AIRBORNE = np.array(fk.GEAR_AIRBORNE)
-_N_GEAR = len(fk.GEAR_FIELDS)
+_GEAR_AIRBORNE = np.array(GEAR_AIRBORNE)
+_N_GEAR = len(GEAR_FIELDS)
 _I8P = ir.IntType(8).as_pointer()
 
 
@@ -82,12 +97,12 @@ def read_properties(d: Array, raw: Array, near: bool) -> None:
     """A step's reads into raw (N_READ,): RAW_FIELDS, then GEAR_FIELDS when near, else GEAR_AIRBORNE (LoopIO's
     read_near / read)."""
     get = d[D_GET]
-    n = N_READ if near else fk.N_RAW
+    n = N_READ if near else N_RAW
     for i in range(n):
         raw[i] = _get(get, d[D_READ + i])
     if not near:
         for i in range(_N_GEAR):
-            raw[fk.N_RAW + i] = _GEAR_AIRBORNE[i]
+            raw[N_RAW + i] = _GEAR_AIRBORNE[i]
 
 
 @njit(cache=True)
@@ -102,11 +117,11 @@ def write_and_run(d: Array, par: Array, de: float, da: float, dr: float, thr: fl
     _set(s, d[w + WRITE_DR], dr)
     _set(s, d[w + WRITE_THR0], thr)
     _set(s, d[w + WRITE_THR1], thr)
-    if par[fk.P_STEP + fk.F_TURBULENT] != 0.0:
+    if par[layouts.P_STEP + layouts.F_TURBULENT] != 0.0:
         _set(s, d[w + WRITE_GN], gn)
         _set(s, d[w + WRITE_GE], ge)
         _set(s, d[w + WRITE_GD], gd)
-    if par[fk.P_STEP + fk.F_N_TERRAIN] > 1:
+    if par[layouts.P_STEP + layouts.F_N_TERRAIN] > 1:
         _set(s, d[w + WRITE_TERRAIN], terr_ft)
     _run(d[D_RUN], d[D_EXEC])
 

@@ -40,21 +40,240 @@ from numba import njit
 
 from approachsim import geo, units
 from approachsim.core import geodesy as gk
+from approachsim.core.layouts import (
+    AP_ALIGN_BANK_MAX,
+    AP_ALIGN_CAS,
+    AP_ALIGN_H,
+    AP_ALIGN_TAU,
+    AP_BANK_LIMIT,
+    AP_CAS0,
+    AP_CH,
+    AP_CLIMB_MAX,
+    AP_CONE_A,
+    AP_CONE_B,
+    AP_CONE_C,
+    AP_CONV,
+    AP_DT,
+    AP_FLARE_H,
+    AP_HEADING,
+    AP_K_BETA,
+    AP_K_BETA_ALIGN,
+    AP_K_DA_ALIGN,
+    AP_K_FLARE,
+    AP_K_FLARE_I,
+    AP_K_GS_D,
+    AP_K_GS_I,
+    AP_K_GS_P,
+    AP_K_LOC_D,
+    AP_K_LOC_I,
+    AP_K_LOC_P,
+    AP_K_P,
+    AP_K_PD,
+    AP_K_PHI,
+    AP_K_PHI_ALIGN,
+    AP_K_PI,
+    AP_K_Q,
+    AP_K_R_ALIGN,
+    AP_K_TD,
+    AP_K_THETA,
+    AP_K_THR,
+    AP_K_TI,
+    AP_K_V_I,
+    AP_K_V_P,
+    AP_PITCH_LIMIT,
+    AP_RATE_TAU,
+    AP_RETARD_H,
+    AP_SEB_FF,
+    AP_SH,
+    AP_SINK_MAX,
+    AP_SPD_W,
+    AP_T_H,
+    AP_T_V,
+    AP_TAN_GP,
+    AP_TAU_V,
+    AP_TAU_WIND,
+    AP_TD_SINK,
+    AP_TECS,
+    AP_THETA0,
+    AP_THR0,
+    AP_VERT_ACC,
+    AP_X_GPI,
+    APS_ALIGNING,
+    APS_E_F,
+    APS_FLARE_H_OFF,
+    APS_FLARE_TAU,
+    APS_FLARING,
+    APS_INT_B,
+    APS_INT_D,
+    APS_INT_E,
+    APS_INT_FLARE,
+    APS_INT_T,
+    APS_INT_Y,
+    APS_THETA_C,
+    APS_THETA_FLARE0,
+    APS_V_LAG,
+    APS_WIND,
+    C_CA,
+    C_CB,
+    C_CC,
+    C_DT,
+    C_HTHR,
+    C_LEVER,
+    C_ORIGIN,
+    C_RE,
+    C_RN,
+    C_RWY,
+    C_TAN_GP,
+    C_X_GPI,
+    CONTROLS_COL,
+    F_CA,
+    F_CB,
+    F_CC,
+    F_LAND,
+    F_MON_FLOOR,
+    F_N_TERRAIN,
+    F_PITCH_TRIM,
+    F_STOP_H,
+    F_TAN_GP,
+    F_TURBULENT,
+    F_WIND_E,
+    F_WIND_N,
+    F_X_GPI,
+    FS_BETA,
+    FS_CAS,
+    FS_DA,
+    FS_DE,
+    FS_DR,
+    FS_H_GEAR,
+    FS_LOWEST,
+    FS_MON,
+    FS_MON_A,
+    FS_MON_B,
+    FS_MON_Z,
+    FS_P,
+    FS_PHI,
+    FS_PSI,
+    FS_Q,
+    FS_R,
+    FS_TAS,
+    FS_TD_SINK,
+    FS_TD_X,
+    FS_THETA,
+    FS_THR,
+    GEAR_AIRBORNE,
+    MN_CA,
+    MN_CB,
+    MN_CC,
+    MN_GS_DOT_TAN,
+    MN_LOC_DOT_TAN,
+    MN_M,
+    MN_N,
+    MN_TAN_GP,
+    MN_TARGET,
+    MN_X_FLOOR,
+    MN_X_GP,
+    MNS_COUNT,
+    MNS_I,
+    MNS_J,
+    MNS_SUM_CAS,
+    MNS_SUM_EXCESS,
+    MNS_SUM_SINK,
+    N_AP_PAR,
+    N_AP_STATE,
+    N_CONST,
+    N_F_PAR,
+    N_F_STATE,
+    N_MN_PAR,
+    N_MN_STATE,
+    N_POE,
+    N_TB_PAR,
+    N_TB_STATE,
+    P_AP,
+    P_IMU,
+    P_MN,
+    P_STEP,
+    P_TB,
+    P_TERRAIN,
+    R_BETA,
+    R_FX,
+    R_FY,
+    R_FZ,
+    R_GEAR_LEFT_FT,
+    R_GEAR_RIGHT_FT,
+    R_H_FT,
+    R_LAT,
+    R_LON,
+    R_MASS,
+    R_P,
+    R_PHI,
+    R_PI,
+    R_PID,
+    R_PSI,
+    R_QI,
+    R_QID,
+    R_RI,
+    R_RID,
+    R_T,
+    R_THETA,
+    R_VC,
+    R_VD,
+    R_VE,
+    R_VN,
+    R_VT,
+    R_WOW_LEFT,
+    R_WOW_NOSE,
+    R_WOW_RIGHT,
+    ROW_AIRSPEED,
+    ROW_EULER,
+    ROW_F_BODY,
+    ROW_GS_DEV,
+    ROW_H,
+    ROW_H_AGL,
+    ROW_LAT,
+    ROW_LOC_DEV,
+    ROW_LON,
+    ROW_P_STATIC,
+    ROW_Q_NB,
+    ROW_R_ECEF,
+    ROW_R_RWY,
+    ROW_T,
+    ROW_T_AIR,
+    ROW_V_NED,
+    ROW_W_IB,
+    S_AP,
+    S_MN,
+    S_RING,
+    S_STEP,
+    S_TB,
+    TB_ALT,
+    TB_COS,
+    TB_DT,
+    TB_SIGMA,
+    TB_SIN,
+    TB_W20,
+    TBS_AU,
+    TBS_AV,
+    TBS_AW,
+    TBS_BU,
+    TBS_BV,
+    TBS_BW,
+    TBS_VALID,
+    TBS_XI_U,
+    TBS_XI_V,
+    TBS_XI_W,
+)
+from approachsim.core.tables import (
+    COEFF_EVERY,
+    LOC_ANTENNA_PAST_THRESHOLD_M,
+    SINK_LIMIT_MPS,
+    SINK_TOLERANCE_MPS,
+    SPEED_HIGH_MPS,
+    SPEED_LOW_MPS,
+    STABILIZATION_HEIGHT_M,
+    WATCH_HEIGHT_M,
+)
 
 Array = np.ndarray
-
-RAW_FIELDS = (
-    "position/lat-geod-rad", "position/long-gc-rad", "position/geod-alt-ft",
-    "velocities/v-north-fps", "velocities/v-east-fps", "velocities/v-down-fps",
-    "attitude/phi-rad", "attitude/theta-rad", "attitude/psi-rad",
-    "velocities/pi-rad_sec", "velocities/qi-rad_sec", "velocities/ri-rad_sec",
-    "accelerations/pidot-rad_sec2", "accelerations/qidot-rad_sec2", "accelerations/ridot-rad_sec2",
-    "forces/fbx-total-lbs", "forces/fby-total-lbs", "forces/fbz-total-lbs", "inertia/mass-slugs",
-    "atmosphere/P-psf", "atmosphere/T-R", "velocities/vc-kts", "aero/beta-rad",
-    "velocities/vtrue-fps",
-)
-"""The JSBSim properties `imu_point_row` reads, in the order of its `raw` (24,) input. JSBSim's Earth-relative body
-rates (velocities/p-rad_sec, ...) are not read: `imu_point_row` derives them from the inertial ones (earth_rates)."""
 
 R_AIR = 287.05287
 """Specific gas constant of dry air, J/(kg K) (US Standard Atmosphere 1976, JSBSim's Rdry)."""
@@ -68,46 +287,11 @@ OMEGA_JSBSIM = geo.OMEGA_JSBSIM
 RANKINE_PER_K = 1.8
 _TWO_PI = 2.0 * math.pi
 
-N_CONST = 22
-
-# --- the stabilized-approach criteria (flight/envelope.py's monitor and its profile checks import them) ---
-LOC_ANTENNA_PAST_THRESHOLD_M = 3300.0
-"""Assumed localizer antenna position past the threshold: a 3000 m runway plus 300 m (no runway length is in
-a profile); only the localizer dot's size depends on it."""
-STABILIZATION_HEIGHT_M = 1000.0 * units.FT
-"""FSF ALAR BN 7.1: stabilized by 1000 ft above the airport in IMC, and stay so below it."""
-WATCH_HEIGHT_M = 1400.0 * units.FT
-"""The monitor is fed from this height down (its 10 s means are full by 1000 ft at any sink rate below
-2400 ft/min); above it the run loop skips it."""
-SPEED_HIGH_MPS = 10.0 * units.KT
-SPEED_LOW_MPS = 5.0 * units.KT
-SINK_LIMIT_MPS = 1000.0 * units.FT / 60.0
-SINK_TOLERANCE_MPS = 300.0 * units.FT / 60.0
-
 MON_OK, MON_GLIDEPATH, MON_LOCALIZER, MON_SPEED, MON_SINK = range(5)
 """Results of one monitor step: stabilized, or which criterion failed (`monitor_step` returns these with two
 figures, flight/envelope.py `unstabilized_reason` words them)."""
 
-# --- MIL-F-8785C turbulence intensity table (flight/turbulence.py's oracle imports it) ---
-POE_ALT_FT = (500.0, 1750.0, 3750.0, 7500.0, 15000.0, 25000.0, 35000.0, 45000.0, 55000.0, 65000.0, 75000.0,
-              80000.0)
-"""Altitudes of the high-altitude intensity table, ft (MIL-F-8785C fig. 7)."""
-POE_SIGMA_FPS = (
-    (3.2, 2.2, 1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-    (4.2, 3.6, 3.3, 1.6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-    (6.6, 6.9, 7.4, 6.7, 4.6, 2.7, 0.4, 0.0, 0.0, 0.0, 0.0, 0.0),
-    (8.6, 9.6, 10.6, 10.1, 8.0, 6.6, 5.0, 4.2, 2.7, 0.0, 0.0, 0.0),
-    (11.8, 13.0, 16.0, 15.1, 11.6, 9.7, 8.1, 8.2, 7.9, 4.9, 3.2, 2.1),
-    (15.6, 17.6, 23.0, 23.6, 22.1, 20.0, 16.0, 15.1, 12.1, 7.9, 6.2, 5.1),
-    (18.7, 21.5, 28.4, 30.2, 30.7, 31.0, 25.2, 23.1, 17.5, 10.7, 8.4, 7.2),
-)
-"""High-altitude turbulence intensity sigma (ft/s) by probability-of-exceedance index 1..7 (rows) and altitude."""
-COEFF_EVERY = 12
-"""Steps between re-evaluations of the scale lengths and intensities."""
 
-
-# positions in RAW_FIELDS of the reads the loop uses besides the truth row
-_R_H_FT, _R_VN, _R_PHI, _R_VC, _R_BETA, _R_VT = 2, 3, 6, 21, 22, 23
 
 
 @njit(cache=True)
@@ -141,17 +325,18 @@ def imu_point_row(raw: Array, const: Array, along_m: Array, height_m: Array, t_s
 def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: float,
                out: Array) -> tuple[float, float, float, float]:
     """imu_point_row, returning (terrain height (m), the CG's Earth-relative body rates p, q, r (rad/s))."""
-    lat, lon, h_ft = raw[0], raw[1], raw[2]
-    vn_f, ve_f, vd_f = raw[3], raw[4], raw[5]
-    phi, th, psi = raw[6], raw[7], raw[8]
-    pi_, qi, ri = raw[9], raw[10], raw[11]
-    pid, qid, rid = raw[12], raw[13], raw[14]
-    fx, fy, fz, m = raw[15], raw[16], raw[17], raw[18]
-    p_psf, t_r, vc_kt = raw[19], raw[20], raw[21]
-    lx, ly, lz, r_n, r_e = const[0], const[1], const[2], const[3], const[4]
-    ox, oy, oz = const[5], const[6], const[7]
-    c00, c01, c02, c10, c11, c12 = const[8], const[9], const[10], const[11], const[12], const[13]
-    h_thr, tan_gp, dt = const[14], const[15], const[21]
+    lat, lon, h_ft = raw[R_LAT], raw[R_LON], raw[R_H_FT]
+    vn_f, ve_f, vd_f = raw[R_VN], raw[R_VE], raw[R_VD]
+    phi, th, psi = raw[R_PHI], raw[R_THETA], raw[R_PSI]
+    pi_, qi, ri = raw[R_PI], raw[R_QI], raw[R_RI]
+    pid, qid, rid = raw[R_PID], raw[R_QID], raw[R_RID]
+    fx, fy, fz, m = raw[R_FX], raw[R_FY], raw[R_FZ], raw[R_MASS]
+    p_psf, t_r, vc_kt = raw[R_P], raw[R_T], raw[R_VC]
+    lx, ly, lz, r_n, r_e = const[C_LEVER], const[C_LEVER + 1], const[C_LEVER + 2], const[C_RN], const[C_RE]
+    ox, oy, oz = const[C_ORIGIN], const[C_ORIGIN + 1], const[C_ORIGIN + 2]
+    c00, c01, c02 = const[C_RWY], const[C_RWY + 1], const[C_RWY + 2]
+    c10, c11, c12 = const[C_RWY + 3], const[C_RWY + 4], const[C_RWY + 5]
+    h_thr, tan_gp, dt = const[C_HTHR], const[C_TAN_GP], const[C_DT]
     hdt = 0.5 * dt
     h = h_ft * _FT
     # body -> NED direction cosines from the Euler angles
@@ -226,21 +411,22 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
     s1, k1 = math.sin(0.5 * phi_i), math.cos(0.5 * phi_i)
     s2, k2_ = math.sin(0.5 * th_i), math.cos(0.5 * th_i)
     s3, k3 = math.sin(0.5 * psi_i), math.cos(0.5 * psi_i)
-    out[0], out[1], out[2], out[3] = t_s, lat_i, lon_i, h_i
-    out[4], out[5], out[6] = x_e, y_e, z_e
-    out[7], out[8], out[9] = vn, ve, vd
-    out[10] = k1 * k2_ * k3 + s1 * s2 * s3
-    out[11] = s1 * k2_ * k3 - k1 * s2 * s3
-    out[12] = k1 * s2 * k3 + s1 * k2_ * s3
-    out[13] = k1 * k2_ * s3 - s1 * s2 * k3
-    out[14], out[15], out[16] = phi_i, th_i, psi_i
-    out[17], out[18], out[19] = pi_, qi, ri
-    out[20], out[21], out[22] = fbx, fby, fbz
-    out[23], out[24], out[25] = p_imu, t_r / RANKINE_PER_K, h_i - terr
-    out[26], out[27], out[28] = xr, yr, zr
-    out[29] = cone_deviation(xr, yr, zr, 0.0, 0.0, 0.0, tan_gp, const[17], const[18], const[19], const[20])[0]
-    out[30] = yr
-    out[35] = vc_kt * _KT
+    out[ROW_T], out[ROW_LAT], out[ROW_LON], out[ROW_H] = t_s, lat_i, lon_i, h_i
+    out[ROW_R_ECEF], out[ROW_R_ECEF + 1], out[ROW_R_ECEF + 2] = x_e, y_e, z_e
+    out[ROW_V_NED], out[ROW_V_NED + 1], out[ROW_V_NED + 2] = vn, ve, vd
+    out[ROW_Q_NB] = k1 * k2_ * k3 + s1 * s2 * s3
+    out[ROW_Q_NB + 1] = s1 * k2_ * k3 - k1 * s2 * s3
+    out[ROW_Q_NB + 2] = k1 * s2 * k3 + s1 * k2_ * s3
+    out[ROW_Q_NB + 3] = k1 * k2_ * s3 - s1 * s2 * k3
+    out[ROW_EULER], out[ROW_EULER + 1], out[ROW_EULER + 2] = phi_i, th_i, psi_i
+    out[ROW_W_IB], out[ROW_W_IB + 1], out[ROW_W_IB + 2] = pi_, qi, ri
+    out[ROW_F_BODY], out[ROW_F_BODY + 1], out[ROW_F_BODY + 2] = fbx, fby, fbz
+    out[ROW_P_STATIC], out[ROW_T_AIR], out[ROW_H_AGL] = p_imu, t_r / RANKINE_PER_K, h_i - terr
+    out[ROW_R_RWY], out[ROW_R_RWY + 1], out[ROW_R_RWY + 2] = xr, yr, zr
+    out[ROW_GS_DEV] = cone_deviation(xr, yr, zr, 0.0, 0.0, 0.0, tan_gp, const[C_X_GPI], const[C_CA], const[C_CB],
+                                     const[C_CC])[0]
+    out[ROW_LOC_DEV] = yr
+    out[ROW_AIRSPEED] = vc_kt * _KT
     return terr, p, q, r
 
 
@@ -250,13 +436,6 @@ def _imu_point(raw: Any, const: Array, along_m: Array, height_m: Array, t_s: flo
 # flight/envelope.StabilityMonitor, method kernel_arrays()), and `fly_step` gets them concatenated (offsets P_*,
 # S_*), so one compiled call per step does everything that is not a JSBSim read or write.
 
-GEAR_FIELDS = ("gear/unit[0]/WOW", "gear/unit[1]/WOW", "gear/unit[2]/WOW", "gear/unit[1]/AGL-ft",
-               "gear/unit[2]/AGL-ft")
-"""The gear state (nose, left main, right main weight on wheels; main-gear heights above the ground, ft), read
-only near the ground; `fly_step`'s raw tuple is RAW_FIELDS + GEAR_FIELDS."""
-GEAR_AIRBORNE = (0.0, 0.0, 0.0, math.inf, math.inf)
-"""GEAR_FIELDS' values standing in for reads far from the ground (no weight on wheels, gear infinitely high)."""
-N_RAW = len(RAW_FIELDS)
 LOW_READ_HEIGHT_M = 100.0
 """IMU height above the terrain below which the gear state counts (the gear hangs about 4 m below it): above it
 `fly_step` takes the gear as GEAR_AIRBORNE, whatever it was given."""
@@ -264,70 +443,12 @@ GEAR_READ_MARGIN_M = 30.0
 """`fly_step` asks for the gear reads at the next step from LOW_READ_HEIGHT_M + this margin down, so that they are
 there whenever the IMU is below LOW_READ_HEIGHT_M (at any vertical speed below margin / dt: 3600 m/s at 120 Hz)."""
 
-# autopilot: parameters (the gains in AP_GAINS order, then trim, geometry, step) and state
-AP_GAINS = ("k_theta", "k_q", "k_gs_p", "k_gs_d", "k_gs_i", "k_v_p", "k_v_i", "tau_v_s", "k_phi", "k_p", "k_beta",
-            "k_loc_p", "k_loc_d", "k_loc_i", "bank_limit_rad", "pitch_limit_rad", "tau_wind_s", "flare_height_m",
-            "touchdown_sink_mps", "k_flare", "k_flare_i", "retard_height_m", "tecs", "tecs_t_h_s", "tecs_t_v_s",
-            "tecs_thr_per_rad", "tecs_k_thr_damp", "tecs_k_thr_i", "tecs_k_pitch_damp", "tecs_k_pitch_i",
-            "tecs_seb_ff", "tecs_spd_weight", "tecs_rate_tau_s", "tecs_sink_max_mps", "tecs_climb_max_mps",
-            "tecs_vert_acc_mps2", "align_height_m", "align_tau_s", "k_r_align", "k_beta_align", "k_phi_align",
-            "k_da_align", "align_bank_max_rad", "align_cas_mps")
-"""flight.design.AutopilotGains fields, in the order of the autopilot parameter vector."""
-(AP_K_THETA, AP_K_Q, AP_K_GS_P, AP_K_GS_D, AP_K_GS_I, AP_K_V_P, AP_K_V_I, AP_TAU_V, AP_K_PHI, AP_K_P, AP_K_BETA,
- AP_K_LOC_P, AP_K_LOC_D, AP_K_LOC_I, AP_BANK_LIMIT, AP_PITCH_LIMIT, AP_TAU_WIND, AP_FLARE_H, AP_TD_SINK,
- AP_K_FLARE, AP_K_FLARE_I, AP_RETARD_H, AP_TECS, AP_T_H, AP_T_V, AP_K_THR, AP_K_TD, AP_K_TI, AP_K_PD, AP_K_PI,
- AP_SEB_FF, AP_SPD_W, AP_RATE_TAU, AP_SINK_MAX, AP_CLIMB_MAX, AP_VERT_ACC, AP_ALIGN_H, AP_ALIGN_TAU, AP_K_R_ALIGN,
- AP_K_BETA_ALIGN, AP_K_PHI_ALIGN, AP_K_DA_ALIGN, AP_ALIGN_BANK_MAX, AP_ALIGN_CAS, AP_THETA0, AP_THR0, AP_CAS0, AP_CH,
- AP_SH, AP_HEADING, AP_TAN_GP, AP_X_GPI, AP_CONE_A, AP_CONE_B, AP_CONE_C, AP_CONV, AP_DT) = range(57)
-N_AP_PAR = 57
-(APS_INT_D, APS_INT_Y, APS_E_F, APS_WIND, APS_INT_E, APS_FLARING, APS_THETA_FLARE0, APS_INT_FLARE,
- APS_THETA_C, APS_V_LAG, APS_INT_T, APS_INT_B, APS_FLARE_TAU, APS_FLARE_H_OFF, APS_ALIGNING) = range(15)
-N_AP_STATE = 15
-
-# Dryden turbulence: parameters (W20, dt, wind-axes rotation, the intensity table's altitudes and the level's row)
-(TB_W20, TB_DT, TB_COS, TB_SIN) = range(4)
-N_POE = len(POE_ALT_FT)
-TB_ALT = 4
-TB_SIGMA = TB_ALT + N_POE
-N_TB_PAR = TB_SIGMA + N_POE
-(TBS_XI_U, TBS_XI_V, TBS_XI_W, TBS_VALID, TBS_AU, TBS_BU, TBS_AV, TBS_BV, TBS_AW, TBS_BW) = range(10)
-N_TB_STATE = 10
-
-# stabilized-approach monitor: parameters, state; its ring buffer is [speed (n) | sink (m) | sink excess (m)]
-(MN_TAN_GP, MN_GS_DOT_TAN, MN_X_GP, MN_X_FLOOR, MN_LOC_DOT_TAN, MN_TCH, MN_TARGET, MN_N, MN_M, MN_CA, MN_CB,
- MN_CC) = range(12)
-N_MN_PAR = 12
-(MNS_I, MNS_J, MNS_COUNT, MNS_SUM_CAS, MNS_SUM_SINK, MNS_SUM_EXCESS) = range(6)
-N_MN_STATE = 6
-# the step: its own parameters and state, then the components' at these offsets
-(F_PITCH_TRIM, F_STOP_H, F_LAND, F_TAN_GP, F_TCH, F_MON_FLOOR, F_WIND_N, F_WIND_E, F_TURBULENT,
- F_N_TERRAIN, F_X_GPI, F_CA, F_CB, F_CC) = range(14)
-N_F_PAR = 14
-P_IMU = 0
-P_STEP = P_IMU + N_CONST
-P_AP = P_STEP + N_F_PAR
-P_TB = P_AP + N_AP_PAR
-P_MN = P_TB + N_TB_PAR
-P_TERRAIN = P_MN + N_MN_PAR
-"""The terrain profile ends the parameter vector: F_N_TERRAIN along-track distances, then as many heights (m)."""
-(FS_DE, FS_DA, FS_DR, FS_THR, FS_LOWEST, FS_TD_X, FS_TD_SINK, FS_MON, FS_MON_Z, FS_MON_A, FS_MON_B,
- FS_PHI, FS_THETA, FS_P, FS_Q, FS_BETA, FS_CAS, FS_H_GEAR, FS_TAS, FS_PSI, FS_R) = range(21)
-N_F_STATE = 21
-S_STEP = 0
-S_AP = S_STEP + N_F_STATE
-S_TB = S_AP + N_AP_STATE
-S_MN = S_TB + N_TB_STATE
-S_RING = S_MN + N_MN_STATE
-"""The monitor's windows end the state vector."""
-
 TERM_NONE, TERM_STOP, TERM_TOUCHDOWN, TERM_SHORT, TERM_GROUND, TERM_DIVERGED, TERM_UNSTABLE = range(7)
 """`fly_step`'s termination codes (flight/run.termination_reason words them)."""
 DIVERGED_BANK_RAD = 1.0
 DIVERGED_VERTICAL_M = 300.0
 DIVERGED_LATERAL_M = 1500.0
 """A run has diverged beyond these: bank, distance from the glidepath, from the centreline."""
-CONTROLS_COL = 31
-"""First of the Truth row's four control columns (elevator incl. pitch trim, aileron, rudder, throttle)."""
 
 
 @njit(cache=True)
@@ -628,20 +749,22 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
     fpar, fst = par[P_STEP:P_STEP + N_F_PAR], st[S_STEP:S_STEP + N_F_STATE]
     nt = int(fpar[F_N_TERRAIN])
     terr, p, q, r = _imu_point(raw, par[P_IMU:P_IMU + N_CONST], par[P_TERRAIN:P_TERRAIN + nt],
-                            par[P_TERRAIN + nt:P_TERRAIN + 2 * nt], k * par[P_IMU + N_CONST - 1], row)
-    vn_f, ve_f, vd_f, phi, theta = raw[_R_VN], raw[_R_VN + 1], raw[_R_VN + 2], raw[_R_PHI], raw[_R_PHI + 1]
-    cas, beta, tas = raw[_R_VC] * _KT, raw[_R_BETA], raw[_R_VT] * _FPS
-    vn, ve, vd, xr, yr, zr = row[7], row[8], row[9], row[26], row[27], row[28]
-    h_agl = row[3] - terr
+                            par[P_TERRAIN + nt:P_TERRAIN + 2 * nt], k * par[P_IMU + C_DT], row)
+    vn_f, ve_f, vd_f, phi, theta = raw[R_VN], raw[R_VE], raw[R_VD], raw[R_PHI], raw[R_THETA]
+    cas, beta, tas = raw[R_VC] * _KT, raw[R_BETA], raw[R_VT] * _FPS
+    vn, ve, vd = row[ROW_V_NED], row[ROW_V_NED + 1], row[ROW_V_NED + 2]
+    xr, yr, zr = row[ROW_R_RWY], row[ROW_R_RWY + 1], row[ROW_R_RWY + 2]
+    h_agl = row[ROW_H] - terr
     if h_agl < LOW_READ_HEIGHT_M:  # the gear counts near the ground only
-        w0, w1, w2, g1_ft, g2_ft = raw[N_RAW], raw[N_RAW + 1], raw[N_RAW + 2], raw[N_RAW + 3], raw[N_RAW + 4]
+        w0, w1, w2 = raw[R_WOW_NOSE], raw[R_WOW_LEFT], raw[R_WOW_RIGHT]
+        g1_ft, g2_ft = raw[R_GEAR_LEFT_FT], raw[R_GEAR_RIGHT_FT]
     else:
         w0, w1, w2, g1_ft, g2_ft = GEAR_AIRBORNE
     near = h_agl < LOW_READ_HEIGHT_M + GEAR_READ_MARGIN_M
     gn = ge = gd = 0.0
     if fpar[F_TURBULENT] != 0.0:  # turbulence for the next step, at the CG's height above the terrain
         tn, te, td = dryden_step(par[P_TB:P_TB + N_TB_PAR], st[S_TB:S_TB + N_TB_STATE], nu, k,
-                                 raw[_R_H_FT] * _FT - terr, tas)
+                                 raw[R_H_FT] * _FT - terr, tas)
         gn, ge, gd = tn / _FPS, te / _FPS, td / _FPS
     # the controls of the previous step act on this row until replaced
     row[CONTROLS_COL] = fst[FS_DE] + fpar[F_PITCH_TRIM]
@@ -654,7 +777,7 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
     # the inner loops' inputs of this step (fly_control's, when a navigation source guides)
     fst[FS_PHI], fst[FS_THETA], fst[FS_P], fst[FS_Q], fst[FS_BETA] = phi, theta, p, q, beta
     fst[FS_CAS], fst[FS_H_GEAR], fst[FS_TAS] = cas, h_gear, tas
-    psi = raw[_R_PHI + 2] if fpar[F_LAND] != 0.0 else math.nan
+    psi = raw[R_PSI] if fpar[F_LAND] != 0.0 else math.nan
     fst[FS_PSI], fst[FS_R] = psi, r
     if guided and code == TERM_NONE:
         de, da, dr, thr = _control(par, st, row, xr, yr, zr, vn, ve, vd, phi, theta, p, q, beta, cas, h_gear, tas,

@@ -3,7 +3,7 @@ compiled step (core/loop/closed_step.py) so that a closed-loop row costs no Pyth
 writes; Python runs only at the rows where the navigation needs it (the start, a baro sample of the damping loop,
 an aiding epoch: nav/closed_loop.py).
 
-Per truth row k (k > 0), with the flight's row buffer buf (flight/run.py columns: w_ib_body 17:20, f_body 20:23):
+Per truth row k (k > 0), with the flight's row buffer buf (core/layouts.py TRUTH_ROW):
 
     IMU increment of (k-1, k]: d = dt w(k-1) (rate or specific force of truth sample k-1 held, sensors/imu.py),
                                dtheta = d + M_g d + c_g[k-1],  dv = d + M_a d + c_a[k-1]  (pre-drawn, affine)
@@ -12,7 +12,7 @@ Per truth row k (k > 0), with the flight's row buffer buf (flight/run.py columns
     rows[k] = the INS state; snap[k] = the filter snapshot in force
     guidance = INS - x_hat (feed-forward) in the runway frame and NED (kernels/strapdown.guidance)
 
-The work vector nw (NW) holds the one run's INS state and the small constants (W_* offsets); the other arrays of
+The work vector nw (core/layouts.py NAV_WORK) holds the one run's INS state and the small constants; the other arrays of
 the row are views of two packed arrays, fa (float64) and ia (int64) (`views`, `packed_sizes`), so that the flight
 loop's compiled call takes three navigation arguments instead of twelve (unboxing an array argument costs ~0.13 us
 of every one of the flight's ~31,000 calls). nav/closed_loop.py builds them and keeps the Navigator's INS state,
@@ -26,45 +26,45 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from approachsim.core.layouts import (
+    NX,
+    ROW_F_BODY,
+    ROW_P_STATIC,
+    ROW_T,
+    ROW_W_IB,
+    W_ANY_BARO,
+    W_BA,
+    W_BARO_EXCL,
+    W_BARO_KERNEL,
+    W_BARO_LOOP,
+    W_BCM1,
+    W_BEXP,
+    W_BFLD,
+    W_BG,
+    W_BSET,
+    W_BSF,
+    W_BT0L,
+    W_CRWY,
+    W_DT,
+    W_EPOCH_ROWS,
+    W_FSUM,
+    W_HB,
+    W_HB_AGE,
+    W_HB_T,
+    W_HTHR,
+    W_LOOP,
+    W_M,
+    W_MA,
+    W_MG,
+    W_N,
+    W_NBE,
+    W_NLAG,
+    W_ORWY,
+    W_SNAP,
+    W_X,
+    W_XNAV,
+)
 from approachsim.core.nav import strapdown as sk
-
-W_X = 0
-"""Packed INS state (16,), kernels/strapdown.py layout."""
-W_XNAV = 16
-"""The estimated navigation errors in force (9,): dp NED m, dv m/s, psi rad."""
-W_FSUM = 25
-"""C_bn dv summed since the last epoch (3,), NED m/s."""
-W_BG, W_BA = 28, 31
-"""Bias feedback (3,) each: rad/s, m/s^2 (zeros feed-forward)."""
-W_LOOP = 34
-"""The damping loop (6,): ins.loop_vector."""
-W_HB = 40
-"""The baro height held for the next intervals, m (nan: none; the loop holds)."""
-W_DT = 41
-W_MG, W_MA = 42, 51
-"""IMU scale factor + misalignment matrices M_g, M_a (9,) each, row-major."""
-W_CRWY, W_ORWY, W_HTHR = 60, 66, 69
-"""Runway frame: the first two rows of C_ecef->rwy (6,), its ECEF origin (3,), the threshold height (m)."""
-W_SNAP = 70
-"""Index of the filter snapshot in force (the Navigator's)."""
-W_EPOCH_ROWS = 71
-W_ANY_BARO = 72
-"""1 when the INS had a baro at some interval since the last epoch (else the loop held throughout)."""
-W_BARO_LOOP = 73
-"""1 when the damping loop takes baro samples."""
-W_BARO_KERNEL = 74
-"""1 when the baro samples are made here (a plain barometric altimeter, sensors/baro.py), else by Python."""
-W_BARO_EXCL = 75
-"""1 when the online FDE has excluded the baro (the loop holds)."""
-W_BSET, W_BT0L, W_BEXP, W_BSF = 76, 77, 78, 79
-"""The baro's setting (Pa), ISA T0 / L (m), exponent R L / g0 and this run's scale factor (sensors/baro.py)."""
-W_BFLD, W_BCM1 = 80, 81
-"""The baro's temperature correction: field geopotential elevation H_f (m) and c - 1 (sensors/baro.py)."""
-W_N, W_M, W_NBE, W_NLAG = 82, 83, 84, 85
-"""Sizes of the packed arrays (`views`): truth rows n, IMU samples m, baro samples, lag weights."""
-W_HB_T, W_HB_AGE = 86, 87
-"""The held baro sample's time (s, truth row time) and its age at the interval start being stepped (s)."""
-NW = 88
 
 NAV_START, NAV_BARO, NAV_EPOCH = 1, 2, 4
 """Bits of nav_row's code: the rows at which Python must act."""
@@ -74,15 +74,16 @@ NAV_START, NAV_BARO, NAV_EPOCH = 1, 2, 4
 def baro_sample(k: int, buf: np.ndarray, nw: np.ndarray, lag_w: np.ndarray, bias: float, noise: float) -> float:
     """The barometric altimeter's sample at truth row k (core/sensors/baro.baro_apply for one run, the same
     operations in order): h_ind = (T0 / L)(1 - (p / p_set)^(R L / g0)) of the static pressure at the IMU (buf column
-    23; with a lag, the weights lag_w over rows k, k - 1, ..., clipped at 0), h_c = h_ind + (h_ind - H_f)(c - 1),
+    ROW_P_STATIC; with a lag, the weights lag_w over rows k, k - 1, ..., clipped at 0),
+    h_c = h_ind + (h_ind - H_f)(c - 1),
     h = h_c (1 + S) + bias + noise."""
     t0l, p_set, ex = nw[W_BT0L], nw[W_BSET], nw[W_BEXP]
     if lag_w.shape[0] > 0:
         h = 0.0
         for q in range(lag_w.shape[0]):
-            h += t0l * (1.0 - (buf[max(k - q, 0), 23] / p_set) ** ex) * lag_w[q]
+            h += t0l * (1.0 - (buf[max(k - q, 0), ROW_P_STATIC] / p_set) ** ex) * lag_w[q]
     else:
-        h = t0l * (1.0 - (buf[k, 23] / p_set) ** ex)
+        h = t0l * (1.0 - (buf[k, ROW_P_STATIC] / p_set) ** ex)
     h = h + (h - nw[W_BFLD]) * nw[W_BCM1]
     return h * (1.0 + nw[W_BSF]) + bias + noise
 
@@ -102,7 +103,7 @@ def nav_row(k: int, buf: np.ndarray, nw: np.ndarray, cg: np.ndarray, ca: np.ndar
         code = NAV_START
     else:
         dt = nw[W_DT]
-        w, f = buf[k - 1, 17:20], buf[k - 1, 20:23]
+        w, f = buf[k - 1, ROW_W_IB:ROW_W_IB + 3], buf[k - 1, ROW_F_BODY:ROW_F_BODY + 3]
         mg, ma = nw[W_MG:W_MG + 9], nw[W_MA:W_MA + 9]
         for r in range(3):
             d0, d1, d2 = dt * w[0], dt * w[1], dt * w[2]
@@ -114,10 +115,10 @@ def nav_row(k: int, buf: np.ndarray, nw: np.ndarray, cg: np.ndarray, ca: np.ndar
         hb = nw[W_HB:W_HB + 1].reshape(1, 1)
         if hb[0, 0] == hb[0, 0]:
             nw[W_ANY_BARO] = 1.0
-        nw[W_HB_AGE] = buf[k - 1, 0] - nw[W_HB_T]
-        sk.strapdown(nw[W_X:W_X + 16].reshape(1, 16), dth, dv, dt, nw[W_BG:W_BG + 3].reshape(1, 3),
+        nw[W_HB_AGE] = buf[k - 1, ROW_T] - nw[W_HB_T]
+        sk.strapdown(nw[W_X:W_X + NX].reshape(1, NX), dth, dv, dt, nw[W_BG:W_BG + 3].reshape(1, 3),
                      nw[W_BA:W_BA + 3].reshape(1, 3), hb, nw[W_HB_AGE:W_HB_AGE + 1], nw[W_LOOP:W_LOOP + 6],
-                     nw[W_FSUM:W_FSUM + 3].reshape(1, 3), np.empty((1, 0, 16)), 0)
+                     nw[W_FSUM:W_FSUM + 3].reshape(1, 3), np.empty((1, 0, NX)), 0)
         if k % int(nw[W_EPOCH_ROWS]) == 0:
             code |= NAV_EPOCH
     j = baro_j[k]
@@ -125,10 +126,10 @@ def nav_row(k: int, buf: np.ndarray, nw: np.ndarray, cg: np.ndarray, ca: np.ndar
         if nw[W_BARO_KERNEL] != 0.0 and code == 0:  # the held baro for the next intervals (nan: excluded)
             nw[W_HB] = np.nan if nw[W_BARO_EXCL] != 0.0 else baro_sample(k, buf, nw, lag_w, baro_e[j, 0],
                                                                           baro_e[j, 1])
-            nw[W_HB_T] = buf[k, 0]
+            nw[W_HB_T] = buf[k, ROW_T]
         else:
             code |= NAV_BARO
-    for q in range(16):
+    for q in range(NX):
         rows[k, q] = nw[W_X + q]
     snap[k] = int(nw[W_SNAP])
     return code
@@ -139,13 +140,13 @@ def nav_guidance(nw: np.ndarray, out: np.ndarray) -> None:
     """The guidance of the current INS state and estimate into out (6,): runway-frame position (m) and NED velocity
     (m/s) of the feed-forward output INS - x_hat (kernels/strapdown.guidance)."""
     c = nw[W_CRWY:W_CRWY + 6].reshape(2, 3)
-    sk.guidance(nw[W_X:W_X + 16].reshape(1, 16), nw[W_XNAV:W_XNAV + 9], c, nw[W_ORWY:W_ORWY + 3], nw[W_HTHR], out)
+    sk.guidance(nw[W_X:W_X + NX].reshape(1, NX), nw[W_XNAV:W_XNAV + 9], c, nw[W_ORWY:W_ORWY + 3], nw[W_HTHR], out)
 
 
 def packed_sizes(n: int, m: int, n_baro: int, n_lag: int) -> tuple[int, int]:
     """Lengths of the packed arrays fa, ia (`views`) for n truth rows, m IMU samples, n_baro baro samples and n_lag
     lag weights."""
-    return 2 * 3 * m + 16 * n + 6 * n + 2 * n_baro + n_lag + 6, 2 * n
+    return 2 * 3 * m + NX * n + 6 * n + 2 * n_baro + n_lag + 6, 2 * n
 
 
 @njit(cache=True)
@@ -160,8 +161,8 @@ def views(nw: np.ndarray, fa: np.ndarray, ia: np.ndarray) -> tuple:
     o += 3 * m
     ca = fa[o:o + 3 * m].reshape(m, 3)
     o += 3 * m
-    rows = fa[o:o + 16 * n].reshape(n, 16)
-    o += 16 * n
+    rows = fa[o:o + NX * n].reshape(n, NX)
+    o += NX * n
     guidance = fa[o:o + 6 * n].reshape(n, 6)
     o += 6 * n
     baro_e = fa[o:o + 2 * nb].reshape(nb, 2)

@@ -17,8 +17,8 @@ import jsbsim
 import numpy as np
 import pytest
 
+from approachsim.core import layouts
 from approachsim.core.loop import direct as dk
-from approachsim.core.loop import flight_step as fk
 from approachsim.core.loop import jsbsim_abi
 from approachsim.flight.fdm import FDM
 from approachsim.flight.run import Approach
@@ -43,7 +43,7 @@ def _trimmed_io(prof) -> tuple[FDM, object]:
     approach = Approach(prof)
     fdm = FDM(approach.aircraft.jsbsim_model, approach.dt_s)
     approach._trim(fdm, start_condition(prof, approach.aircraft))
-    return fdm, fdm.loop_io(fk.RAW_FIELDS, fk.GEAR_FIELDS, fk.GEAR_AIRBORNE)
+    return fdm, fdm.loop_io(layouts.RAW_FIELDS, layouts.GEAR_FIELDS, layouts.GEAR_AIRBORNE)
 
 
 def _assert_same(a: object, b: object, path: str = "") -> int:
@@ -69,7 +69,7 @@ def direct_available():
     if not SUPPORTED:
         assert io.direct is None
         pytest.skip("the direct JSBSim path needs CPython on x86-64 Linux")
-    assert io.direct is not None and io.direct.shape == (dk.N_D,)
+    assert io.direct is not None and io.direct.shape == (layouts.N_D,)
     return True
 
 
@@ -129,7 +129,7 @@ def test_the_compiled_closed_loop_flies_the_python_loops_bits(case, direct_avail
 def test_direct_reads_are_the_wrappers_reads(direct_available):
     """read_properties through the C++ getters gives LoopIO.read_near's and read's values, bit for bit."""
     _, io = _trimmed_io(_profile("default"))
-    raw = np.full(dk.N_READ, np.nan)
+    raw = np.full(layouts.N_READ, np.nan)
     for near, read in ((True, io.read_near), (False, io.read)):
         dk.read_properties(io.direct, raw, near)
         assert np.array_equal(raw, np.array(read()))
@@ -153,8 +153,8 @@ def test_direct_writes_are_the_wrappers_writes(direct_available):
                 continue
             setter(value)
         io_p.run()
-        par = np.zeros(fk.P_STEP + fk.N_F_PAR)
-        par[fk.P_STEP + fk.F_TURBULENT], par[fk.P_STEP + fk.F_N_TERRAIN] = turbulent, hilly
+        par = np.zeros(layouts.P_STEP + layouts.N_F_PAR)
+        par[layouts.P_STEP + layouts.F_TURBULENT], par[layouts.P_STEP + layouts.F_N_TERRAIN] = turbulent, hilly
         dk.write_and_run(io_d.direct, par, *cmd)
         after = [fdm_d.node(n).get_double_value() for n in names]
         written = [*range(5), *((5, 6, 7) if turbulent else ()), *((8,) if hilly >= 2 else ())]

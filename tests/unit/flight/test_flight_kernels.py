@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from approachsim import geo, units
+from approachsim.core import layouts
 from approachsim.core.loop import flight_step as fk
 from approachsim.flight import vectors as fv
 from approachsim.nav import ins
@@ -27,7 +28,7 @@ DT = 1.0 / 120.0
 
 def _raw(n, rng):
     """n sets of JSBSim reads (RAW_FIELDS order, JSBSim units) around a 737 on approach."""
-    raw = np.empty((n, len(fk.RAW_FIELDS)))
+    raw = np.empty((n, len(layouts.RAW_FIELDS)))
     raw[:, 0] = RWY.threshold_lat_rad + rng.normal(0.0, 0.01, n)
     raw[:, 1] = RWY.threshold_lon_rad + rng.normal(0.0, 0.01, n)
     raw[:, 2] = rng.uniform(100.0, 3500.0, n)
@@ -135,16 +136,16 @@ def test_kernel_reproduces_the_flight_loop_rows(monkeypatch):
 
     def recording_node(self, name):
         n = node(self, name)
-        return Recorder(n, name) if name in fk.RAW_FIELDS else n
+        return Recorder(n, name) if name in layouts.RAW_FIELDS else n
 
     monkeypatch.setattr(fdm_mod.FDM, "node", recording_node)
     prof = load_profile("profiles/default.toml")
     approach = Approach(prof)
     res = approach.fly(seed=1, run=0, max_time_s=5.0)
     truth = res.truth
-    raw = np.array([v for name, v in reads]).reshape(-1, len(fk.RAW_FIELDS))
+    raw = np.array([v for name, v in reads]).reshape(-1, len(layouts.RAW_FIELDS))
     assert raw.shape[0] == len(truth)
-    assert [name for name, _ in reads[:len(fk.RAW_FIELDS)]] == list(fk.RAW_FIELDS)
+    assert [name for name, _ in reads[:len(layouts.RAW_FIELDS)]] == list(layouts.RAW_FIELDS)
     ic = start_condition(prof, approach.aircraft)
     fdm = fdm_mod.FDM(approach.aircraft.jsbsim_model, approach.dt_s)
     approach._trim(fdm, ic)

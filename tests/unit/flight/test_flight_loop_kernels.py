@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from approachsim import geo, units
+from approachsim.core import layouts, tables
 from approachsim.core.entry import entry_point
 from approachsim.core.loop import flight_step as fk
 from approachsim.flight import vectors as fv
@@ -59,8 +60,8 @@ def _autopilot(gains):
 def test_the_autopilot_gain_layout_is_the_gains_dataclass():
     import dataclasses
 
-    assert fk.AP_GAINS == tuple(f.name for f in dataclasses.fields(AutopilotGains))
-    assert fk.N_AP_PAR == len(fk.AP_GAINS) + 13
+    assert layouts.AP_GAINS == tuple(f.name for f in dataclasses.fields(AutopilotGains))
+    assert layouts.N_AP_PAR == len(layouts.AP_GAINS) + 13
 
 
 def _autopilot_inputs(rng, n, *, flare):
@@ -140,7 +141,7 @@ def test_dryden_scales_equal_the_oracle_across_the_regimes():
     for level, (w20, index) in (("light", (25.0, 3)), ("moderate", (50.0, 4)), ("severe", (75.0, 6))):
         turb = DrydenTurbulence(level, np.random.default_rng(0), 1, DT, 0.0)
         par, _ = fv.dryden_arrays(turb)
-        alt, sig = par[fk.TB_ALT:fk.TB_ALT + fk.N_POE], par[fk.TB_SIGMA:fk.TB_SIGMA + fk.N_POE]
+        alt, sig = par[layouts.TB_PAR.slice("poe_alt_ft")], par[layouts.TB_PAR.slice("poe_sigma_fps")]
         for h in heights:
             assert fk.dryden_scales(h, w20, alt, sig) == scales(h, w20, index), (level, h)
 
@@ -166,8 +167,9 @@ def test_dryden_kernel_equals_the_oracle_bit_for_bit(level):
 
 
 def _monitor_inputs(rng, n, reason):
-    """n steps descending from fk.WATCH_HEIGHT_M on the path at the target speed, disturbed so that `reason` fires."""
-    z = np.linspace(fk.WATCH_HEIGHT_M, 100.0, n)
+    """n steps descending from tables.WATCH_HEIGHT_M on the path at the target speed, disturbed so that `reason`
+    fires."""
+    z = np.linspace(tables.WATCH_HEIGHT_M, 100.0, n)
     x = (TCH - z) / math.tan(GP)
     y = rng.normal(0.0, 2.0, n)
     cas = 72.0 + rng.normal(0.0, 0.5, n)
@@ -225,9 +227,9 @@ def _step_vectors(gains, *, land=False, turbulent=True, stop_h=-math.inf, n_step
 
 def test_termination_codes_in_order_and_their_words(gains):
     par, st, *_ = _step_vectors(gains, land=True, stop_h=10.0)
-    fpar, fst = par[fk.P_STEP:fk.P_STEP + fk.N_F_PAR], st[fk.S_STEP:fk.S_STEP + fk.N_F_STATE]
-    mpar, mst = par[fk.P_MN:fk.P_MN + fk.N_MN_PAR], st[fk.S_MN:fk.S_MN + fk.N_MN_STATE]
-    ring = st[fk.S_RING:]
+    fpar, fst = par[layouts.FLIGHT_PAR.slice("step")], st[layouts.FLIGHT_STATE.slice("step")]
+    mpar, mst = par[layouts.P_MN:layouts.P_MN + layouts.N_MN_PAR], st[layouts.S_MN:layouts.S_MN + layouts.N_MN_STATE]
+    ring = st[layouts.S_RING:]
     air = dict(vn=70.0, ve=0.0, vd=3.7, h_agl=500.0, phi=0.0, wow_nose=0.0, wow_left=0.0, wow_right=0.0,
                vn_cg=70.0, ve_cg=0.0, vd_cg=3.7, cas=72.0, tas=75.0)
 
@@ -242,7 +244,7 @@ def test_termination_codes_in_order_and_their_words(gains):
     assert term(x_high, 0.0, high) == fk.TERM_NONE
     assert term(0.0, 0.0, 9.0, wow_left=1.0) == fk.TERM_STOP  # the stop height comes first
     assert term(400.0, 0.0, 11.0, wow_left=1.0) == fk.TERM_TOUCHDOWN
-    assert fst[fk.FS_TD_X] == 400.0 and fst[fk.FS_TD_SINK] == 3.7
+    assert fst[layouts.FS_TD_X] == 400.0 and fst[layouts.FS_TD_SINK] == 3.7
     assert term(-36.576, 0.0, 11.0, wow_right=1.0) == fk.TERM_SHORT
     assert termination_reason(fk.TERM_SHORT, fst) == "touchdown short of the threshold (120 ft)"
     assert term(400.0, 0.0, 11.0, wow_left=1.0, wow_nose=1.0) == fk.TERM_GROUND  # nose gear first
@@ -254,7 +256,7 @@ def test_termination_codes_in_order_and_their_words(gains):
     assert term(x_high, -1501.0, high) == fk.TERM_DIVERGED
     low = 600.0 * units.FT
     assert term((TCH - low) / math.tan(GP), 0.0, low + 30.0) == fk.TERM_UNSTABLE  # 1 dot is ~22 m here
-    assert fst[fk.FS_MON] == MON_GLIDEPATH and fst[fk.FS_MON_Z] == low + 30.0
+    assert fst[layouts.FS_MON] == MON_GLIDEPATH and fst[layouts.FS_MON_Z] == low + 30.0
     assert termination_reason(fk.TERM_UNSTABLE, fst) == "unstabilized at 698 ft: glidepath deviation +1.37 dots"
     for code, words in ((fk.TERM_STOP, "reached stop height"), (fk.TERM_TOUCHDOWN, "touchdown"),
                         (fk.TERM_GROUND, "ground contact"), (fk.TERM_DIVERGED, "diverged"),
@@ -272,7 +274,7 @@ def _synthetic_raw(rng, n, along_m=(-9000.0, -7000.0)):
     h = 1600.0 + TCH - along * math.tan(GP) + rng.normal(0.0, 1.0, n)
     ecef = frame.origin_ecef + np.outer(along, frame.c_ecef_to_rwy[0])
     lat, lon, _ = geo.ecef_to_geodetic(ecef)
-    raw = np.empty((n, len(fk.RAW_FIELDS)))
+    raw = np.empty((n, len(layouts.RAW_FIELDS)))
     raw[:, 0], raw[:, 1], raw[:, 2] = lat, lon, h / units.FT
     vg = 70.0 / units.FPS
     raw[:, 3:6] = [vg * math.cos(0.4), vg * math.sin(0.4), vg * math.tan(GP)]
@@ -306,7 +308,8 @@ def test_fly_step_is_the_composition_of_its_pieces(gains):
     nu = turb.nu.copy()
     de, da, dr, thr = 0.0, 0.0, 0.0, ap.trim.throttle
     for k in range(n):
-        code, *cmd, gn, ge, gd, terr_ft, near = fk.fly_step(k, (*raw[k], *fk.GEAR_AIRBORNE), buf, nu, par, st, True)
+        reads = (*raw[k], *layouts.GEAR_AIRBORNE)
+        code, *cmd, gn, ge, gd, terr_ft, near = fk.fly_step(k, reads, buf, nu, par, st, True)
         assert code == fk.TERM_NONE and not near
         row = rows[k]
         terr = float(np.interp(row[26], along, height))
@@ -320,7 +323,7 @@ def test_fly_step_is_the_composition_of_its_pieces(gains):
         np.testing.assert_allclose(buf[k, 31:35], [de - 0.1, da, dr, thr], rtol=1e-12, atol=1e-12)
         cols = [c for c in range(36) if not 31 <= c < 35]
         np.testing.assert_allclose(buf[k, cols], row[cols], rtol=1e-12, atol=1e-9)
-    assert st[fk.S_STEP + fk.FS_LOWEST] == buf[:, 28].min()
+    assert st[layouts.S_STEP + layouts.FS_LOWEST] == buf[:, 28].min()
 
 
 def test_navigation_guidance_path_equals_the_guided_step(gains):
@@ -333,13 +336,14 @@ def test_navigation_guidance_path_equals_the_guided_step(gains):
     nu = turb_b.nu.copy()
     guidance = np.full((n, 6), np.nan)
     for k in range(n):
-        reads = (*raw[k], *fk.GEAR_AIRBORNE)
+        reads = (*raw[k], *layouts.GEAR_AIRBORNE)
         out_a = fk.fly_step(k, reads, buf_a, nu, par_a, st_a, True)
         out_b = fk.fly_step(k, reads, buf_b, nu, par_b, st_b, False)
         if k:  # the row holds the commands in force (the previous step's), pitch trim added
             np.testing.assert_array_equal(buf_b[k, 31:35], buf_a[k - 1, 31:35])
         guidance[k, 0:3], guidance[k, 3:6] = buf_b[k, 26:29], buf_b[k, 7:10]
-        assert out_b[1:5] == tuple(st_b[fk.S_STEP + fk.FS_DE:fk.S_STEP + fk.FS_THR + 1])  # the ones in force
+        in_force = st_b[layouts.S_STEP + layouts.FS_DE:layouts.S_STEP + layouts.FS_THR + 1]
+        assert out_b[1:5] == tuple(in_force)  # the ones in force
         assert fk.fly_control(k, guidance, buf_b, par_b, st_b) == out_a[1:5]
         assert out_a[5:] == out_b[5:]
     np.testing.assert_array_equal(buf_a, buf_b)
@@ -356,7 +360,7 @@ def test_the_gear_counts_only_near_the_ground(gains):
 
     def at(h_agl_m, gear):
         r, buf = raw.copy(), np.full((1, 36), np.nan)
-        fk.fly_step(0, (*r, *fk.GEAR_AIRBORNE), buf, nu, par, st.copy(), True)
+        fk.fly_step(0, (*r, *layouts.GEAR_AIRBORNE), buf, nu, par, st.copy(), True)
         r[2] += (h_agl_m - buf[0, 25]) / units.FT
         out = fk.fly_step(0, (*r, *gear), buf, nu, par, st.copy(), True)
         assert buf[0, 25] == pytest.approx(h_agl_m, abs=0.01)
@@ -366,7 +370,7 @@ def test_the_gear_counts_only_near_the_ground(gains):
     assert at(fk.LOW_READ_HEIGHT_M + fk.GEAR_READ_MARGIN_M - 1.0, mains_down) == (fk.TERM_NONE, True)
     assert at(fk.LOW_READ_HEIGHT_M + 1.0, mains_down) == (fk.TERM_NONE, True)
     assert at(fk.LOW_READ_HEIGHT_M - 1.0, mains_down) == (fk.TERM_GROUND, True)
-    assert at(fk.LOW_READ_HEIGHT_M - 1.0, fk.GEAR_AIRBORNE) == (fk.TERM_NONE, True)
+    assert at(fk.LOW_READ_HEIGHT_M - 1.0, layouts.GEAR_AIRBORNE) == (fk.TERM_NONE, True)
 
 
 def test_entry_point_calls_the_same_compiled_step(gains):
@@ -375,7 +379,7 @@ def test_entry_point_calls_the_same_compiled_step(gains):
     raw = _synthetic_raw(np.random.default_rng(12), n)
     buf = np.full((n, 36), np.nan)
     nu = np.zeros((n, 3))
-    reads = (*raw[0], *fk.GEAR_AIRBORNE)
+    reads = (*raw[0], *layouts.GEAR_AIRBORNE)
     entry = entry_point(fk.fly_step, 0, reads, buf, nu, par, st, True)
     assert entry is not fk.fly_step  # numba still exposes it (else the loop falls back on the dispatcher)
     st2, buf2 = st.copy(), buf.copy()
