@@ -138,7 +138,7 @@ class NavigationSource(Protocol):
 
     A source may also offer `inloop()`, returning None or an object whose arrays the flight loop's compiled step
     steps the navigation with (core/loop/nav_row.py: nw, cg, ca, rows, snap, baro_j, baro_e, lag_w, dth, dv) and whose
-    act(k, truth, code) it calls at the rows the step asks for; step() is then not called (nav/closed_loop.py).
+    act(k, truth, code) it calls at the rows the step asks for; step() is then not called (loop/closed_loop.py).
     """
 
     def step(self, k: int, truth: Truth) -> tuple[Array, Array]: ...
@@ -293,7 +293,7 @@ class PseudoliteSamples:
 
 @dataclass(frozen=True)
 class ApproachErrors:
-    """Error split of one flown approach (nav/closed_loop.py), RNP convention: TSE = FTE + NSE.
+    """Error split of one flown approach (loop/closed_loop.py), RNP convention: TSE = FTE + NSE.
 
     Components on the last axis: (lateral = cross-track, vertical = height above the ideal glidepath), m.
     """

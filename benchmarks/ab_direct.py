@@ -22,7 +22,7 @@ from approachsim.core.loop import jsbsim_abi  # noqa: E402
 from approachsim.flight.fdm import FDM  # noqa: E402
 from approachsim.flight.run import Approach  # noqa: E402
 from approachsim.flight.trim import start_condition  # noqa: E402
-from approachsim.nav.closed_loop import NavInTheLoop  # noqa: E402
+from approachsim.loop.closed_loop import NavInTheLoop  # noqa: E402
 from approachsim.profile import load_profile  # noqa: E402
 
 

@@ -18,7 +18,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 from approachsim.flight.run import Approach  # noqa: E402
-from approachsim.nav import closed_loop as cl  # noqa: E402
+from approachsim.loop import closed_loop as cl  # noqa: E402
 from approachsim.profile import load_profile  # noqa: E402
 
 

@@ -49,7 +49,7 @@ _FIRST_CALL = """
 import time, numpy as np
 t0 = time.perf_counter()
 from approachsim.nav import ins
-from approachsim.nav.closed_loop import NavInTheLoop  # noqa: F401 (imports every nav and sensor kernel module)
+from approachsim.loop.closed_loop import NavInTheLoop  # noqa: F401 (imports every nav and sensor kernel module)
 from approachsim.core.loop import flight_step as fk
 t1 = time.perf_counter()
 s = ins.init_state(0.6, -2.1, 100.0, [60.0, 0.0, 3.0], np.eye(3))
@@ -108,7 +108,7 @@ def bench_ratios(repeat: int) -> None:
     min and median of wall and CPU time (the machine's speed drifts: the ratios of one pass are the figures)."""
     from approachsim.flight.fdm import FDM
     from approachsim.flight.run import Approach
-    from approachsim.nav.closed_loop import NavInTheLoop
+    from approachsim.loop.closed_loop import NavInTheLoop
     from approachsim.nav.system import NavSystem
     from approachsim.profile import load_profile
     from approachsim.seeding import stream, stream_int

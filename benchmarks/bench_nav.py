@@ -17,7 +17,7 @@ from pathlib import Path
 
 from approachsim.flight.fdm import FDM
 from approachsim.flight.run import Approach
-from approachsim.nav.closed_loop import NavInTheLoop
+from approachsim.loop.closed_loop import NavInTheLoop
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream, stream_int

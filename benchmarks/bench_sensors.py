@@ -133,7 +133,7 @@ def selection_part(suite, truth, seed: int, runs: list[int], repeat: int) -> Non
 
 def one_row_part(prof, suite, truth, seed: int, run: int, repeat: int) -> None:
     """One truth row at a time: us per aiding epoch (baro + radalt + gnss [+ pseudolite] at each GNSS epoch) and
-    ms per approach of the closed loop's calls (nav/closed_loop.py: those at every aiding epoch and the baro at
+    ms per approach of the closed loop's calls (loop/closed_loop.py: those at every aiding epoch and the baro at
     every baro sample for the damping loop), before (generic path, numpy GNSS), generic compiled, prepared."""
     errors = suite.draw(truth.t_s, seed, run)
     names = tuple(n for n in EPOCH_SENSORS if n in suite.sensors)

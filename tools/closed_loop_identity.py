@@ -45,7 +45,7 @@ def _arrays(prefix: str, obj, out: dict) -> None:
 def fly_all() -> dict[str, np.ndarray]:
     """Every profile's closed loop, runs 0 and 1 of seed 1: their arrays by name."""
     from approachsim.flight.run import Approach
-    from approachsim.nav.closed_loop import NavInTheLoop
+    from approachsim.loop.closed_loop import NavInTheLoop
     from approachsim.profile import load_profile
 
     out: dict[str, np.ndarray] = {}

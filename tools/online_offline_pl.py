@@ -27,7 +27,7 @@ from approachsim import units  # noqa: E402
 from approachsim.flight.run import Approach  # noqa: E402
 from approachsim.integrity.bank import run_bank, score_category  # noqa: E402
 from approachsim.integrity.requirements import REQUIREMENTS  # noqa: E402
-from approachsim.nav.closed_loop import NavInTheLoop  # noqa: E402
+from approachsim.loop.closed_loop import NavInTheLoop  # noqa: E402
 from approachsim.profile import parse_profile  # noqa: E402
 
 DEFAULT = ROOT / "profiles" / "default.toml"

@@ -45,6 +45,11 @@ def evaluate_results(
 
     det = details(cols, res, cfg, sum_counts(results), integrity_fn=campaign_integrity)
     det["failures"] = {str(r.run): r.error for r in results if not r.ok}
+    paths: dict[str, list[int]] = {}
+    for r in results:
+        if r.path is not None:
+            paths.setdefault(r.path, []).append(int(r.run))
+    det["paths"] = paths
     geom = gnss_geometry([r.run for r in results if r.ok], cols)
     if geom is not None:
         det["gnss_geometry"] = geom

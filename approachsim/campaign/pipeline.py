@@ -50,7 +50,7 @@ STAGES = (
     ("approachsim.nav.system", "NavSystem", "navigation system"),
 )
 """(module, required attribute, what) of every stage the pipeline needs."""
-CLOSED_LOOP_STAGE = ("approachsim.nav.closed_loop", "NavInTheLoop", "closed-loop navigation source")
+CLOSED_LOOP_STAGE = ("approachsim.loop.closed_loop", "NavInTheLoop", "closed-loop navigation source")
 """The extra stage closed-loop mode needs."""
 
 
@@ -277,6 +277,7 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     optimal filter the runs share their covariance and gains (NavSystem.shares_covariance; a run's covariance
     depends only on the truth and its own measurement schedule, so this holds there too).
     """
+    from approachsim.loop.paths import open_loop_path
     from approachsim.nav.system import NavSystem
     from approachsim.seeding import stream
     from approachsim.sensors.states import start_states
@@ -305,24 +306,25 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
 
         group = GroupInputs(records, keep)
     out = []
+    path = f"flight={flight.loop} {open_loop_path(nav)}"
     for k, (i, nr) in enumerate(zip(runs, navruns, strict=True)):
         try:
             g = records.get("gnss")
-            out.append(_score(profile, i, truth, nr.solution, _clock_truth(records, k, truth.t_s),
-                              None if g is None else g.run(k), seed=seed,
-                              bank_group=None if group is None else (group, k)))
+            r = _score(profile, i, truth, nr.solution, _clock_truth(records, k, truth.t_s),
+                       None if g is None else g.run(k), seed=seed, bank_group=None if group is None else (group, k))
+            out.append(dataclasses.replace(r, path=path))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out
 
 
 def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool = False) -> list[RunResult]:
-    """Each run flies on its own navigation solution (nav.closed_loop.NavInTheLoop as the flight's navigation
+    """Each run flies on its own navigation solution (loop.closed_loop.NavInTheLoop as the flight's navigation
     source); the aircraft is parsed and linearized once per task. land: each run flies on to touchdown, its
     navigation is scored down to where an approach run stops and its touchdown is scored (module docstring)."""
     import numpy as np
 
-    from approachsim.nav.closed_loop import NavInTheLoop
+    from approachsim.loop.closed_loop import NavInTheLoop
 
     approach = _approach(profile, land)
     gear = main_gear_lever_arms_m(approach) if land else None
@@ -347,7 +349,7 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool =
             r = _score(profile, i, truth, nav, clock_true, _gnss_closed_loop(source, truth), flight, seed)
             if td:
                 r = dataclasses.replace(r, scalars={**r.scalars, **td})
-            out.append(r)
+            out.append(dataclasses.replace(r, path=f"flight={flight.loop} {source.path.name}"))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out

@@ -51,6 +51,9 @@ class RunResult:
     counts: Mapping[str, Array] = field(default_factory=_empty)
     """Histograms summed over the campaign (integrity: (error, protection level) cells per category and axis,
     integrity.campaign), stored sparse in the JSON line; empty when integrity is off."""
+    path: str | None = None
+    """Which code produced the run (loop/paths.py: the flight loop and the navigation's row and epoch paths), or
+    None (a failed run, or a line written before paths were recorded)."""
 
     @classmethod
     def failed(cls, run: int, error: str) -> RunResult:
@@ -66,6 +69,7 @@ class RunResult:
             "scalars": {k: float(v) for k, v in self.scalars.items()},
             "arrays": {k: [float(x) for x in np.asarray(v, dtype=float)] for k, v in self.arrays.items()},
             **({"counts": {k: _sparse(v) for k, v in self.counts.items()}} if self.counts else {}),
+            **({"path": self.path} if self.path is not None else {}),
         }
 
     def json_line(self) -> str:
@@ -82,11 +86,12 @@ class RunResult:
             scalars={k: float(v) for k, v in d.get("scalars", {}).items()},
             arrays={k: np.asarray(v, dtype=float) for k, v in d.get("arrays", {}).items()},
             counts={k: _dense(v) for k, v in d.get("counts", {}).items()},
+            path=d.get("path"),
         )
 
     def same_as(self, other: RunResult) -> bool:
         """Bit-identical outcome (scalars and arrays; nan equals nan)."""
-        if (self.run, self.ok, self.error) != (other.run, other.ok, other.error):
+        if (self.run, self.ok, self.error, self.path) != (other.run, other.ok, other.error, other.path):
             return False
         if list(self.scalars) != list(other.scalars) or list(self.arrays) != list(other.arrays):
             return False

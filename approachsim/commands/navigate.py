@@ -43,7 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _summary(nav, truth, profile, res) -> dict:
     from approachsim import geo, units
-    from approachsim.nav.closed_loop import approach_errors
+    from approachsim.loop.errors import approach_errors
 
     e = nav.true_error_nav
     nees = [float(x @ np.linalg.solve(P, x)) for x, P in zip(e, nav.P_nav, strict=True)]
@@ -81,7 +81,8 @@ def run(args: argparse.Namespace) -> int:
     """Fly, navigate, write files and figures; print a summary."""
     from approachsim.flight.run import Approach
     from approachsim.flight.truthfile import save_truth
-    from approachsim.nav.closed_loop import NavInTheLoop, approach_errors
+    from approachsim.loop.closed_loop import NavInTheLoop
+    from approachsim.loop.errors import approach_errors
     from approachsim.nav.system import NavSystem
     from approachsim.seeding import stream
     from approachsim.sensors.states import start_states

@@ -25,7 +25,7 @@ by this package's sources alone (approachsim/__init__.py), so editing a stage ne
         flight_step   one flight step: the IMU-point truth row, turbulence, autopilot, stabilized-approach monitor,
                       termination (flight/run.py; oracles in flight/)
         nav_row       the closed loop's navigation row inside the flight step
-        aiding        the closed loop's aiding-epoch inputs and epoch (nav/closed_loop.py)
+        aiding        the closed loop's aiding-epoch inputs and epoch (loop/closed_loop.py)
         closed_step   the flight step with the navigation row (nav_row) and the autopilot on it
         direct        the loop with JSBSim's property reads, writes and steps called from compiled code
         jsbsim_abi    the JSBSim wheel's C++ entry points, found and checked (ctypes; the guard of `direct`)

@@ -41,6 +41,7 @@ docs/truth.md says why each term is there.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -53,6 +54,7 @@ from approachsim.core.entry import entry_point
 from approachsim.core.loop import closed_step as ck
 from approachsim.core.loop import direct as dk
 from approachsim.core.loop import flight_step as fk
+from approachsim.core.loop import jsbsim_abi
 from approachsim.evaluate.touchdown import touchdown_scalars
 from approachsim.flight import vectors as fv
 from approachsim.flight.aircraft import Aircraft, load_aircraft
@@ -150,6 +152,10 @@ class FlightResult:
     heading, rad (+: the gear moves to the right of where the nose points; nan: none)."""
     touchdown_crab_rad: float = math.nan
     """Landing runs: heading minus the runway heading at touchdown, rad (nan: none)."""
+    loop: str = "python"
+    """Which flight loop flew it (`flight_loop`): "direct" (JSBSim's C++ called from compiled code) or "python"."""
+    loop_reason: str | None = None
+    """Why the loop was "python" (None: it was "direct")."""
 
     @property
     def ok(self) -> bool:
@@ -280,7 +286,7 @@ class Approach:
         # the loop: JSBSim's reads, one compiled call (fly_step: truth row, turbulence, termination and, guided by
         # the truth, the autopilot), the writes, JSBSim's step; a navigation source sees row k between fly_step
         # and the autopilot (fly_control)
-        # A source whose navigation runs compiled (`inloop()`, nav/closed_loop.py) is stepped inside the same call
+        # A source whose navigation runs compiled (`inloop()`, loop/closed_loop.py) is stepped inside the same call
         # (core/loop/closed_step.py fly_step_closed, on the navigation's packed arrays nw, fa, ia): Python acts
         # only at the rows it asks for (start, baro samples, aiding epochs)
         guided = src is None
@@ -292,6 +298,7 @@ class Approach:
             guidance = fused.guidance  # its rows: the kernel writes them
         else:
             guidance = None if src is None else np.full((n_max, 6), np.nan)
+        loop, loop_reason = flight_loop(io, guided, fused)
         read, read_near, run_step = io.read, io.read_near, io.run
         raw0 = (0.0,) * (layouts.N_RAW + len(layouts.GEAR_FIELDS))
         step = entry_point(fk.fly_step, 0, raw0, buf, nu, par, st, guided)
@@ -307,7 +314,7 @@ class Approach:
         code = fk.TERM_NONE
         near = True
         k = 0
-        direct = io.direct if (guided or fused is not None) else None
+        direct = io.direct if loop == "direct" else None
         if direct is not None:  # the same loop compiled, JSBSim called from it (core/loop/direct.py)
             raw = np.zeros(layouts.N_READ)
             if guided:
@@ -372,6 +379,8 @@ class Approach:
             seed=seed,
             run=run,
             turbulence_seed=turb_seed,
+            loop=loop,
+            loop_reason=loop_reason,
         )
 
     @staticmethod
@@ -437,6 +446,20 @@ class Approach:
         return par, st, nu
 
 
+
+
+def flight_loop(io: Any, guided: bool, fused: Any) -> tuple[str, str | None]:
+    """Which loop flies this run, chosen once: "direct" (core/loop/direct.py: JSBSim's property reads, writes and
+    step called from compiled code) when the autopilot flies on the truth (guided) or the navigation source steps in
+    the compiled row (fused, its InLoop arrays), and the jsbsim wheel's C++ entry points were found and checked on
+    this run's objects (io.direct); else "python" with the reason. Both give the same bits."""
+    if not guided and fused is None:
+        return "python", "the navigation source steps in Python every row (no compiled row: loop/paths.py)"
+    if io.direct is None:
+        if os.environ.get(jsbsim_abi.ENV_SWITCH, "1").strip() == "0":
+            return "python", f"{jsbsim_abi.ENV_SWITCH}=0"
+        return "python", "the jsbsim wheel's C++ entry points were not found or not checked (core/loop/jsbsim_abi.py)"
+    return "direct", None
 
 
 def termination_reason(code: int, fs: Array) -> str:

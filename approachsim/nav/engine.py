@@ -262,10 +262,14 @@ class EpochEngine:
     @classmethod
     def of(cls, system: Any) -> EpochEngine | None:
         """The engine of `system`, or None when its configuration takes the generic path (module docstring)."""
+        return cls(system) if cls.supports(system) else None
+
+    @staticmethod
+    def supports(system: Any) -> bool:
+        """Whether `system` has the compiled epoch: the optimal Kalman filter on a configuration whose runs can share
+        one covariance (NavSystem.shares_covariance)."""
         f = system.filter
-        if not (isinstance(f, KalmanFilter) and f.policy is optimal_policy and system.shares_covariance()):
-            return None
-        return cls(system)
+        return isinstance(f, KalmanFilter) and f.policy is optimal_policy and system.shares_covariance()
 
     def _obs_args(self, obs: Observations, members: list[int], dbs: list[RunDatabase]) -> tuple:
         """class_epoch's observation arguments of the members (core/nav/epoch.py)."""

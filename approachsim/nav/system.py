@@ -8,7 +8,7 @@ NavSystem holds the configuration and the models built from it: the error-state 
 nav/registry.py), the noise model from the sensors' error budgets (nav/noise.py), the measurement rows
 (nav/rows.py) with the filter's terrain database, and the damping-loop gains. It starts runs (`start`: INS errors
 and filter states) and passes them over whole records (`run`) through the navigation step object
-(nav/navigator.py), which the closed loop (nav/closed_loop.py) steps row by row instead.
+(nav/navigator.py), which the closed loop (loop/closed_loop.py) steps row by row instead.
 
 The INS integrates every IMU increment; at each aiding epoch (nav.aiding_rate_hz) the filter predicts with the
 discretized error model (errormodel.dynamics + discretize, linearized about the INS solution) and takes every

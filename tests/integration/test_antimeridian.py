@@ -23,7 +23,8 @@ import pytest
 from approachsim import units
 from approachsim.campaign.evaluation import evaluate_profile
 from approachsim.flight.run import Approach
-from approachsim.nav.closed_loop import NavInTheLoop, approach_errors
+from approachsim.loop.closed_loop import NavInTheLoop
+from approachsim.loop.errors import approach_errors
 from approachsim.profile import parse_profile
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -152,6 +152,12 @@ def test_open_loop_evaluation_end_to_end(tmp_path, capsys):
         assert dist["fraction_used_lt4"] == 0.0 and dist["fraction_visible_lt5"] == 0.0  # exact: counts of 0 / n
     # integrity (on by default for CAT II / III): the bank's counts per category, at filter epochs, and figures
     det = json.loads((out / "details.json").read_text())
+    # which code produced each run (loop/paths.py): the default profile's open loop shares its covariance, and
+    # its truth flew on the compiled JSBSim loop unless the wheel's entry points could not be checked here
+    assert list(det["paths"].values()) == [[0, 1]], det["paths"]
+    (path,) = det["paths"]
+    assert path.endswith(" epoch=shared") and path.split()[0] in ("flight=direct", "flight=python"), path
+    assert all(json.loads(line)["path"] == path for line in (out / "runs.jsonl").read_text().splitlines())
     integ = det["integrity"]
     assert integ["categories_in_verdict"] == ["CAT II", "CAT III"] and "k_v" not in det
     for cat, key in (("CAT I", "cat1"), ("CAT II", "cat2"), ("CAT III", "cat3")):

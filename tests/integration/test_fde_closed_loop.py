@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from approachsim.flight.run import Approach
-from approachsim.nav.closed_loop import NavInTheLoop, approach_errors
+from approachsim.loop.closed_loop import NavInTheLoop
+from approachsim.loop.errors import approach_errors
 from approachsim.profile import parse_profile
 
 pytestmark = pytest.mark.slow

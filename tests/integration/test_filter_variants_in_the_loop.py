@@ -22,7 +22,7 @@ from scipy.stats import chi2
 
 from approachsim import geo
 from approachsim.flight.run import Approach
-from approachsim.nav.closed_loop import NavInTheLoop
+from approachsim.loop.closed_loop import NavInTheLoop
 from approachsim.nav.registry import FILTERS
 from approachsim.profile import parse_profile
 

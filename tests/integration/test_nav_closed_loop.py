@@ -13,7 +13,8 @@ import pytest
 
 from approachsim import geo, units
 from approachsim.flight.run import Approach
-from approachsim.nav.closed_loop import NavInTheLoop, approach_errors, path_deviation
+from approachsim.loop.closed_loop import NavInTheLoop
+from approachsim.loop.errors import approach_errors, path_deviation
 from approachsim.profile import parse_profile
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"

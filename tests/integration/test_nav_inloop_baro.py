@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from approachsim.flight.run import Approach
-from approachsim.nav.closed_loop import NavInTheLoop
+from approachsim.loop.closed_loop import NavInTheLoop
 from approachsim.profile import parse_profile
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"

@@ -58,7 +58,7 @@ def test_a_failed_landing_is_a_failed_run_with_its_reason(monkeypatch):
 
     monkeypatch.setattr(pipeline, "_approach", lambda p, land=False: ShortApproach())
     monkeypatch.setattr(pipeline, "main_gear_lever_arms_m", lambda a: np.zeros((2, 3)))
-    monkeypatch.setattr("approachsim.nav.closed_loop.NavInTheLoop", NoNav)
+    monkeypatch.setattr("approachsim.loop.closed_loop.NavInTheLoop", NoNav)
     (r,) = pipeline.closed_loop_group(profile, 1, [0], land=True)
     assert not r.ok
     assert r.error == "RuntimeError: failed landing: touchdown short of the threshold (120 ft) (lowest 2 ft)"

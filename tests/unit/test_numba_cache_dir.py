@@ -81,7 +81,7 @@ def test_numba_does_not_load_a_kernel_cached_for_another_cpu(tmp_path):
 
 def test_editing_a_stage_keeps_the_cache_and_editing_core_starts_a_fresh_one(tmp_path):
     """The cache key covers core/ (and the units and geo constants the kernels freeze) alone: a copy of the package
-    with a stage module edited (nav/closed_loop.py, flight/run.py: the loop's wiring) has the same key, so the
+    with a stage module edited (loop/closed_loop.py, flight/run.py: the loop's wiring) has the same key, so the
     first evaluate after such an edit loads every kernel from the cache; an edited kernel module gets a new key."""
     import shutil
     from pathlib import Path
@@ -94,7 +94,7 @@ def test_editing_a_stage_keeps_the_cache_and_editing_core_starts_a_fresh_one(tmp
     target = "x86_64-unknown-linux-gnu|haswell|+avx2,+fma"
     key = approachsim.core._numba_cache_key(pkg, target)
     assert key == approachsim.core._numba_cache_key(src, target)
-    for stage in ("nav/closed_loop.py", "flight/run.py", "sensors/baro.py", "integrity/bank.py"):
+    for stage in ("loop/closed_loop.py", "flight/run.py", "sensors/baro.py", "integrity/bank.py"):
         with (pkg / stage).open("a", encoding="utf-8") as f:
             f.write("\n# edited\n")
         assert approachsim.core._numba_cache_key(pkg, target) == key, stage

@@ -1,6 +1,6 @@
 """The closed loop's aiding epoch as one compiled call (numba, cache=True): the per-run EKF's whole epoch
 (core/nav/epoch.own_epoch) with what the Navigator does around it at an epoch of a feed-forward run, so that an
-epoch of the closed loop costs one kernel call plus the sensors' one-row records (nav/closed_loop.py `_fast_epoch`).
+epoch of the closed loop costs one kernel call plus the sensors' one-row records (loop/closed_loop.py `_fast_epoch`).
 
     k = loop_epoch(nw, X, P, e, <own_epoch's model and observation arguments>, XS, PP, PC, PD, PN, ic)
 
@@ -54,7 +54,7 @@ def loop_epoch(nw: np.ndarray, X: np.ndarray, P: np.ndarray, e: int, lay: np.nda
     for c in range(3):
         f_ned[c] = nw[layouts.W_FSUM + c] / dt
     y = nw[layouts.W_X:layouts.W_X + 16]
-    # no carrier phase on this path (closed_loop.fast_epoch_unavailable sends it to the Navigator's): no carrier
+    # no carrier phase on this path (loop/paths.py sends it to the Navigator's): no carrier
     # rows, no ionosphere states, no new arcs (the engine's own empties, nav/engine.py)
     k = ke.own_epoch(X, P, lay, q, gse, gmp, loop, held, dt, f_ned, y, F, Qc, phi, qd, baro_h, baro_r, radalt_h,
                      ra_pct, ra_floor, tx, th, rwy, dbp, db_x, db_u, rho, r_sv, sig, channel_states,
@@ -146,7 +146,7 @@ def direct_inputs(k: int, t: float, tol: float,
                   clk: np.ndarray, g_ts: np.ndarray, scale: float, g_rx: np.ndarray, g_sv: np.ndarray,
                   rho: np.ndarray, r_sv_out: np.ndarray, sig_out: np.ndarray, el_out: np.ndarray,
                   guard: bool, lo: float, g: np.ndarray, mp_arg: np.ndarray) -> int:
-    """The closed loop's direct epoch inputs at truth row k (time t) in one call (nav/closed_loop.py
+    """The closed loop's direct epoch inputs at truth row k (time t) in one call (loop/closed_loop.py
     `_direct_inputs`): the sensors' one-row kernels on the values their h_one / channels_one give them, the same
     kernels in the same order, so the same bits:
 

@@ -1,7 +1,7 @@
 """The closed loop's per-row navigation as a compiled kernel (numba, cache=True), called by the flight loop's
 compiled step (core/loop/closed_step.py) so that a closed-loop row costs no Python beyond JSBSim's reads and
 writes; Python runs only at the rows where the navigation needs it (the start, a baro sample of the damping loop,
-an aiding epoch: nav/closed_loop.py).
+an aiding epoch: loop/closed_loop.py).
 
 Per truth row k (k > 0), with the flight's row buffer buf (core/layouts.py TRUTH_ROW):
 
@@ -15,7 +15,7 @@ Per truth row k (k > 0), with the flight's row buffer buf (core/layouts.py TRUTH
 The work vector nw (core/layouts.py NAV_WORK) holds the one run's INS state and the small constants; the other arrays of
 the row are views of two packed arrays, fa (float64) and ia (int64) (`views`, `packed_sizes`), so that the flight
 loop's compiled call takes three navigation arguments instead of twelve (unboxing an array argument costs ~0.13 us
-of every one of the flight's ~31,000 calls). nav/closed_loop.py builds them and keeps the Navigator's INS state,
+of every one of the flight's ~31,000 calls). loop/closed_loop.py builds them and keeps the Navigator's INS state,
 specific-force sum, rows and snapshot index as views of these arrays, so both see the same numbers. The numpy
 oracle is NavInTheLoop.step (the generic per-row path, kept for quantized or faulted IMUs):
 tests/unit/nav/test_system_closed_loop.py flies both.

@@ -253,7 +253,7 @@ def test_closed_loop_step_by_step_equals_the_open_loop_pass_with_carrier():
     gives the open-loop pass's navigation with carrier phase, through a GNSS outage (new arcs after it), on the GBAS
     carrier candidate: the closed loop draws for a longer flight, and every draw (the GBAS white noise from its own
     child stream, receiver.draw) is a prefix of the longer record's."""
-    from approachsim.nav.closed_loop import NavInTheLoop
+    from approachsim.loop.closed_loop import NavInTheLoop
 
     path = PROFILES / "gbas-carrier-cat3-candidate.toml"
     data = tomllib.loads(path.read_text(encoding="utf-8"))

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from approachsim.flight.run import Approach
-from approachsim.nav.closed_loop import NavInTheLoop
+from approachsim.loop.closed_loop import NavInTheLoop
 from approachsim.profile import parse_profile
 
 pytestmark = pytest.mark.equality
@@ -48,8 +48,9 @@ def test_compiled_epoch_equals_the_navigator_path(name):
     prof = _profile(name)
     src, res, nav = _fly(prof, True)
     src0, res0, nav0 = _fly(prof, False)
-    assert src.fast_epoch_unavailable() is None and src._fast.e == len(nav.t_epoch_s) > 10  # every epoch compiled
-    assert src0._fast is None
+    assert src.path.epoch == "fused" and src.path.reason("epoch") is None
+    assert src._fast.e == len(nav.t_epoch_s) > 10  # every epoch compiled
+    assert src0._fast is None and src0.path.epoch == "generic" and "oracle" in src0.path.reason("epoch")
     eq = np.testing.assert_array_equal
     eq(res.guidance_r_rwy, res0.guidance_r_rwy)
     eq(res.guidance_v_ned, res0.guidance_v_ned)
@@ -70,7 +71,7 @@ def test_configurations_without_the_compiled_epoch_take_the_navigator_path(nav, 
     generic filters): the source says why, and flies."""
     prof = _profile("default.toml", **nav)
     src, res, run = _fly(prof, True, seconds=3.0)
-    assert why in src.fast_epoch_unavailable()
+    assert src.path.epoch == "generic" and why in src.path.reason("epoch")
     assert src._fast is None and len(run.t_epoch_s) > 0 and np.all(np.isfinite(run.solution.r_ecef))
 
 
@@ -169,5 +170,10 @@ def test_compiled_channel_sigmas_equal_the_budget_numpy(multipath_model):
         assert q is q0
         np.testing.assert_array_equal(gse, gse0)
         np.testing.assert_array_equal(gmp, gmp0)
-    src.compiled_sigmas = False  # the numpy formulas: the fallback the flight takes when asked
-    assert src._sigma_scratch(src.nav.noise_model.sensors.gnss.budget(), 24) is None
+    assert src.path.sigmas == "compiled"
+    src.compiled_sigmas = False  # the path is chosen once per run: a switch set after the start changes nothing
+    assert src.path.sigmas == "compiled"
+    fresh = NavInTheLoop(prof, seed=3, run=5, max_time_s=10.0)
+    fresh.compiled_sigmas = False  # the numpy formulas: the fallback the flight takes when asked
+    assert fresh.path.sigmas == "numpy" and "compiled_sigmas" in fresh.path.reason("sigmas")
+    assert fresh._sigma_scratch(fresh.nav.noise_model.sensors.gnss.budget(), 24) is None

@@ -1,5 +1,5 @@
 """The one sign convention of the navigation error (docs/contract.md, "Signs: navigation error and NSE"): the
-evaluator's error e = estimate - truth and the PBN split TSE = FTE + NSE of nav/closed_loop.approach_errors
+evaluator's error e = estimate - truth and the PBN split TSE = FTE + NSE of loop/closed_loop.approach_errors
 against the straight glide path cone, so NSE = -e in path terms (to the cone's first order), and the evaluator's
 FTE = TSE + e is the same identity."""
 
@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from approachsim import synthetic
-from approachsim.nav.closed_loop import approach_errors
+from approachsim.loop.errors import approach_errors
 from approachsim.profile import load_profile
 
 PROFILE = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")

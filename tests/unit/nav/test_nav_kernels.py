@@ -150,7 +150,7 @@ def test_closed_loop_steps_equal_the_open_loop_pass_to_rounding(feedback, cold):
     from pathlib import Path
 
     from approachsim import synthetic
-    from approachsim.nav.closed_loop import NavInTheLoop
+    from approachsim.loop.closed_loop import NavInTheLoop
     from approachsim.nav.system import NavSystem
     from approachsim.profile import parse_profile
     from approachsim.seeding import stream

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from approachsim import geo, synthetic
-from approachsim.nav.closed_loop import NavInTheLoop
+from approachsim.loop.closed_loop import NavInTheLoop
 from approachsim.nav.system import NavSystem
 from approachsim.profile import parse_profile
 from approachsim.seeding import stream
@@ -39,7 +39,7 @@ def test_step_by_step_equals_open_loop_pass(quantized, feedback, realistic):
     truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=prof.rates.imu_hz, start_distance_m=70.0 * 6.0,
                                         ground_speed_mps=70.0)
     src = NavInTheLoop(prof, seed=4, run=2, max_time_s=30.0)
-    assert (src._imu_affine is None) == quantized
+    assert (src.imu_affine_terms() is None) == quantized and (src.path.row == "generic") == quantized
     r_rwy = np.array([src.step(k, truth)[0] for k in range(len(truth))])
     closed = src.result(truth)
     assert (src.navigator.runs[0].db_error is not None) == realistic

@@ -1,9 +1,8 @@
-"""Navigation in the loop: a NavigationSource that runs the INS + filter step by step inside the flight loop,
-and the flight technical / navigation system / total system error split of a flown approach.
+"""Navigation in the loop: a NavigationSource that runs the INS + filter step by step inside the flight loop.
 
     source = NavInTheLoop(profile, seed, run)          # sensor errors drawn once, applied row by row
     result = Approach(profile).fly(seed, run, nav_source=source)
-    errors = approach_errors(result.truth, result.guidance_r_rwy, profile.runway)   # TSE = FTE + NSE
+    errors = approach_errors(result.truth, result.guidance_r_rwy, profile.runway)   # loop/errors.py
 
 The source reads truth rows <= k only (records.NavigationSource): at row k it applies the pre-drawn IMU
 errors to the increment (k-1, k], steps the INS, and at aiding epochs applies the other sensors' pre-drawn
@@ -13,12 +12,12 @@ errors to row k and runs the filter (system.NavSystem.aid). Guidance gets the na
 Flown by JSBSim (`inloop`), the row runs inside the flight's compiled step (core/loop/nav_row.py) and an aiding
 epoch is one compiled call (core/loop/aiding.py: the per-run EKF's epoch and the Navigator's
 bookkeeping) on the sensors' one-row records, when the configuration has the compiled epoch
-(`fast_epoch_unavailable`: not with feedback, the online FDE, the robust or U-D filters, loose coupling, an adaptive
-loop, carrier phase); otherwise, and as its test oracle (`fast_epochs = False`), the Navigator's numpy path.
-The compiled epoch's sensor inputs come straight from the baro's, radar altimeter's and GPS receiver's kernels,
-fused in one compiled call (`_direct_inputs`, closed_loop_epoch.direct_inputs, no records; `direct_inputs = False`
-or a faulted sensor, GBAS, carrier: from the records) and the GPS channel sigmas partly compiled (`_noise_arrays`;
-`compiled_sigmas = False`: numpy), the same bits either way
+(loop/paths.py chooses every part of the path once per run: not with feedback, the online FDE, the robust or U-D
+filters, loose coupling, an adaptive loop, carrier phase); otherwise, and as its test oracle (`fast_epochs = False`),
+the Navigator's numpy path. The compiled epoch's sensor inputs come straight from the baro's, radar altimeter's and
+GPS receiver's kernels, fused in one compiled call (`_direct_inputs`, core/loop/aiding.direct_inputs, no records;
+`direct_inputs = False` or a faulted sensor, GBAS, carrier: from the records) and the GPS channel sigmas partly
+compiled (`_noise_arrays`; `compiled_sigmas = False`: numpy), the same bits either way
 (tests/unit/nav/test_closed_loop_epoch.py; tools/closed_loop_identity.py against a saved reference).
 """
 
@@ -37,18 +36,16 @@ from approachsim.core.entry import entry_point
 from approachsim.core.loop import aiding as ce
 from approachsim.core.loop import nav_row as ik
 from approachsim.core.nav import strapdown as sk
-from approachsim.glidepath import GlidePath
+from approachsim.loop import paths
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav.base import FilterState
 from approachsim.nav.navigator import Navigator, NavRun
 from approachsim.nav.observations import Observations
 from approachsim.nav.system import NavSystem, tuned_records
-from approachsim.records import ApproachErrors, Truth
+from approachsim.records import Truth
 from approachsim.seeding import stream
-from approachsim.sensors.baro import Baro, PreparedBaro
-from approachsim.sensors.gnss.receiver import IONO_SHELL_M, PreparedGnss
-from approachsim.sensors.radalt import PreparedRadalt
+from approachsim.sensors.gnss.receiver import IONO_SHELL_M
 from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite
 
@@ -137,7 +134,7 @@ class _Act:
 class FastEpoch:
     """The closed loop's compiled aiding epoch (core/loop/aiding.py loop_epoch): its constant
     arguments, scratch and the epoch history it writes (XS, PP, PC, PD, PN: one row per epoch, the Navigator's
-    snapshots are views of them), made once at the start (NavInTheLoop.fast_epoch_unavailable says when not)."""
+    snapshots are views of them), made once at the start (loop/paths.py says when not)."""
 
     q: Array
     """The error model's scalar noise (errormodel.kernel_noise of the elevation-free noise; does not depend on the
@@ -254,7 +251,7 @@ class NavInTheLoop:
         self._recs: tuple[int, dict[str, Any]] | None = None
         """The last epoch's sensor records (row, records): the baro's is the damping loop's sample at that row."""
         self.fast_epochs = True
-        """Run the aiding epochs compiled when the configuration allows (`fast_epoch_unavailable`); False: always
+        """Run the aiding epochs compiled when the configuration allows (loop/paths.py); False: always
         the Navigator's numpy path (the compiled epoch's test oracle)."""
         self.direct_inputs = True
         """The compiled epoch's sensor inputs straight from the sensors' kernels when possible (FastEpoch.direct);
@@ -262,6 +259,20 @@ class NavInTheLoop:
         self.compiled_sigmas = True
         """The GPS channel sigmas of the compiled epoch partly compiled (FastEpoch.sig); False: numpy's formulas
         (their test oracle)."""
+        self._path: paths.LoopPath | None = None
+
+    @property
+    def path(self) -> paths.LoopPath:
+        """Which code runs this source (loop/paths.py `choose`), chosen at its first use from the configuration
+        and the oracle switches above, then fixed for the run."""
+        if self._path is None:
+            self._path = paths.choose(self)
+        return self._path
+
+    def imu_affine_terms(self) -> tuple[Array, Array, Array, Array] | None:
+        """The IMU's affine error terms (S_g + M_g, S_a + M_a, c_g, c_a; `_imu_error_terms`), or None when the IMU
+        is quantized or faulted."""
+        return self._imu_affine
 
     def _imu_error_terms(self) -> tuple[Array, Array, Array, Array] | None:
         """The IMU error model is affine in the true increments (sensors/imu.py):
@@ -362,7 +373,7 @@ class NavInTheLoop:
     def inloop(self) -> InLoop | None:
         """The arrays of the compiled per-row navigation (records.NavigationSource), or None when the IMU errors
         are not affine (quantized or faulted IMU: every sample goes through its model, `step`)."""
-        if self._imu_affine is None:
+        if self.path.row != "compiled":
             return None
         if self._inloop is None:
             m_g, m_a, c_g, c_a = self._imu_affine
@@ -386,7 +397,7 @@ class NavInTheLoop:
                 keep = rows < n
                 baro_j[rows[keep]] = np.flatnonzero(keep)
                 baro = self.suite.sensors["baro"]
-                if type(baro) is Baro:  # a plain altimeter: its samples made in the kernel (a faulted one: Python)
+                if self.path.baro == "compiled":  # a plain altimeter: its samples made in the kernel
                     nw[layouts.W_BARO_KERNEL] = 1.0
                     (nw[layouts.W_BSET], nw[layouts.W_BT0L], nw[layouts.W_BEXP], nw[layouts.W_BFLD],
                      nw[layouts.W_BCM1]) = baro.kernel_constants()
@@ -422,7 +433,7 @@ class NavInTheLoop:
                                 lp.rows3, lp.snap)
             self._estimate_in_force()
             self._recs = (0, recs)
-            if self.fast_epochs and self.fast_epoch_unavailable() is None:
+            if self.path.epoch != "generic":
                 self._fast = self._fast_epoch_arrays()
         navigator = self.navigator
         run = navigator.runs[0]
@@ -461,22 +472,6 @@ class NavInTheLoop:
 
     # --- the compiled aiding epoch (core/loop/aiding.py) -------------------------------------------
 
-    def fast_epoch_unavailable(self) -> str | None:
-        """Why the aiding epochs cannot run compiled (None: they can): they need the compiled per-run EKF epoch
-        (nav/engine.py: the optimal 'ekf', tight GPS coupling, a constant or no baro loop, no online FDE, no carrier
-        phase) and feed-forward output (feedback corrects the INS in numpy: Navigator._feedback). The others take
-        the Navigator's numpy path at every epoch (the same numbers)."""
-        nav = self.navigator
-        if any(r.fde is not None for r in nav.runs):
-            return "online FDE ([nav.fde] enabled): nav/fde.py's epoch"
-        if nav.engine is None or nav.shared is not None:
-            return "no compiled epoch for this filter configuration (nav/engine.py EpochEngine.of)"
-        if self.nav.nav.feedback:
-            return "feedback ([nav] feedback = true): the INS reset in numpy"
-        if self.nav.layout.has("amb"):
-            return "carrier phase: the ambiguity resets at new arcs"
-        return None
-
     def _fast_epoch_arrays(self) -> FastEpoch:
         """The compiled epoch's constants, scratch and history rows (one per possible epoch)."""
         nav = self.navigator
@@ -490,32 +485,19 @@ class NavInTheLoop:
             budget=None if g is None else g.budget(), held_possible=lay.has("ac") and self.gains is not None,
             P=np.array(nav.runs[0].fs.P, dtype=float), X=np.zeros((1, n)), f_ned=np.zeros(3),
             XS=np.zeros((n_ep, n)), PP=np.zeros((n_ep, 3, 3)), PC=np.zeros(n_ep), PD=np.zeros((n_ep, n)),
-            PN=np.zeros((n_ep, 9, 9)), direct=self.direct_inputs and self._direct_possible(),
+            PN=np.zeros((n_ep, 9, 9)), direct=self.path.epoch == "fused",
             sig=self._sigma_scratch(None if g is None else g.budget(), lay.n_sv))
 
     def _sigma_scratch(self, b: Any, n_sv: int) -> tuple | None:
         """FastEpoch.sig for the budget b (None: no GPS) and n_sv channels: None unless stand-alone with channels
         (and `compiled_sigmas`)."""
-        if b is None or b.gbas is not None or n_sv == 0 or not self.compiled_sigmas:
+        if self.path.sigmas != "compiled":
             return None
         do253 = b.multipath_model == "do253"
         gmp = np.zeros(n_sv) if do253 else _per_channel(b.multipath_m, n_sv).copy()
         return (*(np.zeros(n_sv) for _ in range(6)), gmp,
                 (geo.A_WGS84, IONO_SHELL_M, float(b.clock_ephemeris_m**2), float(b.iono_zenith_m),
                  float(b.tropo_zenith_m), do253))
-
-    def _direct_possible(self) -> bool:
-        """Whether every aiding sensor's epoch input has its direct form (`_direct_inputs`): a plain (not faulted)
-        baro and radar altimeter, a one-run, one-sky GPS receiver of code ranging without GBAS or carrier phase;
-        the pseudolite's record is made as before."""
-        ps = self.prepared.sensors
-        for name, kind in (("baro", PreparedBaro), ("radalt", PreparedRadalt), ("gnss", PreparedGnss)):
-            p = ps.get(name)
-            if p is not None and type(p) is not kind:
-                return False
-        g = ps.get("gnss")
-        return g is None or (g.rx.budget.gbas is None and g.rx.carrier is None and not g.per_run
-                             and not g.errors.batched)
 
     def _noise_arrays(self, el: Array | None) -> tuple[Array, Array, Array]:
         """NoiseModel.kernel_arrays(el) (nav/noise.py) with the elevation-free scalars kept: the GPS channel
@@ -725,23 +707,3 @@ class NavInTheLoop:
     def result(self, truth: Truth) -> NavRun:
         """The navigation run over the flown truth (call after the flight)."""
         return self.navigator.results(truth, len(truth))[0]
-
-
-def path_deviation(r_rwy: Array, runway: Any) -> Array:
-    """Deviation (..., 2) of runway-frame points from the desired path: (cross-track y, height above the straight
-    ILS glide path cone, approachsim.glidepath: the one geometric reference the flight and the campaign's FTE use),
-    m."""
-    r = np.asarray(r_rwy, dtype=float)
-    return np.stack([r[..., 1], GlidePath.of(runway).deviation_rwy_m(r)], axis=-1)
-
-
-def approach_errors(truth: Truth, guidance_r_rwy: Array, runway: Any) -> ApproachErrors:
-    """FTE, NSE and TSE (lateral, vertical) of a flown approach (RNP convention, records.ApproachErrors).
-
-    FTE = deviation of the position guidance flew on from the desired path; TSE = deviation of the true
-    position; NSE = TSE - FTE = d(true) - d(estimate): the navigation error seen in path terms, so that
-    TSE = FTE + NSE (the along-track error enters NSE through the glidepath slope).
-    """
-    fte = path_deviation(guidance_r_rwy, runway)
-    tse = path_deviation(truth.r_rwy, runway)
-    return ApproachErrors(t_s=np.asarray(truth.t_s, dtype=float), fte_m=fte, nse_m=tse - fte, tse_m=tse)
