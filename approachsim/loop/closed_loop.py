@@ -173,14 +173,12 @@ _NO_RECS: dict[str, Any] = {}
 
 @dataclass
 class _Direct:
-    """closed_loop_epoch.direct_inputs' argument list for one run (NavInTheLoop._direct_arrays): its sample indices
-    at args[jb], args[jr], args[jg] (-1: none at the row), best4-fixed's plan (PreparedGnss.plan, args[jg + 5]; None
-    for the other selections), and the output buffers the epoch's inputs are read from."""
+    """core/loop/aiding.direct_inputs' argument list for one run (NavInTheLoop._direct_arrays): the row and time
+    (args[0], args[1]), the sample indices args[3:6] (baro, radar altimeter, GPS; -1: none at the row), the GPS
+    selection plan args[6] (best4-fixed's is made per epoch: `plan`, PreparedGnss.plan; None for the other
+    selections), each sensor's tuple, and the output buffers the epoch's inputs are read from."""
 
     args: list
-    jb: int
-    jr: int
-    jg: int
     plan: Any
     baro_h: Array
     baro_r: float
@@ -580,14 +578,11 @@ class NavInTheLoop:
             d = self._direct = self._direct_arrays(truth)
         args = d.args
         args[0], args[1] = k, t
-        j = ps.sample("baro", k)
-        args[d.jb] = -1 if j is None else j
-        j = ps.sample("radalt", k)
-        args[d.jr] = -1 if j is None else j
-        j = ps.sample("gnss", k)
-        args[d.jg] = -1 if j is None else j
+        for c, name in ((3, "baro"), (4, "radalt"), (5, "gnss")):
+            j = ps.sample(name, k)
+            args[c] = -1 if j is None else j
         if d.plan is not None:
-            args[d.jg + 5] = d.plan(truth)
+            args[6] = d.plan(truth)
         if d.call is None:
             d.call = entry_point(ce.direct_inputs, *args)
         flags = d.call(*args)
@@ -613,22 +608,22 @@ class NavInTheLoop:
         b = ps.get("baro")
         if b is not None:
             lag, w, kc, _ = b.one_constants(truth)
-            baro = (-1, truth.p_static_pa, w, *kc, b.sf, b.bias, b.noise, b.errors.t_s, np.empty((1, lag.shape[0])),
+            baro = (truth.p_static_pa, w, *kc, b.sf, b.bias, b.noise, b.errors.t_s, np.empty((1, lag.shape[0])),
                     np.empty((1, 1)))
             baro_r = float(b.baro.noise_sigma_m) ** 2
         else:
-            baro = (-1, z1, z1, 0.0, 1.0, 1.0, 0.0, 0.0, z1, z2, z2, z1, np.empty((1, 1)), np.empty((1, 1)))
+            baro = (z1, z1, 0.0, 1.0, 1.0, 0.0, 0.0, z1, z2, z2, z1, np.empty((1, 1)), np.empty((1, 1)))
             baro_r = 0.0
         hold, baro_h, radalt_h = np.zeros(1), np.full(1, math.nan), np.full(1, math.nan)
         r = ps.get("radalt")
         out = (np.empty((1, 1)), np.empty((1, 1)), np.empty((1, 1), dtype=bool))
         if r is not None:
             a = r.ra
-            radalt = (-1, truth.h_agl_m, truth.euler_rad, r.bias, r.markov, r.noise, r.errors.t_s,
+            radalt = (truth.h_agl_m, truth.euler_rad, r.bias, r.markov, r.noise, r.errors.t_s,
                       float(a.percent_sigma), a.floor_m**2, float(a.max_range_m), float(a.max_pitch_rad),
                       float(a.max_roll_rad), np.empty((3, 1)), *out, radalt_h)
         else:
-            radalt = (-1, z1, np.zeros((0, 3)), z1, z2, z2, z1, 0.0, 0.0, 0.0, 0.0, 0.0, np.empty((3, 1)), *out,
+            radalt = (z1, np.zeros((0, 3)), z1, z2, z2, z1, 0.0, 0.0, 0.0, 0.0, 0.0, np.empty((3, 1)), *out,
                       radalt_h)
         g = ps.get("gnss")
         fe = self._fast
@@ -638,23 +633,22 @@ class NavInTheLoop:
             mode, consts, series = g.direct_constants()
             n_ch = g.r_sv.shape[2]
             guard = sg is not None and sg[0].shape[0] == n_ch
-            gnss = (-1, truth.r_ecef, g.r_sv, float(g.rx.mask_rad), mode, g.plan(truth), *consts, *series, g.bias,
+            plan0 = g.plan(truth)
+            gnss = (truth.r_ecef, g.r_sv, float(g.rx.mask_rad), mode, *consts, *series, g.bias,
                     g.errors.t_s, float(self.nav.nav.gps_sigma_scale), np.empty((1, 3)),
                     np.empty((g.r_sv.shape[0], 1) + g.r_sv.shape[2:]))
             plan = g.plan if g.rx.selection == "best4-fixed" else None
         else:
             n_ch, guard = 0, False
             s3 = np.zeros((1, 0, 0))
-            gnss = (-1, np.zeros((0, 3)), np.zeros((1, 0, 0, 3)), 0.0, 0, np.zeros((1, 0), dtype=bool), 0.0, False,
+            plan0 = np.zeros((1, 0), dtype=bool)
+            gnss = (np.zeros((0, 3)), np.zeros((1, 0, 0, 3)), 0.0, 0, 0.0, False,
                     0.0, 0.0, 0.0, 0.0, 0.0, s3, s3, s3, s3, s3, z2, z1, 1.0, np.empty((1, 3)), np.zeros((1, 1, 0, 3)))
         rho, r_sv, sig, el = np.empty((1, n_ch)), np.empty((n_ch, 3)), np.empty(n_ch), np.empty(n_ch)
         gs = (sg[0], sg[1]) if guard else (z1, z1)
-        args = [0, 0.0, 0.25 * self.dt, *baro, hold, baro_h, *radalt, *gnss, rho, r_sv, sig, el, guard, _EL_MIN,
-                *gs]
-        jb = 3
-        jr = jb + len(baro) + 2
-        jg = jr + len(radalt)
-        return _Direct(args=args, jb=jb, jr=jr, jg=jg, plan=plan, baro_h=baro_h, baro_r=baro_r, radalt_h=radalt_h,
+        args = [0, 0.0, 0.25 * self.dt, -1, -1, -1, plan0, (*baro, hold, baro_h), radalt, gnss,
+                (rho, r_sv, sig, el), (guard, _EL_MIN, *gs)]
+        return _Direct(args=args, plan=plan, baro_h=baro_h, baro_r=baro_r, radalt_h=radalt_h,
                        rho=rho, r_sv=r_sv, sig=sig, el=el, no_rho=np.zeros((1, 0)), guard=guard,
                        recs={"baro": _BaroAt(hold)}, pseudolite="pseudolite" in ps)
 

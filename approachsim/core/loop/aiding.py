@@ -132,34 +132,39 @@ GNSS_IN = 8
 
 
 @njit(cache=True)
-def direct_inputs(k: int, t: float, tol: float,
-                  jb: int, p_static: np.ndarray, b_w: np.ndarray, b_set: float, b_t0l: float, b_exp: float,
-                  b_fld: float, b_cm1: float, b_sf: np.ndarray, b_bias: np.ndarray, b_noise: np.ndarray,
-                  b_ts: np.ndarray, b_p: np.ndarray, b_out: np.ndarray, b_hold: np.ndarray, baro_h: np.ndarray,
-                  jr: int, h_agl: np.ndarray, euler: np.ndarray, r_bias: np.ndarray, r_markov: np.ndarray,
-                  r_noise: np.ndarray, r_ts: np.ndarray, r_pct: float, r_floor2: float, r_max: float,
-                  r_pitch_max: float, r_roll_max: float, r_in: np.ndarray, r_meas: np.ndarray, r_sig: np.ndarray,
-                  r_valid: np.ndarray, radalt_h: np.ndarray,
-                  jg: int, r_ecef: np.ndarray, r_sv_all: np.ndarray, mask: float, mode: int, plan: np.ndarray,
-                  shell: float, do253: bool, mp_m: float, ce2: float, iono_z: float, tropo_z: float, cn2: float,
-                  s_ce: np.ndarray, s_iono: np.ndarray, s_tropo: np.ndarray, s_mp: np.ndarray, s_noise: np.ndarray,
-                  clk: np.ndarray, g_ts: np.ndarray, scale: float, g_rx: np.ndarray, g_sv: np.ndarray,
-                  rho: np.ndarray, r_sv_out: np.ndarray, sig_out: np.ndarray, el_out: np.ndarray,
-                  guard: bool, lo: float, g: np.ndarray, mp_arg: np.ndarray) -> int:
+def direct_inputs(k: int, t: float, tol: float, jb: int, jr: int, jg: int, plan: np.ndarray, baro: tuple,
+                  radalt: tuple, gnss: tuple, out: tuple, guard: tuple) -> int:
     """The closed loop's direct epoch inputs at truth row k (time t) in one call (loop/closed_loop.py
     `_direct_inputs`): the sensors' one-row kernels on the values their h_one / channels_one give them, the same
-    kernels in the same order, so the same bits:
+    kernels in the same order, so the same bits. Each sensor's constants, drawn errors, scratch and outputs come as
+    one tuple (loop/closed_loop.py `_direct_arrays` builds them once a run):
+
+        baro   = (p_static, b_w, b_set, b_t0l, b_exp, b_fld, b_cm1, b_sf, b_bias, b_noise, b_ts, b_p, b_out, b_hold,
+                  baro_h)
+        radalt = (h_agl, euler, r_bias, r_markov, r_noise, r_ts, r_pct, r_floor2, r_max, r_pitch_max, r_roll_max,
+                  r_in, r_meas, r_sig, r_valid, radalt_h)
+        gnss   = (r_ecef, r_sv_all, mask, mode, shell, do253, mp_m, ce2, iono_z, tropo_z, cn2, s_ce, s_iono, s_tropo,
+                  s_mp, s_noise, clk, g_ts, scale, g_rx, g_sv)
+        out    = (rho, r_sv_out, sig_out, el_out);  guard = (guard, lo, g, mp_arg)
 
         baro sample jb (-1: none): p[0, q] = p_static[max(k - q, 0)] (q < len b_p), baro_apply -> b_hold[0]; when
             |b_ts[jb] - t| <= tol: baro_h[0] = that height (else nan)                       (PreparedBaro.h_one)
         radar altimeter sample jr: radalt_apply on row k; radalt_h[0] = the height where valid and in time, else
             nan                                                                             (PreparedRadalt.h_one)
-        GPS sample jg in time: sky on (r_ecef[k], r_sv_all[:, jg]) (copied to g_rx, g_sv), pseudoranges on the
-            series' sample jg: rho (1, 24) (nan where not selected), r_sv_out = r_sv_all[0, jg], sig_out = sigma
-            (times scale when scale != 1), el_out = elevations; guard: channel_guard(el_out, lo, g, mp_arg)
-                                                                                            (PreparedGnss.channels_one)
+        GPS sample jg in time: sky on (r_ecef[k], r_sv_all[:, jg]) (copied to g_rx, g_sv) with the selection plan,
+            pseudoranges on the series' sample jg: rho (1, 24) (nan where not selected), r_sv_out = r_sv_all[0, jg],
+            sig_out = sigma (times scale when scale != 1), el_out = elevations; guard: channel_guard(el_out, lo, g,
+            mp_arg)                                                                         (PreparedGnss.channels_one)
 
     Returns the flags HAS_BARO | BARO_IN | RADALT_IN | GNSS_IN of what was set."""
+    (p_static, b_w, b_set, b_t0l, b_exp, b_fld, b_cm1, b_sf, b_bias, b_noise, b_ts, b_p, b_out, b_hold,
+     baro_h) = baro
+    (h_agl, euler, r_bias, r_markov, r_noise, r_ts, r_pct, r_floor2, r_max, r_pitch_max, r_roll_max, r_in, r_meas,
+     r_sig, r_valid, radalt_h) = radalt
+    (r_ecef, r_sv_all, mask, mode, shell, do253, mp_m, ce2, iono_z, tropo_z, cn2, s_ce, s_iono, s_tropo, s_mp,
+     s_noise, clk, g_ts, scale, g_rx, g_sv) = gnss
+    rho, r_sv_out, sig_out, el_out = out
+    do_guard, lo, g, mp_arg = guard
     flags = 0
     baro_h[0] = math.nan
     radalt_h[0] = math.nan
@@ -199,7 +204,7 @@ def direct_inputs(k: int, t: float, tol: float,
                 r_sv_out[i, c] = r_sv_all[0, jg, i, c]
             sig_out[i] = sigma[0, 0, i] if scale == 1.0 else sigma[0, 0, i] * scale
             el_out[i] = el[0, 0, i]
-        if guard:
+        if do_guard:
             channel_guard(el_out, lo, g, mp_arg)
         flags |= GNSS_IN
     return flags

@@ -496,14 +496,15 @@ def _tecs(par: Array, st: Array, d: float, d_dot: float, h_dot: float, v: float)
 
 
 @njit(cache=True)
-def autopilot_step(par: Array, st: Array, x: float, y: float, z: float, vn: float, ve: float, vd: float,
-                   phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float,
-                   tas: float, psi: float, r: float) -> tuple[float, float, float, float]:
+def autopilot_step(par: Array, st: Array, guide: tuple, air: tuple) -> tuple[float, float, float, float]:
     """One autopilot step (flight/autopilot.Autopilot.step, the oracle, whose module docstring has the laws):
-    guidance position (runway frame, m), NED velocity (m/s), attitude (rad), body rates (rad/s), sideslip (rad),
+    guide = (x, y, z, vn, ve, vd), the guidance position (runway frame, m) and NED velocity (m/s); air = (phi,
+    theta, p, q, beta, cas, h_gear, tas, psi, r), the aircraft's attitude (rad), body rates (rad/s), sideslip (rad),
     CAS (m/s), main-gear height (m; nan: no flare), TAS (m/s; nan: no speed complement), true heading (rad; nan:
     no decrab) and yaw rate (rad/s) -> elevator, aileron, rudder, throttle. par: AP_* parameters, st: APS_* state
     (updated)."""
+    x, y, z, vn, ve, vd = guide
+    phi, theta, p, q, beta, cas, h_gear, tas, psi, r = air
     dt = par[AP_DT]
     if tas > 1.0:  # inertially smoothed speed
         gs = math.sqrt(vn * vn + ve * ve + vd * vd)
@@ -684,17 +685,20 @@ def monitor_step(par: Array, st: Array, ring: Array, x_m: float, y_m: float, z_m
 
 
 @njit(cache=True)
-def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, x: float, y: float, z: float,
-                vn: float, ve: float, vd: float, h_agl: float, phi: float, wow_nose: float, wow_left: float,
-                wow_right: float, vn_cg: float, ve_cg: float, vd_cg: float, cas: float, tas: float) -> int:
+def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, imu: tuple, h_agl: float,
+                phi: float, wow: tuple, v_cg: tuple, cas: float, tas: float) -> int:
     """Why the run ends at this step (TERM_*; TERM_NONE: it goes on), checked in this order on the true state:
     the IMU at the stop height; (landing runs) a main gear on the ground with the nose gear in the air: touchdown,
     short of the threshold when x < 0; anything else on the ground or the IMU at the terrain; divergence (bank,
     distance from the glidepath or the centreline); below WATCH_HEIGHT_M (above the flare on landing runs) the
     stabilized-approach monitor, fed the speed through the mean air mass (CG ground velocity minus the steady
-    wind) as CAS with JSBSim's CAS/TAS ratio. Position x, y, z (runway frame), velocity (IMU, NED) and height
-    above the terrain in m, m/s; wow_* JSBSim's weight-on-wheels; CG velocity, CAS and TAS in m/s.
-    fpar, fst: the step's F_* parameters and FS_* state (touchdown and monitor figures are stored there)."""
+    wind) as CAS with JSBSim's CAS/TAS ratio. imu = (x, y, z, vn, ve, vd): the IMU's position (runway frame, m)
+    and NED velocity (m/s); h_agl its height above the terrain (m); phi the bank (rad); wow = (nose, left, right)
+    JSBSim's weight-on-wheels; v_cg the CG's NED velocity, CAS and TAS in m/s. fpar, fst: the step's F_* parameters
+    and FS_* state (touchdown and monitor figures are stored there)."""
+    x, y, z, vn, ve, vd = imu
+    wow_nose, wow_left, wow_right = wow
+    vn_cg, ve_cg, vd_cg = v_cg
     if z <= fpar[F_STOP_H]:
         return TERM_STOP
     if fpar[F_LAND] != 0.0 and (wow_left > 0.0 or wow_right > 0.0) and wow_nose == 0.0:
@@ -717,12 +721,10 @@ def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, x
 
 
 @njit(cache=True)
-def _control(par: Array, st: Array, row: Array, x: float, y: float, z: float, vn: float, ve: float, vd: float,
-             phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float,
-             tas: float, psi: float, r: float) -> tuple[float, float, float, float]:
-    """The autopilot on guidance (x, y, z, vn, ve, vd); the commands go into the row and the step's state."""
-    de, da, dr, thr = autopilot_step(par[P_AP:P_AP + N_AP_PAR], st[S_AP:S_AP + N_AP_STATE], x, y, z, vn, ve, vd,
-                                     phi, theta, p, q, beta, cas, h_gear, tas, psi, r)
+def _control(par: Array, st: Array, row: Array, guide: tuple, air: tuple) -> tuple[float, float, float, float]:
+    """The autopilot on guidance `guide` (x, y, z, vn, ve, vd) and the aircraft's `air` (autopilot_step); the
+    commands go into the row and the step's state."""
+    de, da, dr, thr = autopilot_step(par[P_AP:P_AP + N_AP_PAR], st[S_AP:S_AP + N_AP_STATE], guide, air)
     row[CONTROLS_COL] = de + par[P_STEP + F_PITCH_TRIM]
     row[CONTROLS_COL + 1], row[CONTROLS_COL + 2], row[CONTROLS_COL + 3] = da, dr, thr
     st[S_STEP + FS_DE], st[S_STEP + FS_DA], st[S_STEP + FS_DR], st[S_STEP + FS_THR] = de, da, dr, thr
@@ -771,8 +773,9 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
     row[CONTROLS_COL + 1], row[CONTROLS_COL + 2], row[CONTROLS_COL + 3] = fst[FS_DA], fst[FS_DR], fst[FS_THR]
     if zr < fst[FS_LOWEST]:
         fst[FS_LOWEST] = zr
-    code = termination(fpar, fst, par[P_MN:P_MN + N_MN_PAR], st[S_MN:S_MN + N_MN_STATE], st[S_RING:], xr, yr, zr,
-                       vn, ve, vd, h_agl, phi, w0, w1, w2, vn_f * _FPS, ve_f * _FPS, vd_f * _FPS, cas, tas)
+    code = termination(fpar, fst, par[P_MN:P_MN + N_MN_PAR], st[S_MN:S_MN + N_MN_STATE], st[S_RING:],
+                       (xr, yr, zr, vn, ve, vd), h_agl, phi, (w0, w1, w2), (vn_f * _FPS, ve_f * _FPS, vd_f * _FPS),
+                       cas, tas)
     h_gear = min(g1_ft, g2_ft) * _FT if fpar[F_LAND] != 0.0 else math.nan
     # the inner loops' inputs of this step (fly_control's, when a navigation source guides)
     fst[FS_PHI], fst[FS_THETA], fst[FS_P], fst[FS_Q], fst[FS_BETA] = phi, theta, p, q, beta
@@ -780,8 +783,8 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
     psi = raw[R_PSI] if fpar[F_LAND] != 0.0 else math.nan
     fst[FS_PSI], fst[FS_R] = psi, r
     if guided and code == TERM_NONE:
-        de, da, dr, thr = _control(par, st, row, xr, yr, zr, vn, ve, vd, phi, theta, p, q, beta, cas, h_gear, tas,
-                                   psi, r)
+        de, da, dr, thr = _control(par, st, row, (xr, yr, zr, vn, ve, vd),
+                                   (phi, theta, p, q, beta, cas, h_gear, tas, psi, r))
     else:
         de, da, dr, thr = fst[FS_DE], fst[FS_DA], fst[FS_DR], fst[FS_THR]
     return code, de, da, dr, thr, gn, ge, gd, terr / _FT, near
@@ -793,8 +796,9 @@ def fly_control(k: int, guidance: Array, buf: Array, par: Array, st: Array) -> t
     velocity (m/s), after fly_step(..., guided=False); returns elevator, aileron, rudder, throttle to set."""
     g = guidance[k]
     s = st[S_STEP:S_STEP + N_F_STATE]
-    return _control(par, st, buf[k], g[0], g[1], g[2], g[3], g[4], g[5], s[FS_PHI], s[FS_THETA], s[FS_P], s[FS_Q],
-                    s[FS_BETA], s[FS_CAS], s[FS_H_GEAR], s[FS_TAS], s[FS_PSI], s[FS_R])
+    return _control(par, st, buf[k], (g[0], g[1], g[2], g[3], g[4], g[5]),
+                    (s[FS_PHI], s[FS_THETA], s[FS_P], s[FS_Q], s[FS_BETA], s[FS_CAS], s[FS_H_GEAR], s[FS_TAS],
+                     s[FS_PSI], s[FS_R]))
 
 
 @njit(cache=True)

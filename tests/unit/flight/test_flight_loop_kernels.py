@@ -110,8 +110,8 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
         hg = None if math.isnan(h_gear[k]) else h_gear[k]
         want = ap.step(*args, hg, None if math.isnan(tas[k]) else tas[k], psi=None if hg is None else psi[k],
                        r=att[k, 5])
-        got = fk.autopilot_step(par, st, *args, h_gear[k], tas[k], psi[k] if hg is not None else math.nan,
-                                att[k, 5])
+        got = fk.autopilot_step(par, st, args[:6], (*args[6:], h_gear[k], tas[k],
+                                                     psi[k] if hg is not None else math.nan, att[k, 5]))
         # exact: the kernel and its Python oracle do the same scalar IEEE operations in the same order (numba emits
         # no FMA without fastmath, both call the same libm), which the generic-CPU pass checks as well
         assert got == want, f"step {k}"
@@ -235,9 +235,9 @@ def test_termination_codes_in_order_and_their_words(gains):
 
     def term(x, y, z, **kw):
         a = {**air, **kw}
-        return fk.termination(fpar, fst, mpar, mst, ring, x, y, z, a["vn"], a["ve"], a["vd"], a["h_agl"], a["phi"],
-                              a["wow_nose"], a["wow_left"], a["wow_right"], a["vn_cg"], a["ve_cg"], a["vd_cg"],
-                              a["cas"], a["tas"])
+        return fk.termination(fpar, fst, mpar, mst, ring, (x, y, z, a["vn"], a["ve"], a["vd"]), a["h_agl"],
+                              a["phi"], (a["wow_nose"], a["wow_left"], a["wow_right"]),
+                              (a["vn_cg"], a["ve_cg"], a["vd_cg"]), a["cas"], a["tas"])
 
     high = 1500.0 * units.FT
     x_high = (TCH - high) / math.tan(GP)
