@@ -300,14 +300,15 @@ class Approach:
             guidance = None if src is None else np.full((n_max, 6), np.nan)
         loop, loop_reason = flight_loop(io, guided, fused)
         read, read_near, run_step = io.read, io.read_near, io.run
-        raw0 = (0.0,) * (layouts.N_RAW + len(layouts.GEAR_FIELDS))
-        step = entry_point(fk.fly_step, 0, raw0, buf, nu, par, st, guided)
-        control = None if guided else entry_point(fk.fly_control, 0, guidance, buf, par, st)
-        if fused is not None:
-            nav_args = (fused.nw, fused.fa, fused.ia)
-            step_nav = entry_point(ck.fly_step_closed, 0, raw0, buf, nu, par, st, *nav_args)
-            control_nav = entry_point(ck.fly_control_closed, 0, buf, par, st, *nav_args)
-            act = fused.act
+        if loop == "python":  # the Python loop's compiled steps (the reads are a tuple): compiled only when flown
+            raw0 = (0.0,) * (layouts.N_RAW + len(layouts.GEAR_FIELDS))
+            step = entry_point(fk.fly_step, 0, raw0, buf, nu, par, st, guided)
+            control = None if guided else entry_point(fk.fly_control, 0, guidance, buf, par, st)
+            if fused is not None:
+                nav_args = (fused.nw, fused.fa, fused.ia)
+                step_nav = entry_point(ck.fly_step_closed, 0, raw0, buf, nu, par, st, *nav_args)
+                control_nav = entry_point(ck.fly_control_closed, 0, buf, par, st, *nav_args)
+                act = fused.act
         set_de, set_da, set_dr, (set_thr0, set_thr1) = io.set_elevator, io.set_aileron, io.set_rudder, io.set_throttle
         set_gn, set_ge, set_gd = io.set_gust_fps
         set_terrain_ft = io.set_terrain_ft
