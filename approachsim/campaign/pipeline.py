@@ -43,6 +43,7 @@ from typing import Any
 
 from approachsim.campaign.result import RunResult
 from approachsim.config import ProfileError
+from approachsim.memo import TruthMemo
 
 STAGES = (
     ("approachsim.flight.run", "Approach", "flight (JSBSim truth)"),
@@ -102,7 +103,7 @@ def spec_for(profile: Any, mode: str, land: bool = False) -> PipelineSpec:
 
 def _score(
     profile: Any, run: int, truth: Any, nav: Any, clock_true: Any, gnss: Any = None, flight: Any = None,
-    seed: int | None = None, bank_group: Any = None,
+    seed: int | None = None, bank_group: Any = None, memo: TruthMemo | None = None,
 ) -> RunResult:
     from approachsim.evaluate.score import HEIGHT_GRID_FT, score_run
 
@@ -112,7 +113,7 @@ def _score(
         g = flight.guidance_r_rwy
         fte = {"fte_lat_m": g[:, 1], "fte_vert_m": profile.runway.glidepath.deviation_rwy_m(g)}
     scalars, arrays, series = score_run(
-        truth, nav, cfg, clock_bias_true_m=clock_true, keep_series=run < cfg.series_runs, **fte
+        truth, nav, cfg, clock_bias_true_m=clock_true, keep_series=run < cfg.series_runs, memo=memo, **fte
     )
     if gnss is not None:
         scalars.update(_geometry_at_dh(gnss, scalars))
@@ -125,7 +126,7 @@ def _score(
         from approachsim.integrity.campaign import score_with_bank
 
         s_int, counts, a_int = score_with_bank(profile, truth, seed, run, nav, HEIGHT_GRID_FT * units.FT,
-                                               group=bank_group)
+                                               group=bank_group, memo=memo)
         scalars.update(s_int)
         arrays = {**arrays, **a_int}
     return RunResult(run=run, ok=True, scalars=scalars, arrays=arrays, series=series, counts=counts)
@@ -184,25 +185,21 @@ def _gnss_closed_loop(source: Any, truth: Any) -> Any:
     return source.suite.sensors["gnss"].apply(truth, e.take(keep))
 
 
-_APPROACHES: dict = {}
-"""The Approach of each profile this worker process has flown (a profile's aircraft is parsed and its trimmed start
-solved once per process, not once per task: closed-loop tasks are one run each)."""
-
-
 def _approach(profile: Any, land: bool = False) -> Any:
+    """The Approach of a profile (flight.run), kept by the profile's value and `land` (`_approach_of`)."""
+    return _approach_of(profile, bool(land))
+
+
+@functools.lru_cache(maxsize=8)
+def _approach_of(profile: Any, land: bool) -> Any:
+    """The Approach of a profile, by (profile value, land): a profile's aircraft is parsed and its trimmed start
+    solved once per worker process, not once per task (closed-loop tasks are one run each)."""
     from approachsim.flight.run import Approach
 
-    a = _APPROACHES.get((profile, land))
-    if a is None:
-        if len(_APPROACHES) > 8:
-            _APPROACHES.clear()
-        if land:
-            a = Approach(profile, land=True)
-        else:
-            # fly a little below the lowest decision height so that its crossing is bracketed by samples
-            a = Approach(profile, stop_height_m=approach_stop_height_m(profile))
-        _APPROACHES[(profile, land)] = a
-    return a
+    if land:
+        return Approach(profile, land=True)
+    # fly a little below the lowest decision height so that its crossing is bracketed by samples
+    return Approach(profile, stop_height_m=approach_stop_height_m(profile))
 
 
 def approach_stop_height_m(profile: Any) -> float:
@@ -293,12 +290,14 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     errors = suite.draw(truth.t_s, seed, list(runs))
     records = suite.apply(truth, errors)  # = suite.measure(truth, seed, runs)
     nav = NavSystem.from_profile(profile)
+    memo = TruthMemo(truth)  # the group's shared work on its truth (approachsim/memo.py): this task owns it
     # optimal filter: one covariance per measurement schedule for all runs (linearized along the shared truth);
     # robust / adaptive configurations filter each run on its own
     # with the integrity bank: the pass keeps each run's start and INS for its bank (integrity/bankpass.py)
     keep = {} if profile.evaluation.integrity_on else None
     navruns = nav.run(truth, records, [stream(seed, i, "nav") for i in runs],
-                      shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors), keep=keep)
+                      shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors), keep=keep,
+                      memo=memo)
     group = None
     if keep is not None:
         from approachsim.integrity.bankpass import GroupInputs
@@ -310,7 +309,7 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
             g = records.get("gnss")
             out.append(_score(profile, i, truth, nr.solution, _clock_truth(records, k, truth.t_s),
                               None if g is None else g.run(k), seed=seed,
-                              bank_group=None if group is None else (group, k)))
+                              bank_group=None if group is None else (group, k), memo=memo))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out
@@ -344,7 +343,8 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool =
                 truth, nav, flight = _head(truth, nav, flight, approach_stop_height_m(profile))
             clk = source.errors.clock
             clock_true = None if clk is None else np.interp(truth.t_s, clk.t_s, np.asarray(clk.series["bias"]))
-            r = _score(profile, i, truth, nav, clock_true, _gnss_closed_loop(source, truth), flight, seed)
+            r = _score(profile, i, truth, nav, clock_true, _gnss_closed_loop(source, truth), flight, seed,
+                       memo=TruthMemo(truth))
             if td:
                 r = dataclasses.replace(r, scalars={**r.scalars, **td})
             out.append(r)

@@ -37,6 +37,7 @@ from approachsim.integrity.requirements import (
     vertical_alert_limit_m,
 )
 from approachsim.integrity.separation import SeparationResult, identify_statistic, separation
+from approachsim.memo import TruthMemo
 
 Array = np.ndarray
 
@@ -340,7 +341,8 @@ def score_run(ep: BankEpochs, epoch_hz: float, start_height_m: float, dh_m: dict
 
 
 def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: bool = False, *,
-             compiled: bool = True, group: tuple[Any, int] | None = None) -> tuple[BankEpochs, Any]:
+             compiled: bool = True, group: tuple[Any, int] | None = None, memo: TruthMemo | None = None
+             ) -> tuple[BankEpochs, Any]:
     """Measure run `run` of the campaign seeded `seed` on `truth`, navigate it with the main filter and the
     sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun).
     sensor_modes_on: the baro, radar altimeter and pseudolite units are fault modes too (module docstring).
@@ -353,7 +355,9 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     streams), whose GNSS records then lose one channel each (bank_records). compiled=False: always the latter (the
     oracle of integrity/bankpass.py). group: (bankpass.GroupInputs, k) what the open-loop flight group's pass left
     for this run, its run k (campaign/pipeline.py): nothing is drawn, started or integrated again (the same numbers,
-    bankpass.bank_pass_group)."""
+    bankpass.bank_pass_group). memo: the truth's TruthMemo (approachsim/memo.py) from the caller that shares the
+    truth among runs (an open-loop group, a study's flown truth): the converged start, the reference and the epoch
+    models are then made once."""
     from dataclasses import fields, replace
 
     from approachsim.nav.system import NavSystem
@@ -366,7 +370,7 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
         nav = NavSystem.from_profile(profile)
         if g.usable(nav) and bankpass.applicable(nav, g.records):
             channels = used_channels(np.asarray(g.records["gnss"].valid)[k])
-            bp = bankpass.bank_pass_group(nav, truth, g, k, channels)
+            bp = bankpass.bank_pass_group(nav, truth, g, k, channels, memo)
             if bp is not None:
                 ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth,
                                         profile.runway.heading_rad)
@@ -386,7 +390,7 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     own_ins = bool(sensor_modes_on and "baro" in one and nav.loop_gains() is not None)
     share = not nav.nav.feedback and "imu" in one and not own_ins
     if compiled and share and bankpass.applicable(nav, one):  # the compiled reduced pass (integrity/bankpass.py)
-        bp = bankpass.bank_pass(nav, truth, one, channels, stream(seed, run, "nav"), states)
+        bp = bankpass.bank_pass(nav, truth, one, channels, stream(seed, run, "nav"), states, memo)
         if bp is not None:
             ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth, profile.runway.heading_rad)
             return ep, bp.main_run()
@@ -399,6 +403,6 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
                                 for f in fields(states) if isinstance(getattr(states, f.name), np.ndarray)})
     # every copy starts from the main filter's converged state (the first copy's schedule: all channels)
     navs = nav.run(truth, recs, [stream(seed, run, "nav") for _ in range(copies)],
-                   shared_covariance=nav.shares_covariance(), states=states, copies=share)
+                   shared_covariance=nav.shares_covariance(), states=states, copies=share, memo=memo)
     ep = bank_epochs(navs[0], navs[1:], channels, truth, profile.runway.heading_rad)
     return ep, navs[0]

@@ -36,6 +36,7 @@ from scipy import stats as sps
 
 from approachsim.integrity.bank import BankEpochs, CategoryIntegrity, run_bank, score_category
 from approachsim.integrity.requirements import REQUIREMENTS, describe
+from approachsim.memo import TruthMemo
 
 Array = np.ndarray
 
@@ -170,12 +171,12 @@ def run_integrity(ep: BankEpochs, cfg: Any, *, epoch_hz: float, t0_s: float, ons
 
 
 def score_with_bank(profile: Any, truth: Any, seed: int, run: int, nav: Any = None,
-                    height_grid_m: Array | None = None, group: tuple[Any, int] | None = None
-                    ) -> tuple[dict[str, float], dict[str, Array], dict[str, Array]]:
+                    height_grid_m: Array | None = None, group: tuple[Any, int] | None = None,
+                    memo: TruthMemo | None = None) -> tuple[dict[str, float], dict[str, Array], dict[str, Array]]:
     """Run the bank open loop on `truth` for run `run` of the campaign seeded `seed` and score it
     (run_integrity); nav: the run's own NavSolution (online FDE records), if any; group: what its open-loop
-    flight group's pass left for it (run_bank)."""
-    ep, main = run_bank(bank_profile(profile), truth, seed, run, group=group)
+    flight group's pass left for it, memo: the truth's TruthMemo (run_bank)."""
+    ep, main = run_bank(bank_profile(profile), truth, seed, run, group=group, memo=memo)
     from approachsim.sensors.suite import SensorSuite
 
     prn = getattr(SensorSuite.from_profile(profile).sensors.get("gnss"), "constellation", None)

@@ -51,6 +51,7 @@ approach, so the per-approach probability compared with them is conservative.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 import time
@@ -64,6 +65,7 @@ from scipy import stats as sps
 
 from approachsim.integrity import rare
 from approachsim.integrity.requirements import REQUIREMENTS
+from approachsim.memo import TruthMemo
 
 Array = np.ndarray
 
@@ -151,30 +153,42 @@ def modes_for(profile: Any, names: Sequence[str] | None = None) -> list[FaultMod
 
 # ---- one sample ----------------------------------------------------------------------------------------------
 
-_TRUTHS: dict = {}
-"""Flown truths of this process by (profile, seed, index): (truth, onset window start s, end s)."""
+@dataclass(frozen=True, eq=False)
+class FlownTruth:
+    """One of the study's flown truths, its onset window and the memo of the work its samples share (the bank's
+    reference, epoch models and converged starts: approachsim/memo.py)."""
+
+    truth: Any
+    t_lo_s: float
+    """Start of the onset window: the settle time after the start, s."""
+    t_hi_s: float
+    """End of the onset window: where the truth passes the lowest decision height, s."""
+    memo: TruthMemo
+
+
+@functools.lru_cache(maxsize=16)
+def flown_truth(profile: Any, seed: int, index: int) -> FlownTruth:
+    """Truth `index` of the campaign seeded `seed` (the open-loop group index * flight_group's flight), flown once per
+    process for the same (profile value, seed, index), and its onset window: from the settle time after the start
+    to the lowest decision height, s."""
+    from approachsim.campaign.pipeline import approach_stop_height_m
+    from approachsim.flight.run import Approach
+
+    flight = Approach(profile, stop_height_m=approach_stop_height_m(profile)).fly(
+        seed=seed, run=index * profile.evaluation.flight_group)
+    if not flight.ok:
+        raise RuntimeError(f"truth {index}: the flight failed ({flight.termination})")
+    truth = flight.truth
+    z = np.asarray(truth.r_rwy)[:, 2]
+    low = min(profile.evaluation.dh_m(c) for c in REQUIREMENTS)
+    t_end = float(truth.t_s[int(np.argmax(z < low))]) if np.any(z < low) else float(truth.t_s[-1])
+    return FlownTruth(truth, float(truth.t_s[0]) + profile.evaluation.timeavg_settle_s, t_end, TruthMemo(truth))
 
 
 def flight_truth(profile: Any, seed: int, index: int) -> tuple[Any, float, float]:
-    """Truth `index` of the campaign seeded `seed` (the open-loop group index * flight_group's flight) and the onset
-    window: from the settle time after the start to the lowest decision height, s."""
-    key = (profile, seed, index)
-    if key not in _TRUTHS:
-        from approachsim.campaign.pipeline import approach_stop_height_m
-        from approachsim.flight.run import Approach
-
-        if len(_TRUTHS) > 16:
-            _TRUTHS.clear()
-        flight = Approach(profile, stop_height_m=approach_stop_height_m(profile)).fly(
-            seed=seed, run=index * profile.evaluation.flight_group)
-        if not flight.ok:
-            raise RuntimeError(f"truth {index}: the flight failed ({flight.termination})")
-        truth = flight.truth
-        z = np.asarray(truth.r_rwy)[:, 2]
-        low = min(profile.evaluation.dh_m(c) for c in REQUIREMENTS)
-        t_end = float(truth.t_s[int(np.argmax(z < low))]) if np.any(z < low) else float(truth.t_s[-1])
-        _TRUTHS[key] = (truth, float(truth.t_s[0]) + profile.evaluation.timeavg_settle_s, t_end)
-    return _TRUTHS[key]
+    """(truth, onset window start s, end s) of `flown_truth`."""
+    f = flown_truth(profile, int(seed), int(index))
+    return f.truth, f.t_lo_s, f.t_hi_s
 
 
 def fault_spec(mode: FaultMode, u: Array, profile: Any, truth: Any, seed: int, run: int,
@@ -260,13 +274,14 @@ def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | 
         from approachsim.integrity.bank import run_bank
         from approachsim.integrity.campaign import bank_profile
 
-        truth, t_lo, t_hi = flight_truth(profile, seed, run % truths)
+        flown = flown_truth(profile, int(seed), int(run % truths))
+        truth, t_lo, t_hi = flown.truth, flown.t_lo_s, flown.t_hi_s
         prof = profile
         params: dict = {}
         if mode_name is not None:
             spec, params = fault_spec(fault_mode(mode_name), np.asarray(u), profile, truth, seed, run, (t_lo, t_hi))
             prof = dataclasses.replace(profile, faults=(*tuple(profile.faults or ()), spec))
-        ep, _ = run_bank(bank_profile(prof), truth, seed, run, sensor_modes_on=sensor_modes)
+        ep, _ = run_bank(bank_profile(prof), truth, seed, run, sensor_modes_on=sensor_modes, memo=flown.memo)
         out = limit_states(ep, profile.evaluation, profile.nav.aiding_rate_hz, float(truth.t_s[0]), confirm)
         return {**out, **{f"fault_{k}": float(v) for k, v in params.items()}, "failed": 0.0}
     except Exception as e:  # noqa: BLE001 - a failed sample is data (counted as the event), never dropped
