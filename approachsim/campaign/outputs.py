@@ -41,7 +41,7 @@ def evaluate_results(
     summary = contract_summary(
         res, profile=profile, runs=len(results), seed=seed, closed_loop=closed_loop, failed_runs=failed
     )
-    from approachsim.integrity.campaign import campaign_integrity, sum_counts
+    from approachsim.campaign.integrity_campaign import campaign_integrity, sum_counts
 
     det = details(cols, res, cfg, sum_counts(results), integrity_fn=campaign_integrity)
     det["failures"] = {str(r.run): r.error for r in results if not r.ok}

@@ -27,8 +27,8 @@ approach campaign), and evaluate.touchdown scores the touchdown row (main-gear p
 point's state and the main gears' lever arms). A run that does not put its main gear down on the runway is a
 failed run with its reason ("failed landing: touchdown short of the threshold ..."), never dropped.
 Integrity ([evaluation] integrity lists a category): after the flight, each run is also navigated by the
-solution-separation bank (integrity.campaign.score_with_bank: K + 1 filters in one batched pass, open loop on the
-run's flown truth with the run's own sensor draws): measured 1.86x the wall time of the default 20-run closed-loop
+solution-separation bank (campaign.integrity_campaign.score_with_bank: K + 1 filters in one batched pass, open loop on
+the run's flown truth with the run's own sensor draws): measured 1.86x the wall time of the default 20-run closed-loop
 campaign, about 3x an open-loop one.
 """
 
@@ -123,7 +123,7 @@ def _score(
     if cfg.integrity_on and gnss is not None and seed is not None:
         # the solution-separation bank, open loop on this run's (flown) truth with its own sensor draws
         from approachsim import units
-        from approachsim.integrity.campaign import score_with_bank
+        from approachsim.campaign.integrity_campaign import score_with_bank
 
         s_int, counts, a_int = score_with_bank(profile, truth, seed, run, nav, HEIGHT_GRID_FT * units.FT,
                                                group=bank_group, memo=memo)
@@ -293,14 +293,14 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     memo = TruthMemo(truth)  # the group's shared work on its truth (approachsim/memo.py): this task owns it
     # optimal filter: one covariance per measurement schedule for all runs (linearized along the shared truth);
     # robust / adaptive configurations filter each run on its own
-    # with the integrity bank: the pass keeps each run's start and INS for its bank (integrity/bankpass.py)
+    # with the integrity bank: the pass keeps each run's start and INS for its bank (campaign/bankpass.py)
     keep = {} if profile.evaluation.integrity_on else None
     navruns = nav.run(truth, records, [stream(seed, i, "nav") for i in runs],
                       shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors), keep=keep,
                       memo=memo)
     group = None
     if keep is not None:
-        from approachsim.integrity.bankpass import GroupInputs
+        from approachsim.campaign.bankpass import GroupInputs
 
         group = GroupInputs(records, keep)
     out = []

@@ -4,7 +4,7 @@ Navigator.compiled_pass filters such runs with core/nav/epoch.shared_pass on the
 gmp states, of which a run measures 4-6 with best-four selection. The channels a run never measures are lone
 first-order Gauss-Markov states, uncorrelated with the rest at the start (checked: a correlated one is kept), which
 no row touches: dropping them removes exact zeros from every sum and keeps the others' order, so the kept states
-are the same floating-point numbers (integrity/bankpass.py's module docstring gives the argument; the reduced
+are the same floating-point numbers (campaign/bankpass.py's module docstring gives the argument; the reduced
 models here, `models` and `cut`, and the compiled pass core/nav/copies.bank_epochs serve both). The dropped
 states are then carried in closed form exactly as the full pass computes them (x <- 0 + phi x; P <- Qd + phi (0 +
 phi P)): x_out, P's diagonal and the final X, P are those of shared_pass bit for bit
@@ -52,7 +52,7 @@ docstring)."""
 
 def kept_channels(lay: em.StateLayout, used: Array, P0: Array) -> Array:
     """The channels whose states stay: those measured, and any whose states are correlated with another state in the
-    start covariance P0 (a dropped state must be uncorrelated with all others: integrity/bankpass.py's docstring)."""
+    start covariance P0 (a dropped state must be uncorrelated with all others: campaign/bankpass.py's docstring)."""
     n_sv = lay.n_sv
     keep = np.zeros(n_sv, dtype=bool)
     keep[np.asarray(used, dtype=int)] = True
@@ -187,7 +187,7 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
     gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse, f_gmp, ins_y, baro_h, baro_r,
     radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig) without carrier phase; out: its outputs
     (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav), filled here; ic the clock state's index; runs_out: each
-    run's ReducedRun appended (what the integrity bank's copy 0 computes again: integrity/bankpass.py); valid (N, k):
+    run's ReducedRun appended (what the integrity bank's copy 0 computes again: campaign/bankpass.py); valid (N, k):
     the channels each run's record has valid (kept as the bank keeps them, so that its copy 0 is this); memo: the
     truth's TruthMemo, where the runs' banks find the models (`models`). Returns E, or -1 with nothing changed when a
     model cannot be reduced (the caller runs shared_pass)."""

@@ -320,7 +320,7 @@ class NavSystem:
         converged start. copies: the runs are copies of one run (the same IMU and baro records and start draws:
         the integrity bank's sub-filters, which differ only in the measurements they use): the INS is integrated
         once for all of them (feed-forward only; checked). keep: a dict that receives what the runs' integrity
-        banks reuse (integrity/bankpass.py, open loop): "start" [(x_hat (n,), P (n, n))] each run's filter start,
+        banks reuse (campaign/bankpass.py, open loop): "start" [(x_hat (n,), P (n, n))] each run's filter start,
         "db" its terrain-database error, "ins_epoch_rows" (N, E, 16) the INS states at the aiding epochs (rows
         epoch_rows, 2 epoch_rows, ...; packed, kernels/strapdown.py), "epoch_rows", "feed_forward". memo: the
         truth's TruthMemo (approachsim/memo.py), owned by the caller that shares the truth among runs (the campaign's

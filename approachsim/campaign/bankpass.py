@@ -1,13 +1,13 @@
 """The integrity bank's navigation pass (issue 26, speed): the main filter and the K sub-filters of one open-loop run
 over the run's records in one compiled call, on the states the bank can move.
 
-What integrity.bank.run_bank did before through NavSystem.run(copies=True) (and still does where this pass does not
-apply, `applicable`), with the same arithmetic:
+What campaign.integrity_bank.run_bank did before through NavSystem.run(copies=True) (and still does where this pass does
+not apply, `applicable`), with the same arithmetic:
 
 - one draw of the run's sensors (every copy's records are the same draws: the same streams), one converged start
   (the copies share the main filter's: nav/system.py NavSystem.start), one INS over every row (feed-forward: the
   INS does not depend on the filter), the copies' observations stacked once and copy k + 1 without its mode's
-  samples (integrity.bank.bank_records: an invalid sample is no measurement);
+  samples (campaign.integrity_bank.bank_records: an invalid sample is no measurement);
 - the model of every epoch (Phi, Qd at the reference: the truth) made once per flight group's truth on the full
   layout (core/nav/copies.models, kept in the group truth's memo, approachsim/memo.py), cut to the run's
   reduced state; then every epoch of every copy, each its own class (per-run GPS sky), in one call of
@@ -21,7 +21,7 @@ segment keeps its prior row exactly; checked here, else the channel is kept). So
 exactly zero off the diagonal: in the prediction W = Phi P, Phi W' + Qd their terms are exact zeros, and the
 scalar updates (core/nav/kalman.gain and _joseph_cov) skip the rows where P h is zero and add exact zeros in the
 other rows' dropped columns. Every remaining term is summed in the same order (the kept states keep their order),
-so the kept states' estimates and covariances are the same floating-point numbers (tests/unit/integrity/
+so the kept states' estimates and covariances are the same floating-point numbers (tests/unit/campaign/
 test_bankpass.py compares them with the full-state pass bit for bit). The bank needs only the navigation states'
 estimates and covariance block: the dropped states never reach it. The cost of an epoch falls with the square
 of the state count: 70 states (24 channels) to 22 + 2 x (channels used), about 32 with best-four selection.
@@ -36,7 +36,7 @@ bank_epochs_carrier): the gio states' Qd at the copy's sky, then its ambiguities
 bank.bank_records, so it never resets amb_c), the reset zeroing a kept row and column of Phi (a copy) and Qd as on
 the full layout, then class_epoch with the carrier rows after the code rows. The copies start with no arc (the
 converged start is code only: nav/initial.py). The candidate's 121 states (24 channels) to 25 + 4 x (channels used)
-(tests/unit/integrity/test_bankpass_carrier.py: bit for bit against the copies' full-state pass, with an outage
+(tests/unit/campaign/test_bankpass_carrier.py: bit for bit against the copies' full-state pass, with an outage
 that opens a new arc).
 """
 
@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from approachsim import geo
+from approachsim.campaign.bank_modes import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
 from approachsim.core.nav import copies as kcp
 from approachsim.memo import TruthMemo, memoized
 from approachsim.nav import errormodel as em
@@ -109,7 +110,7 @@ def applicable(nav: Any, records: dict[str, Any]) -> bool:
 
 def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: np.random.Generator,
               states: Any, memo: TruthMemo | None = None) -> BankPass | None:
-    """The main filter and one sub-filter per mode of `modes` (integrity.bank mode codes) over one run's records
+    """The main filter and one sub-filter per mode of `modes` (campaign/bank_modes.py codes) over one run's records
     (`applicable`; run axis of length one), started from the run's realized sensor states `states`
     (sensors.states.start_states) with its "nav" stream `rng` (module docstring). None when an epoch's model is
     too large for the compiled discretization (the caller takes NavSystem.run, which falls back to numpy's). memo:
@@ -218,8 +219,6 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     own filter of the run on its reduced state (nav/reduced.ReducedRun), which is copy 0 (the same start, INS,
     observations and models in the same compiled pass): taken as copy 0 when its channels are the copies' (only the
     sub-filters are run), else None. memo: the truth's TruthMemo (the reference, the epoch models)."""
-    from approachsim.integrity.bank import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
-
     lay = nav.layout
     eng = EpochEngine(nav)
     # the epochs and the reference (the truth at the epoch rows: nav/shared.py)

@@ -1,7 +1,7 @@
 """Integrity in a campaign: one run's integrity scalars from the solution-separation bank, and their campaign
 statistics for details.json.
 
-Per run (run_integrity): the bank (integrity.bank.run_bank, the main filter and one sub-filter per used GNSS
+Per run (run_integrity): the bank (campaign.integrity_bank.run_bank, the main filter and one sub-filter per used GNSS
 channel, open loop on the run's truth; in closed loop the flown truth) is scored per category at the filter
 epochs from evaluation.timeavg_settle_s after the run start down to the category's decision height
 (bank.score_category: H0 / H1 protection levels on the vertical and lateral approach axes with the category's
@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 from scipy import stats as sps
 
-from approachsim.integrity.bank import BankEpochs, CategoryIntegrity, run_bank, score_category
+from approachsim.campaign.integrity_bank import BankEpochs, CategoryIntegrity, run_bank, score_category
 from approachsim.integrity.requirements import REQUIREMENTS, describe
 from approachsim.memo import TruthMemo
 

@@ -7,10 +7,10 @@ from a Gaussian tail with the covariance's overbound measured on simulated runs.
 **What is simulated.** One sample of mode k is an open-loop navigation of a flown approach (one of `truths`
 JSBSim flights of the profile, shared as the campaign's open loop shares them) with the run's own sensor and filter
 noise (its own run index, so its own streams and, with per-run epochs, its own GPS sky), one fault from the mode
-with the parameters u maps to, through the solution-separation bank (integrity.bank.run_bank: the main filter and
-one sub-filter per used GPS channel, the exclusion at the first detection), scored per category as the campaign
-does (integrity.bank.score_category: epochs from the settle time down to the category's DH, Annex 10 alert limits
-at the aircraft's distance and height). The event is hazardously misleading information at any epoch: the output
+with the parameters u maps to, through the solution-separation bank (campaign.integrity_bank.run_bank: the main filter
+and one sub-filter per used GPS channel, the exclusion at the first detection), scored per category as the campaign
+does (campaign.integrity_bank.score_category: epochs from the settle time down to the category's DH, Annex 10 alert
+limits at the aircraft's distance and height). The event is hazardously misleading information at any epoch: the output
 error beyond the alert limit on either axis while the output's protection levels are inside both limits. Its
 limit-state function (continuous, for the adaptive steps) is
 
@@ -226,7 +226,7 @@ def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float, confirm: bool 
     epochs, `detected` (any detection) and the excluded channel; fault-free diagnostics: the normalized main errors
     and separations (`z2_v`, `z2_l`, `ss2`: sums of squares, `n_z`, `n_ss`: counts). confirm: the bank identifies
     with the second look (bank.second_level)."""
-    from approachsim.integrity.bank import score_category
+    from approachsim.campaign.integrity_bank import score_category
 
     out: dict[str, float] = {}
     settled = ep.t_s >= t0_s + cfg.timeavg_settle_s
@@ -271,8 +271,8 @@ def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | 
     returned with `failed` = 1 and every category's hmi_g = +1e3 (a failed navigation counts as the event:
     conservative)."""
     try:
-        from approachsim.integrity.bank import run_bank
-        from approachsim.integrity.campaign import bank_profile
+        from approachsim.campaign.integrity_bank import run_bank
+        from approachsim.campaign.integrity_campaign import bank_profile
 
         flown = flown_truth(profile, int(seed), int(run % truths))
         truth, t_lo, t_hi = flown.truth, flown.t_lo_s, flown.t_hi_s
