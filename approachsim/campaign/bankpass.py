@@ -59,6 +59,7 @@ from approachsim.nav.base import workspace
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, stacked_new_arcs
 from approachsim.nav.navigator import NavRun, StatusLog, _stacked_observations, true_error_rows
 from approachsim.nav.observations import Observations
+from approachsim.nav.system import tuned_records
 
 Array = np.ndarray
 
@@ -115,8 +116,6 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     (sensors.states.start_states) with its "nav" stream `rng` (module docstring). None when an epoch's model is
     too large for the compiled discretization (the caller takes NavSystem.run, which falls back to numpy's). memo:
     the truth's TruthMemo (its converged start, reference and epoch models kept for the other runs on it)."""
-    from approachsim.nav.system import tuned_records
-
     records = tuned_records(records, nav.nav.gps_sigma_scale)
     imu = records["imu"]
     dth, dvb = np.asarray(imu.dtheta_body)[:1], np.asarray(imu.dv_body)[:1]
@@ -174,8 +173,6 @@ class GroupInputs:
     def observations(self, nav: Any, truth: Any) -> dict[str, Any]:
         """_stacked_observations of every run of the group at the epochs (once)."""
         if self._obs is None:
-            from approachsim.nav.system import tuned_records
-
             recs = tuned_records(self.records, nav.nav.gps_sigma_scale)
             dt = float(recs["imu"].dt_s)
             er = self.keep["epoch_rows"]

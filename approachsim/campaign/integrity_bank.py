@@ -39,6 +39,10 @@ from approachsim.integrity.requirements import (
 )
 from approachsim.integrity.separation import SeparationResult, identify_statistic, separation
 from approachsim.memo import TruthMemo
+from approachsim.nav.system import NavSystem
+from approachsim.seeding import stream
+from approachsim.sensors.states import start_states
+from approachsim.sensors.suite import SensorSuite
 
 Array = np.ndarray
 
@@ -341,11 +345,6 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     truth among runs (an open-loop group, a study's flown truth): the converged start, the reference and the epoch
     models are then made once."""
     from dataclasses import fields, replace
-
-    from approachsim.nav.system import NavSystem
-    from approachsim.seeding import stream
-    from approachsim.sensors.states import start_states
-    from approachsim.sensors.suite import SensorSuite
 
     if compiled and group is not None and not sensor_modes_on:
         g, k = group

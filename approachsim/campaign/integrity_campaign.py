@@ -35,8 +35,10 @@ import numpy as np
 from scipy import stats as sps
 
 from approachsim.campaign.integrity_bank import BankEpochs, CategoryIntegrity, run_bank, score_category
+from approachsim.evaluate.dh import interp_on_height
 from approachsim.integrity.requirements import REQUIREMENTS, describe
 from approachsim.memo import TruthMemo
+from approachsim.sensors.suite import SensorSuite
 
 Array = np.ndarray
 
@@ -127,8 +129,6 @@ def run_integrity(ep: BankEpochs, cfg: Any, *, epoch_hz: float, t0_s: float, ons
                   fault_ch: int = -1, nav: Any = None, height_grid_m: Array | None = None
                   ) -> tuple[dict[str, float], dict[str, Array], dict[str, Array]]:
     """(scalars, counts, arrays) of one run (module docstring); cfg: the EvaluationConfig."""
-    from approachsim.evaluate.dh import interp_on_height
-
     scalars: dict[str, float] = {}
     counts: dict[str, Array] = {}
     arrays: dict[str, Array] = {}
@@ -177,8 +177,6 @@ def score_with_bank(profile: Any, truth: Any, seed: int, run: int, nav: Any = No
     (run_integrity); nav: the run's own NavSolution (online FDE records), if any; group: what its open-loop
     flight group's pass left for it, memo: the truth's TruthMemo (run_bank)."""
     ep, main = run_bank(bank_profile(profile), truth, seed, run, group=group, memo=memo)
-    from approachsim.sensors.suite import SensorSuite
-
     prn = getattr(SensorSuite.from_profile(profile).sensors.get("gnss"), "constellation", None)
     onset, ch = first_fault(profile, None if prn is None else prn.prn)
     return run_integrity(ep, profile.evaluation, epoch_hz=profile.nav.aiding_rate_hz, t0_s=float(truth.t_s[0]),

@@ -63,9 +63,16 @@ from typing import Any
 import numpy as np
 from scipy import stats as sps
 
+from approachsim.campaign.integrity_bank import run_bank, score_category
+from approachsim.campaign.integrity_campaign import bank_profile
+from approachsim.campaign.pipeline import approach_stop_height_m
+from approachsim.campaign.runner import register_pickling
+from approachsim.flight.run import Approach
 from approachsim.integrity import rare
 from approachsim.integrity.requirements import REQUIREMENTS
 from approachsim.memo import TruthMemo
+from approachsim.sensors.faults import FaultSpec
+from approachsim.sensors.suite import SensorSuite
 
 Array = np.ndarray
 
@@ -171,9 +178,6 @@ def flown_truth(profile: Any, seed: int, index: int) -> FlownTruth:
     """Truth `index` of the campaign seeded `seed` (the open-loop group index * flight_group's flight), flown once per
     process for the same (profile value, seed, index), and its onset window: from the settle time after the start
     to the lowest decision height, s."""
-    from approachsim.campaign.pipeline import approach_stop_height_m
-    from approachsim.flight.run import Approach
-
     flight = Approach(profile, stop_height_m=approach_stop_height_m(profile)).fly(
         seed=seed, run=index * profile.evaluation.flight_group)
     if not flight.ok:
@@ -194,15 +198,11 @@ def flight_truth(profile: Any, seed: int, index: int) -> tuple[Any, float, float
 def fault_spec(mode: FaultMode, u: Array, profile: Any, truth: Any, seed: int, run: int,
                window: tuple[float, float]) -> tuple[Any, dict]:
     """The FaultSpec u maps to (module docstring) and its physical parameters."""
-    from approachsim.sensors.faults import FaultSpec
-
     u = np.asarray(u, float)
     onset = window[0] + float(sps.norm.cdf(u[0])) * (window[1] - window[0])
     mag = mode.magnitude(float(u[1]))
     channel, n_used = None, 1
     if mode.sensor == "gnss":
-        from approachsim.sensors.suite import SensorSuite
-
         suite = SensorSuite.from_profile(profile)
         g = suite.without(*[s for s in suite.sensors if s != "gnss"]).measure(truth, seed=seed, runs=[run])["gnss"]
         j = int(np.clip(np.searchsorted(g.t_s, onset), 0, len(g.t_s) - 1))
@@ -226,8 +226,6 @@ def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float, confirm: bool 
     epochs, `detected` (any detection) and the excluded channel; fault-free diagnostics: the normalized main errors
     and separations (`z2_v`, `z2_l`, `ss2`: sums of squares, `n_z`, `n_ss`: counts). confirm: the bank identifies
     with the second look (bank.second_level)."""
-    from approachsim.campaign.integrity_bank import score_category
-
     out: dict[str, float] = {}
     settled = ep.t_s >= t0_s + cfg.timeavg_settle_s
     for cat, req in REQUIREMENTS.items():
@@ -271,9 +269,6 @@ def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | 
     returned with `failed` = 1 and every category's hmi_g = +1e3 (a failed navigation counts as the event:
     conservative)."""
     try:
-        from approachsim.campaign.integrity_bank import run_bank
-        from approachsim.campaign.integrity_campaign import bank_profile
-
         flown = flown_truth(profile, int(seed), int(run % truths))
         truth, t_lo, t_hi = flown.truth, flown.t_lo_s, flown.t_hi_s
         prof = profile
@@ -314,8 +309,6 @@ class Simulator:
     def __enter__(self) -> Simulator:
         if self.workers > 1:
             import multiprocessing
-
-            from approachsim.campaign.runner import register_pickling
 
             register_pickling()
             self._pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("fork"))

@@ -8,7 +8,9 @@ Stages are used through their public entry points only:
     scoring     approachsim.evaluate.score.score_run(truth, nav, cfg) -> scalars, arrays, series
 
 A stage that is not importable makes `require_stages` raise PipelineUnavailable (the CLI prints it and
-exits 1): numbers are never invented for a missing stage.
+exits 1): numbers are never invented for a missing stage. So this module imports the stages it checks (flight,
+sensors, nav, and the integrity bank, which imports nav) inside the functions that use them, after require_stages:
+importing the pipeline never needs them (the function-local imports marked "stage" below).
 
 Work sharing: runs come in fixed groups of consecutive runs (evaluation.flight_group); a task holds some
 runs of one group, and the aircraft is parsed and linearized once per task. Open loop: every run of a group
@@ -41,9 +43,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from approachsim import units
 from approachsim.campaign.result import RunResult
 from approachsim.config import ProfileError
+from approachsim.evaluate.limits import CATEGORIES
+from approachsim.evaluate.score import CATEGORY_KEYS, HEIGHT_GRID_FT, score_run
+from approachsim.evaluate.touchdown import touchdown_scalars
 from approachsim.memo import TruthMemo
+from approachsim.seeding import stream
 
 STAGES = (
     ("approachsim.flight.run", "Approach", "flight (JSBSim truth)"),
@@ -105,8 +112,6 @@ def _score(
     profile: Any, run: int, truth: Any, nav: Any, clock_true: Any, gnss: Any = None, flight: Any = None,
     seed: int | None = None, bank_group: Any = None, memo: TruthMemo | None = None,
 ) -> RunResult:
-    from approachsim.evaluate.score import HEIGHT_GRID_FT, score_run
-
     cfg = profile.evaluation
     fte = {}
     if flight is not None:  # closed loop: FTE is the deviation of the position guidance flew on
@@ -122,8 +127,7 @@ def _score(
     counts = {}
     if cfg.integrity_on and gnss is not None and seed is not None:
         # the solution-separation bank, open loop on this run's (flown) truth with its own sensor draws
-        from approachsim import units
-        from approachsim.campaign.integrity_campaign import score_with_bank
+        from approachsim.campaign.integrity_campaign import score_with_bank  # stage (module docstring)
 
         s_int, counts, a_int = score_with_bank(profile, truth, seed, run, nav, HEIGHT_GRID_FT * units.FT,
                                                group=bank_group, memo=memo)
@@ -153,9 +157,7 @@ def _geometry_at_dh(gnss: Any, scalars: dict) -> dict:
     channels used, satellites in view (above the mask) and used; the run's epoch offset (h) when drawn."""
     import numpy as np
 
-    from approachsim.evaluate.limits import CATEGORIES
-    from approachsim.evaluate.score import CATEGORY_KEYS
-    from approachsim.sensors.gnss.constellation import dops_ned
+    from approachsim.sensors.gnss.constellation import dops_ned  # stage (module docstring)
 
     out = {}
     for cat in CATEGORIES:
@@ -194,7 +196,7 @@ def _approach(profile: Any, land: bool = False) -> Any:
 def _approach_of(profile: Any, land: bool) -> Any:
     """The Approach of a profile, by (profile value, land): a profile's aircraft is parsed and its trimmed start
     solved once per worker process, not once per task (closed-loop tasks are one run each)."""
-    from approachsim.flight.run import Approach
+    from approachsim.flight.run import Approach  # stage (module docstring)
 
     if land:
         return Approach(profile, land=True)
@@ -205,8 +207,6 @@ def _approach_of(profile: Any, land: bool) -> Any:
 def approach_stop_height_m(profile: Any) -> float:
     """Where an approach run (not a landing) stops: the IMU 20 ft below the lowest decision height, at least 5 ft
     above the threshold, m."""
-    from approachsim import units
-
     return max(min(profile.evaluation.dh_ft.values()) - 20.0, 5.0) * units.FT
 
 
@@ -274,8 +274,7 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     optimal filter the runs share their covariance and gains (NavSystem.shares_covariance; a run's covariance
     depends only on the truth and its own measurement schedule, so this holds there too).
     """
-    from approachsim.nav.system import NavSystem
-    from approachsim.seeding import stream
+    from approachsim.nav.system import NavSystem  # stage (module docstring)
     from approachsim.sensors.states import start_states
     from approachsim.sensors.suite import SensorSuite
 
@@ -300,7 +299,7 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
                       memo=memo)
     group = None
     if keep is not None:
-        from approachsim.campaign.bankpass import GroupInputs
+        from approachsim.campaign.bankpass import GroupInputs  # stage (module docstring)
 
         group = GroupInputs(records, keep)
     out = []
@@ -321,7 +320,7 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool =
     navigation is scored down to where an approach run stops and its touchdown is scored (module docstring)."""
     import numpy as np
 
-    from approachsim.nav.closed_loop import NavInTheLoop
+    from approachsim.nav.closed_loop import NavInTheLoop  # stage (module docstring)
 
     approach = _approach(profile, land)
     gear = main_gear_lever_arms_m(approach) if land else None
@@ -337,8 +336,6 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool =
             nav = source.result(truth).solution
             td = {}
             if land:
-                from approachsim.evaluate.touchdown import touchdown_scalars
-
                 td = touchdown_scalars(truth, gear)
                 truth, nav, flight = _head(truth, nav, flight, approach_stop_height_m(profile))
             clk = source.errors.clock

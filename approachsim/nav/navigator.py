@@ -30,7 +30,7 @@ from approachsim.core.nav import epoch as ke
 from approachsim.core.nav import output as ko
 from approachsim.memo import TruthMemo
 from approachsim.nav import errormodel as em
-from approachsim.nav import ins
+from approachsim.nav import ins, reduced
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import FilterState, UpdateStatus
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, new_arcs, reset_arcs, stacked_new_arcs
@@ -474,13 +474,12 @@ class Navigator:
         ins_y = np.ascontiguousarray(self.rows[self.ins_of][:, e_rows])
         done = -1
         if per_run_sky and k and lay.has("gse") and not eng.carrier:  # each run on its reduced state
-            from approachsim.nav.reduced import reduced_singletons
-
             args = (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse,
                     f_gmp, ins_y, baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig)
             self.reduced_runs = []
-            done = reduced_singletons(system, truth, eng, args, (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav),
-                                      self._ic, self.reduced_runs, _valid_channels(records, N), memo)
+            done = reduced.reduced_singletons(system, truth, eng, args,
+                                              (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav), self._ic,
+                                              self.reduced_runs, _valid_channels(records, N), memo)
             if done < 0:
                 self.reduced_runs = None
         if done < 0:
