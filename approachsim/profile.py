@@ -24,6 +24,7 @@ from approachsim.evaluate.config import EvaluationConfig, parse_evaluation
 from approachsim.geo import RunwayFrame
 from approachsim.glidepath import GlidePath
 from approachsim.nav.config import NavConfig, parse_nav
+from approachsim.resources import find_aircraft_file
 from approachsim.sensors import atmosphere
 from approachsim.sensors.config import SensorsConfig, parse_faults, parse_sensors
 
@@ -302,8 +303,6 @@ def _run_duration_estimate_s(runway: Runway, aircraft: AircraftChoice, env: Envi
     """
     cas = aircraft.approach_speed_mps
     if cas is None:
-        from approachsim.resources import find_aircraft_file
-
         path = find_aircraft_file(aircraft.name, source)
         try:
             cas = float(tomllib.loads(path.read_text(encoding="utf-8"))["approach"]["approach_speed_kt"]) * units.KT

@@ -2,7 +2,7 @@
 
 - one flight group (campaign/pipeline.open_loop_group, 25 runs on one truth) with the bank and accuracy only
   (evaluation.integrity = []), alternately `--repeat` times: the bank's share per run is the difference;
-- per run, the bank from what the group's pass left (integrity/bankpass.bank_pass_group, what the pipeline runs),
+- per run, the bank from what the group's pass left (campaign/bankpass.bank_pass_group, what the pipeline runs),
   from the run's own records (bankpass.bank_pass) and NavSystem.run's batched copies (run_bank(..., compiled=False),
   the path before issue 26's speed work and the oracle), with their BankEpochs compared bit for bit.
 
@@ -37,9 +37,9 @@ def main() -> None:
     import numpy as np
 
     from approachsim.campaign import pipeline
-    from approachsim.integrity.bank import run_bank
-    from approachsim.integrity.bankpass import GroupInputs
-    from approachsim.integrity.campaign import bank_profile
+    from approachsim.campaign.bankpass import GroupInputs
+    from approachsim.campaign.integrity_bank import run_bank
+    from approachsim.campaign.integrity_campaign import bank_profile
     from approachsim.nav.system import NavSystem
     from approachsim.profile import load_profile
     from approachsim.seeding import stream

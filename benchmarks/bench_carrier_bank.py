@@ -7,7 +7,7 @@ navigation, scoring with the bank), interleaved in one process, and the runs' re
 Cases (each warmed up once on run 0):
 
     code       profiles/gbas-cat3-candidate.toml
-    carrier    profiles/gbas-carrier-cat3-candidate.toml, the bank's compiled pass (integrity/bankpass.py)
+    carrier    profiles/gbas-carrier-cat3-candidate.toml, the bank's compiled pass (campaign/bankpass.py)
     fallback   the same, the bank through NavSystem.run's copies (bankpass.applicable False for carrier phase: what
                main did before this branch)
 
@@ -31,8 +31,8 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import numpy as np  # noqa: E402
 
+from approachsim.campaign import bankpass  # noqa: E402
 from approachsim.campaign.pipeline import open_loop_group  # noqa: E402
-from approachsim.integrity import bankpass  # noqa: E402
 from approachsim.nav.engine import EpochEngine  # noqa: E402
 from approachsim.profile import load_profile  # noqa: E402
 

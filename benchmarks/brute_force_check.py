@@ -26,8 +26,8 @@ from pathlib import Path
 import numpy as np
 from scipy import stats as sps
 
+from approachsim.campaign.integrity_risk import Simulator, _columns
 from approachsim.integrity import rare
-from approachsim.integrity.risk import Simulator, _columns
 
 ROOT = Path(__file__).resolve().parents[1]
 MODE = "baro-step-halfnormal"

@@ -1,5 +1,5 @@
 """Issue 11 acceptance, faulted part: a pseudorange ramp (0.1, 0.5, 2 m/s) or step (10-100 m) on one used GPS
-satellite, starting at a random time on final, scored by the solution-separation bank (integrity.campaign).
+satellite, starting at a random time on final, scored by the solution-separation bank (campaign.integrity_campaign).
 
     PYTHONPATH=. python benchmarks/integrity_acceptance.py KIND RUNS [--seed S] [--out FILE.json] [--closed]
 
@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from approachsim import units
+from approachsim.campaign.integrity_campaign import campaign_integrity, score_with_bank
 from approachsim.campaign.pipeline import _approach, closed_loop_group
 from approachsim.campaign.result import RunResult
-from approachsim.integrity.campaign import campaign_integrity, score_with_bank
 from approachsim.profile import load_profile
 from approachsim.report.integrity import fig_integrity_tta
 from approachsim.seeding import stream

@@ -1,5 +1,5 @@
 """The tables of docs/integrity.md "Integrity risk" from integrity_risk.json files (the totals recomputed with
-integrity.risk.totals, so a change of the combination is seen on stored studies).
+campaign.integrity_risk.totals, so a change of the combination is seen on stored studies).
 
     PYTHONPATH=. python benchmarks/integrity_risk_tables.py DIR/integrity_risk.json [...]
     PYTHONPATH=. python benchmarks/integrity_risk_tables.py --merge A/integrity_risk.json B/integrity_risk.json
@@ -15,7 +15,7 @@ import json
 import sys
 from pathlib import Path
 
-from approachsim.integrity.risk import totals
+from approachsim.campaign.integrity_risk import totals
 
 
 def g(x: float | None) -> str:

@@ -1,6 +1,6 @@
 """Issue 26 item 2: the 3 m radar-altimeter bias near the ground. Is it detected, or bounded by the protection
-level? Open loop on flown default approaches (integrity.risk's sampler), the bias starting ONSET s before the lowest
-decision height, GPS-only bank and the bank with the sensor modes (the radar altimeter a fault mode).
+level? Open loop on flown default approaches (campaign.integrity_risk's sampler), the bias starting ONSET s before the
+lowest decision height, GPS-only bank and the bank with the sensor modes (the radar altimeter a fault mode).
 
     PYTHONPATH=. python benchmarks/radalt_bias_near_ground.py [--runs 30] [--bias-m 3] [--onset-s 60] [--workers 2]
 
@@ -16,8 +16,8 @@ import time
 import numpy as np
 from scipy.stats import norm
 
-from approachsim.integrity.bank import RADALT_MODE
-from approachsim.integrity.risk import MODES, Simulator, _columns
+from approachsim.campaign.bank_modes import RADALT_MODE
+from approachsim.campaign.integrity_risk import MODES, Simulator, _columns
 from approachsim.profile import load_profile
 
 
@@ -34,7 +34,7 @@ def main() -> None:
     mode = MODES["radalt-bias"]
     for sensor_modes in (False, True):
         with Simulator(profile, a.seed, 4, a.workers, sensor_modes) as sim:
-            from approachsim.integrity.risk import flight_truth
+            from approachsim.campaign.integrity_risk import flight_truth
 
             _, lo, hi = flight_truth(profile, a.seed, 0)
             frac = min(max((hi - a.onset_s - lo) / (hi - lo), 1e-9), 1 - 1e-9)

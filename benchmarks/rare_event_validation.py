@@ -6,20 +6,20 @@ real simulation.
         [--thresholds C1,C2] [--brute N] [--samples N] [--seed S] [--workers K] [--truths T] [--pilot N]
         [--vmax-file F] [--no-nais] [--method nais|ce] [--strata E1,E2 --strata-samples N] [--out FILE.json]
 
-The event: the protected output's largest vertical error over the CAT I window (integrity.risk.limit_states
+The event: the protected output's largest vertical error over the CAT I window (campaign.integrity_risk.limit_states
 `cat1_vmax_m`: the main solution, after an exclusion the excluded sub-solution) exceeds C metres, given one fault of
-the mode with its parameters drawn from the mode's distribution. The default mode (integrity.risk.VALIDATION_MODES)
-is a baro step of 5 m |u| (half-normal) at a uniform onset: the GPS-only bank cannot see it, so the error's tail is
-the step's own and importance sampling over u has something to find. (A satellite ramp with the same event does
-not: its largest vertical error is the nominal noise's, rank correlation 0.04 with the ramp's rate over 1500 runs,
-and NAIS had not reached 2.9 m after about 1300 runs: IS over the fault parameters only helps where the event is
-driven by them.) The levels C are where brute force can answer (about 1e-2 and 1e-3 here); --pilot N runs N plain
-samples on other run indices first and prints the quantiles to choose them (neither the brute-force nor the IS
-samples see the pilot). Brute force (plain numpy normals through the same map) runs once and its values are compared
-with every C; they are appended to --vmax-file as chunks finish, so a brute-force-only run (--no-nais) and a
-NAIS-only run (--brute 0 with the same --vmax-file, read at the end) can go side by side. NAIS runs once per C, each
-on its own run indices (its own noise) and its own OpenTURNS seed. Prints and writes the table: estimate, CoV,
-one-sided bounds, hits, evaluations, wall time, whether the intervals overlap.
+the mode with its parameters drawn from the mode's distribution. The default mode
+(campaign.integrity_risk.VALIDATION_MODES) is a baro step of 5 m |u| (half-normal) at a uniform onset: the GPS-only
+bank cannot see it, so the error's tail is the step's own and importance sampling over u has something to find. (A
+satellite ramp with the same event does not: its largest vertical error is the nominal noise's, rank correlation
+0.04 with the ramp's rate over 1500 runs, and NAIS had not reached 2.9 m after about 1300 runs: IS over the fault
+parameters only helps where the event is driven by them.) The levels C are where brute force can answer (about 1e-2
+and 1e-3 here); --pilot N runs N plain samples on other run indices first and prints the quantiles to choose them
+(neither the brute-force nor the IS samples see the pilot). Brute force (plain numpy normals through the same map)
+runs once and its values are compared with every C; they are appended to --vmax-file as chunks finish, so a
+brute-force-only run (--no-nais) and a NAIS-only run (--brute 0 with the same --vmax-file, read at the end) can go
+side by side. NAIS runs once per C, each on its own run indices (its own noise) and its own OpenTURNS seed. Prints
+and writes the table: estimate, CoV, one-sided bounds, hits, evaluations, wall time, whether the intervals overlap.
 
 --strata E1,E2,...: a second reference, stratified plain Monte Carlo over the magnitude input |u_1| (Cochran,
 *Sampling techniques*, ch. 5): strata [E1, E2), ..., [Ek, inf) of known probability P_j = 2 (Phi(E_j+1) -
@@ -40,8 +40,8 @@ from pathlib import Path
 import numpy as np
 from scipy import stats as sps
 
+from approachsim.campaign.integrity_risk import MODES, VALIDATION_MODES, Simulator, _columns, fault_mode
 from approachsim.integrity import rare
-from approachsim.integrity.risk import MODES, VALIDATION_MODES, Simulator, _columns, fault_mode
 from approachsim.profile import load_profile
 
 

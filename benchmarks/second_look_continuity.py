@@ -1,14 +1,14 @@
 """Issue 26, the second look's cost in continuity under faults: the same faulted bank epochs scored with the
 first-look identification (exclude the first detection's suspect for good), with the second look
-(integrity.bank.second_level: not protected until a mode's exclusion is confirmed, and again when a later detection
-names another mode) and with the second look `at_once` (a clear first detection excluded at once, only an ambiguous
-one waits), per sample and category.
+(campaign.integrity_bank.second_level: not protected until a mode's exclusion is confirmed, and again when a later
+detection names another mode) and with the second look `at_once` (a clear first detection excluded at once, only an
+ambiguous one waits), per sample and category.
 
     PYTHONPATH=. python benchmarks/second_look_continuity.py [--profile P] [--mode sat-ramp] [--samples N]
         [--seed S] [--workers K] [--truths T] [--out FILE.json]
 
-Samples are plain Monte Carlo over the mode's fault distribution (integrity.risk.fault_spec: onset uniform over the
-approach window, log-uniform magnitude, the faulted satellite uniform over those in use), on flown truths
+Samples are plain Monte Carlo over the mode's fault distribution (campaign.integrity_risk.fault_spec: onset uniform over
+the approach window, log-uniform magnitude, the faulted satellite uniform over those in use), on flown truths
 (risk.flight_truth) and the open-loop bank (risk.run_sample's path); both scorings read the same bank epochs, so
 every difference is the rule's. An epoch is alerted when its protection level reaches the alert limit on either
 axis (PL = inf while the second look has not confirmed). Per category: samples detected, samples where the second
@@ -31,17 +31,17 @@ from pathlib import Path
 
 import numpy as np
 
+from approachsim.campaign.integrity_risk import CATEGORY_KEYS, MODES, fault_mode, fault_spec, flight_truth, modes_for
 from approachsim.integrity import rare
 from approachsim.integrity.requirements import REQUIREMENTS
-from approachsim.integrity.risk import CATEGORY_KEYS, MODES, fault_mode, fault_spec, flight_truth, modes_for
 from approachsim.profile import load_profile
 
 
 def sample(profile, seed: int, truths: int, mode_name: str, run: int, u: list[float]) -> dict:
     """One faulted sample scored both ways: per category (epochs, alerted epochs first / second look, alerted
     epochs the first look protected, hmi epochs first / second, detected)."""
-    from approachsim.integrity.bank import run_bank, score_category
-    from approachsim.integrity.campaign import bank_profile
+    from approachsim.campaign.integrity_bank import run_bank, score_category
+    from approachsim.campaign.integrity_campaign import bank_profile
 
     truth, t_lo, t_hi = flight_truth(profile, seed, run % truths)
     spec, params = fault_spec(fault_mode(mode_name), np.asarray(u), profile, truth, seed, run, (t_lo, t_hi))
@@ -97,8 +97,8 @@ def main() -> None:
     else:
         rows = [r for c in chunks for r in _task(c)]
     wall = time.time() - t
-    # the mode's prior per approach, as integrity.risk takes it: per satellite (pseudolite unit) times the most in
-    # use over the samples
+    # the mode's prior per approach, as campaign.integrity_risk takes it: per satellite (pseudolite unit) times the most
+    # in use over the samples
     prior = mode.prior * (max(int(r["n_channels"]) for r in rows) if mode.has_channel else 1)
     res: dict = {"profile": profile.name, "mode": a.mode, "prior_per_approach": prior, "samples": a.samples,
                  "seed": a.seed, "wall_s": wall, "categories": {}}

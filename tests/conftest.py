@@ -28,7 +28,7 @@ LONGEST_FIRST = (
     "tests/integration/test_nav_consistency_jsbsim.py",
     "tests/unit/nav/test_filter_contract.py",
     "tests/unit/nav/test_epoch_engine.py",  # the longest of the generic-CPU equality pass, with the ones above
-    "tests/unit/integrity/test_bankpass_carrier.py",
+    "tests/unit/campaign/test_bankpass_carrier.py",
     "tests/unit/nav/test_epoch_kernels.py",
 )
 

@@ -5,7 +5,7 @@
 
 The default profile with all satellites in view (the bank needs redundancy), the online FDE on with the category's
 allocation, fault-free: JSBSim flies each run closed loop on the FDE's solution; the bank then re-navigates the
-truth it flew (integrity.bank.run_bank). Both PLs come from integrity.protection with the same K factors; they
+truth it flew (campaign.integrity_bank.run_bank). Both PLs come from integrity.protection with the same K factors; they
 differ in the fault they bound (one arriving at this epoch, detected by the residual test; one persisting over the
 run, detected by the separation test). Prints, per axis, the median and range of online / offline over the
 category's window (from 1000 ft down to its decision height), and both at the decision height.
@@ -24,8 +24,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from approachsim import units  # noqa: E402
+from approachsim.campaign.integrity_bank import run_bank, score_category  # noqa: E402
 from approachsim.flight.run import Approach  # noqa: E402
-from approachsim.integrity.bank import run_bank, score_category  # noqa: E402
 from approachsim.integrity.requirements import REQUIREMENTS  # noqa: E402
 from approachsim.loop.closed_loop import NavInTheLoop  # noqa: E402
 from approachsim.profile import parse_profile  # noqa: E402

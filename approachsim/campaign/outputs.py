@@ -18,6 +18,7 @@ from approachsim.campaign.result import RunResult
 from approachsim.evaluate.config import EvaluationConfig
 from approachsim.evaluate.stats import MIN_GROUPS
 from approachsim.evaluate.summary import contract_summary, details, gnss_geometry, verdicts
+from approachsim.evaluate.touchdown import touchdown_details, touchdown_summary
 
 
 def columns(results: list[RunResult]) -> dict[str, np.ndarray]:
@@ -41,7 +42,9 @@ def evaluate_results(
     summary = contract_summary(
         res, profile=profile, runs=len(results), seed=seed, closed_loop=closed_loop, failed_runs=failed
     )
-    from approachsim.integrity.campaign import campaign_integrity, sum_counts
+    # imported here: integrity_campaign imports the bank, which imports the navigation stage, and importing this
+    # module must not need a stage (campaign/pipeline.py require_stages reports a missing one first)
+    from approachsim.campaign.integrity_campaign import campaign_integrity, sum_counts
 
     det = details(cols, res, cfg, sum_counts(results), integrity_fn=campaign_integrity)
     det["failures"] = {str(r.run): r.error for r in results if not r.ok}
@@ -54,8 +57,6 @@ def evaluate_results(
     if geom is not None:
         det["gnss_geometry"] = geom
     if land:
-        from approachsim.evaluate.touchdown import touchdown_details, touchdown_summary
-
         det["touchdown"] = touchdown_details(cols, runs=len(results), failed_runs=failed, level=cfg.confidence)
         summary["touchdown"] = touchdown_summary(det["touchdown"])
     return summary, det

@@ -8,7 +8,9 @@ Stages are used through their public entry points only:
     scoring     approachsim.evaluate.score.score_run(truth, nav, cfg) -> scalars, arrays, series
 
 A stage that is not importable makes `require_stages` raise PipelineUnavailable (the CLI prints it and
-exits 1): numbers are never invented for a missing stage.
+exits 1): numbers are never invented for a missing stage. So this module imports the stages it checks (flight,
+sensors, nav, and the integrity bank, which imports nav) inside the functions that use them, after require_stages:
+importing the pipeline never needs them (the function-local imports marked "stage" below).
 
 Work sharing: runs come in fixed groups of consecutive runs (evaluation.flight_group); a task holds some
 runs of one group, and the aircraft is parsed and linearized once per task. Open loop: every run of a group
@@ -27,8 +29,8 @@ approach campaign), and evaluate.touchdown scores the touchdown row (main-gear p
 point's state and the main gears' lever arms). A run that does not put its main gear down on the runway is a
 failed run with its reason ("failed landing: touchdown short of the threshold ..."), never dropped.
 Integrity ([evaluation] integrity lists a category): after the flight, each run is also navigated by the
-solution-separation bank (integrity.campaign.score_with_bank: K + 1 filters in one batched pass, open loop on the
-run's flown truth with the run's own sensor draws): measured 1.86x the wall time of the default 20-run closed-loop
+solution-separation bank (campaign.integrity_campaign.score_with_bank: K + 1 filters in one batched pass, open loop on
+the run's flown truth with the run's own sensor draws): measured 1.86x the wall time of the default 20-run closed-loop
 campaign, about 3x an open-loop one.
 """
 
@@ -41,8 +43,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from approachsim import units
 from approachsim.campaign.result import RunResult
 from approachsim.config import ProfileError
+from approachsim.evaluate.limits import CATEGORIES
+from approachsim.evaluate.score import CATEGORY_KEYS, HEIGHT_GRID_FT, score_run
+from approachsim.evaluate.touchdown import touchdown_scalars
+from approachsim.memo import TruthMemo
+from approachsim.seeding import stream
 
 STAGES = (
     ("approachsim.flight.run", "Approach", "flight (JSBSim truth)"),
@@ -102,17 +110,15 @@ def spec_for(profile: Any, mode: str, land: bool = False) -> PipelineSpec:
 
 def _score(
     profile: Any, run: int, truth: Any, nav: Any, clock_true: Any, gnss: Any = None, flight: Any = None,
-    seed: int | None = None, bank_group: Any = None,
+    seed: int | None = None, bank_group: Any = None, memo: TruthMemo | None = None,
 ) -> RunResult:
-    from approachsim.evaluate.score import HEIGHT_GRID_FT, score_run
-
     cfg = profile.evaluation
     fte = {}
     if flight is not None:  # closed loop: FTE is the deviation of the position guidance flew on
         g = flight.guidance_r_rwy
         fte = {"fte_lat_m": g[:, 1], "fte_vert_m": profile.runway.glidepath.deviation_rwy_m(g)}
     scalars, arrays, series = score_run(
-        truth, nav, cfg, clock_bias_true_m=clock_true, keep_series=run < cfg.series_runs, **fte
+        truth, nav, cfg, clock_bias_true_m=clock_true, keep_series=run < cfg.series_runs, memo=memo, **fte
     )
     if gnss is not None:
         scalars.update(_geometry_at_dh(gnss, scalars))
@@ -121,11 +127,10 @@ def _score(
     counts = {}
     if cfg.integrity_on and gnss is not None and seed is not None:
         # the solution-separation bank, open loop on this run's (flown) truth with its own sensor draws
-        from approachsim import units
-        from approachsim.integrity.campaign import score_with_bank
+        from approachsim.campaign.integrity_campaign import score_with_bank  # stage (module docstring)
 
         s_int, counts, a_int = score_with_bank(profile, truth, seed, run, nav, HEIGHT_GRID_FT * units.FT,
-                                               group=bank_group)
+                                               group=bank_group, memo=memo)
         scalars.update(s_int)
         arrays = {**arrays, **a_int}
     return RunResult(run=run, ok=True, scalars=scalars, arrays=arrays, series=series, counts=counts)
@@ -152,9 +157,7 @@ def _geometry_at_dh(gnss: Any, scalars: dict) -> dict:
     channels used, satellites in view (above the mask) and used; the run's epoch offset (h) when drawn."""
     import numpy as np
 
-    from approachsim.evaluate.limits import CATEGORIES
-    from approachsim.evaluate.score import CATEGORY_KEYS
-    from approachsim.sensors.gnss.constellation import dops_ned
+    from approachsim.sensors.gnss.constellation import dops_ned  # stage (module docstring)
 
     out = {}
     for cat in CATEGORIES:
@@ -184,32 +187,26 @@ def _gnss_closed_loop(source: Any, truth: Any) -> Any:
     return source.suite.sensors["gnss"].apply(truth, e.take(keep))
 
 
-_APPROACHES: dict = {}
-"""The Approach of each profile this worker process has flown (a profile's aircraft is parsed and its trimmed start
-solved once per process, not once per task: closed-loop tasks are one run each)."""
-
-
 def _approach(profile: Any, land: bool = False) -> Any:
-    from approachsim.flight.run import Approach
+    """The Approach of a profile (flight.run), kept by the profile's value and `land` (`_approach_of`)."""
+    return _approach_of(profile, bool(land))
 
-    a = _APPROACHES.get((profile, land))
-    if a is None:
-        if len(_APPROACHES) > 8:
-            _APPROACHES.clear()
-        if land:
-            a = Approach(profile, land=True)
-        else:
-            # fly a little below the lowest decision height so that its crossing is bracketed by samples
-            a = Approach(profile, stop_height_m=approach_stop_height_m(profile))
-        _APPROACHES[(profile, land)] = a
-    return a
+
+@functools.lru_cache(maxsize=8)
+def _approach_of(profile: Any, land: bool) -> Any:
+    """The Approach of a profile, by (profile value, land): a profile's aircraft is parsed and its trimmed start
+    solved once per worker process, not once per task (closed-loop tasks are one run each)."""
+    from approachsim.flight.run import Approach  # stage (module docstring)
+
+    if land:
+        return Approach(profile, land=True)
+    # fly a little below the lowest decision height so that its crossing is bracketed by samples
+    return Approach(profile, stop_height_m=approach_stop_height_m(profile))
 
 
 def approach_stop_height_m(profile: Any) -> float:
     """Where an approach run (not a landing) stops: the IMU 20 ft below the lowest decision height, at least 5 ft
     above the threshold, m."""
-    from approachsim import units
-
     return max(min(profile.evaluation.dh_ft.values()) - 20.0, 5.0) * units.FT
 
 
@@ -277,9 +274,8 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     optimal filter the runs share their covariance and gains (NavSystem.shares_covariance; a run's covariance
     depends only on the truth and its own measurement schedule, so this holds there too).
     """
-    from approachsim.loop.paths import open_loop_path
-    from approachsim.nav.system import NavSystem
-    from approachsim.seeding import stream
+    from approachsim.loop.paths import open_loop_path  # stage (module docstring)
+    from approachsim.nav.system import NavSystem  # stage (module docstring)
     from approachsim.sensors.states import start_states
     from approachsim.sensors.suite import SensorSuite
 
@@ -294,15 +290,17 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
     errors = suite.draw(truth.t_s, seed, list(runs))
     records = suite.apply(truth, errors)  # = suite.measure(truth, seed, runs)
     nav = NavSystem.from_profile(profile)
+    memo = TruthMemo(truth)  # the group's shared work on its truth (approachsim/memo.py): this task owns it
     # optimal filter: one covariance per measurement schedule for all runs (linearized along the shared truth);
     # robust / adaptive configurations filter each run on its own
-    # with the integrity bank: the pass keeps each run's start and INS for its bank (integrity/bankpass.py)
+    # with the integrity bank: the pass keeps each run's start and INS for its bank (campaign/bankpass.py)
     keep = {} if profile.evaluation.integrity_on else None
     navruns = nav.run(truth, records, [stream(seed, i, "nav") for i in runs],
-                      shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors), keep=keep)
+                      shared_covariance=nav.shares_covariance(), states=start_states(suite, truth, errors), keep=keep,
+                      memo=memo)
     group = None
     if keep is not None:
-        from approachsim.integrity.bankpass import GroupInputs
+        from approachsim.campaign.bankpass import GroupInputs  # stage (module docstring)
 
         group = GroupInputs(records, keep)
     out = []
@@ -311,7 +309,8 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
         try:
             g = records.get("gnss")
             r = _score(profile, i, truth, nr.solution, _clock_truth(records, k, truth.t_s),
-                       None if g is None else g.run(k), seed=seed, bank_group=None if group is None else (group, k))
+                       None if g is None else g.run(k), seed=seed, bank_group=None if group is None else (group, k),
+                       memo=memo)
             out.append(dataclasses.replace(r, path=path))
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
@@ -324,7 +323,7 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool =
     navigation is scored down to where an approach run stops and its touchdown is scored (module docstring)."""
     import numpy as np
 
-    from approachsim.loop.closed_loop import NavInTheLoop
+    from approachsim.loop.closed_loop import NavInTheLoop  # stage (module docstring)
 
     approach = _approach(profile, land)
     gear = main_gear_lever_arms_m(approach) if land else None
@@ -340,13 +339,12 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool =
             nav = source.result(truth).solution
             td = {}
             if land:
-                from approachsim.evaluate.touchdown import touchdown_scalars
-
                 td = touchdown_scalars(truth, gear)
                 truth, nav, flight = _head(truth, nav, flight, approach_stop_height_m(profile))
             clk = source.errors.clock
             clock_true = None if clk is None else np.interp(truth.t_s, clk.t_s, np.asarray(clk.series["bias"]))
-            r = _score(profile, i, truth, nav, clock_true, _gnss_closed_loop(source, truth), flight, seed)
+            r = _score(profile, i, truth, nav, clock_true, _gnss_closed_loop(source, truth), flight, seed,
+                       memo=TruthMemo(truth))
             if td:
                 r = dataclasses.replace(r, scalars={**r.scalars, **td})
             out.append(dataclasses.replace(r, path=f"flight={flight.loop} {source.path.name}"))

@@ -65,6 +65,9 @@ from typing import Any
 import numpy as np
 from scipy import stats as sps
 
+from approachsim import units
+from approachsim.evaluate.score import CATEGORY_KEYS
+
 SCHEMA = "approachsim.baseline/2"
 SCHEMAS = ("approachsim.baseline/1", SCHEMA)
 ALPHA = 1e-3
@@ -160,9 +163,6 @@ def paired_change(old: np.ndarray, new: np.ndarray, alpha: float = ALPHA, margin
 
 def per_run_errors(results: list, categories: dict[str, str] | None = None) -> dict:
     """Per-run errors at each decision height, ft, in run order (None for a failed run): the baseline's record."""
-    from approachsim import units
-    from approachsim.evaluate.score import CATEGORY_KEYS
-
     cats = CATEGORY_KEYS if categories is None else categories
     rs = sorted(results, key=lambda r: r.run)
     out: dict = {"runs": [int(r.run) for r in rs]}

@@ -50,7 +50,7 @@ class RunResult:
     """Time series kept for this run (equal-length (n,) arrays, written to their own file), or None."""
     counts: Mapping[str, Array] = field(default_factory=_empty)
     """Histograms summed over the campaign (integrity: (error, protection level) cells per category and axis,
-    integrity.campaign), stored sparse in the JSON line; empty when integrity is off."""
+    campaign.integrity_campaign), stored sparse in the JSON line; empty when integrity is off."""
     path: str | None = None
     """Which code produced the run (loop/paths.py: the flight loop and the navigation's row and epoch paths), or
     None (a failed run, or a line written before paths were recorded)."""

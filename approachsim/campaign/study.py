@@ -29,8 +29,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from approachsim.campaign.evaluation import evaluate_profile
+from approachsim.campaign.pipeline import spec_for
 from approachsim.config import ProfileError, Section
 from approachsim.profile import Profile, parse_profile
+from approachsim.resources import shipped_profiles
 
 MODES = ("closed", "open")
 
@@ -156,8 +159,6 @@ def load_study(path: str | Path) -> Study:
 
 def _base_profile(study_path: Path, ref: str) -> Path:
     """The base profile: a path relative to the study file, else a shipped profile name (approachsim profiles)."""
-    from approachsim.resources import shipped_profiles
-
     base = (study_path.parent / ref).resolve()
     if base.is_file():
         return base
@@ -211,9 +212,6 @@ def run_study(
     """
     import csv
     import json
-
-    from approachsim.campaign.evaluation import evaluate_profile
-    from approachsim.campaign.pipeline import spec_for
 
     spec_fn = spec_fn or spec_for
     out_dir = Path(out_dir)

@@ -1,7 +1,7 @@
 """`approachsim integrity-risk PROFILE [--modes M,...] [--method nais|ce|mc] [--samples N] [--max-calls N]
 [--fault-free-runs N] [--truths T] [--seed S] [--workers K] [--sensor-modes] [--second-level] [--out DIR]
 [--require CAT]`: the
-probability of hazardously misleading information per category by rare-event simulation (integrity/risk.py,
+probability of hazardously misleading information per category by rare-event simulation (campaign/integrity_risk.py,
 docs/integrity.md "Integrity risk"), against the Annex 10 allocations.
 
 Writes DIR/integrity_risk.json (docs/contract.md) and prints one line per category. Exit status: 0 the study ran;
@@ -64,7 +64,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def check_options(args: argparse.Namespace, profile: object) -> dict:
     """Validate the options (ProfileError naming the option); the keyword arguments of integrity_risk."""
-    from approachsim.integrity.risk import MODES, modes_for
+    from approachsim.campaign.integrity_risk import MODES, modes_for
 
     if not 10 <= args.samples <= 1_000_000:
         raise ProfileError(f"--samples: must be in [10, 1000000], got {args.samples}")
@@ -100,8 +100,8 @@ def _fmt(x: float | None) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Run the study, write integrity_risk.json, print the table."""
+    from approachsim.campaign.integrity_risk import integrity_risk
     from approachsim.commands.evaluate import parse_require
-    from approachsim.integrity.risk import integrity_risk
     from approachsim.profile import load_profile
 
     profile = load_profile(args.profile)

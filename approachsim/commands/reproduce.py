@@ -1,8 +1,10 @@
 """`approachsim reproduce PAPER --out DIR [--seed S] [--runs N]`: rerun a seed paper's own experiment.
 
 The command composes the two stages: the paper module (`approachsim.papers.<name>`) computes and returns
-(`compute(*, seed, runs) -> (result, data)`, `note(result, figures) -> str`, `headline(result) -> list[str]`),
-the report module (`approachsim.report.papers_<name>`) draws the figures from `data`; this command writes
+(`compute(*, seed, runs) -> (result, data)`) and its note module writes (`note(result, figures) -> str`,
+`headline(result) -> list[str]`: the paper module itself, but for gray-maybeck's papers/gray_maybeck_note.py, which
+sits above its paper module), the report module (`approachsim.report.papers_<name>`) draws the figures from
+`data`; this command writes
 DIR/<paper>.json (the paper's tables and ours side by side), DIR/<paper>.md (the reproduction note) and the
 figures, and prints a short summary and the paths. Papers are loaded lazily by name.
 """
@@ -20,13 +22,18 @@ from typing import Any
 from approachsim.config import ProfileError
 
 PAPERS = {
-    "hajiyev-saltoglu": ("approachsim.papers.hajiyev_saltoglu", "approachsim.report.papers_hajiyev_saltoglu"),
-    "manero-hajiyev": ("approachsim.papers.manero_hajiyev", "approachsim.report.papers_manero_hajiyev"),
-    "sokolovic": ("approachsim.papers.sokolovic", "approachsim.report.papers_sokolovic"),
-    "chernodarov": ("approachsim.papers.chernodarov", "approachsim.report.papers_chernodarov"),
-    "gray-maybeck": ("approachsim.papers.gray_maybeck", "approachsim.report.papers_gray_maybeck"),
+    "hajiyev-saltoglu": ("approachsim.papers.hajiyev_saltoglu", "approachsim.report.papers_hajiyev_saltoglu",
+                         "approachsim.papers.hajiyev_saltoglu"),
+    "manero-hajiyev": ("approachsim.papers.manero_hajiyev", "approachsim.report.papers_manero_hajiyev",
+                       "approachsim.papers.manero_hajiyev"),
+    "sokolovic": ("approachsim.papers.sokolovic", "approachsim.report.papers_sokolovic",
+                  "approachsim.papers.sokolovic"),
+    "chernodarov": ("approachsim.papers.chernodarov", "approachsim.report.papers_chernodarov",
+                    "approachsim.papers.chernodarov"),
+    "gray-maybeck": ("approachsim.papers.gray_maybeck", "approachsim.report.papers_gray_maybeck",
+                     "approachsim.papers.gray_maybeck_note"),
 }
-"""Paper name -> (module that computes, module that draws)."""
+"""Paper name -> (module that computes, module that draws, module that writes the note and headline)."""
 
 DEFAULT_RUNS = 100
 """Runs when --runs is not given and the paper module has no DEFAULT_RUNS of its own."""
@@ -76,7 +83,7 @@ def reproduce(name: str, out_dir: Path, *, seed: int, runs: int, cases: list[str
     figures = _figure_writer(name)(data, out_dir)
     result["figures"] = figures
     (out_dir / f"{name}.json").write_text(json.dumps(result, indent=2))
-    (out_dir / f"{name}.md").write_text(paper.note(result, figures))
+    (out_dir / f"{name}.md").write_text(importlib.import_module(PAPERS[name][2]).note(result, figures))
     return result
 
 
@@ -133,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
     result = reproduce(args.paper, args.out, seed=args.seed, runs=runs, cases=cases, closed=args.closed,
                        sensitivity_runs=args.sensitivity)
     print(f"{args.paper}: {runs} runs, seed {args.seed}")
-    for line in paper.headline(result):
+    for line in importlib.import_module(PAPERS[args.paper][2]).headline(result):
         print(f"  {line}")
     print(f"wrote {args.out / (args.paper + '.md')} (the note), {args.out / (args.paper + '.json')} (all numbers) "
           f"and {len(result['figures'])} figure(s) in {args.out}")

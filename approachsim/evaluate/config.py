@@ -57,7 +57,7 @@ class EvaluationConfig:
     """Failure probability a category tolerates; 0: any failed run fails every category (evaluate/verdict.py)."""
     integrity: tuple[str, ...] = DEFAULT_INTEGRITY
     """Categories whose verdict includes the integrity criterion (evaluate/verdict.py); when any is listed, every
-    run is scored by the solution-separation bank (integrity/campaign.py) and details.json carries `integrity`
+    run is scored by the solution-separation bank (campaign/integrity_campaign.py) and details.json carries `integrity`
     for every category."""
 
     @property

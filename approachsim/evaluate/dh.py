@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from approachsim.memo import TruthMemo, memoized
 from approachsim.records import NavSolution, Truth
 
 Array = np.ndarray
@@ -36,15 +37,16 @@ class RunwayErrors:
     """(n, 3) error in local NED axes at the true position, m."""
 
 
-def runway_errors(truth: Truth, nav: NavSolution) -> RunwayErrors:
-    """Per-epoch error of `nav` against `truth` (same time base; nav may be shorter if it stopped)."""
+def runway_errors(truth: Truth, nav: NavSolution, memo: TruthMemo | None = None) -> RunwayErrors:
+    """Per-epoch error of `nav` against `truth` (same time base; nav may be shorter if it stopped). memo: the
+    truth's TruthMemo (its trigonometry and heights then made once for the runs that share it)."""
     n = min(len(truth), nav.t_s.shape[0])
     if n < 2:
         raise ValueError(f"navigation solution has {n} samples; need at least 2")
     if not np.allclose(nav.t_s[:n], truth.t_s[:n], rtol=0.0, atol=1e-6):
         raise ValueError("navigation solution and truth are not on the same time base")
     dr = nav.r_ecef[:n] - truth.r_ecef[:n]
-    sl, cl, so, co, hat = _truth_terms(truth, n)
+    sl, cl, so, co, hat = memoized(memo, truth, "dh.truth_terms", n, lambda: _truth_terms(truth, n), keep=2)
     e_ned = _rotate_ned(dr, sl, cl, so, co)
     e_rwy = dr @ truth.runway.c_ecef_to_rwy.T
     return RunwayErrors(
@@ -52,22 +54,11 @@ def runway_errors(truth: Truth, nav: NavSolution) -> RunwayErrors:
     )
 
 
-_TRUTH_TERMS: tuple = (None, -1, ())
-"""The last truth's (truth, n, terms) of `_truth_terms`: the runs of an open-loop group share their truth."""
-
-
 def _truth_terms(truth: Truth, n: int) -> tuple[Array, Array, Array, Array, Array]:
-    """sin / cos of the truth's first n latitudes and longitudes and its heights above the threshold, computed once
-    per truth (the memo holds the truth itself, so its identity cannot be reused while it is kept; one immutable
-    tuple, replaced whole, so a thread reads one truth's memo or another's, never a mix)."""
-    global _TRUTH_TERMS
-    memo = _TRUTH_TERMS
-    if memo[0] is truth and memo[1] == n:
-        return memo[2]
+    """sin / cos of the truth's first n latitudes and longitudes and its heights above the threshold (kept in the
+    truth's TruthMemo when the caller has one: the runs of a group share their truth)."""
     lat, lon = truth.lat_rad[:n], truth.lon_rad[:n]
-    terms = (np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon), truth.runway.height_above_threshold(truth.h_m[:n]))
-    _TRUTH_TERMS = (truth, n, terms)
-    return terms
+    return np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon), truth.runway.height_above_threshold(truth.h_m[:n])
 
 
 def ecef_to_ned_vectors(d_ecef: Array, lat_rad: Array, lon_rad: Array) -> Array:

@@ -32,6 +32,7 @@ from approachsim.evaluate.dh import at_crossing, dh_crossing, interp_on_height, 
 from approachsim.evaluate.integrity import availability, integrity_series, stanford_regions
 from approachsim.evaluate.limits import CATEGORIES, LIMITS
 from approachsim.evaluate.timeavg import mean_square_ft2, state_errors_m
+from approachsim.memo import TruthMemo, memoized
 from approachsim.records import NavSolution, Truth
 
 CATEGORY_KEYS = {"CAT I": "cat1", "CAT II": "cat2", "CAT III": "cat3"}
@@ -62,22 +63,6 @@ def glidepath_tan(truth: Truth, hat_m: np.ndarray) -> float:
     return float(-np.polyfit(x, y, 1)[0])
 
 
-_GLIDEPATH_TAN: tuple = (None, -1, 0.0)
-"""The last truth's (truth, n, glidepath_tan): the runs of an open-loop group share their truth."""
-
-
-def _glidepath_tan_of(truth: Truth, hat_m: np.ndarray) -> float:
-    """glidepath_tan(truth, hat_m) for hat_m the truth's own first n heights above the threshold (runway_errors),
-    computed once per truth (the memo holds the truth itself; one immutable tuple, replaced whole)."""
-    global _GLIDEPATH_TAN
-    memo, n = _GLIDEPATH_TAN, hat_m.shape[0]
-    if memo[0] is truth and memo[1] == n:
-        return memo[2]
-    tan_gp = glidepath_tan(truth, hat_m)
-    _GLIDEPATH_TAN = (truth, n, tan_gp)
-    return tan_gp
-
-
 def score_run(
     truth: Truth,
     nav: NavSolution,
@@ -87,12 +72,16 @@ def score_run(
     keep_series: bool = False,
     fte_lat_m: np.ndarray | None = None,
     fte_vert_m: np.ndarray | None = None,
+    memo: TruthMemo | None = None,
 ) -> tuple[dict[str, float], dict[str, np.ndarray], dict[str, np.ndarray] | None]:
-    """(scalars, arrays, series or None) of one run; RunScoreError when it cannot be scored."""
-    err = runway_errors(truth, nav)
+    """(scalars, arrays, series or None) of one run; RunScoreError when it cannot be scored. memo: the truth's
+    TruthMemo (approachsim/memo.py), which the runs of an open-loop group share: the truth's trigonometry and
+    glidepath slope are then made once."""
+    err = runway_errors(truth, nav, memo)
     integ = integrity_series(err.e_ned, nav.P_pos_ned, cfg.k_v, cfg.k_h)
     n = err.t_s.shape[0]
-    tan_gp = _glidepath_tan_of(truth, err.hat_m)
+    # hat_m is the truth's own first n heights above the threshold: the slope is a function of (truth, n)
+    tan_gp = memoized(memo, truth, "score.glidepath_tan", n, lambda: glidepath_tan(truth, err.hat_m), keep=2)
     scalars: dict[str, float] = {}
     for cat in CATEGORIES:
         key = CATEGORY_KEYS[cat]

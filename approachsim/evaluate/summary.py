@@ -27,6 +27,7 @@ from approachsim.evaluate.verdict import (
     category_verdict,
     integrity_verdict,
 )
+from approachsim.integrity.requirements import REQUIREMENTS
 
 SCHEMA = "approachsim.summary/1"
 
@@ -68,9 +69,7 @@ def verdicts(
 
 
 def integrity_criterion(columns: Mapping[str, np.ndarray], category: str, cfg: EvaluationConfig) -> IntegrityVerdict:
-    """The integrity criterion of `category` from the bank's per-run columns (integrity.campaign)."""
-    from approachsim.integrity.requirements import REQUIREMENTS
-
+    """The integrity criterion of `category` from the bank's per-run columns (campaign.integrity_campaign)."""
     key = CATEGORY_KEYS[category]
     req = REQUIREMENTS[category]
     dh = _col(columns, f"{key}_int_avail_dh")
@@ -122,7 +121,7 @@ def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cf
             counts: Mapping[str, np.ndarray] | None = None, integrity_fn: Callable[..., dict] | None = None) -> dict:
     """Everything beside the contract: bounds, ICAO limits, failures, integrity, FTE / TSE, time-averaged RMS.
 
-    integrity_fn: the campaign scoring of the solution-separation bank (integrity.campaign.campaign_integrity,
+    integrity_fn: the campaign scoring of the solution-separation bank (campaign.integrity_campaign.campaign_integrity,
     handed in by the campaign stage: the evaluator does not import the navigation system the bank runs)."""
     cats = {}
     for r in results:
@@ -181,7 +180,7 @@ def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cf
         "time_averaged_rms_ft": {k: _num(v) for k, v in ta.items()},
     }
     if bank and integrity_fn is not None:
-        out["protection_levels"] = "solution-separation bank (integrity.campaign)"
+        out["protection_levels"] = "solution-separation bank (campaign.integrity_campaign)"
         out["integrity"] = integrity_fn(
             columns, counts or {}, cfg, verdicts={r.category: r.integrity for r in results if r.integrity})
     else:

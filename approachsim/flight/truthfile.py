@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from approachsim import records
 from approachsim.geo import RunwayFrame
 from approachsim.records import Truth
 
@@ -40,8 +41,6 @@ def _descriptions() -> dict[str, str]:
     """Each Truth field's docstring (the attribute docstrings of records.Truth, read from its source)."""
     import ast
     import inspect
-
-    from approachsim import records
 
     tree = ast.parse(inspect.getsource(records.Truth))
     body = tree.body[0].body  # type: ignore[attr-defined]

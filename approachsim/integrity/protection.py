@@ -1,5 +1,5 @@
 """Protection levels: the one formula the online FDE (nav/fde.py) and the offline solution-separation bank
-(integrity/separation.py, integrity/bank.py) share, and the single-epoch separation of a measurement left out.
+(integrity/separation.py, campaign/integrity_bank.py) share, and the single-epoch separation of a measurement left out.
 
 Per approach axis a (vertical, lateral), with the K factors of integrity.requirements (one allocation for both):
 

@@ -40,11 +40,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from approachsim.config import ProfileError, Section
-from approachsim.integrity.requirements import REQUIREMENTS
+from approachsim.integrity.requirements import REQUIREMENTS, IntegrityRequirement
 from approachsim.nav import registry
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav import vertical_loop as vl
-from approachsim.nav.fde import FdeConfig
 
 LOOP_FORMS = ("none",) + tuple(vl.GAIN_FORMS)
 START_MODES = ("converged", "prior")
@@ -64,6 +63,30 @@ class InitialError:
     heading_rad: float = 0.5e-3
     start: str = "converged"
     converge_s: float = 600.0
+
+
+@dataclass(frozen=True)
+class FdeConfig:
+    """[nav.fde]: enabled, the category whose continuity budget sets the thresholds, the moving-sum window
+    (epochs) and the rollback depth (epochs) after an exclusion."""
+
+    enabled: bool = False
+    category: str = "CAT II"
+    window: int = 20
+    rollback_epochs: int = 30
+
+    def __post_init__(self) -> None:
+        if self.category not in REQUIREMENTS:
+            raise ValueError(f"category must be one of {', '.join(REQUIREMENTS)}; got {self.category!r}")
+        if int(self.window) != self.window or not 1 <= self.window <= 600:
+            raise ValueError(f"window must be an integer in [1, 600] epochs; got {self.window!r}")
+        if int(self.rollback_epochs) != self.rollback_epochs or not 0 <= self.rollback_epochs <= 600:
+            raise ValueError(f"rollback_epochs must be an integer in [0, 600]; got {self.rollback_epochs!r}")
+
+    @property
+    def requirement(self) -> IntegrityRequirement:
+        """The category's integrity requirement."""
+        return REQUIREMENTS[self.category]
 
 
 @dataclass(frozen=True)

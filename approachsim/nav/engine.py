@@ -27,12 +27,14 @@ import numpy as np
 
 from approachsim import geo
 from approachsim.core.nav import epoch as ke
+from approachsim.core.sensors.gnss import gbas_channel_sigmas
 from approachsim.nav import errormodel as em
 from approachsim.nav import measurements as meas
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import KalmanFilter, UpdateStatus, optimal_policy, workspace
 from approachsim.nav.observations import Observations
-from approachsim.sensors.gnss.receiver import IONO_SHELL_M
+from approachsim.sensors.gnss.elevation import IONO_SHELL_M
+from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
 
 Array = np.ndarray
 
@@ -237,9 +239,6 @@ class EpochEngine:
         if self._gbas is None:
             ke.channel_sigmas(el, *self._sky_budget, gse, gmp)
         else:
-            from approachsim.core.sensors.gnss import gbas_channel_sigmas
-            from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
-
             x, dh, v = (np.full(el.shape[0], g) for g in REFERENCE_GEOMETRY)
             gbas_channel_sigmas(el, x, dh, v, *self._gbas, gse, gmp)
         return gse, gmp

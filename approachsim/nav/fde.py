@@ -53,12 +53,11 @@ from scipy.stats import chi2, ncx2, norm
 
 from approachsim.integrity.protection import epoch_shift, protection_levels
 from approachsim.integrity.requirements import (
-    REQUIREMENTS,
-    IntegrityRequirement,
     lateral_alert_limit_m,
     vertical_alert_limit_m,
 )
 from approachsim.nav.base import FilterState, NavFilter, ScalarMeasurement, UpdateStatus
+from approachsim.nav.config import FdeConfig
 from approachsim.nav.observations import FIX, Source
 from approachsim.records import ExclusionEvent
 
@@ -72,30 +71,6 @@ MIN_RANGING = 4
 
 RESET_GROUPS = ("dp", "dv", "psi", "bg", "ba")
 """Error-state groups the feedback mode resets into the INS (NavSystem._feedback)."""
-
-
-@dataclass(frozen=True)
-class FdeConfig:
-    """[nav.fde]: enabled, the category whose continuity budget sets the thresholds, the moving-sum window
-    (epochs) and the rollback depth (epochs) after an exclusion."""
-
-    enabled: bool = False
-    category: str = "CAT II"
-    window: int = 20
-    rollback_epochs: int = 30
-
-    def __post_init__(self) -> None:
-        if self.category not in REQUIREMENTS:
-            raise ValueError(f"category must be one of {', '.join(REQUIREMENTS)}; got {self.category!r}")
-        if int(self.window) != self.window or not 1 <= self.window <= 600:
-            raise ValueError(f"window must be an integer in [1, 600] epochs; got {self.window!r}")
-        if int(self.rollback_epochs) != self.rollback_epochs or not 0 <= self.rollback_epochs <= 600:
-            raise ValueError(f"rollback_epochs must be an integer in [0, 600]; got {self.rollback_epochs!r}")
-
-    @property
-    def requirement(self) -> IntegrityRequirement:
-        """The category's integrity requirement."""
-        return REQUIREMENTS[self.category]
 
 
 def _ranging(sources: set[Source]) -> int:

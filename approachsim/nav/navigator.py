@@ -28,8 +28,9 @@ import numpy as np
 from approachsim import geo
 from approachsim.core.nav import epoch as ke
 from approachsim.core.nav import output as ko
+from approachsim.memo import TruthMemo
 from approachsim.nav import errormodel as em
-from approachsim.nav import ins
+from approachsim.nav import ins, reduced
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import FilterState, UpdateStatus
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, new_arcs, reset_arcs, stacked_new_arcs
@@ -402,11 +403,13 @@ class Navigator:
                 and self.shared.singletons and not self.system.nav.feedback)
 
     def compiled_pass(self, records: Any, truth: Truth, batched: bool, dtheta: Array, dv: Array, dt_s: float,
-                      h_baro: Array | None, epoch_rows: int, baro_age_s: Array | None = None) -> bool:
+                      h_baro: Array | None, epoch_rows: int, baro_age_s: Array | None = None,
+                      memo: TruthMemo | None = None) -> bool:
         """The whole open-loop pass in two compiled calls (`can_pass`): the INS over every row, then every epoch of
         every run (core/nav/epoch.shared_pass: the per-epoch path's arithmetic, nav/shared.py's singletons). Fills
         the state `results` reads. False, with nothing changed but the INS rows, when an epoch's model is too
-        large for the compiled discretization (the caller then takes the per-epoch path from the start)."""
+        large for the compiled discretization (the caller then takes the per-epoch path from the start). memo: the
+        truth's TruthMemo (the reduced pass's epoch models, nav/reduced.models)."""
         system, lay, sh, eng = self.system, self.layout, self.shared, self.engine
         m = dtheta.shape[1]
         x0 = self.x.copy()
@@ -471,13 +474,12 @@ class Navigator:
         ins_y = np.ascontiguousarray(self.rows[self.ins_of][:, e_rows])
         done = -1
         if per_run_sky and k and lay.has("gse") and not eng.carrier:  # each run on its reduced state
-            from approachsim.nav.reduced import reduced_singletons
-
             args = (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse,
                     f_gmp, ins_y, baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig)
             self.reduced_runs = []
-            done = reduced_singletons(system, truth, eng, args, (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav),
-                                      self._ic, self.reduced_runs, _valid_channels(records, N))
+            done = reduced.reduced_singletons(system, truth, eng, args,
+                                              (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav), self._ic,
+                                              self.reduced_runs, _valid_channels(records, N), memo)
             if done < 0:
                 self.reduced_runs = None
         if done < 0:

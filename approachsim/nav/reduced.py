@@ -4,7 +4,7 @@ Navigator.compiled_pass filters such runs with core/nav/epoch.shared_pass on the
 gmp states, of which a run measures 4-6 with best-four selection. The channels a run never measures are lone
 first-order Gauss-Markov states, uncorrelated with the rest at the start (checked: a correlated one is kept), which
 no row touches: dropping them removes exact zeros from every sum and keeps the others' order, so the kept states
-are the same floating-point numbers (integrity/bankpass.py's module docstring gives the argument; the reduced
+are the same floating-point numbers (campaign/bankpass.py's module docstring gives the argument; the reduced
 models here, `models` and `cut`, and the compiled pass core/nav/copies.bank_epochs serve both). The dropped
 states are then carried in closed form exactly as the full pass computes them (x <- 0 + phi x; P <- Qd + phi (0 +
 phi P)): x_out, P's diagonal and the final X, P are those of shared_pass bit for bit
@@ -14,8 +14,7 @@ phi P)): x_out, P's diagonal and the final X, P are those of shared_pass bit for
 from __future__ import annotations
 
 import dataclasses
-import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -24,6 +23,7 @@ from approachsim.core.nav import copies as kcp
 from approachsim.core.nav import epoch as ke
 from approachsim.core.nav import kalman as kk
 from approachsim.core.nav import reduced as kred
+from approachsim.memo import TruthMemo, memoized
 from approachsim.nav import errormodel as em
 
 Array = np.ndarray
@@ -52,7 +52,7 @@ docstring)."""
 
 def kept_channels(lay: em.StateLayout, used: Array, P0: Array) -> Array:
     """The channels whose states stay: those measured, and any whose states are correlated with another state in the
-    start covariance P0 (a dropped state must be uncorrelated with all others: integrity/bankpass.py's docstring)."""
+    start covariance P0 (a dropped state must be uncorrelated with all others: campaign/bankpass.py's docstring)."""
     n_sv = lay.n_sv
     keep = np.zeros(n_sv, dtype=bool)
     keep[np.asarray(used, dtype=int)] = True
@@ -80,28 +80,44 @@ def reduced_layout(lay: em.StateLayout, kept: Array) -> tuple[em.StateLayout, Ar
     return red, np.asarray(idx, dtype=int)
 
 
-_MODELS: list = []
-"""`models`' last result: (system, weak reference to the truth, dt, held, model) (the runs of a flight group share
-it)."""
+@dataclass(frozen=True, eq=False)
+class EpochModels:
+    """`models`' compact Phi, Qd of every epoch (E, n1, n1) on `layout` (the layout with one GPS channel), and the
+    cuts of them to the reduced layouts asked for so far (`cut`: the runs of a flight group mostly share a few
+    channel counts), which this object owns and keeps as long as it lives."""
+
+    phi: Array
+    qd: Array
+    layout: em.StateLayout
+    cuts: dict = field(default_factory=dict, repr=False)
 
 
 def models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array, dt: Array, ref: Array,
-            ref_cbn: Array, f_ref: Array, held: Array) -> tuple[Array, Array, em.StateLayout] | None:
-    """Phi, Qd of every epoch (kernels/copies.models: what shared_pass makes) in compact form, kept for the last
-    (system, truth) objects with the same intervals and damping-loop holds: (E, n1, n1) on the layout with one GPS
-    channel (the channels' states are lone, their rows and columns zero off the diagonal: checked; Phi's diagonal is the
-    same for every channel, the Qd diagonal each copy's own, set in the kernel), and that layout. Discretized on
-    that layout: the same numbers as on the full one (the module docstring's argument: lone states are closed
-    form, the coupled component the same matrix). None when an epoch's model is too large for the compiled
-    discretization or the channels are not lone."""
-    key_dt, key_held = dt.tobytes(), held.tobytes()
-    for sys_, tr, kd, kh, val in _MODELS:
-        if sys_ is nav and tr() is truth and kd == key_dt and kh == key_held:
-            return val
+           ref_cbn: Array, f_ref: Array, held: Array, memo: TruthMemo | None = None) -> EpochModels | None:
+    """Phi, Qd of every epoch (kernels/copies.models: what shared_pass makes) in compact form: (E, n1, n1) on the
+    layout with one GPS channel (the channels' states are lone, their rows and columns zero off the diagonal:
+    checked; Phi's diagonal is the same for every channel, the Qd diagonal each copy's own, set in the kernel), and
+    that layout. Discretized on that layout: the same numbers as on the full one (the module docstring's argument:
+    lone states are closed form, the coupled component the same matrix). None when an epoch's model is too large
+    for the compiled discretization or the channels are not lone.
+
+    memo: the truth's TruthMemo (approachsim/memo.py): the model is made once for the runs and banks of a flight
+    group that share the layout, the noise, the damping-loop gains, the epoch intervals dt and the loop's holds
+    `held` (the reference ref, ref_cbn, f_ref is the truth's at the epochs dt gives); the last one is kept."""
     lay = nav.layout
-    carrier = lay.has("amb")
-    if carrier:  # the ionosphere's Gauss-Markov (kernels/carrier.dynamics; the ambiguities are random constants)
+    gio = gio_tau = None
+    if lay.has("amb"):  # the ionosphere's Gauss-Markov (kernels/carrier.dynamics; the ambiguities are random constants)
         gio, gio_tau = em.kernel_carrier(nav.noise(None), lay.n_sv)
+    key = (lay.packed.tobytes(), q.tobytes(), gse.tobytes(), gmp.tobytes(), loop.tobytes(), dt.tobytes(),
+           held.tobytes(), None if gio is None else (gio.tobytes(), gio_tau))
+    return memoized(memo, truth, "reduced.models", key,
+                    lambda: _make_models(lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, held, gio, gio_tau), keep=1)
+
+
+def _make_models(lay: em.StateLayout, q: Array, gse: Array, gmp: Array, loop: Array, dt: Array, ref: Array,
+                 ref_cbn: Array, f_ref: Array, held: Array, gio: Array | None, gio_tau: float | None
+                 ) -> EpochModels | None:
+    carrier = gio is not None
     if lay.n_sv:  # one channel stands for all: its states' F, Qc depend on the channel only through the sigma, which
         # enters Qc alone (kernels/errormodel.dynamics: a Markov state of the common tau), and each copy's Qd sets it
         lay1, _ = reduced_layout(lay, np.array([0]))
@@ -126,31 +142,21 @@ def models(nav: Any, truth: Any, q: Array, gse: Array, gmp: Array, loop: Array, 
             if (np.any(a[:, ch][:, :, rest]) or np.any(a[:, rest][:, :, ch])
                     or np.any(a[:, ch[:, None], ch[None, :]][:, off])):
                 return None
-    val = (phi, qd, lay1)
-    _MODELS[:] = [(nav, weakref.ref(truth), key_dt, key_held, val)]
-    return val
+    return EpochModels(phi, qd, lay1)
 
 
-_CUTS: list = []
-"""`cut`'s results for the last model: (model, {reduced layout: (Phi, Qd)}) (the runs of a flight group share the
-model and mostly a few channel counts; the kernel only reads them)."""
-
-
-def cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -> tuple[Array, Array]:
+def cut(model: EpochModels, red: em.StateLayout) -> tuple[Array, Array]:
     """Phi, Qd (E, n_r, n_r) of the reduced layout `red` from `models`' compact form: the one channel's lone states
-    repeated on the diagonal of each kept channel's, every other entry as the full model's. Kept per layout for the
-    last model."""
-    if not _CUTS or _CUTS[0][0] is not model:
-        _CUTS[:] = [(model, {})]
-    memo = _CUTS[0][1]
+    repeated on the diagonal of each kept channel's, every other entry as the full model's. Kept per layout on the
+    model (EpochModels.cuts; the kernel only reads them)."""
     key = red.packed.tobytes()
-    if key not in memo:
-        memo[key] = _make_cut(model, red)
-    return memo[key]
+    if key not in model.cuts:
+        model.cuts[key] = _make_cut(model, red)
+    return model.cuts[key]
 
 
-def _make_cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -> tuple[Array, Array]:
-    phi1, qd1, lay1 = model
+def _make_cut(model: EpochModels, red: em.StateLayout) -> tuple[Array, Array]:
+    phi1, qd1, lay1 = model.phi, model.qd, model.layout
     if not red.has("gse"):
         return phi1, qd1
     src, chan = [], []
@@ -176,21 +182,22 @@ def _make_cut(model: tuple[Array, Array, em.StateLayout], red: em.StateLayout) -
 
 
 def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tuple, ic: int,
-                       runs_out: list | None = None, valid: Array | None = None) -> int:
+                       runs_out: list | None = None, valid: Array | None = None, memo: TruthMemo | None = None) -> int:
     """shared_pass for per-run-sky runs, each on its reduced state. args: shared_pass's inputs (X, P3, lay, q, gse,
     gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse, f_gmp, ins_y, baro_h, baro_r,
     radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig) without carrier phase; out: its outputs
     (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav), filled here; ic the clock state's index; runs_out: each
-    run's ReducedRun appended (what the integrity bank's copy 0 computes again: integrity/bankpass.py); valid (N, k):
-    the channels each run's record has valid (kept as the bank keeps them, so that its copy 0 is this). Returns E,
-    or -1 with nothing changed when a model cannot be reduced (the caller runs shared_pass)."""
+    run's ReducedRun appended (what the integrity bank's copy 0 computes again: campaign/bankpass.py); valid (N, k):
+    the channels each run's record has valid (kept as the bank keeps them, so that its copy 0 is this); memo: the
+    truth's TruthMemo, where the runs' banks find the models (`models`). Returns E, or -1 with nothing changed when a
+    model cannot be reduced (the caller runs shared_pass)."""
     (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse, f_gmp, ins_y,
      baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig) = args
     codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav = out
     N, E = held.shape
     run_models = []
     for i in range(N):  # every run's model first: nothing is changed when one cannot be reduced
-        model = models(system, truth, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, np.ascontiguousarray(held[i]))
+        model = models(system, truth, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, np.ascontiguousarray(held[i]), memo)
         if model is None:
             return -1
         run_models.append(model)
@@ -200,7 +207,7 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
     ig, im = lay.i("gse"), lay.i("gmp")
     ws: dict[int, tuple] = {}
     for i in range(N):
-        phi1, _qd1, lay1 = run_models[i]
+        phi1, lay1 = run_models[i].phi, run_models[i].layout
         kept = kept_channels(lay, np.flatnonzero(measured[i]), P3[i])
         red, idx = reduced_layout(lay, kept)
         phi, qd = cut(run_models[i], red)

@@ -29,6 +29,7 @@ from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import ScalarMeasurement
 from approachsim.nav.config import NavConfig
 from approachsim.nav.errormodel import StateLayout
+from approachsim.nav.noise import NoiseModel
 from approachsim.nav.observations import BARO, CP, FIX, GPS, PL, RADALT, Observations, Source
 from approachsim.sensors.config import SensorsConfig
 
@@ -79,8 +80,6 @@ class MeasurementRows:
     @property
     def carrier_sigma_m(self) -> float:
         """The carrier rows' white 1-sigma, m (nav/noise.py NoiseModel.carrier_sigma_m)."""
-        from approachsim.nav.noise import NoiseModel
-
         return NoiseModel(self.sensors, self.nav, self.layout).carrier_sigma_m()
 
     def radalt_sigma_m(self, h_agl_m: float) -> float:

@@ -30,7 +30,6 @@ has its own filter state, or with `shared_covariance` one covariance and gain pe
 from __future__ import annotations
 
 import hashlib
-import weakref
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
@@ -38,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from approachsim import geo
+from approachsim.memo import TruthMemo, memoized
 from approachsim.nav import errormodel as em
 from approachsim.nav import initial, ins
 from approachsim.nav import terrain_db as tdb
@@ -59,13 +59,8 @@ Array = np.ndarray
 
 __all__ = ["NavRun", "NavSystem", "StatusLog", "TerrainDatabase"]
 
-_SYSTEMS: dict = {}
-"""NavSystem.from_profile's systems, by profile (a few per process)."""
-_PREPARED: dict = {}
-"""NavSystem._prepared's converged starts: key -> (system, weak reference to the truth, initial.Prepared), oldest
-first."""
-_PREPARED_MAX = 64
-"""Starts kept (two flight groups of 25 runs: a group's bank runs right after its pass)."""
+PREPARED_KEEP = 64
+"""Converged starts a truth's memo keeps (NavSystem._prepared: one per run's sky; a flight group has 25 runs)."""
 
 
 def _radalt_states(sensors: SensorsConfig, nav: NavConfig) -> dict[str, bool]:
@@ -127,23 +122,10 @@ class NavSystem:
 
     @classmethod
     def from_profile(cls, profile: Any) -> NavSystem:
-        """The navigation system of a Profile (its [nav], [sensors], runway and terrain); one object per profile
-        and process (a function of the profile's value: the open-loop group's pass and each run's integrity bank
-        use the same one, and so share its starts, `start`)."""
-        try:
-            sys_ = _SYSTEMS.get(profile)
-        except TypeError:  # an unhashable profile-like object: build it each time
-            sys_, profile_key = None, None
-        else:
-            profile_key = profile
-        if sys_ is None:
-            nav = getattr(profile, "nav", DEFAULT_NAV)
-            sys_ = cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain)
-            if profile_key is not None:
-                if len(_SYSTEMS) >= 8:
-                    _SYSTEMS.clear()
-                _SYSTEMS[profile_key] = sys_
-        return sys_
+        """The navigation system of a Profile (its [nav], [sensors], runway and terrain). A value: systems of equal
+        profiles are equal (and hash alike), so what a truth's memo keeps for one serves the other (`_prepared`)."""
+        nav = getattr(profile, "nav", DEFAULT_NAV)
+        return cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain)
 
     # --- models -------------------------------------------------------------------------------------------
 
@@ -202,8 +184,8 @@ class NavSystem:
 
     def start(self, truth: Truth, rngs: list[np.random.Generator], row: int = 0,
               elevation_rad: Array | None = None, *, obs: Observations | None = None,
-              states: SensorStates | None = None, elevation_per_run: Array | None = None
-              ) -> tuple[ins.InsState, list[RunFilter]]:
+              states: SensorStates | None = None, elevation_per_run: Array | None = None,
+              memo: TruthMemo | None = None) -> tuple[ins.InsState, list[RunFilter]]:
         """INS states of len(rngs) runs at truth row `row` with their initial errors, and their filters
         (elevation_rad: the GPS channels' elevations at the start, for their P0).
 
@@ -211,7 +193,8 @@ class NavSystem:
         "converged" (nav/initial.py): obs, the observations at the row (`observations`, run axis first; the
         first run's schedule is flown), and states, the runs' realized sensor errors there
         (sensors/states.py), are required; runs with one sky start with the same converged covariance.
-        elevation_per_run (N, k): each run's own GPS sky at the start (the prior start's P0 per run)."""
+        elevation_per_run (N, k): each run's own GPS sky at the start (the prior start's P0 per run). memo: the
+        truth's TruthMemo, which keeps each sky's converged start (`_prepared`)."""
         n = len(rngs)
         c_true = ins.cbn_from_quaternion(truth.q_nb[row])
         s = ins.init_state(np.full(n, truth.lat_rad[row]), truth.lon_rad[row], truth.h_m[row], truth.v_ned[row],
@@ -243,7 +226,7 @@ class NavSystem:
                 i0 = first.setdefault(key, i)
                 P0 = self.initial_covariance(obs.elevations(i))
                 if key not in prep:
-                    prep[key] = self._prepared(truth, obs.run(i0), row, P0, states.take(i))
+                    prep[key] = self._prepared(truth, obs.run(i0), row, P0, states.take(i), memo)
                 d = initial.draw(self, truth, obs.run(i0), states.take(i), [g], row, P0, prep[key])
                 draws.append(d)
             e = np.concatenate([d[0] for d in draws])
@@ -260,33 +243,26 @@ class NavSystem:
                 for i in range(n)]
         return s, runs
 
-    def _prepared(self, truth: Truth, obs: Observations, row: int, P0: Array, states: SensorStates
-                  ) -> initial.Prepared:
-        """The converged start's P_conv and conditioner (initial.Prepared) of one run's sky and schedule, made once
-        per process for the same inputs (the open-loop pass of a flight group makes every run's; that run's
-        integrity bank then finds it here instead of repeating the 600 s Riccati recursion and the
-        eigen-decompositions). Keyed by this system and truth (the objects: the entry keeps the system, and lives only
-        as long as the truth) and the bytes
-        of everything else initial.draw reads (the row, P0, the run's observations at the row, the sensor states'
-        indices)."""
+    def _prepared(self, truth: Truth, obs: Observations, row: int, P0: Array, states: SensorStates,
+                  memo: TruthMemo | None = None) -> initial.Prepared:
+        """The converged start's P_conv and conditioner (initial.Prepared) of one run's sky and schedule. With the
+        truth's memo it is made once for the same inputs (an integrity bank that starts its run again, off the
+        group's pass, finds it there instead of repeating the 600 s Riccati recursion and the eigen-decompositions):
+        keyed by this system (a value: nav/sensors/runway/terrain) and the bytes of everything else initial.draw
+        reads (the row, P0, the run's observations at the row, the sensor states' indices)."""
         s_idx, _ = initial.sensor_vector(self.layout, states, P0)
         parts = [np.asarray(P0, dtype=float).tobytes(), str(row).encode(), np.asarray(s_idx).tobytes()]
         for f in fields(obs):
             v = getattr(obs, f.name)
             parts.append(f.name.encode())
             parts.append(repr(v.shape).encode() + v.tobytes() if isinstance(v, np.ndarray) else repr(v).encode())
-        key = (id(self), id(truth), hashlib.blake2b(b"\0".join(parts), digest_size=20).digest())
-        hit = _PREPARED.get(key)
-        if hit is not None and hit[0] is self and hit[1]() is truth:
-            return hit[2]
-        P_conv = initial.converged_covariance(self, truth, obs, row, P0, self.nav.initial_error.converge_s)
-        prepared = initial.Prepared(P_conv, initial.conditioner(P_conv, P0[np.ix_(s_idx, s_idx)], s_idx))
-        for k in [k for k, v in _PREPARED.items() if v[1]() is None]:  # the truths gone: their starts too
-            del _PREPARED[k]
-        if len(_PREPARED) >= _PREPARED_MAX:
-            _PREPARED.pop(next(iter(_PREPARED)))
-        _PREPARED[key] = (self, weakref.ref(truth), prepared)
-        return prepared
+        key = (self, hashlib.blake2b(b"\0".join(parts), digest_size=20).digest())
+
+        def make() -> initial.Prepared:
+            P_conv = initial.converged_covariance(self, truth, obs, row, P0, self.nav.initial_error.converge_s)
+            return initial.Prepared(P_conv, initial.conditioner(P_conv, P0[np.ix_(s_idx, s_idx)], s_idx))
+
+        return memoized(memo, truth, "system.prepared", key, make, keep=PREPARED_KEEP)
 
     def _fde(self) -> FdeState | None:
         """A run's online FDE state ([nav.fde] enabled), else None."""
@@ -333,7 +309,7 @@ class NavSystem:
 
     def run(self, truth: Truth, records: Mapping[str, Any], rngs: np.random.Generator | list[np.random.Generator],
             *, shared_covariance: bool = False, states: SensorStates | None = None, copies: bool = False,
-            keep: dict | None = None) -> NavRun | list[NavRun]:
+            keep: dict | None = None, memo: TruthMemo | None = None) -> NavRun | list[NavRun]:
         """Navigate over whole records (open loop: the truth is only read at row 0, at the epochs for the error
         history and, with the shared covariance, as the reference trajectory).
 
@@ -344,9 +320,12 @@ class NavSystem:
         converged start. copies: the runs are copies of one run (the same IMU and baro records and start draws:
         the integrity bank's sub-filters, which differ only in the measurements they use): the INS is integrated
         once for all of them (feed-forward only; checked). keep: a dict that receives what the runs' integrity
-        banks reuse (integrity/bankpass.py, open loop): "start" [(x_hat (n,), P (n, n))] each run's filter start,
+        banks reuse (campaign/bankpass.py, open loop): "start" [(x_hat (n,), P (n, n))] each run's filter start,
         "db" its terrain-database error, "ins_epoch_rows" (N, E, 16) the INS states at the aiding epochs (rows
-        epoch_rows, 2 epoch_rows, ...; packed, kernels/strapdown.py), "epoch_rows", "feed_forward".
+        epoch_rows, 2 epoch_rows, ...; packed, kernels/strapdown.py), "epoch_rows", "feed_forward". memo: the
+        truth's TruthMemo (approachsim/memo.py), owned by the caller that shares the truth among runs (the campaign's
+        open-loop group): the converged starts and the reduced pass's epoch models are kept there for the runs'
+        integrity banks.
         """
         records = tuned_records(records, self.nav.gps_sigma_scale)
         if shared_covariance and not self.shares_covariance():
@@ -367,7 +346,7 @@ class NavSystem:
         # the GPS channels' elevations at the first GNSS sample (P0 of the channel states)
         el0 = None if gnss is None else (gnss.elevation_rad[:, 0] if sky else gnss.elevation_rad[0])
         s, runs = self.start(truth, gens, elevation_rad=None if el0 is None else (el0[0] if sky else el0), obs=obs0,
-                             states=states, elevation_per_run=el0 if sky else None)
+                             states=states, elevation_per_run=el0 if sky else None, memo=memo)
         shared = (SharedCovariance.start(runs, truth, m, epoch_rows, obs0.per_run_sky) if shared_covariance
                   else None)
         ins_of = None
@@ -397,7 +376,8 @@ class NavSystem:
                 if not np.all((hb_full == hb_full[:1]) | (np.isnan(hb_full) & np.isnan(hb_full[:1]))):
                     raise ValueError("run(copies=True): the copies' baro records differ")
                 hb_full = hb_full[:1]
-        if nav.can_pass() and nav.compiled_pass(records, truth, batched, dth, dvb, dt, hb_full, epoch_rows, age):
+        if nav.can_pass() and nav.compiled_pass(records, truth, batched, dth, dvb, dt, hb_full, epoch_rows, age,
+                                                memo=memo):
             if keep is not None:
                 keep["ins_epoch_rows"] = nav.rows[:, epoch_rows::epoch_rows].copy()
                 if nav.reduced_runs is not None:

@@ -40,6 +40,13 @@ import numpy as np
 
 from approachsim import seeding, units
 from approachsim.config import ProfileError
+from approachsim.nav.system import NavSystem
+from approachsim.papers import gray_maybeck_faithful as gf
+from approachsim.papers import gray_maybeck_sensitivity as sens
+from approachsim.profile import parse_profile
+from approachsim.resources import shipped_profiles
+from approachsim.sensors.gnss.clock import ClockModel
+from approachsim.sensors.presets import PRESETS
 
 PAPER = "gray-maybeck"
 TITLE = ("Gray & Maybeck, *An integrated GPS/INS/Baro and radar altimeter system for aircraft precision approach "
@@ -266,7 +273,7 @@ def case_settings(case: Case, variant: str = "closed") -> list[tuple[str, Any]]:
     settings win). variant "closed" is exactly the closed-loop study the regress baselines were made with."""
     if variant not in VARIANTS:
         raise ProfileError(f"gray-maybeck variant: must be one of {', '.join(VARIANTS)}; got {variant!r}")
-    windows = OUTAGE_WINDOWS_S if variant == "closed" else _faithful().OUTAGE_WINDOWS_S
+    windows = OUTAGE_WINDOWS_S if variant == "closed" else gf.OUTAGE_WINDOWS_S
     faults = [{"sensor": "gnss", "kind": "outage", "start_s": a, "end_s": b}
               for a, b in windows[case.gps_outages]]
     own = [
@@ -282,18 +289,10 @@ def case_settings(case: Case, variant: str = "closed") -> list[tuple[str, Any]]:
     return out
 
 
-def _faithful() -> Any:
-    from approachsim.papers import gray_maybeck_faithful
-
-    return gray_maybeck_faithful
-
-
 def faithful_overrides(case: Case) -> dict[str, Any]:
     """The faithful variant's own values for a case (gray_maybeck_faithful.faithful_settings on the case's
     closed-loop profile and IMU grade)."""
-    from approachsim.sensors.presets import PRESETS
-
-    return _faithful().faithful_settings(case_profile(case, "closed"), PRESETS[case.grade])
+    return gf.faithful_settings(case_profile(case, "closed"), PRESETS[case.grade])
 
 
 def settings_dict(case: Case, variant: str = "closed", extra: Sequence[tuple[str, Any]] = ()) -> dict[str, Any]:
@@ -318,8 +317,6 @@ def _set(data: dict, dotted: str, value: Any) -> None:
 
 def base_profile_path() -> Path:
     """The shipped profile every case starts from."""
-    from approachsim.resources import shipped_profiles
-
     return {s.name: s.path for s in shipped_profiles()}["gray-maybeck"]
 
 
@@ -328,8 +325,6 @@ def case_profile(case: Case, variant: str = "closed", extra: Sequence[tuple[str,
     """The validated Profile of one case in a variant ("closed": the regress baselines' profile, unchanged;
     "faithful"), with extra settings after the variant's (a sensitivity row); ProfileError names the field if a
     value is rejected."""
-    from approachsim.profile import parse_profile
-
     path = base_profile_path()
     data = tomllib.loads(path.read_text(encoding="utf-8"))
     for dotted, value in settings_dict(case, variant, extra).items():
@@ -360,8 +355,6 @@ def select_cases(names: Sequence[str] | None) -> tuple[Case, ...]:
 
 def filter_states(profile: Any) -> dict[str, int]:
     """Our filter's error states for a case (nav/errormodel.StateLayout): total and per block."""
-    from approachsim.nav.system import NavSystem
-
     lay = NavSystem.from_profile(profile).layout
     blocks = {k: s.stop - s.start for k, s in lay.index.items()}
     return {"total": int(lay.n), **{k: int(v) for k, v in blocks.items()}}
@@ -374,8 +367,6 @@ def truth_states(profile: Any, *, n_sv: int = 4) -> dict[str, int]:
     factor when on), GPS per used satellite (clock/ephemeris, iono, tropo, multipath) and the receiver clock (2),
     radar-altimeter Markov error when on, pseudolite multipath / tropo / clock when on. White noise is not a
     state (as in the paper's truth model)."""
-    from approachsim.sensors.presets import PRESETS
-
     s = profile.sensors
     g = PRESETS[s.imu.grade]
     imu = 0
@@ -564,8 +555,6 @@ def gps_implied(profile: Any, geometry: dict | None) -> dict:
 
 def _clock_q_sigma_ft(profile: Any, dt_s: float) -> float:
     """1-sigma (ft) of the receiver clock bias process noise over dt_s (the two-state clock's Q[0, 0])."""
-    from approachsim.sensors.gnss.clock import ClockModel
-
     g = profile.sensors.gnss
     q = ClockModel.named(g.oscillator, g.clock_bias0_sigma_m, g.clock_drift0_sigma_mps).q(dt_s)
     return float(math.sqrt(q[0, 0]) / units.FT)
@@ -612,7 +601,7 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
     chosen = select_cases(cases)
     variant = "closed" if closed else "faithful"
     mode = "closed" if closed else "open"
-    windows = OUTAGE_WINDOWS_S if closed else _faithful().OUTAGE_WINDOWS_S
+    windows = OUTAGE_WINDOWS_S if closed else gf.OUTAGE_WINDOWS_S
     root = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="gray-maybeck-"))
     per_case: dict[int, dict] = {}
     ms_by_run: dict[int, dict[int, dict[str, float]]] = {}
@@ -685,10 +674,9 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
         "wall_s": float(sum(v["wall_s"] for v in per_case.values())),
     }
     if sensitivity_runs:
-        from approachsim.papers import gray_maybeck_sensitivity as sens
-
         result["sensitivity"] = sens.run_table(seed=seed, runs=sensitivity_runs, root=root / "sensitivity",
-                                               evaluate=evaluate_profile, columns=columns, workers=workers)
+                                               evaluate=evaluate_profile, columns=columns, cases=CASES,
+                                               case_profile=case_profile, workers=workers)
     return result, {"per_case": per_case, "ms_by_run": ms_by_run}
 
 
@@ -714,18 +702,3 @@ def _pattern(per_case: dict[int, dict]) -> dict:
     return {"cases": len(st), "reproduces": st.count("reproduces"), "differs": st.count("differs"),
             "indeterminate": st.count("indeterminate"),
             "differing_cases": [v["case"] for v in per_case.values() if v["claim"]["status"] == "differs"]}
-
-# --- the note (papers/gray_maybeck_note.py) ------------------------------------------------------------------
-
-def note(result: dict, figures: Sequence[str]) -> str:
-    """The reproduction note (markdown): gray_maybeck_note.note."""
-    from approachsim.papers import gray_maybeck_note
-
-    return gray_maybeck_note.note(result, figures)
-
-
-def headline(result: dict) -> list[str]:
-    """Short printed findings, chosen from the numbers: gray_maybeck_note.headline."""
-    from approachsim.papers import gray_maybeck_note
-
-    return gray_maybeck_note.headline(result)

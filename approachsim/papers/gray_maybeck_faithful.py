@@ -53,6 +53,8 @@ from typing import Any
 import numpy as np
 
 from approachsim import geo, units
+from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
+from approachsim.sensors.gnss.receiver import best_pdop_four
 
 PAPER_HORIZONTAL_M = 4.0
 """The paper's GPS horizontal precision, 1 sigma (sec. 2)."""
@@ -78,9 +80,6 @@ def approach_dops(profile: Any, times_s: tuple[float, ...] = (0.0, 60.0, 120.0, 
     """Mean HDOP, VDOP, PDOP over the approach of the four best4-fixed plans at its start (the best-PDOP four at
     t = 0), at the profile's runway and pinned epoch (300 m above the threshold: the sky does not change over
     10 nmi)."""
-    from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
-    from approachsim.sensors.gnss.receiver import best_pdop_four
-
     rw, g = profile.runway, profile.sensors.gnss
     lat, lon = np.array([rw.threshold_lat_rad]), np.array([rw.threshold_lon_rad])
     r = geo.geodetic_to_ecef(lat, lon, np.array([rw.elevation_m + 300.0])).reshape(1, 3)

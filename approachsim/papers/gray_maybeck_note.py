@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from approachsim import units
 from approachsim.papers.claims import reproduces
 from approachsim.papers.gray_maybeck import PAPER_RUNS, STATES, TITLE
+from approachsim.papers.gray_maybeck_sensitivity import METRICS
 
 CAT2_LATERAL_FT = 8.6
 """FAA CAT II lateral 1-sigma limit (Table 1)."""
@@ -309,8 +310,6 @@ def _cat2_sensitivity_words(sens: dict) -> str:
 
 def sensitivity_section(result: dict) -> list[str]:
     """The sensitivity table (papers/gray_maybeck_sensitivity.py) and its computed findings."""
-    from approachsim.papers.gray_maybeck_sensitivity import METRICS
-
     sens = result["sensitivity"]
     tab = sens.get("table") or {}
     if not tab:
@@ -353,8 +352,6 @@ def _significant(ci: Sequence[float]) -> bool:
 def sensitivity_findings(sens: dict) -> list[str]:
     """Sentences from the sensitivity numbers: what moves X-XII across the CAT II line, what moves the pseudolite's
     cut toward the paper's, and what the paper's numbers would need."""
-    from approachsim.papers.gray_maybeck_sensitivity import METRICS
-
     tab = sens["table"]
     fv = tab["faithful"]["value"]
     rows = {k: r for k, r in tab.items() if k != "faithful"}

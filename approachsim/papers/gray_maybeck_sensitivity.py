@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from approachsim import seeding, units
+from approachsim.papers import gray_maybeck_faithful as gf
 
 STATES = ("latitude", "longitude", "altitude", "clock_bias")
 BOOTSTRAP = 2000
@@ -188,14 +189,14 @@ def _case_arrays(ev: Any, columns: Callable[[list], dict[str, np.ndarray]]) -> d
     return out
 
 
-def run_table(*, seed: int, runs: int, root: Path, evaluate: Any, columns: Any, workers: int | None = None,
-              rows: Sequence[Row] = ROWS) -> dict:
+def run_table(*, seed: int, runs: int, root: Path, evaluate: Any, columns: Any, cases: Sequence[Any],
+              case_profile: Callable[..., Any], workers: int | None = None, rows: Sequence[Row] = ROWS) -> dict:
     """Fly the faithful reference and every row (open loop, `runs` runs per case, the same seed), then the paired
-    table. Returns {"runs", "rows": [{key, label, cases}], "table": paired_table(...), "failed": {row: {case:
-    n}}, "verdicts": {row: {case: CAT II verdict}}, "common_runs", "wall_s"}."""
-    from approachsim.papers import gray_maybeck as gm
-
-    by_num = {c.number: c for c in gm.CASES}
+    table. cases: the paper's cases (papers/gray_maybeck.CASES) and case_profile(case, variant, extra, label=) the
+    profile of one (gray_maybeck.case_profile), handed in by gray_maybeck.compute, which runs this table (this
+    module stays below it). Returns {"runs", "rows": [{key, label, cases}], "table": paired_table(...), "failed":
+    {row: {case: n}}, "verdicts": {row: {case: CAT II verdict}}, "common_runs", "wall_s"}."""
+    by_num = {c.number: c for c in cases}
     per: dict[str, dict[int, dict[int, dict[str, float]]]] = {}
     failed: dict[str, dict[str, int]] = {}
     verdicts: dict[str, dict[str, str]] = {}
@@ -204,7 +205,7 @@ def run_table(*, seed: int, runs: int, root: Path, evaluate: Any, columns: Any, 
         per[key], failed[key], verdicts[key] = {}, {}, {}
         for c in cases:
             case = by_num[c]
-            prof = gm.case_profile(case, "faithful", extra, label=key if key != "faithful" else "")
+            prof = case_profile(case, "faithful", extra, label=key if key != "faithful" else "")
             ev = evaluate(prof, runs=runs, seed=seed, mode="open", out_dir=root / key / case.roman,
                           workers=workers, resume=True, progress=False)
             wall += ev.wall_s
@@ -221,15 +222,13 @@ def run_table(*, seed: int, runs: int, root: Path, evaluate: Any, columns: Any, 
         return {c: {col: np.array([per[key][c][r][col] for r in common]) for col in per[key][c][common[0]]}
                 for c in ALL_CASES}
 
-    ref_prof = gm.case_profile(by_num[11], "faithful")
-    from approachsim.papers import gray_maybeck_faithful as gf
-
+    ref_prof = case_profile(by_num[11], "faithful")
     uere_f = gf.budget_uere_m(ref_prof.sensors.gnss.budget())
-    uere_n = gf.budget_uere_m(gm.case_profile(by_num[11], "faithful", (("sensors.gnss.budget_scale", 1.0),))
+    uere_n = gf.budget_uere_m(case_profile(by_num[11], "faithful", (("sensors.gnss.budget_scale", 1.0),))
                               .sensors.gnss.budget())
     table = paired_table(arrays("faithful"), {r.key: arrays(r.key) for r in rows}, seed=seed) if common else {}
     return {"runs": runs, "common_runs": len(common), "rows": [{"key": r.key, "label": r.label,
-                                                                 "cases": [gm.ROMAN[c - 1] for c in r.cases]}
+                                                                 "cases": [by_num[c].roman for c in r.cases]}
                                                                 for r in rows],
             "table": table, "failed": failed, "verdicts": verdicts, "wall_s": wall,
             "faithful_uere_m": uere_f, "nrc_uere_m": uere_n}

@@ -43,6 +43,7 @@ from approachsim.campaign.outputs import verdict_table
 from approachsim.campaign.result import RunResult
 from approachsim.evaluate.limits import CATEGORIES, LIMITS
 from approachsim.evaluate.score import CATEGORY_KEYS, HEIGHT_GRID_FT
+from approachsim.evaluate.stats import quantile_ranks
 from approachsim.report.integrity import CAPTIONS as INTEGRITY_CAPTIONS
 from approachsim.report.integrity import INTEGRITY_HEADER, integrity_figures, integrity_rows
 from approachsim.report.touchdown import CAPTIONS as TOUCHDOWN_CAPTIONS
@@ -303,8 +304,6 @@ def _table(header: list[str], rows: list[list]) -> str:
 
 def _min_runs_for_p95_upper() -> int:
     """Smallest run count for which the 95th percentile has a distribution-free 95 % upper bound."""
-    from approachsim.evaluate.stats import quantile_ranks
-
     n = 1
     while quantile_ranks(n)[1] is None and n < 10000:
         n += 1

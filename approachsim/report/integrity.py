@@ -1,4 +1,5 @@
-"""Integrity figures of an evaluation campaign with integrity on (details.json `integrity`, integrity.campaign):
+"""Integrity figures of an evaluation campaign with integrity on (details.json `integrity`,
+campaign.integrity_campaign):
 
 * integrity_stanford.png: Stanford diagram per category (columns) and axis (rows: vertical, lateral) over
   every run's filter epochs: |error| of the protected output against its solution-separation protection level,

@@ -16,16 +16,16 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from approachsim.nav import monitors as mon
+from approachsim.nav.ud import INFLUENCES, InfluenceFunction
+from approachsim.papers.chernodarov import nees_bounds
+
 _RAD_S_TO_DEG_H = 180.0 / np.pi * 3600.0
 _RAD_TO_ARCSEC = 180.0 / np.pi * 3600.0
 
 
 def write_figures(s: Any, results: dict[str, Any], p: Any, out_dir: Path) -> list[str]:
     """Write chernodarov_fig{1,2,4}.png and chernodarov_nees.png; return the file names."""
-    from approachsim.nav import monitors as mon
-    from approachsim.nav.ud import INFLUENCES, InfluenceFunction
-    from approachsim.papers.chernodarov import nees_bounds
-
     out_dir = Path(out_dir)
     names = []
 

@@ -15,6 +15,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from approachsim.papers.sokolovic import SokolovicParams, trajectory
+
 _STYLE = {"constant": ("k", "-"), "tanh": ("tab:blue", "--"), "sinh": ("tab:red", "-")}
 
 
@@ -46,8 +48,6 @@ def _rms_pair(res: Any, forms: tuple[str, str], title: str, path: Path) -> None:
 
 def write_figures(res: Any, out_dir: Path) -> list[str]:
     """Write sokolovic_fig{3,5,6,7}.png into out_dir from a `SokolovicRuns`; return the file names."""
-    from approachsim.papers.sokolovic import SokolovicParams, trajectory
-
     out_dir = Path(out_dir)
     names = []
     p = SokolovicParams()

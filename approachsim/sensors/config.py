@@ -18,7 +18,7 @@ from approachsim.config import ProfileError, Section
 from approachsim.sensors.faults import FAULT_KINDS, FaultSpec
 from approachsim.sensors.gnss.carrier import L1_WAVELENGTH_M, CarrierModel
 from approachsim.sensors.gnss.clock import OSCILLATORS
-from approachsim.sensors.gnss.constellation import parse_epoch
+from approachsim.sensors.gnss.constellation import SLOTS, parse_epoch
 from approachsim.sensors.gnss.gbas import AADS, GADS, GbasModel
 from approachsim.sensors.gnss.receiver import (
     CLOCK_EPHEMERIS_M,
@@ -363,8 +363,6 @@ def _check_channel(f: Section, sensor: str, channel: int, sensors: SensorsConfig
     if sensor in ("baro", "radalt"):
         raise ProfileError(f"{name}: the {sensor} has one channel; remove channel")
     if sensor == "gnss":
-        from approachsim.sensors.gnss.constellation import SLOTS
-
         prns = sorted(slot[3] for slot in SLOTS)
         if channel not in prns:
             raise ProfileError(f"{name}: no PRN {channel} in the constellation (PRNs {prns[0]}-{prns[-1]})")

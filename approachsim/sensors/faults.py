@@ -31,6 +31,8 @@ from typing import Any
 import numpy as np
 
 from approachsim.sensors import base
+from approachsim.sensors.gnss.carrier import ambiguities, carrier_arcs
+from approachsim.sensors.gnss.receiver import carrier_continuation, carrier_gap, carrier_last
 
 Array = np.ndarray
 
@@ -212,8 +214,6 @@ def rearc(phi: Array, arc: Array, valid: Array, batched: bool, carrier: tuple) -
     """Carrier phase and arcs (gnss/carrier.py) after faults left `valid`: the arcs made afresh from valid (carrier =
     (j0, prev_valid, prev_arc, pool) as carrier.carrier_arcs and carrier.ambiguities take them), and where a channel's
     arc changed, its old arc's ambiguity replaced by the new one's (nan where not valid)."""
-    from approachsim.sensors.gnss.carrier import ambiguities, carrier_arcs
-
     one = (lambda a: a) if batched else (lambda a: np.asarray(a)[None])
     j0, pv, pa, pool = carrier
     old = one(arc)
@@ -241,8 +241,6 @@ class PreparedFaulted:
         outage, which continue from sample to sample (in increasing order, skipped ones run first, as the
         receiver's)."""
         if self.carrier is not None:
-            from approachsim.sensors.gnss.receiver import carrier_gap
-
             for jj in carrier_gap(self._carrier, j):
                 self._one(truth, jj)
         return self._one(truth, j)
@@ -252,8 +250,6 @@ class PreparedFaulted:
         rec = self.inner.at(truth, j)
         carrier = None
         if self.carrier is not None:
-            from approachsim.sensors.gnss.receiver import carrier_continuation, carrier_last
-
             carrier = carrier_continuation(self._carrier, j, self.carrier[3])
         elif not any(m[j] for m in self.masks):
             return rec

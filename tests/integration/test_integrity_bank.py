@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from approachsim import units
+from approachsim.campaign.integrity_bank import run_bank, score_run
 from approachsim.flight.run import Approach
-from approachsim.integrity.bank import run_bank, score_run
 from approachsim.profile import parse_profile
 
 pytestmark = pytest.mark.slow

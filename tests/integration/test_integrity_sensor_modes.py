@@ -9,8 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from approachsim.integrity.bank import BARO_MODE, RADALT_MODE, run_bank
-from approachsim.integrity.risk import flight_truth, limit_states
+from approachsim.campaign.bank_modes import BARO_MODE, RADALT_MODE
+from approachsim.campaign.integrity_bank import run_bank
+from approachsim.campaign.integrity_risk import flight_truth, limit_states
 from approachsim.profile import load_profile
 from approachsim.sensors.faults import FaultSpec
 

@@ -94,7 +94,7 @@ def test_editing_a_stage_keeps_the_cache_and_editing_core_starts_a_fresh_one(tmp
     target = "x86_64-unknown-linux-gnu|haswell|+avx2,+fma"
     key = approachsim.core._numba_cache_key(pkg, target)
     assert key == approachsim.core._numba_cache_key(src, target)
-    for stage in ("loop/closed_loop.py", "flight/run.py", "sensors/baro.py", "integrity/bank.py"):
+    for stage in ("loop/closed_loop.py", "flight/run.py", "sensors/baro.py", "campaign/integrity_bank.py"):
         with (pkg / stage).open("a", encoding="utf-8") as f:
             f.write("\n# edited\n")
         assert approachsim.core._numba_cache_key(pkg, target) == key, stage

@@ -35,7 +35,7 @@ Ground (reference receivers' noise and multipath), the ground accuracy designato
 
 Airborne (receiver noise and airframe multipath on the 100 s smoothed code), sigma_air^2 = sigma_multipath^2 +
 sigma_noise^2 (Stanford MAAST af_cnmp_mops.m [V], reference section 8):
-  s_mp = the DO-253 airframe multipath 0.13 + 0.53 exp(-theta / 10 deg) (receiver.do253_multipath_sigma_m), the
+  s_mp = the DO-253 airframe multipath 0.13 + 0.53 exp(-theta / 10 deg) (elevation.do253_multipath_sigma_m), the
   receiver's multipath series (multipath_model = "do253" is required), correlated over multipath_tau_s;
   s_noise = the airborne accuracy designator (AAD) curve a0 + a1 exp(-theta / theta0): AAD-B 0.11, 0.13, 4 deg [V]
   (MAAST init_aadb.m / init_cnmp_mops.m, 2018 "corrected noise term to AAD-B"); AAD-A 0.15, 0.43, 6.9 deg [S] (two
@@ -70,7 +70,7 @@ smoothing filter accumulated along its path):
   the GBAS form of DO-253 / Annex 10 App. B 3.6.5.5 [U: the form written from memory, its clause not read]; its
   variables -- x_air the distance between the aircraft and the reference point, v_air the aircraft's speed, the
   gradient sigma -- as a NAVIGATION (ION) paper's GBAS error model lists them after RTCA DO-245A (Table 2,
-  navi.ion.org) [S]; F the thin-shell obliquity at 350 km (receiver.iono_obliquity, the
+  navi.ion.org) [S]; F the thin-shell obliquity at 350 km (elevation.iono_obliquity, the
   Annex's F_pp with the WGS-84 semi-major axis for R_e = 6378.1363 km: 0.7 m apart), tau = 100 s (the smoothing time
   constant), sigma_vig default 4 mm/km, the nominal mid-latitude (CONUS) vertical gradient (Lee et al., as cited in
   GPS Solutions s10291-024-01669-9 [S]; the NAVIGATION table uses the same 0.004 m/km). x_air: the slant distance
@@ -115,6 +115,7 @@ from types import MappingProxyType
 import numpy as np
 
 from approachsim import geo, units
+from approachsim.sensors.gnss.elevation import IONO_SHELL_M, do253_multipath_sigma_m, iono_obliquity
 
 Array = np.ndarray
 
@@ -196,8 +197,6 @@ class GbasModel:
 
     def iono_sigma_m(self, el_rad: Array, x_air_m: Array, v_air_mps: Array) -> Array:
         """sigma_iono = F(theta) sigma_vig (x_air + 2 tau v_air), m."""
-        from approachsim.sensors.gnss.receiver import iono_obliquity
-
         return iono_obliquity(el_rad) * self.sigma_vig_per_m * (x_air_m + 2.0 * SMOOTHING_TAU_S * v_air_mps)
 
     def tropo_sigma_m(self, el_rad: Array, dh_m: Array) -> Array:
@@ -210,8 +209,6 @@ class GbasModel:
     def scales(self, el_rad: Array, x_air_m: Array, dh_m: Array, v_air_mps: Array) -> dict[str, Array]:
         """The five scales of the module docstring (m) and `sigma`, their RSS with CARRIER_NOISE_M, broadcast over the
         arguments."""
-        from approachsim.sensors.gnss.receiver import do253_multipath_sigma_m
-
         out = {"ground": self.ground_sigma_m(el_rad), "iono": self.iono_sigma_m(el_rad, x_air_m, v_air_mps),
                "tropo": self.tropo_sigma_m(el_rad, dh_m), "multipath": do253_multipath_sigma_m(el_rad),
                "noise": self.airborne_noise_sigma_m(el_rad)}
@@ -274,8 +271,6 @@ class GbasModel:
     def channel_kernel_args(self) -> tuple:
         """The constant arguments of core/sensors/gnss.gbas_channel_sigmas between the geometry and the outputs:
         gbas_channel_sigmas(el, x_air, dh, v_air, *model.channel_kernel_args(), gse, gmp)."""
-        from approachsim.sensors.gnss.receiver import IONO_SHELL_M
-
         return (self.gad_params(), float(self.reference_receivers), self.aad_params(), float(self.sigma_vig_per_m),
                 SMOOTHING_TAU_S, float(self.refractivity_sigma), float(self.scale_height_m), IONO_SHELL_M)
 

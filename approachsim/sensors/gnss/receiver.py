@@ -99,6 +99,7 @@ from approachsim.sensors import base
 from approachsim.sensors.gnss.carrier import CarrierModel, ambiguities, carrier_arcs
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
+from approachsim.sensors.gnss.elevation import IONO_SHELL_M, do253_multipath_sigma_m, iono_obliquity, tropo_mapping
 from approachsim.sensors.gnss.gbas import CARRIER_NOISE_M, SMOOTHING_TAU_S, GbasModel, station_geometry
 
 Array = np.ndarray
@@ -117,8 +118,6 @@ SELECTIONS = ("best4", "best4-fixed", "all")
 the approach, the best-PDOP four (at the run start) among the satellites that stay above the mask for
 fixed_hold_s seen from the start position (truth row 0 only: stateless), kept while all four are in view,
 with per-epoch best4 at any epoch where one is not. all: every satellite in view."""
-IONO_SHELL_M = 350e3
-"""Thin-shell ionosphere height, m (Klobuchar / DO-229)."""
 
 
 @dataclass(frozen=True)
@@ -193,11 +192,6 @@ class GnssErrorBudget:
         return gse, gmp
 
 
-def do253_multipath_sigma_m(el_rad: Array) -> Array:
-    """Airframe multipath 1-sigma (m): 0.13 + 0.53 exp(-el / 10 deg) (RTCA DO-253 / DO-229; MAAST init_cnmp_mops)."""
-    return 0.13 + 0.53 * np.exp(-np.degrees(np.asarray(el_rad, dtype=float)) / 10.0)
-
-
 def make_budget(code: str, multipath_model: str = "nrc1995", clock_ephemeris: str = "nrc1995",
                 multipath_tau_s: float | None = None, gbas: GbasModel | None = None) -> GnssErrorBudget:
     """The code preset with the chosen multipath model and clock/ephemeris budget (module docstring); tau None:
@@ -233,17 +227,6 @@ CODE_PRESETS: Mapping[str, GnssErrorBudget] = MappingProxyType({
                            code_noise_m=0.6),
 })
 """Receiver code presets (module docstring gives the sources)."""
-
-
-def iono_obliquity(el_rad: Array) -> Array:
-    """Thin-shell ionospheric obliquity factor 1 / sqrt(1 - (R cos el / (R + h_I))^2)."""
-    x = geo.A_WGS84 * np.cos(el_rad) / (geo.A_WGS84 + IONO_SHELL_M)
-    return 1.0 / np.sqrt(1.0 - x * x)
-
-
-def tropo_mapping(el_rad: Array) -> Array:
-    """Tropospheric mapping 1.001 / sqrt(0.002001 + sin^2 el) (RTCA DO-229 A.4.2.4)."""
-    return 1.001 / np.sqrt(0.002001 + np.sin(el_rad) ** 2)
 
 
 def best_pdop_four(u_los: Array, visible: Array) -> Array:

@@ -10,6 +10,7 @@ from evalpairs import RWY, cross_axis_ned, make_nav, make_truth
 
 from approachsim import units
 from approachsim.evaluate.dh import at_crossing, dh_crossing, ecef_to_ned_vectors, interp_on_height, runway_errors
+from approachsim.memo import TruthMemo
 
 
 def test_crossing_exact_on_a_straight_line():
@@ -86,14 +87,20 @@ def test_time_base_mismatch_is_rejected():
 
 
 def test_runway_errors_of_alternating_truths_equal_the_direct_rotation():
-    # runway_errors keeps the last truth's trigonometry and heights (the runs of a group share their truth): a
-    # second truth of the same length, then the first again, must each get their own, bit for bit
+    # with a memo (approachsim/memo.py: the runs of a group share their truth's trigonometry and heights) each truth
+    # has its own: a second truth of the same length, then the first again, must each get their own, bit for bit,
+    # and the same as without a memo; a memo is never used for another truth
     a, b = make_truth(hz=2.0, dur_s=150.0), make_truth(hz=2.0, hat0_m=650.0, dur_s=150.0, loc_dev_m=40.0)
     assert len(a) == len(b)
+    memos = {id(a): TruthMemo(a), id(b): TruthMemo(b)}
     e = 3.0 * cross_axis_ned() + np.array([0.0, 0.0, -2.0])
     for truth in (a, b, a):
         nav = make_nav(truth, e)
-        err = runway_errors(truth, nav)
+        err = runway_errors(truth, nav, memos[id(truth)])
         dr = nav.r_ecef - truth.r_ecef
         np.testing.assert_array_equal(err.e_ned, ecef_to_ned_vectors(dr, truth.lat_rad, truth.lon_rad))
         np.testing.assert_array_equal(err.hat_m, truth.runway.height_above_threshold(truth.h_m))
+        np.testing.assert_array_equal(err.e_ned, runway_errors(truth, nav).e_ned)
+    assert len(memos[id(a)]) == 1
+    with pytest.raises(ValueError, match="another truth"):
+        runway_errors(b, make_nav(b, e), memos[id(a)])

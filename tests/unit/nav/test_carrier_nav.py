@@ -19,9 +19,9 @@ from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import measurements as meas
 from approachsim.nav import terrain_db as tdb
-from approachsim.nav.config import InitialError
+from approachsim.nav.config import FdeConfig, InitialError
 from approachsim.nav.engine import EpochEngine
-from approachsim.nav.fde import FdeConfig, FdeState, _ranging
+from approachsim.nav.fde import FdeState, _ranging
 from approachsim.nav.observations import CP, GPS, Source
 from approachsim.nav.rows import Row
 from approachsim.nav.system import NavSystem

@@ -19,7 +19,7 @@ from scipy.stats import binom, chi2
 from approachsim import synthetic
 from approachsim.config import ProfileError
 from approachsim.integrity.requirements import REQUIREMENTS
-from approachsim.nav.fde import FdeConfig
+from approachsim.nav.config import FdeConfig
 from approachsim.nav.navigator import RunFilter, loop_held
 from approachsim.nav.observations import Observations
 from approachsim.nav.system import NavSystem

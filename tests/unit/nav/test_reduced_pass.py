@@ -2,7 +2,7 @@
 it replaces (core/nav/epoch.shared_pass, what Navigator.compiled_pass runs when the reduction does not apply): the
 same estimates, covariances, measurement rows and solutions, with a baro outage that holds the damping loop and
 with pseudolites. The reduction drops exact zeros and keeps every other sum's order (the module docstring): measured
-equal to the last bit on this machine; asserted to the floors of tests/unit/integrity/test_bankpass.py (the same
+equal to the last bit on this machine; asserted to the floors of tests/unit/campaign/test_bankpass.py (the same
 argument for the bank's copies), the integer row codes and counts exactly."""
 
 from __future__ import annotations

@@ -25,7 +25,8 @@ from approachsim.profile import load_profile, parse_profile
 from approachsim.seeding import stream
 from approachsim.sensors.faults import FaultSpec
 from approachsim.sensors.gnss.carrier import L1_WAVELENGTH_M, CarrierModel, carrier_arcs
-from approachsim.sensors.gnss.receiver import draw_receiver_clock, iono_obliquity, tropo_mapping
+from approachsim.sensors.gnss.elevation import iono_obliquity, tropo_mapping
+from approachsim.sensors.gnss.receiver import draw_receiver_clock
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"

@@ -14,11 +14,11 @@ from approachsim.config import ProfileError, Section
 from approachsim.nav.system import NavSystem
 from approachsim.seeding import stream
 from approachsim.sensors.config import SensorsConfig, parse_sensors
+from approachsim.sensors.gnss.elevation import do253_multipath_sigma_m
 from approachsim.sensors.gnss.receiver import (
     CLOCK_EPHEMERIS_M,
     SIDEREAL_DAY_S,
     GnssReceiver,
-    do253_multipath_sigma_m,
     draw_epoch_offsets,
     make_budget,
 )

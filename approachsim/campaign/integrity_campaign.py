@@ -1,7 +1,7 @@
 """Integrity in a campaign: one run's integrity scalars from the solution-separation bank, and their campaign
 statistics for details.json.
 
-Per run (run_integrity): the bank (integrity.bank.run_bank, the main filter and one sub-filter per used GNSS
+Per run (run_integrity): the bank (campaign.integrity_bank.run_bank, the main filter and one sub-filter per used GNSS
 channel, open loop on the run's truth; in closed loop the flown truth) is scored per category at the filter
 epochs from evaluation.timeavg_settle_s after the run start down to the category's decision height
 (bank.score_category: H0 / H1 protection levels on the vertical and lateral approach axes with the category's
@@ -34,8 +34,11 @@ from typing import Any
 import numpy as np
 from scipy import stats as sps
 
-from approachsim.integrity.bank import BankEpochs, CategoryIntegrity, run_bank, score_category
+from approachsim.campaign.integrity_bank import BankEpochs, CategoryIntegrity, run_bank, score_category
+from approachsim.evaluate.dh import interp_on_height
 from approachsim.integrity.requirements import REQUIREMENTS, describe
+from approachsim.memo import TruthMemo
+from approachsim.sensors.suite import SensorSuite
 
 Array = np.ndarray
 
@@ -126,8 +129,6 @@ def run_integrity(ep: BankEpochs, cfg: Any, *, epoch_hz: float, t0_s: float, ons
                   fault_ch: int = -1, nav: Any = None, height_grid_m: Array | None = None
                   ) -> tuple[dict[str, float], dict[str, Array], dict[str, Array]]:
     """(scalars, counts, arrays) of one run (module docstring); cfg: the EvaluationConfig."""
-    from approachsim.evaluate.dh import interp_on_height
-
     scalars: dict[str, float] = {}
     counts: dict[str, Array] = {}
     arrays: dict[str, Array] = {}
@@ -170,14 +171,12 @@ def run_integrity(ep: BankEpochs, cfg: Any, *, epoch_hz: float, t0_s: float, ons
 
 
 def score_with_bank(profile: Any, truth: Any, seed: int, run: int, nav: Any = None,
-                    height_grid_m: Array | None = None, group: tuple[Any, int] | None = None
-                    ) -> tuple[dict[str, float], dict[str, Array], dict[str, Array]]:
+                    height_grid_m: Array | None = None, group: tuple[Any, int] | None = None,
+                    memo: TruthMemo | None = None) -> tuple[dict[str, float], dict[str, Array], dict[str, Array]]:
     """Run the bank open loop on `truth` for run `run` of the campaign seeded `seed` and score it
     (run_integrity); nav: the run's own NavSolution (online FDE records), if any; group: what its open-loop
-    flight group's pass left for it (run_bank)."""
-    ep, main = run_bank(bank_profile(profile), truth, seed, run, group=group)
-    from approachsim.sensors.suite import SensorSuite
-
+    flight group's pass left for it, memo: the truth's TruthMemo (run_bank)."""
+    ep, main = run_bank(bank_profile(profile), truth, seed, run, group=group, memo=memo)
     prn = getattr(SensorSuite.from_profile(profile).sensors.get("gnss"), "constellation", None)
     onset, ch = first_fault(profile, None if prn is None else prn.prn)
     return run_integrity(ep, profile.evaluation, epoch_hz=profile.nav.aiding_rate_hz, t0_s=float(truth.t_s[0]),

@@ -1,5 +1,5 @@
-"""The integrity-risk study's pieces without flying (integrity/risk.py): the HMI limit state agrees with the bank's
-HMI count, the fault-parameter map, the modes a profile has, the totals and their verdicts."""
+"""The integrity-risk study's pieces without flying (campaign/integrity_risk.py): the HMI limit state agrees with the
+bank's HMI count, the fault-parameter map, the modes a profile has, the totals and their verdicts."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
+from approachsim.campaign.integrity_bank import BankEpochs
+from approachsim.campaign.integrity_risk import MODES, fault_spec, limit_states, modes_for, totals
 from approachsim.evaluate.config import EvaluationConfig
-from approachsim.integrity.bank import BankEpochs
 from approachsim.integrity.requirements import REQUIREMENTS
-from approachsim.integrity.risk import MODES, fault_spec, limit_states, modes_for, totals
 from approachsim.profile import load_profile
 from approachsim.resources import shipped_profile
 

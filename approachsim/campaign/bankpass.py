@@ -1,15 +1,15 @@
 """The integrity bank's navigation pass (issue 26, speed): the main filter and the K sub-filters of one open-loop run
 over the run's records in one compiled call, on the states the bank can move.
 
-What integrity.bank.run_bank did before through NavSystem.run(copies=True) (and still does where this pass does not
-apply, `applicable`), with the same arithmetic:
+What campaign.integrity_bank.run_bank did before through NavSystem.run(copies=True) (and still does where this pass does
+not apply, `applicable`), with the same arithmetic:
 
 - one draw of the run's sensors (every copy's records are the same draws: the same streams), one converged start
   (the copies share the main filter's: nav/system.py NavSystem.start), one INS over every row (feed-forward: the
   INS does not depend on the filter), the copies' observations stacked once and copy k + 1 without its mode's
-  samples (integrity.bank.bank_records: an invalid sample is no measurement);
+  samples (campaign.integrity_bank.bank_records: an invalid sample is no measurement);
 - the model of every epoch (Phi, Qd at the reference: the truth) made once per flight group's truth on the full
-  layout (core/nav/copies.models, kept for the last truth: the group's runs share it), cut to the run's
+  layout (core/nav/copies.models, kept in the group truth's memo, approachsim/memo.py), cut to the run's
   reduced state; then every epoch of every copy, each its own class (per-run GPS sky), in one call of
   core/nav/copies.bank_epochs (core/nav/epoch.shared_pass's loop with the model given), on the *reduced*
   state: the GPS channel states (gse, gmp) of the channels the run never measures are dropped.
@@ -21,7 +21,7 @@ segment keeps its prior row exactly; checked here, else the channel is kept). So
 exactly zero off the diagonal: in the prediction W = Phi P, Phi W' + Qd their terms are exact zeros, and the
 scalar updates (core/nav/kalman.gain and _joseph_cov) skip the rows where P h is zero and add exact zeros in the
 other rows' dropped columns. Every remaining term is summed in the same order (the kept states keep their order),
-so the kept states' estimates and covariances are the same floating-point numbers (tests/unit/integrity/
+so the kept states' estimates and covariances are the same floating-point numbers (tests/unit/campaign/
 test_bankpass.py compares them with the full-state pass bit for bit). The bank needs only the navigation states'
 estimates and covariance block: the dropped states never reach it. The cost of an epoch falls with the square
 of the state count: 70 states (24 channels) to 22 + 2 x (channels used), about 32 with best-four selection.
@@ -36,20 +36,22 @@ bank_epochs_carrier): the gio states' Qd at the copy's sky, then its ambiguities
 bank.bank_records, so it never resets amb_c), the reset zeroing a kept row and column of Phi (a copy) and Qd as on
 the full layout, then class_epoch with the carrier rows after the code rows. The copies start with no arc (the
 converged start is code only: nav/initial.py). The candidate's 121 states (24 channels) to 25 + 4 x (channels used)
-(tests/unit/integrity/test_bankpass_carrier.py: bit for bit against the copies' full-state pass, with an outage
+(tests/unit/campaign/test_bankpass_carrier.py: bit for bit against the copies' full-state pass, with an outage
 that opens a new arc).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import weakref
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from approachsim import geo
+from approachsim.campaign.bank_modes import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
 from approachsim.core.nav import copies as kcp
+from approachsim.memo import TruthMemo, memoized
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import reduced as rd
@@ -57,6 +59,7 @@ from approachsim.nav.base import workspace
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, stacked_new_arcs
 from approachsim.nav.navigator import NavRun, StatusLog, _stacked_observations, true_error_rows
 from approachsim.nav.observations import Observations
+from approachsim.nav.system import tuned_records
 
 Array = np.ndarray
 
@@ -107,13 +110,12 @@ def applicable(nav: Any, records: dict[str, Any]) -> bool:
 
 
 def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: np.random.Generator,
-              states: Any) -> BankPass | None:
-    """The main filter and one sub-filter per mode of `modes` (integrity.bank mode codes) over one run's records
+              states: Any, memo: TruthMemo | None = None) -> BankPass | None:
+    """The main filter and one sub-filter per mode of `modes` (campaign/bank_modes.py codes) over one run's records
     (`applicable`; run axis of length one), started from the run's realized sensor states `states`
     (sensors.states.start_states) with its "nav" stream `rng` (module docstring). None when an epoch's model is
-    too large for the compiled discretization (the caller takes NavSystem.run, which falls back to numpy's)."""
-    from approachsim.nav.system import tuned_records
-
+    too large for the compiled discretization (the caller takes NavSystem.run, which falls back to numpy's). memo:
+    the truth's TruthMemo (its converged start, reference and epoch models kept for the other runs on it)."""
     records = tuned_records(records, nav.nav.gps_sigma_scale)
     imu = records["imu"]
     dth, dvb = np.asarray(imu.dtheta_body)[:1], np.asarray(imu.dv_body)[:1]
@@ -125,7 +127,8 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     # the start, as NavSystem.run's: the copies share the main filter's (one draw, repeated)
     obs0 = Observations.at(records, float(truth.t_s[0]), tol, True)
     el0 = np.asarray(gnss.elevation_rad)[:, 0]
-    s, runs = nav.start(truth, [rng], elevation_rad=el0[0], obs=obs0, states=states, elevation_per_run=el0)
+    s, runs = nav.start(truth, [rng], elevation_rad=el0[0], obs=obs0, states=states, elevation_per_run=el0,
+                        memo=memo)
     # the INS once (Navigator.propagate: feed-forward, no bias feedback), with the damping loop's baro
     held = _baro_held(nav, records, truth, m)
     hb_full, age = (None, None) if held is None else held
@@ -139,7 +142,7 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     used = np.flatnonzero(np.any(np.asarray(gnss.valid, dtype=bool)[0], axis=0))
     return _core(nav, truth, modes, m, epoch_rows, runs[0].fs.x, np.asarray(runs[0].fs.P, dtype=float),
                  runs[0].db_error, rows[0, epoch_rows::epoch_rows], None if hb_full is None else hb_full[0], o, used,
-                 runs[0].arcs)
+                 runs[0].arcs, memo=memo)
 
 
 def _baro_held(nav: Any, records: dict[str, Any], truth: Any, m: int) -> tuple[Array, Array] | None:
@@ -170,8 +173,6 @@ class GroupInputs:
     def observations(self, nav: Any, truth: Any) -> dict[str, Any]:
         """_stacked_observations of every run of the group at the epochs (once)."""
         if self._obs is None:
-            from approachsim.nav.system import tuned_records
-
             recs = tuned_records(self.records, nav.nav.gps_sigma_scale)
             dt = float(recs["imu"].dt_s)
             er = self.keep["epoch_rows"]
@@ -180,10 +181,12 @@ class GroupInputs:
         return self._obs
 
 
-def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Array) -> BankPass | None:
+def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Array,
+                    memo: TruthMemo | None = None) -> BankPass | None:
     """`bank_pass` for run k of an open-loop flight group from what the group's pass left (GroupInputs): its start,
     its INS at the epochs and its records; nothing drawn or integrated again (the same numbers: the pass's start and
-    INS are the run's own, whatever the batch)."""
+    INS are the run's own, whatever the batch). memo: the group truth's TruthMemo (the pass's epoch models; the
+    reference made once for the group's banks)."""
     recs = group.records
     imu = recs["imu"]
     m = int(np.shape(imu.dtheta_body)[1])
@@ -200,21 +203,19 @@ def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Arr
     x_hat, P = group.keep["start"][k]
     main = group.keep["reduced_runs"][k] if "reduced_runs" in group.keep else None
     return _core(nav, truth, modes, m, er, x_hat, P, group.keep["db"][k], group.keep["ins_epoch_rows"][k],
-                 None if hb is None else hb[0], o, used, main=main)
+                 None if hb is None else hb[0], o, used, main=main, memo=memo)
 
 
 def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Array, P_conv: Array,
           db_error: Any, ins_ep: Array, hb1: Array | None, o: dict[str, Any], used: Array,
-          arcs0: Array | None = None, main: Any = None) -> BankPass | None:
+          arcs0: Array | None = None, main: Any = None, memo: TruthMemo | None = None) -> BankPass | None:
     """The pass from the run's start (x_hat, P_conv, its terrain-database error), its INS states at the epochs
     ins_ep (E, 16), its baro held for the damping loop hb1 (m,) or None, its stacked observations o (one run) and
     the GNSS channels it measures; carrier phase: arcs0 (k,) the start's carrier arc ids (None: none yet), from
     which each copy's new arcs (its ambiguity resets) follow as in Navigator.compiled_pass. main: the group pass's
     own filter of the run on its reduced state (nav/reduced.ReducedRun), which is copy 0 (the same start, INS,
     observations and models in the same compiled pass): taken as copy 0 when its channels are the copies' (only the
-    sub-filters are run), else None."""
-    from approachsim.integrity.bank import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
-
+    sub-filters are run), else None. memo: the truth's TruthMemo (the reference, the epoch models)."""
     lay = nav.layout
     eng = EpochEngine(nav)
     # the epochs and the reference (the truth at the epoch rows: nav/shared.py)
@@ -226,7 +227,8 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     held1 = np.zeros(E, dtype=np.int64)
     if lay.has("ac") and hb1 is not None:
         held1[:] = np.all(np.isnan(hb1[:E * epoch_rows]).reshape(E, epoch_rows), axis=1)  # the epochs' intervals
-    ref, ref_cbn, f_ref, ref_agl = _reference(nav, truth, m, epoch_rows, e_rows)
+    ref, ref_cbn, f_ref, ref_agl = memoized(memo, truth, "bankpass.reference", (m, epoch_rows, nav.terrain_h),
+                                            lambda: _reference(nav, truth, m, epoch_rows, e_rows), keep=2)
     # the copies' observations: copy 0 all, copy k + 1 without mode k (bank.bank_records)
     baro_h = np.repeat(o["baro_h"], C, axis=0)
     radalt_h = np.repeat(o["radalt_h"], C, axis=0)
@@ -300,7 +302,7 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     n_rows = np.zeros((C, E), dtype=np.int64)
     x_out, pd, pnav = np.zeros((C, E, n)), np.zeros((C, E, n)), np.zeros((C, E, 9, 9))
     ins_y = np.ascontiguousarray(np.broadcast_to(ins_ep, (C, E, ins.NX)))
-    model = rd.models(nav, truth, q, gse_full, gmp_full, loop, dt_e, ref, ref_cbn, f_ref, held1)
+    model = rd.models(nav, truth, q, gse_full, gmp_full, loop, dt_e, ref, ref_cbn, f_ref, held1, memo)
     if model is None:
         return None
     phi, qd = rd.cut(model, red)
@@ -337,27 +339,11 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     return BankPass(t_e, err, pnav, x_out, pd, red, kept, (codes[0], n_rows[0], nu[0], S[0]))
 
 
-_REFERENCES: list = []
-"""`_reference`'s last result: (system, weak reference to the truth, m, epoch_rows, value); the runs of an open-loop
-flight group share their truth, so their banks share its reference."""
-
-
 def _reference(nav: Any, truth: Any, m: int, epoch_rows: int, e_rows: Array) -> tuple[Array, Array, Array, Array]:
     """The reference at the epochs (nav/shared.py, Navigator.compiled_pass): packed truth rows (E, 16), their
     body-to-NED matrices (E, 3, 3), the interval's mean specific force NED (E, 3) m/s^2, the height above the
-    terrain (E,) m. Kept for the last (system, truth) objects (the kernel only reads them)."""
-    for sys_, tr, m_, er, val in _REFERENCES:
-        if sys_ is nav and tr() is truth and m_ == m and er == epoch_rows:
-            return val
-    val = _make_reference(nav, truth, m, epoch_rows, e_rows)
-    _REFERENCES[:] = [(nav, weakref.ref(truth), m, epoch_rows, val)]
-    return val
-
-
-def _make_reference(nav: Any, truth: Any, m: int, epoch_rows: int, e_rows: Array
-                    ) -> tuple[Array, Array, Array, Array]:
-    from approachsim import geo
-
+    terrain database nav.terrain_h (E,) m: a function of the truth, m and epoch_rows (e_rows = epoch_rows, 2
+    epoch_rows, ... <= m) and the terrain, kept in the truth's memo by `_core` (the kernel only reads it)."""
     E = e_rows.shape[0]
     c_bn = ins.cbn_from_quaternion(truth.q_nb[:m + 1])
     f_ned = np.einsum("nij,nj->ni", c_bn[:m], truth.f_body[:m])

@@ -10,10 +10,8 @@ import numpy as np
 import pytest
 from scipy import stats as sps
 
-from approachsim.evaluate.config import EvaluationConfig
-from approachsim.evaluate.verdict import category_verdict, integrity_verdict
-from approachsim.integrity.bank import BankEpochs
-from approachsim.integrity.campaign import (
+from approachsim.campaign.integrity_bank import BankEpochs
+from approachsim.campaign.integrity_campaign import (
     NB,
     STANFORD_EDGES_M,
     campaign_integrity,
@@ -22,6 +20,8 @@ from approachsim.integrity.campaign import (
     stanford_counts,
     stanford_hist,
 )
+from approachsim.evaluate.config import EvaluationConfig
+from approachsim.evaluate.verdict import category_verdict, integrity_verdict
 from approachsim.integrity.requirements import REQUIREMENTS
 
 CFG = EvaluationConfig(timeavg_settle_s=0.0)
@@ -168,8 +168,8 @@ def test_integrity_blocks_meets_and_decides_runs_needed():
 def test_run_result_counts_round_trip_sparse():
     import json
 
+    from approachsim.campaign.integrity_campaign import sum_counts
     from approachsim.campaign.result import RunResult
-    from approachsim.integrity.campaign import sum_counts
 
     h = np.zeros(NB * NB)
     h[[3, 700, 1599]] = [2.0, 5.0, 1.0]

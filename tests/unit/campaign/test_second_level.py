@@ -1,9 +1,9 @@
-"""Second-level identification (integrity/bank.py second_level, score_category(confirm=True)): constructed
+"""Second-level identification (campaign/integrity_bank.py second_level, score_category(confirm=True)): constructed
 statistic sequences, and the pinned bank epochs of the misidentified ramp of docs/integrity.md (closed loop with the
 online FDE, default profile, seed 1, run 44: PRN 20 (channel 18) ramped at 2 m/s from 78.6 s; the first detection's
 largest identification statistic named channel 21 and the output carried the fault: 152 misleading and 62 hazardously
-misleading CAT I epochs). Data: tests/unit/integrity/data/run44_bank_epochs.npz, the BankEpochs of that run
-(integrity.bank.run_bank on its flown truth), written by the session that added the second look (issue 26)."""
+misleading CAT I epochs). Data: tests/unit/campaign/data/run44_bank_epochs.npz, the BankEpochs of that run
+(campaign.integrity_bank.run_bank on its flown truth), written by the session that added the second look (issue 26)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from approachsim.integrity.bank import BankEpochs, score_category, second_level
+from approachsim.campaign.integrity_bank import BankEpochs, score_category, second_level
 from approachsim.integrity.requirements import REQUIREMENTS
 from approachsim.units import FT
 

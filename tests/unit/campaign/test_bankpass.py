@@ -1,4 +1,4 @@
-"""The integrity bank's compiled reduced-state pass (integrity/bankpass.py, core/nav/copies.py) against the
+"""The integrity bank's compiled reduced-state pass (campaign/bankpass.py, core/nav/copies.py) against the
 path it replaces, NavSystem.run's batched copies on the full state (run_bank(..., compiled=False), core/nav/epoch.
 shared_pass): the same main and sub-solution errors, variances and identification statistics, to the rounding
 floors of tests/floors.py (measured equal to the last bit on this machine: the reduction drops exact zeros, module
@@ -16,8 +16,8 @@ import pytest
 from floors import R_EARTH_M, R_GPS_MAX_M, assert_within, floor
 
 from approachsim import synthetic
-from approachsim.integrity import bankpass
-from approachsim.integrity.bank import run_bank
+from approachsim.campaign import bankpass
+from approachsim.campaign.integrity_bank import run_bank
 from approachsim.nav import errormodel as em
 from approachsim.nav import reduced
 from approachsim.nav.system import NavSystem

@@ -1,4 +1,4 @@
-"""The integrity bank's compiled reduced-state pass with GPS carrier phase (integrity/bankpass.py,
+"""The integrity bank's compiled reduced-state pass with GPS carrier phase (campaign/bankpass.py,
 core/nav/copies.bank_epochs_carrier) against the path it replaces, NavSystem.run's batched copies on the full
 state (run_bank(..., compiled=False): Navigator.compiled_pass, core/nav/epoch.shared_pass with the carrier states):
 bit for bit, on the shipped carrier candidate (GBAS, all in view, two pseudolites) and with a channel's carrier
@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 from approachsim import synthetic
-from approachsim.integrity import bankpass
-from approachsim.integrity.bank import run_bank
+from approachsim.campaign import bankpass
+from approachsim.campaign.integrity_bank import run_bank
 from approachsim.nav import reduced
 from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile

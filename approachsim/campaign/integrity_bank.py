@@ -4,13 +4,13 @@ The main filter uses every measurement; sub-filter k is the same navigation syst
 GNSS channel k never used (every channel the main filter used during the run is a fault mode). With
 `sensor_modes` (run_bank) the baro, the radar altimeter and each pseudolite unit are fault modes too: sub-filter k
 then never uses that source (its record invalid throughout, as an outage: the navigation holds the baro damping
-loop without a baro, nav/fde.py). Mode codes (`BankEpochs.channels`): a GNSS channel index >= 0, BARO_MODE,
-RADALT_MODE, PSEUDOLITE_MODE - u for pseudolite unit u. The bank runs
+loop without a baro, nav/fde.py). Mode codes (`BankEpochs.channels`, campaign/bank_modes.py): a GNSS channel index
+>= 0, BARO_MODE, RADALT_MODE, PSEUDOLITE_MODE - u for pseudolite unit u. The bank runs
 as K + 1 copies of the run in one batched pass (same sensor draws, same initial-error draw: the
 copies differ only in the excluded channel), with the shared covariance where the configuration allows it: with
 the compiled optimal filter and per-run GPS skies (the default) one compiled call on the states the copies can move
-(integrity/bankpass.py; in an open-loop campaign from the start and INS its flight group's pass left), elsewhere
-NavSystem.run(copies=True). Both give the same numbers (tests/unit/integrity/test_bankpass.py).
+(campaign/bankpass.py; in an open-loop campaign from the start and INS its flight group's pass left), elsewhere
+NavSystem.run(copies=True). Both give the same numbers (tests/unit/campaign/test_bankpass.py).
 
 At each filter epoch, in the approach frame (vertical up; lateral = cross-track, + right of the runway
 heading), the separation of sub-solution k is e_k - e_0 (the difference of the output errors against truth,
@@ -29,7 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from approachsim.integrity import bankpass
+from approachsim.campaign import bankpass
+from approachsim.campaign.bank_modes import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE, mode_name
 from approachsim.integrity.requirements import (
     REQUIREMENTS,
     IntegrityRequirement,
@@ -37,27 +38,13 @@ from approachsim.integrity.requirements import (
     vertical_alert_limit_m,
 )
 from approachsim.integrity.separation import SeparationResult, identify_statistic, separation
+from approachsim.memo import TruthMemo
+from approachsim.nav.system import NavSystem
+from approachsim.seeding import stream
+from approachsim.sensors.states import start_states
+from approachsim.sensors.suite import SensorSuite
 
 Array = np.ndarray
-
-
-BARO_MODE = -2
-"""Mode code of the baro (a sub-filter without it)."""
-RADALT_MODE = -3
-"""Mode code of the radar altimeter."""
-PSEUDOLITE_MODE = -10
-"""Mode code of pseudolite unit 0; unit u is PSEUDOLITE_MODE - u."""
-
-
-def mode_name(code: int) -> str:
-    """A mode code's source: "gnss <channel>", "baro", "radalt" or "pseudolite <unit>"."""
-    if code >= 0:
-        return f"gnss {code}"
-    if code == BARO_MODE:
-        return "baro"
-    if code == RADALT_MODE:
-        return "radalt"
-    return f"pseudolite {PSEUDOLITE_MODE - code}"
 
 
 def sensor_modes(records: dict[str, Any]) -> list[int]:
@@ -340,33 +327,31 @@ def score_run(ep: BankEpochs, epoch_hz: float, start_height_m: float, dh_m: dict
 
 
 def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: bool = False, *,
-             compiled: bool = True, group: tuple[Any, int] | None = None) -> tuple[BankEpochs, Any]:
+             compiled: bool = True, group: tuple[Any, int] | None = None, memo: TruthMemo | None = None
+             ) -> tuple[BankEpochs, Any]:
     """Measure run `run` of the campaign seeded `seed` on `truth`, navigate it with the main filter and the
     sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun).
     sensor_modes_on: the baro, radar altimeter and pseudolite units are fault modes too (module docstring).
 
-    Where integrity.bankpass applies (the compiled optimal filter, feed-forward, per-run GPS skies: the default),
+    Where campaign.bankpass applies (the compiled optimal filter, feed-forward, per-run GPS skies: the default),
     the run is measured once and bankpass.bank_pass navigates every copy in one compiled call on the reduced
     state (the same numbers; the main NavRun then has no solution and the reduced layout). Elsewhere the copies
     share the run's IMU record and its INS (NavSystem.run(copies=True), feed-forward): the IMU is
     drawn and applied once; the other sensors are measured for the K + 1 copies (the same draws: the same
     streams), whose GNSS records then lose one channel each (bank_records). compiled=False: always the latter (the
-    oracle of integrity/bankpass.py). group: (bankpass.GroupInputs, k) what the open-loop flight group's pass left
+    oracle of campaign/bankpass.py). group: (bankpass.GroupInputs, k) what the open-loop flight group's pass left
     for this run, its run k (campaign/pipeline.py): nothing is drawn, started or integrated again (the same numbers,
-    bankpass.bank_pass_group)."""
+    bankpass.bank_pass_group). memo: the truth's TruthMemo (approachsim/memo.py) from the caller that shares the
+    truth among runs (an open-loop group, a study's flown truth): the converged start, the reference and the epoch
+    models are then made once."""
     from dataclasses import fields, replace
-
-    from approachsim.nav.system import NavSystem
-    from approachsim.seeding import stream
-    from approachsim.sensors.states import start_states
-    from approachsim.sensors.suite import SensorSuite
 
     if compiled and group is not None and not sensor_modes_on:
         g, k = group
         nav = NavSystem.from_profile(profile)
         if g.usable(nav) and bankpass.applicable(nav, g.records):
             channels = used_channels(np.asarray(g.records["gnss"].valid)[k])
-            bp = bankpass.bank_pass_group(nav, truth, g, k, channels)
+            bp = bankpass.bank_pass_group(nav, truth, g, k, channels, memo)
             if bp is not None:
                 ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth,
                                         profile.runway.heading_rad)
@@ -385,8 +370,8 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     # a sub-filter without the baro has its own INS when the baro damping loop drives the INS vertical channel
     own_ins = bool(sensor_modes_on and "baro" in one and nav.loop_gains() is not None)
     share = not nav.nav.feedback and "imu" in one and not own_ins
-    if compiled and share and bankpass.applicable(nav, one):  # the compiled reduced pass (integrity/bankpass.py)
-        bp = bankpass.bank_pass(nav, truth, one, channels, stream(seed, run, "nav"), states)
+    if compiled and share and bankpass.applicable(nav, one):  # the compiled reduced pass (campaign/bankpass.py)
+        bp = bankpass.bank_pass(nav, truth, one, channels, stream(seed, run, "nav"), states, memo)
         if bp is not None:
             ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth, profile.runway.heading_rad)
             return ep, bp.main_run()
@@ -399,6 +384,6 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
                                 for f in fields(states) if isinstance(getattr(states, f.name), np.ndarray)})
     # every copy starts from the main filter's converged state (the first copy's schedule: all channels)
     navs = nav.run(truth, recs, [stream(seed, run, "nav") for _ in range(copies)],
-                   shared_covariance=nav.shares_covariance(), states=states, copies=share)
+                   shared_covariance=nav.shares_covariance(), states=states, copies=share, memo=memo)
     ep = bank_epochs(navs[0], navs[1:], channels, truth, profile.runway.heading_rad)
     return ep, navs[0]

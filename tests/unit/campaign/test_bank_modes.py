@@ -1,4 +1,4 @@
-"""Sensor fault modes of the bank (integrity/bank.py): a sub-filter's copy of the records without the baro, the
+"""Sensor fault modes of the bank (campaign/integrity_bank.py): a sub-filter's copy of the records without the baro, the
 radar altimeter or one pseudolite unit (invalid and nan throughout, as an outage), the GNSS channels as before."""
 
 from __future__ import annotations
@@ -8,14 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from approachsim.integrity.bank import (
-    BARO_MODE,
-    PSEUDOLITE_MODE,
-    RADALT_MODE,
-    bank_records,
-    mode_name,
-    sensor_modes,
-)
+from approachsim.campaign.bank_modes import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE, mode_name
+from approachsim.campaign.integrity_bank import bank_records, sensor_modes
 
 
 @dataclass(frozen=True)

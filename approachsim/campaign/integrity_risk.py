@@ -7,10 +7,10 @@ from a Gaussian tail with the covariance's overbound measured on simulated runs.
 **What is simulated.** One sample of mode k is an open-loop navigation of a flown approach (one of `truths`
 JSBSim flights of the profile, shared as the campaign's open loop shares them) with the run's own sensor and filter
 noise (its own run index, so its own streams and, with per-run epochs, its own GPS sky), one fault from the mode
-with the parameters u maps to, through the solution-separation bank (integrity.bank.run_bank: the main filter and
-one sub-filter per used GPS channel, the exclusion at the first detection), scored per category as the campaign
-does (integrity.bank.score_category: epochs from the settle time down to the category's DH, Annex 10 alert limits
-at the aircraft's distance and height). The event is hazardously misleading information at any epoch: the output
+with the parameters u maps to, through the solution-separation bank (campaign.integrity_bank.run_bank: the main filter
+and one sub-filter per used GPS channel, the exclusion at the first detection), scored per category as the campaign
+does (campaign.integrity_bank.score_category: epochs from the settle time down to the category's DH, Annex 10 alert
+limits at the aircraft's distance and height). The event is hazardously misleading information at any epoch: the output
 error beyond the alert limit on either axis while the output's protection levels are inside both limits. Its
 limit-state function (continuous, for the adaptive steps) is
 
@@ -51,6 +51,7 @@ approach, so the per-approach probability compared with them is conservative.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 import time
@@ -62,8 +63,16 @@ from typing import Any
 import numpy as np
 from scipy import stats as sps
 
+from approachsim.campaign.integrity_bank import run_bank, score_category
+from approachsim.campaign.integrity_campaign import bank_profile
+from approachsim.campaign.pipeline import approach_stop_height_m
+from approachsim.campaign.runner import register_pickling
+from approachsim.flight.run import Approach
 from approachsim.integrity import rare
 from approachsim.integrity.requirements import REQUIREMENTS
+from approachsim.memo import TruthMemo
+from approachsim.sensors.faults import FaultSpec
+from approachsim.sensors.suite import SensorSuite
 
 Array = np.ndarray
 
@@ -151,44 +160,49 @@ def modes_for(profile: Any, names: Sequence[str] | None = None) -> list[FaultMod
 
 # ---- one sample ----------------------------------------------------------------------------------------------
 
-_TRUTHS: dict = {}
-"""Flown truths of this process by (profile, seed, index): (truth, onset window start s, end s)."""
+@dataclass(frozen=True, eq=False)
+class FlownTruth:
+    """One of the study's flown truths, its onset window and the memo of the work its samples share (the bank's
+    reference, epoch models and converged starts: approachsim/memo.py)."""
+
+    truth: Any
+    t_lo_s: float
+    """Start of the onset window: the settle time after the start, s."""
+    t_hi_s: float
+    """End of the onset window: where the truth passes the lowest decision height, s."""
+    memo: TruthMemo
+
+
+@functools.lru_cache(maxsize=16)
+def flown_truth(profile: Any, seed: int, index: int) -> FlownTruth:
+    """Truth `index` of the campaign seeded `seed` (the open-loop group index * flight_group's flight), flown once per
+    process for the same (profile value, seed, index), and its onset window: from the settle time after the start
+    to the lowest decision height, s."""
+    flight = Approach(profile, stop_height_m=approach_stop_height_m(profile)).fly(
+        seed=seed, run=index * profile.evaluation.flight_group)
+    if not flight.ok:
+        raise RuntimeError(f"truth {index}: the flight failed ({flight.termination})")
+    truth = flight.truth
+    z = np.asarray(truth.r_rwy)[:, 2]
+    low = min(profile.evaluation.dh_m(c) for c in REQUIREMENTS)
+    t_end = float(truth.t_s[int(np.argmax(z < low))]) if np.any(z < low) else float(truth.t_s[-1])
+    return FlownTruth(truth, float(truth.t_s[0]) + profile.evaluation.timeavg_settle_s, t_end, TruthMemo(truth))
 
 
 def flight_truth(profile: Any, seed: int, index: int) -> tuple[Any, float, float]:
-    """Truth `index` of the campaign seeded `seed` (the open-loop group index * flight_group's flight) and the onset
-    window: from the settle time after the start to the lowest decision height, s."""
-    key = (profile, seed, index)
-    if key not in _TRUTHS:
-        from approachsim.campaign.pipeline import approach_stop_height_m
-        from approachsim.flight.run import Approach
-
-        if len(_TRUTHS) > 16:
-            _TRUTHS.clear()
-        flight = Approach(profile, stop_height_m=approach_stop_height_m(profile)).fly(
-            seed=seed, run=index * profile.evaluation.flight_group)
-        if not flight.ok:
-            raise RuntimeError(f"truth {index}: the flight failed ({flight.termination})")
-        truth = flight.truth
-        z = np.asarray(truth.r_rwy)[:, 2]
-        low = min(profile.evaluation.dh_m(c) for c in REQUIREMENTS)
-        t_end = float(truth.t_s[int(np.argmax(z < low))]) if np.any(z < low) else float(truth.t_s[-1])
-        _TRUTHS[key] = (truth, float(truth.t_s[0]) + profile.evaluation.timeavg_settle_s, t_end)
-    return _TRUTHS[key]
+    """(truth, onset window start s, end s) of `flown_truth`."""
+    f = flown_truth(profile, int(seed), int(index))
+    return f.truth, f.t_lo_s, f.t_hi_s
 
 
 def fault_spec(mode: FaultMode, u: Array, profile: Any, truth: Any, seed: int, run: int,
                window: tuple[float, float]) -> tuple[Any, dict]:
     """The FaultSpec u maps to (module docstring) and its physical parameters."""
-    from approachsim.sensors.faults import FaultSpec
-
     u = np.asarray(u, float)
     onset = window[0] + float(sps.norm.cdf(u[0])) * (window[1] - window[0])
     mag = mode.magnitude(float(u[1]))
     channel, n_used = None, 1
     if mode.sensor == "gnss":
-        from approachsim.sensors.suite import SensorSuite
-
         suite = SensorSuite.from_profile(profile)
         g = suite.without(*[s for s in suite.sensors if s != "gnss"]).measure(truth, seed=seed, runs=[run])["gnss"]
         j = int(np.clip(np.searchsorted(g.t_s, onset), 0, len(g.t_s) - 1))
@@ -212,8 +226,6 @@ def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float, confirm: bool 
     epochs, `detected` (any detection) and the excluded channel; fault-free diagnostics: the normalized main errors
     and separations (`z2_v`, `z2_l`, `ss2`: sums of squares, `n_z`, `n_ss`: counts). confirm: the bank identifies
     with the second look (bank.second_level)."""
-    from approachsim.integrity.bank import score_category
-
     out: dict[str, float] = {}
     settled = ep.t_s >= t0_s + cfg.timeavg_settle_s
     for cat, req in REQUIREMENTS.items():
@@ -257,16 +269,14 @@ def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | 
     returned with `failed` = 1 and every category's hmi_g = +1e3 (a failed navigation counts as the event:
     conservative)."""
     try:
-        from approachsim.integrity.bank import run_bank
-        from approachsim.integrity.campaign import bank_profile
-
-        truth, t_lo, t_hi = flight_truth(profile, seed, run % truths)
+        flown = flown_truth(profile, int(seed), int(run % truths))
+        truth, t_lo, t_hi = flown.truth, flown.t_lo_s, flown.t_hi_s
         prof = profile
         params: dict = {}
         if mode_name is not None:
             spec, params = fault_spec(fault_mode(mode_name), np.asarray(u), profile, truth, seed, run, (t_lo, t_hi))
             prof = dataclasses.replace(profile, faults=(*tuple(profile.faults or ()), spec))
-        ep, _ = run_bank(bank_profile(prof), truth, seed, run, sensor_modes_on=sensor_modes)
+        ep, _ = run_bank(bank_profile(prof), truth, seed, run, sensor_modes_on=sensor_modes, memo=flown.memo)
         out = limit_states(ep, profile.evaluation, profile.nav.aiding_rate_hz, float(truth.t_s[0]), confirm)
         return {**out, **{f"fault_{k}": float(v) for k, v in params.items()}, "failed": 0.0}
     except Exception as e:  # noqa: BLE001 - a failed sample is data (counted as the event), never dropped
@@ -299,8 +309,6 @@ class Simulator:
     def __enter__(self) -> Simulator:
         if self.workers > 1:
             import multiprocessing
-
-            from approachsim.campaign.runner import register_pickling
 
             register_pickling()
             self._pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("fork"))
