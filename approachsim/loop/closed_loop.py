@@ -45,7 +45,7 @@ from approachsim.nav.observations import Observations
 from approachsim.nav.system import NavSystem, tuned_records
 from approachsim.records import Truth
 from approachsim.seeding import stream
-from approachsim.sensors.gnss.receiver import IONO_SHELL_M
+from approachsim.sensors.gnss.elevation import IONO_SHELL_M
 from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite
 
