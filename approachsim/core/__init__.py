@@ -11,6 +11,8 @@ by this package's sources alone (approachsim/__init__.py), so editing a stage ne
     entry          a dispatcher's compiled entry point, called without numba's per-call typing (numba internals)
     sensors/       the sensor models' error application (each sensor module's `apply`; oracle `apply_reference`)
         imu, noise, baro, radalt, pseudolite, gnss (orbits, look angles, selection, pseudoranges and rates)
+        gnss_errors   each GNSS range-error formula once (DO-229 tropo mapping, iono obliquity, DO-253 multipath,
+                      the filter's channel sigmas, the GBAS scales), scalar
     nav/           the navigation stage's arithmetic
         strapdown     the strapdown INS mechanization over many runs and IMU intervals (nav/ins.py)
         output        the navigation output of every row, INS - x_hat

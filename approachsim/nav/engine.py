@@ -25,8 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from approachsim import geo
 from approachsim.core.nav import epoch as ke
+from approachsim.core.sensors import gnss as gk
 from approachsim.nav import errormodel as em
 from approachsim.nav import measurements as meas
 from approachsim.nav import terrain_db as tdb
@@ -211,8 +211,8 @@ class EpochEngine:
         self._gbas = None
         if g is not None:  # the channel-noise budget of channel_sigmas
             bud = g.budget()
-            self._sky_budget = (geo.A_WGS84, IONO_SHELL_M, bud.clock_ephemeris_m, bud.iono_zenith_m,
-                                bud.tropo_zenith_m, bud.multipath_model == "do253", float(bud.multipath_m))
+            self._sky_budget = (IONO_SHELL_M, bud.clock_ephemeris_m, bud.iono_zenith_m, bud.tropo_zenith_m,
+                                bud.multipath_model == "do253", float(bud.multipath_m))
             if bud.gbas is not None:
                 self._gbas = bud.gbas.channel_kernel_args()
         self.F, self.Qc, self.phi, self.qd = (np.zeros((n, n)) for _ in range(4))
@@ -230,18 +230,17 @@ class EpochEngine:
     def channel_sigmas(self, el: Array) -> tuple[Array, Array]:
         """The GPS channel states' slow and fast 1-sigma (m) at elevations el (N, k) rad, each element on its own:
         the receiver budget's channel_sigmas_m with nav/noise.py's elevation guard, compiled. Stand-alone:
-        core/nav/epoch.channel_sigmas; GBAS corrections: core/sensors/gnss.gbas_channel_sigmas at
+        core/sensors/gnss.channel_sigmas; GBAS corrections: core/sensors/gnss.gbas_channel_sigmas at
         gbas.REFERENCE_GEOMETRY (the filter's elevation-only channel noise, as nav/noise.py builds it)."""
         el = np.ascontiguousarray(el, dtype=float)
         gse, gmp = np.empty(el.shape), np.empty(el.shape)
         if self._gbas is None:
-            ke.channel_sigmas(el, *self._sky_budget, gse, gmp)
+            gk.channel_sigmas(el, *self._sky_budget, gse, gmp)
         else:
-            from approachsim.core.sensors.gnss import gbas_channel_sigmas
             from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
 
             x, dh, v = (np.full(el.shape[0], g) for g in REFERENCE_GEOMETRY)
-            gbas_channel_sigmas(el, x, dh, v, *self._gbas, gse, gmp)
+            gk.gbas_channel_sigmas(el, x, dh, v, *self._gbas, gse, gmp)
         return gse, gmp
 
     def carrier_channel_sigmas(self, el: Array) -> tuple[Array, Array, Array]:

@@ -33,6 +33,7 @@ from approachsim.core.loop import nav_row as ik
 from approachsim.core.nav import epoch as ke
 from approachsim.core.sensors import baro as bk
 from approachsim.core.sensors import gnss as gk
+from approachsim.core.sensors import gnss_errors as ge
 from approachsim.core.sensors import radalt as rk
 
 
@@ -89,14 +90,12 @@ RAD_TO_DEG = 180.0 / math.pi
 def channel_guard(el: np.ndarray, lo: float, g: np.ndarray, mp_arg: np.ndarray) -> None:
     """The GPS channel states' elevations as the noise model guards them (nav/noise.py): g = max(el, lo) with nan
     read as 0.5 rad, and mp_arg = -degrees(g) / 10, the argument of DO-253's multipath curve
-    (receiver.do253_multipath_sigma_m). numpy's operations one by one (where, maximum, degrees, negative, divide):
-    exact in IEEE arithmetic, the same bits."""
+    (core/sensors/gnss_errors.py guard_elevation, do253_exponent). numpy's operations one by one (where, maximum,
+    degrees, negative, divide): exact in IEEE arithmetic, the same bits."""
     for i in range(el.shape[0]):
-        e = el[i]
-        e = 0.5 if e != e else e
-        e = e if e >= lo else lo
+        e = ge.guard_elevation(el[i], lo)
         g[i] = e
-        mp_arg[i] = -(e * RAD_TO_DEG) / 10.0
+        mp_arg[i] = ge.do253_exponent(e)
 
 
 @njit(cache=True)
@@ -104,21 +103,13 @@ def channel_sigmas(cos_g: np.ndarray, sin_g: np.ndarray, exp_mp: np.ndarray, a_m
                    ce2: float, iono_zenith_m: float, tropo_zenith_m: float, do253: bool, gse: np.ndarray,
                    gmp: np.ndarray) -> None:
     """A stand-alone budget's channel sigmas (receiver.GnssErrorBudget.channel_sigmas_m, m) from numpy's cos, sin of
-    the guarded elevations and exp of mp_arg (channel_guard): x = a cos / (a + h), F = 1 / sqrt(1 - x^2),
-    M = 1.001 / sqrt(0.002001 + sin^2), gse = sqrt(ce^2 + (I_z F)^2 + (T_z M)^2), gmp = 0.13 + 0.53 exp (do253;
-    else gmp is left as it is). The same operations in numpy's order (no transcendental function here: those stay
+    the guarded elevations and exp of mp_arg (channel_guard): core/sensors/gnss_errors.channel_sigmas, gse =
+    sqrt(ce^2 + (I_z F)^2 + (T_z M)^2), gmp = 0.13 + 0.53 exp (do253; else gmp is left as it is); a_m is that
+    module's R (the WGS-84 a). The same operations in numpy's order (no transcendental function here: those stay
     numpy's, whose last bit numba's may not match), the same bits."""
-    den = a_m + shell_m
-    for i in range(cos_g.shape[0]):
-        x = a_m * cos_g[i] / den
-        f = 1.0 / math.sqrt(1.0 - x * x)
-        s = sin_g[i]
-        m = 1.001 / math.sqrt(0.002001 + s * s)
-        fi = iono_zenith_m * f
-        tm = tropo_zenith_m * m
-        gse[i] = math.sqrt(ce2 + fi * fi + tm * tm)
-        if do253:
-            gmp[i] = 0.13 + 0.53 * exp_mp[i]
+    for i in range(cos_g.shape[0]):  # a_m: gnss_errors' R (the same WGS-84 a)
+        gse[i], gmp[i] = ge.channel_sigmas(cos_g[i], sin_g[i], exp_mp[i], shell_m, ce2, iono_zenith_m,
+                                           tropo_zenith_m, do253, gmp[i])
 
 
 HAS_BARO = 1

@@ -336,29 +336,6 @@ def _with_resets(phi: np.ndarray, qd: np.ndarray, lay: np.ndarray, new: np.ndarr
 
 
 @njit(cache=True)
-def channel_sigmas(el: np.ndarray, a_m: float, shell_m: float, ce_m: float, iono_m: float, tropo_m: float,
-                   do253: bool, mp_m: float, gse: np.ndarray, gmp: np.ndarray) -> None:
-    """The GPS channel states' 1-sigma (m) at elevations el (N, k) rad, into gse, gmp (N, k), element by element
-    (nav/noise.py's numpy formulas; a run's values do not depend on the batch):
-
-        el <- max(el, 2 deg) (nan: 0.5 rad);  F = 1 / sqrt(1 - (a cos el / (a + h_I))^2);  M = 1.001 / sqrt(0.002001
-        + sin^2 el);  gse = sqrt(ce^2 + (I F)^2 + (T M)^2);  gmp = 0.13 + 0.53 exp(-el / 10 deg) (DO-253) or mp_m
-    """
-    lo = math.radians(2.0)
-    for i in range(el.shape[0]):
-        for c in range(el.shape[1]):
-            e = el[i, c]
-            e = 0.5 if e != e else e
-            e = max(e, lo)
-            x = a_m * math.cos(e) / (a_m + shell_m)
-            f = 1.0 / math.sqrt(1.0 - x * x)
-            s = math.sin(e)
-            m = 1.001 / math.sqrt(0.002001 + s * s)
-            gse[i, c] = math.sqrt(ce_m**2 + (iono_m * f) ** 2 + (tropo_m * m) ** 2)
-            gmp[i, c] = 0.13 + 0.53 * math.exp(-math.degrees(e) / 10.0) if do253 else mp_m
-
-
-@njit(cache=True)
 def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, gse: np.ndarray, gmp: np.ndarray,
                 loop: np.ndarray, dt: np.ndarray, ref: np.ndarray, ref_cbn: np.ndarray, f_ref: np.ndarray,
                 ref_agl: np.ndarray, held: np.ndarray, ch_gse: np.ndarray, ch_gmp: np.ndarray, f_gse: np.ndarray,

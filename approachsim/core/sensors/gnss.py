@@ -11,6 +11,7 @@ same sample of a batch bit for bit.
     look_angles        range, line of sight, elevation and azimuth of every satellite from the receiver
     sky                look angles, visibility, selection (all / best-PDOP four / a planned four), PDOP, mappings
     pseudoranges       range + mapped errors + receiver clock for every run, nan where not selected
+    channel_sigmas     the navigation filter's GPS channel-state sigmas of a stand-alone budget, element by element
     gbas_scales        the GBAS-corrected residual's scales and nominal sigma per channel (gnss/gbas.py)
     gbas_channel_sigmas the navigation filter's GPS channel-state sigmas under GBAS, element by element
     pseudoranges_gbas  range + scaled GBAS residual series + receiver clock for every run
@@ -26,6 +27,7 @@ import numpy as np
 from numba import njit
 
 from approachsim import geo
+from approachsim.core.sensors import gnss_errors as ge
 
 A = geo.A_WGS84
 B = geo.B_WGS84
@@ -33,7 +35,6 @@ E2 = geo.E2_WGS84
 EP2 = E2 / (1.0 - E2)
 OMEGA_E = geo.OMEGA_E
 TWO_PI = 2.0 * math.pi
-RAD_TO_DEG = 180.0 / math.pi
 
 MODE_ALL = 0
 """Selection: every visible channel."""
@@ -299,12 +300,10 @@ def sky(r_rx: np.ndarray, r_sv: np.ndarray, mask_rad: float, mode: int, plan: np
             pd[s, i] = pdop(u[s, i], sel[s, i])
             for j in range(k):
                 e = el[s, i, j]
-                x = A * math.cos(e) / (A + shell_m)
-                f = 1.0 / math.sqrt(1.0 - x * x)
-                sn = math.sin(e)
-                mt = 1.001 / math.sqrt(0.002001 + sn * sn)
+                f = ge.iono_obliquity(math.cos(e), shell_m)
+                mt = ge.tropo_mapping(math.sin(e))
                 if do253:
-                    msc = 0.13 + 0.53 * math.exp(-(e * RAD_TO_DEG) / 10.0)
+                    msc = ge.do253_multipath_m(e)
                     mps = msc
                 else:
                     msc = 1.0
@@ -346,20 +345,22 @@ def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_sc
 
 
 @njit(cache=True)
-def _gbas_terms(e: float, path: float, hfac: float, gad: np.ndarray, n_ref: float, aad: np.ndarray,
-                shell_m: float) -> tuple[float, float, float, float, float]:
-    """The five GBAS scales (ground, iono, tropo, multipath, noise), m, of one channel at elevation e (rad), with
-    path = sigma_vig (x_air + 2 tau v_air) and hfac = sigma_n h0 1e-6 |1 - exp(-dh / h0)| (gbas_scales)."""
-    if e > gad[0]:
-        a = gad[1] + gad[2] * math.exp(-e / gad[3])
-        a2 = gad[4]
-    else:
-        a = gad[5] + gad[6] * math.exp(-e / gad[7])
-        a2 = gad[8]
-    x = A * math.cos(e) / (A + shell_m)
-    sn = math.sin(e)
-    return (math.sqrt(a * a / n_ref + a2 * a2), path / math.sqrt(1.0 - x * x), hfac / math.sqrt(0.002 + sn * sn),
-            0.13 + 0.53 * math.exp(-(e * RAD_TO_DEG) / 10.0), aad[0] + aad[1] * math.exp(-e / aad[2]))
+def channel_sigmas(el: np.ndarray, shell_m: float, ce_m: float, iono_m: float, tropo_m: float, do253: bool,
+                   mp_m: float, gse: np.ndarray, gmp: np.ndarray) -> None:
+    """The GPS channel states' 1-sigma (m) of a stand-alone budget at elevations el (N, k) rad, into gse, gmp (N, k),
+    element by element (the compiled twin of receiver.GnssErrorBudget.channel_sigmas_m behind nav/noise.py's
+    elevation guard; a run's values do not depend on the batch): gnss_errors.channel_sigmas at
+    el <- guard_elevation(el) (nan: 0.5 rad, at least 2 deg),
+
+        gse = sqrt(ce^2 + (I F)^2 + (T M)^2),  gmp = 0.13 + 0.53 exp(-el / 10 deg) (DO-253) or mp_m
+    """
+    ce2 = ce_m * ce_m
+    for i in range(el.shape[0]):
+        for c in range(el.shape[1]):
+            e = ge.guard_elevation(el[i, c], ge.ELEVATION_FLOOR_RAD)
+            decay = math.exp(ge.do253_exponent(e)) if do253 else 0.0
+            gse[i, c], gmp[i, c] = ge.channel_sigmas(math.cos(e), math.sin(e), decay, shell_m, ce2, iono_m, tropo_m,
+                                                     do253, mp_m)
 
 
 @njit(cache=True)
@@ -373,15 +374,12 @@ def gbas_channel_sigmas(el: np.ndarray, x_air: np.ndarray, dh: np.ndarray, v_air
 
         el <- max(el, 2 deg) (nan: 0.5 rad);  gse = sqrt(ground^2 + iono^2 + tropo^2);  gmp = sqrt(mp^2 + noise^2)
     """
-    lo = math.radians(2.0)
     for i in range(el.shape[0]):
         path = sigma_vig * (x_air[i] + 2.0 * tau_s * v_air[i])
         hfac = sigma_n * h0_m * 1e-6 * abs(-math.expm1(-dh[i] / h0_m))
         for c in range(el.shape[1]):
-            e = el[i, c]
-            e = 0.5 if e != e else e
-            e = max(e, lo)
-            g, io, tr, mp, nz = _gbas_terms(e, path, hfac, gad, n_ref, aad, shell_m)
+            e = ge.guard_elevation(el[i, c], ge.ELEVATION_FLOOR_RAD)
+            g, io, tr, mp, nz = ge.gbas_terms(e, path, hfac, gad, n_ref, aad, shell_m)
             gse[i, c] = math.sqrt(g * g + io * io + tr * tr)
             gmp[i, c] = math.sqrt(mp * mp + nz * nz)
 
@@ -419,7 +417,7 @@ def gbas_scales(el: np.ndarray, r_rx: np.ndarray, h_m: np.ndarray, v_ned: np.nda
             path = sigma_vig * (x_air + 2.0 * tau_s * v_air)
             hfac = sigma_n * h0_m * 1e-6 * abs(-math.expm1(-(h_m[i] - station_h_m) / h0_m))
             for j in range(k):
-                g, io, tr, mp, nz = _gbas_terms(el[s, i, j], path, hfac, gad, n_ref, aad, shell_m)
+                g, io, tr, mp, nz = ge.gbas_terms(el[s, i, j], path, hfac, gad, n_ref, aad, shell_m)
                 s_gnd[s, i, j] = g
                 s_iono[s, i, j] = io
                 s_tropo[s, i, j] = tr

@@ -194,7 +194,8 @@ class GnssErrorBudget:
 
 
 def do253_multipath_sigma_m(el_rad: Array) -> Array:
-    """Airframe multipath 1-sigma (m): 0.13 + 0.53 exp(-el / 10 deg) (RTCA DO-253 / DO-229; MAAST init_cnmp_mops)."""
+    """Airframe multipath 1-sigma (m): 0.13 + 0.53 exp(-el / 10 deg) (RTCA DO-253 / DO-229; MAAST init_cnmp_mops).
+    numpy, the oracle of the kernels' core/sensors/gnss_errors.do253_multipath_m."""
     return 0.13 + 0.53 * np.exp(-np.degrees(np.asarray(el_rad, dtype=float)) / 10.0)
 
 
@@ -236,13 +237,15 @@ CODE_PRESETS: Mapping[str, GnssErrorBudget] = MappingProxyType({
 
 
 def iono_obliquity(el_rad: Array) -> Array:
-    """Thin-shell ionospheric obliquity factor 1 / sqrt(1 - (R cos el / (R + h_I))^2)."""
+    """Thin-shell ionospheric obliquity factor 1 / sqrt(1 - (R cos el / (R + h_I))^2). numpy, the oracle of the
+    kernels' core/sensors/gnss_errors.iono_obliquity."""
     x = geo.A_WGS84 * np.cos(el_rad) / (geo.A_WGS84 + IONO_SHELL_M)
     return 1.0 / np.sqrt(1.0 - x * x)
 
 
 def tropo_mapping(el_rad: Array) -> Array:
-    """Tropospheric mapping 1.001 / sqrt(0.002001 + sin^2 el) (RTCA DO-229 A.4.2.4)."""
+    """Tropospheric mapping 1.001 / sqrt(0.002001 + sin^2 el) (RTCA DO-229 A.4.2.4). numpy, the oracle of the
+    kernels' core/sensors/gnss_errors.tropo_mapping."""
     return 1.001 / np.sqrt(0.002001 + np.sin(el_rad) ** 2)
 
 
