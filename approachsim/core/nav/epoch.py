@@ -44,15 +44,6 @@ CODE_BARO, CODE_RADALT, CODE_GPS, CODE_PL, CODE_CP = 0, 1, 100, 200, 300
 
 
 @njit(cache=True)
-def _c_en(lat: float, lon: float, c: np.ndarray) -> None:
-    """ECEF -> NED rotation at (lat, lon), rad (geo.c_ecef_to_ned), into c (3, 3)."""
-    sl, cl, so, co = math.sin(lat), math.cos(lat), math.sin(lon), math.cos(lon)
-    c[0, 0], c[0, 1], c[0, 2] = -sl * co, -sl * so, cl
-    c[1, 0], c[1, 1], c[1, 2] = -so, co, 0.0
-    c[2, 0], c[2, 1], c[2, 2] = -cl * co, -cl * so, -sl
-
-
-@njit(cache=True)
 def _ecef(y: np.ndarray, r: np.ndarray) -> None:
     """ECEF position (m) of the packed INS state y (16,) into r (3,)."""
     r[0], r[1], r[2] = gk.geodetic_to_ecef(y[0], y[1], y[2])
@@ -121,7 +112,7 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
     c_ins = np.empty((3, 3))
     c_ref = np.empty((3, 3))
     _ecef(ref, r_ref)
-    _c_en(ref[0], ref[1], c_ref)
+    gk.c_ecef_to_ned(ref[0], ref[1], c_ref)
     k = 0
     empty_u = np.zeros(0)
     # baro
@@ -166,13 +157,13 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
         sv = c if channel_states else -1
         if own:
             _ecef(ins[0], r_ins)
-            _c_en(ins[0, 0], ins[0, 1], c_ins)
+            gk.c_ecef_to_ned(ins[0, 0], ins[0, 1], c_ins)
             nu[0] = km._pseudorange(lay, X[0], r_ins, c_ins, r_sv[c], rho[0, c], sv, -1, h, True)
         else:
             km._pseudorange(lay, x0, r_ref, c_ref, r_sv[c], rho[0, c], sv, -1, h, True)
             for m in range(M):
                 _ecef(ins[m], r_ins)
-                _c_en(ins[m, 0], ins[m, 1], c_ins)
+                gk.c_ecef_to_ned(ins[m, 0], ins[m, 1], c_ins)
                 nu[m] = km._pseudorange(lay, X[m], r_ins, c_ins, r_sv[c], rho[m, c], sv, -1, x0, False)
         if i_gio >= 0 and sv >= 0:  # carrier phase: the code's ionosphere is the gio state, -1 in the row
             h[i_gio + c] = -1.0
@@ -189,13 +180,13 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
             continue
         if own:
             _ecef(ins[0], r_ins)
-            _c_en(ins[0, 0], ins[0, 1], c_ins)
+            gk.c_ecef_to_ned(ins[0, 0], ins[0, 1], c_ins)
             nu[0] = kcar.carrier_phase(lay, X[0], r_ins, c_ins, r_sv[c], cp[0, c], c, h, True)
         else:
             kcar.carrier_phase(lay, x0, r_ref, c_ref, r_sv[c], cp[0, c], c, h, True)
             for m in range(M):
                 _ecef(ins[m], r_ins)
-                _c_en(ins[m, 0], ins[m, 1], c_ins)
+                gk.c_ecef_to_ned(ins[m, 0], ins[m, 1], c_ins)
                 nu[m] = kcar.carrier_phase(lay, X[m], r_ins, c_ins, r_sv[c], cp[m, c], c, x0, False)
         S_out[k] = _apply(X, P, h, cp_r, nu, b, kc)
         codes[k] = CODE_CP + c
@@ -209,13 +200,13 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
         pl = c if pl_states else -1
         if own:
             _ecef(ins[0], r_ins)
-            _c_en(ins[0, 0], ins[0, 1], c_ins)
+            gk.c_ecef_to_ned(ins[0, 0], ins[0, 1], c_ins)
             nu[0] = km._pseudorange(lay, X[0], r_ins, c_ins, r_pl[c], pl_rho[0, c], -1, pl, h, True)
         else:
             km._pseudorange(lay, x0, r_ref, c_ref, r_pl[c], pl_rho[0, c], -1, pl, h, True)
             for m in range(M):
                 _ecef(ins[m], r_ins)
-                _c_en(ins[m, 0], ins[m, 1], c_ins)
+                gk.c_ecef_to_ned(ins[m, 0], ins[m, 1], c_ins)
                 nu[m] = km._pseudorange(lay, X[m], r_ins, c_ins, r_pl[c], pl_rho[m, c], -1, pl, x0, False)
         S_out[k] = _apply(X, P, h, pl_sig[c] ** 2, nu, b, kc)
         codes[k] = CODE_PL + c

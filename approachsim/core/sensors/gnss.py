@@ -27,12 +27,9 @@ import numpy as np
 from numba import njit
 
 from approachsim import geo
+from approachsim.core import geodesy as gd
 from approachsim.core.sensors import gnss_errors as ge
 
-A = geo.A_WGS84
-B = geo.B_WGS84
-E2 = geo.E2_WGS84
-EP2 = E2 / (1.0 - E2)
 OMEGA_E = geo.OMEGA_E
 TWO_PI = 2.0 * math.pi
 
@@ -77,33 +74,6 @@ def sv_orbits(u0: np.ndarray, raan: np.ndarray, a_m: float, ci: float, si: float
 
 
 @njit(cache=True)
-def geodetic_lat_lon(x: float, y: float, z: float) -> tuple[float, float]:
-    """Geodetic latitude and longitude (rad) of the ECEF point (x, y, z), m: geo.ecef_to_geodetic's Bowring start
-    and two refinements lat = atan2(z, p (1 - e^2 R_E / (R_E + h))), in the same order."""
-    lon = math.atan2(y, x)
-    p = math.hypot(x, y)
-    theta = math.atan2(z * A, p * B)
-    lat = math.atan2(z + EP2 * B * math.pow(math.sin(theta), 3.0), p - E2 * A * math.pow(math.cos(theta), 3.0))
-    for _ in range(2):
-        s = math.sin(lat)
-        r_e = A / math.sqrt(1.0 - E2 * (s * s))
-        c = abs(math.cos(lat))
-        h = p / max(c, 1e-300) - r_e if c > 1e-9 else abs(z) - B
-        lat = math.atan2(z, p * (1.0 - E2 * r_e / (r_e + h)))
-    return lat, lon
-
-
-@njit(cache=True)
-def c_ecef_to_ned(lat: float, lon: float, c: np.ndarray) -> None:
-    """The rotation ECEF -> local NED at (lat, lon), rad, into c (3, 3) (geo.c_ecef_to_ned)."""
-    sl, cl = math.sin(lat), math.cos(lat)
-    so, co = math.sin(lon), math.cos(lon)
-    c[0, 0], c[0, 1], c[0, 2] = -sl * co, -sl * so, cl
-    c[1, 0], c[1, 1], c[1, 2] = -so, co, 0.0
-    c[2, 0], c[2, 1], c[2, 2] = -cl * co, -cl * so, -sl
-
-
-@njit(cache=True)
 def _look(rx: np.ndarray, c: np.ndarray, r_sv: np.ndarray, rng: np.ndarray, u: np.ndarray, el: np.ndarray,
           az: np.ndarray) -> None:
     """One epoch (constellation.look_angles): d = r_sv - r_rx, range |d|, u = d / |d| (ECEF), u_ned = C u,
@@ -137,8 +107,8 @@ def look_angles(r_rx: np.ndarray, r_sv: np.ndarray) -> tuple[np.ndarray, np.ndar
     az = np.empty((n_sky, m, k))
     c = np.empty((3, 3))
     for i in range(m):
-        lat, lon = geodetic_lat_lon(r_rx[i, 0], r_rx[i, 1], r_rx[i, 2])
-        c_ecef_to_ned(lat, lon, c)
+        lat, lon = gd.geodetic_lat_lon(r_rx[i, 0], r_rx[i, 1], r_rx[i, 2])
+        gd.c_ecef_to_ned(lat, lon, c)
         for s in range(n_sky):
             _look(r_rx[i], c, r_sv[s, i], rng[s, i], u[s, i], el[s, i], az[s, i])
     return rng, u, el, az
@@ -277,8 +247,8 @@ def sky(r_rx: np.ndarray, r_sv: np.ndarray, mask_rad: float, mode: int, plan: np
     c = np.empty((3, 3))
     idx = np.empty(k, dtype=np.int64)
     for i in range(m):
-        lat, lon = geodetic_lat_lon(r_rx[i, 0], r_rx[i, 1], r_rx[i, 2])
-        c_ecef_to_ned(lat, lon, c)
+        lat, lon = gd.geodetic_lat_lon(r_rx[i, 0], r_rx[i, 1], r_rx[i, 2])
+        gd.c_ecef_to_ned(lat, lon, c)
         for s in range(n_sky):
             _look(r_rx[i], c, r_sv[s, i], rng[s, i], u[s, i], el[s, i], az[s, i])
             for j in range(k):
@@ -468,7 +438,7 @@ def pseudorange_rates(u: np.ndarray, v_sv: np.ndarray, lat: np.ndarray, lon: np.
     c = np.empty((3, 3))
     v_rx = np.empty(3)
     for i in range(m):
-        c_ecef_to_ned(lat[i], lon[i], c)
+        gd.c_ecef_to_ned(lat[i], lon[i], c)
         for q in range(3):
             v_rx[q] = c[0, q] * v_ned[i, 0] + c[1, q] * v_ned[i, 1] + c[2, q] * v_ned[i, 2]
         for r in range(n_run):
