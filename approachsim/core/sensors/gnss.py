@@ -10,11 +10,11 @@ same sample of a batch bit for bit.
     sv_orbits          satellite positions (and velocities) on circular Kepler orbits at each sky's sample times
     look_angles        range, line of sight, elevation and azimuth of every satellite from the receiver
     sky                look angles, visibility, selection (all / best-PDOP four / a planned four), PDOP, mappings
-    pseudoranges       range + mapped errors + receiver clock for every run, nan where not selected
+    pseudorange_sum    range + scaled error terms + receiver clock for every run, nan where not selected
+    pseudoranges       pseudorange_sum with the stand-alone receiver's terms (clock/ephemeris, iono, tropo, mp, noise)
     channel_sigmas     the navigation filter's GPS channel-state sigmas of a stand-alone budget, element by element
     gbas_scales        the GBAS-corrected residual's scales and nominal sigma per channel (gnss/gbas.py)
     gbas_channel_sigmas the navigation filter's GPS channel-state sigmas under GBAS, element by element
-    pseudoranges_gbas  range + scaled GBAS residual series + receiver clock for every run
     pseudorange_rates  line-of-sight range rate + clock drift + noise for every run
     best_four_epochs   the best-PDOP four at each of a stack of epochs (best_four: one epoch)
 """
@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import literal_unroll, njit
 
 from approachsim import geo
 from approachsim.core import geodesy as gd
@@ -288,16 +288,17 @@ def sky(r_rx: np.ndarray, r_sv: np.ndarray, mask_rad: float, mode: int, plan: np
 
 
 @njit(cache=True)
-def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_scale: np.ndarray, sel: np.ndarray,
-                 ce: np.ndarray, iono: np.ndarray, tropo: np.ndarray, mp: np.ndarray, noise: np.ndarray,
-                 bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Pseudoranges (R, m, k) m and validity of every run r (receiver.py; run r on sky r, or on sky 0 when there
-    is one sky for all runs):
+def pseudorange_sum(rng: np.ndarray, sel: np.ndarray, terms: tuple, bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pseudoranges (R, m, k) m and validity of every run r (receiver.py; run r on sky r, or on sky 0 when there is
+    one sky for all runs): the range plus each error term scaled, in the order of `terms`, plus the receiver clock:
 
-        rho = |r_sv - r| + E + F I + M T + s_mp m + n + b_rx      (nan where the channel is not selected)
+        rho = |r_sv - r| + s_1 e_1 + s_2 e_2 + ... + b_rx      (nan where the channel is not selected)
 
-    geometry (S, m, k) from `sky`, errors ce, iono, tropo, mp, noise (R, m, k), receiver clock bias (R, m)."""
-    n_run, m, k = ce.shape
+    rng (S, m, k) and sel from `sky`; terms ((s_t (S, m, k), e_t (R, m, k)), ...) the scales (m per unit, or ones)
+    and the error series; bias (R, m) the receiver clock, m. Stand-alone: `pseudoranges`; GBAS: the scales of
+    gbas_scales with the unit series and the white noise (receiver.py)."""
+    n_run, m = bias.shape[0], bias.shape[1]
+    k = rng.shape[2]
     one_sky = rng.shape[0] == 1
     pr = np.empty((n_run, m, k))
     valid = np.empty((n_run, m, k), dtype=np.bool_)
@@ -306,12 +307,27 @@ def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_sc
         for i in range(m):
             b = bias[r, i]
             for j in range(k):
-                p = (rng[s, i, j] + ce[r, i, j] + f_iono[s, i, j] * iono[r, i, j] + m_tropo[s, i, j] * tropo[r, i, j]
-                     + mp[r, i, j] * mp_scale[s, i, j] + noise[r, i, j])
+                p = rng[s, i, j]
+                for t in literal_unroll(terms):
+                    p = p + t[0][s, i, j] * t[1][r, i, j]
                 v = sel[s, i, j]
                 valid[r, i, j] = v
                 pr[r, i, j] = p + b if v else math.nan
     return pr, valid
+
+
+@njit(cache=True)
+def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_scale: np.ndarray, sel: np.ndarray,
+                 ce: np.ndarray, iono: np.ndarray, tropo: np.ndarray, mp: np.ndarray, noise: np.ndarray,
+                 bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The stand-alone receiver's pseudorange_sum (receiver.py):
+
+        rho = |r_sv - r| + E + F I + M T + s_mp m + n + b_rx      (nan where the channel is not selected)
+
+    geometry (S, m, k) from `sky`, errors ce, iono, tropo, mp, noise (R, m, k), receiver clock bias (R, m)."""
+    one = np.ones(rng.shape)
+    return pseudorange_sum(rng, sel, ((one, ce), (f_iono, iono), (m_tropo, tropo), (mp_scale, mp), (one, noise)),
+                           bias)
 
 
 @njit(cache=True)
@@ -395,35 +411,6 @@ def gbas_scales(el: np.ndarray, r_rx: np.ndarray, h_m: np.ndarray, v_ned: np.nda
                 s_noise[s, i, j] = nz
                 sigma[s, i, j] = math.sqrt(g * g + io * io + tr * tr + mp * mp + nz * nz + w2)
     return s_gnd, s_iono, s_tropo, s_mp, s_noise, sigma
-
-
-@njit(cache=True)
-def pseudoranges_gbas(rng: np.ndarray, s_gnd: np.ndarray, s_iono: np.ndarray, s_tropo: np.ndarray, s_mp: np.ndarray,
-                      s_noise: np.ndarray, sel: np.ndarray, gnd: np.ndarray, iono: np.ndarray, tropo: np.ndarray,
-                      mp: np.ndarray, noise: np.ndarray, white: np.ndarray,
-                      bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """GBAS-corrected pseudoranges (R, m, k) m and validity of every run r (run r on sky r, or on sky 0 for one sky):
-
-        rho = |r_sv - r| + s_gnd g + s_iono I + s_tropo T + s_mp m + s_noise n + w + b_rx   (nan where not selected)
-
-    geometry and scales (S, m, k) from `sky` and `gbas_scales`, unit series and the white noise w (m) (R, m, k),
-    receiver clock bias (R, m)."""
-    n_run, m, k = gnd.shape
-    one_sky = rng.shape[0] == 1
-    pr = np.empty((n_run, m, k))
-    valid = np.empty((n_run, m, k), dtype=np.bool_)
-    for r in range(n_run):
-        s = 0 if one_sky else r
-        for i in range(m):
-            b = bias[r, i]
-            for j in range(k):
-                p = (rng[s, i, j] + s_gnd[s, i, j] * gnd[r, i, j] + s_iono[s, i, j] * iono[r, i, j]
-                     + s_tropo[s, i, j] * tropo[r, i, j] + s_mp[s, i, j] * mp[r, i, j]
-                     + s_noise[s, i, j] * noise[r, i, j] + white[r, i, j])
-                v = sel[s, i, j]
-                valid[r, i, j] = v
-                pr[r, i, j] = p + b if v else math.nan
-    return pr, valid
 
 
 @njit(cache=True)
