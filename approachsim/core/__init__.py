@@ -20,8 +20,10 @@ by this package's sources alone (approachsim/__init__.py), so editing a stage ne
         kalman        sparse predict, scalar Joseph update, shared-covariance update, the Riccati segment
         measurements  the baro, radar-altimeter and pseudorange rows with their innovations (nav/measurements.py)
         carrier       the carrier-phase states' dynamics, float-ambiguity resets and rows
-        epoch         a filter epoch of one run or of a shared-covariance class, and the whole open-loop pass
+        epoch         a filter epoch of one run, of a shared-covariance class or of N copies, and the whole
+                      open-loop pass
         copies        the integrity bank's filter copies (integrity/bankpass.py)
+        groups        the epoch kernels' grouped arguments (named tuples: rows, observations, outputs, scratch)
         reduced       the reduced-order filter's dropped channels (nav/reduced.py)
     loop/          the compiled flight loop and the closed loop inside it
         flight_step   one flight step: the IMU-point truth row, turbulence, autopilot, stabilized-approach monitor,
