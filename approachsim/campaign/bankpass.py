@@ -31,7 +31,7 @@ amb) go together (`rd.CHANNEL_GROUPS`): gio is a Gauss-Markov state and amb a ra
 Phi, Qd: kernels/errormodel.discretize's closed form), and a channel never measured has no carrier phase and no
 arc, so its ambiguity is never reset; the argument above holds for them unchanged. The model adds kernels/carrier.
 dynamics (core/nav/copies.carrier_models); each copy's epoch is shared_pass's carrier step (core/nav/copies.
-bank_epochs_carrier): the gio states' Qd at the copy's sky, then its ambiguities reset where its carrier arc begins
+bank_epochs): the gio states' Qd at the copy's sky, then its ambiguities reset where its carrier arc begins
 (engine.stacked_new_arcs over the copy's arc ids: a copy without channel c has no phase and no arc there,
 bank.bank_records, so it never resets amb_c), the reset zeroing a kept row and column of Phi (a copy) and Qd as on
 the full layout, then class_epoch with the carrier rows after the code rows. The copies start with no arc (the
@@ -51,11 +51,11 @@ import numpy as np
 from approachsim import geo
 from approachsim.campaign.bank_modes import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
 from approachsim.core.nav import copies as kcp
+from approachsim.core.nav import groups as kg
 from approachsim.memo import TruthMemo, memoized
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import reduced as rd
-from approachsim.nav.base import workspace
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, stacked_new_arcs
 from approachsim.nav.navigator import NavRun, StatusLog, _stacked_observations, true_error_rows
 from approachsim.nav.observations import Observations
@@ -306,32 +306,37 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     if model is None:
         return None
     phi, qd = rd.cut(model, red)
-    if carrier:  # core/nav/epoch.shared_pass's carrier step (core/nav/copies.bank_epochs_carrier)
+    rows, scr = eng.rows._replace(lay=red.packed), kg.scratch(n)
+    if carrier:  # core/nav/epoch.shared_pass's carrier step (core/nav/copies.bank_epochs with the carrier states)
         f_gio = -np.expm1(-2.0 * dt_e / nz.gio_tau_s)
-        kcp.bank_epochs_carrier(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
-                               o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x,
-                               db_u, rho, r_sv, sig, eng.channel_states, cp, eng.cp_r, pl_rho, r_pl, pl_sig,
-                               eng.pl_states, ch_gio, f_gio, new, eng.amb_prior, codes, nu, S, n_rows, x_out, pd,
-                               pnav, np.zeros(n), np.zeros(n), workspace(n))
+        kcp.bank_epochs(X, P3, phi, qd, ref, kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio), ins_y,
+                        kg.Obs(baro_h, o["baro_r"], radalt_h, ref_agl, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho,
+                               r_pl, pl_sig), new, rows,
+                        kg.PassOut(codes, nu, S, n_rows, x_out, pd, pnav, np.zeros((C, E, 0, 0)), np.zeros((C, 0)), 0),
+                        scr)
     elif main is not None and C > 1 and np.array_equal(main.kept, kept) and main.x.shape == (E, n):
         # copy 0 is the group pass's own filter of the run: the sub-filters only
         c = np.ascontiguousarray
         s1 = (codes[1:].copy(), nu[1:].copy(), S[1:].copy(), n_rows[1:].copy(), x_out[1:].copy(), pd[1:].copy(),
               pnav[1:].copy())
-        kcp.bank_epochs(X[1:].copy(), P3[1:].copy(), phi, qd, red.packed, c(ch_gse[1:]), c(ch_gmp[1:]), f_gse, f_gmp,
-                       ref, ref_agl, c(ins_y[1:]), c(baro_h[1:]), o["baro_r"], c(radalt_h[1:]), eng.ra_pct,
-                       eng.ra_floor, eng.tx, eng.th, eng.rwy, c(dbp[1:]), db_x, c(db_u[1:]), c(rho[1:]), c(r_sv[1:]),
-                       c(sig[1:]), eng.channel_states, c(pl_rho[1:]), r_pl, pl_sig, eng.pl_states, *s1, np.zeros(n),
-                       np.zeros(n), workspace(n))
+        none = np.zeros((C - 1, E, 0))
+        kcp.bank_epochs(X[1:].copy(), P3[1:].copy(), phi, qd, ref,
+                        kg.ChannelQd(c(ch_gse[1:]), c(ch_gmp[1:]), none, f_gse, f_gmp, np.zeros(E)), c(ins_y[1:]),
+                        kg.Obs(c(baro_h[1:]), o["baro_r"], c(radalt_h[1:]), ref_agl, c(dbp[1:]), db_x, c(db_u[1:]),
+                               c(rho[1:]), c(r_sv[1:]), c(sig[1:]), none, c(pl_rho[1:]), r_pl, pl_sig),
+                        np.zeros((C - 1, E, 0), np.int64), rows,
+                        kg.PassOut(*s1, np.zeros((C - 1, E, 0, 0)), np.zeros((C - 1, 0)), 0), scr)
         for a, b, first in zip((codes, nu, S, n_rows, x_out, pd, pnav), s1,
                                (main.codes, main.nu, main.S, main.n_rows, main.x, main.pd, main.pnav), strict=True):
             a[0] = first
             a[1:] = b
     else:
-        kcp.bank_epochs(X, P3, phi, qd, red.packed, ch_gse, ch_gmp, f_gse, f_gmp, ref, ref_agl, ins_y, baro_h,
-                       o["baro_r"], radalt_h, eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy, dbp, db_x, db_u,
-                       rho, r_sv, sig, eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, codes, nu, S, n_rows,
-                       x_out, pd, pnav, np.zeros(n), np.zeros(n), workspace(n))
+        none = np.zeros((C, E, 0))
+        kcp.bank_epochs(X, P3, phi, qd, ref, kg.ChannelQd(ch_gse, ch_gmp, none, f_gse, f_gmp, np.zeros(E)), ins_y,
+                        kg.Obs(baro_h, o["baro_r"], radalt_h, ref_agl, dbp, db_x, db_u, rho, r_sv, sig, none, pl_rho,
+                               r_pl, pl_sig), np.zeros((C, E, 0), np.int64), rows,
+                        kg.PassOut(codes, nu, S, n_rows, x_out, pd, pnav, np.zeros((C, E, 0, 0)), np.zeros((C, 0)), 0),
+                        scr)
     # the outputs' errors at the epochs: the INS rows - x_hat against the truth rows (Navigator.results)
     xe = x_out[:, :, 0:9].reshape(C * E, 9)
     o_s = ins.perturb(ins.unpack(np.tile(ins_ep, (C, 1))), -xe[:, 0:3], -xe[:, 3:6], -xe[:, 6:9])

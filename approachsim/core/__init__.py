@@ -11,6 +11,8 @@ by this package's sources alone (approachsim/__init__.py), so editing a stage ne
     entry          a dispatcher's compiled entry point, called without numba's per-call typing (numba internals)
     sensors/       the sensor models' error application (each sensor module's `apply`; oracle `apply_reference`)
         imu, noise, baro, radalt, pseudolite, gnss (orbits, look angles, selection, pseudoranges and rates)
+        gnss_errors   each GNSS range-error formula once (DO-229 tropo mapping, iono obliquity, DO-253 multipath,
+                      the filter's channel sigmas, the GBAS scales), scalar
     nav/           the navigation stage's arithmetic
         strapdown     the strapdown INS mechanization over many runs and IMU intervals (nav/ins.py)
         output        the navigation output of every row, INS - x_hat
@@ -18,8 +20,10 @@ by this package's sources alone (approachsim/__init__.py), so editing a stage ne
         kalman        sparse predict, scalar Joseph update, shared-covariance update, the Riccati segment
         measurements  the baro, radar-altimeter and pseudorange rows with their innovations (nav/measurements.py)
         carrier       the carrier-phase states' dynamics, float-ambiguity resets and rows
-        epoch         a filter epoch of one run or of a shared-covariance class, and the whole open-loop pass
+        epoch         a filter epoch of one run, of a shared-covariance class or of N copies, and the whole
+                      open-loop pass
         copies        the integrity bank's filter copies (campaign/bankpass.py)
+        groups        the epoch kernels' grouped arguments (named tuples: rows, observations, outputs, scratch)
         reduced       the reduced-order filter's dropped channels (nav/reduced.py)
     loop/          the compiled flight loop and the closed loop inside it
         flight_step   one flight step: the IMU-point truth row, turbulence, autopilot, stabilized-approach monitor,

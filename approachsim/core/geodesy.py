@@ -1,20 +1,24 @@
 """Scalar WGS-84 geodesy and the simulated world's gravity for compiled kernels (numba, cache=True).
 
-The same equations, in the same order, as approachsim.geo (radii, geodetic_to_ecef, gravity_ned): the numpy
-functions there are the oracle (tests/unit/nav/test_nav_kernels.py). The constants are read from approachsim.geo
-when this module is imported, so there is one source for each of them.
+The same equations, in the same order, as approachsim.geo (radii, geodetic_to_ecef, ecef_to_geodetic's latitude and
+longitude, c_ecef_to_ned, gravity_ned): the numpy functions there are the oracle (tests/unit/nav/test_nav_kernels.py,
+tests/unit/sensors/test_gnss_kernels.py). The constants are read from approachsim.geo when this module is imported,
+so there is one source for each of them.
 """
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from approachsim import geo
 
 A = geo.A_WGS84
+B = geo.B_WGS84
 E2 = geo.E2_WGS84
+EP2 = E2 / (1.0 - E2)
 OMEGA_E = geo.OMEGA_E
 _GM = geo.GM_JSBSIM
 _J2A2 = 1.5 * geo.J2_JSBSIM * geo.A_JSBSIM**2
@@ -55,3 +59,38 @@ def gravity_nd(lat: float, h: float) -> tuple[float, float]:
     gp = k * (1.0 + pre * (1.0 - 5.0 * s2)) * p + _OMEGA_J2 * p
     gz = k * (1.0 + pre * (3.0 - 5.0 * s2)) * z
     return -sl * gp + cl * gz, -cl * gp - sl * gz
+
+
+@njit(cache=True)
+def geodetic_lat_lon(x: float, y: float, z: float) -> tuple[float, float]:
+    """Geodetic latitude and longitude (rad) of the ECEF point (x, y, z), m: geo.ecef_to_geodetic's Bowring start
+    and two refinements lat = atan2(z, p (1 - e^2 R_E / (R_E + h))), in the same order."""
+    lon = math.atan2(y, x)
+    p = math.hypot(x, y)
+    theta = math.atan2(z * A, p * B)
+    lat = math.atan2(z + EP2 * B * math.pow(math.sin(theta), 3.0), p - E2 * A * math.pow(math.cos(theta), 3.0))
+    for _ in range(2):
+        s = math.sin(lat)
+        r_e = A / math.sqrt(1.0 - E2 * (s * s))
+        c = abs(math.cos(lat))
+        h = p / max(c, 1e-300) - r_e if c > 1e-9 else abs(z) - B
+        lat = math.atan2(z, p * (1.0 - E2 * r_e / (r_e + h)))
+    return lat, lon
+
+
+@njit(cache=True)
+def ned_axes(lat: float, lon: float) -> tuple[tuple[float, float, float], ...]:
+    """The rows of the rotation ECEF -> local NED at (lat, lon), rad (geo.c_ecef_to_ned): the north, east and down
+    unit vectors in ECEF, (-sin L cos l, -sin L sin l, cos L), (-sin l, cos l, 0), (-cos L cos l, -cos L sin l,
+    -sin L)."""
+    sl, cl = math.sin(lat), math.cos(lat)
+    so, co = math.sin(lon), math.cos(lon)
+    return (-sl * co, -sl * so, cl), (-so, co, 0.0), (-cl * co, -cl * so, -sl)
+
+
+@njit(cache=True)
+def c_ecef_to_ned(lat: float, lon: float, c: np.ndarray) -> None:
+    """The rotation ECEF -> local NED at (lat, lon), rad, into c (3, 3) (geo.c_ecef_to_ned; rows: ned_axes)."""
+    n, e, d = ned_axes(lat, lon)
+    for j in range(3):
+        c[0, j], c[1, j], c[2, j] = n[j], e[j], d[j]

@@ -35,6 +35,7 @@ from approachsim.core import layouts
 from approachsim.core.entry import entry_point
 from approachsim.core.loop import aiding as ce
 from approachsim.core.loop import nav_row as ik
+from approachsim.core.nav import groups as kg
 from approachsim.core.nav import strapdown as sk
 from approachsim.loop import paths
 from approachsim.nav import errormodel as em
@@ -165,6 +166,10 @@ class FastEpoch:
     direct: bool = False
     """The epoch's sensor inputs come straight from the sensors' kernels (NavInTheLoop._direct_inputs: plain baro,
     radar altimeter and stand-alone code GNSS of one run), not from their records (`_epoch_inputs`, the oracle)."""
+    no_cp: Array = field(default_factory=lambda: np.zeros((1, 0)))
+    """No carrier phase on this path (loop/paths.py): the epoch's empty carrier observations and ..."""
+    no_gio: Array = field(default_factory=lambda: np.zeros(0))
+    """... the error model's empty ionosphere states."""
 
 
 _NO_RECS: dict[str, Any] = {}
@@ -669,11 +674,11 @@ class NavInTheLoop:
         fe.X[0] = run.fs.x
         db = nav.dbs[0]
         e = fe.e
-        args = (nw, fe.X, fe.P, e, eng.lay, q, gse, gmp, eng.loop, held, t - nav.t_last, fe.f_ned,
-                eng.F, eng.Qc, eng.phi, eng.qd, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
-                eng.tx, eng.th, eng.rwy, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig,
-                eng.channel_states, pl_rho, r_pl, pl_sig, eng.pl_states, eng.codes, eng._nu[:1],
-                eng.S, eng.h, eng.b, eng.ws, fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic)
+        obs = kg.Obs(baro_h, baro_r, radalt_h, 0.0, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig, fe.no_cp, pl_rho,
+                     r_pl, pl_sig)
+        args = (nw, fe.X, fe.P, e, kg.ErrorModel(eng.lay, q, gse, gmp, eng.loop, fe.no_gio, 1.0), held,
+                t - nav.t_last, fe.f_ned, eng.rows, obs, kg.Out(eng.codes, eng._nu[:1], eng.S), eng.scr,
+                (fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic))
         if fe.call is None:
             fe.call = entry_point(ce.loop_epoch, *args)
         n_rows = fe.call(*args)

@@ -25,13 +25,13 @@ from typing import Any
 
 import numpy as np
 
-from approachsim import geo
 from approachsim.core.nav import epoch as ke
-from approachsim.core.sensors.gnss import gbas_channel_sigmas
+from approachsim.core.nav import groups as kg
+from approachsim.core.sensors import gnss as gk
 from approachsim.nav import errormodel as em
 from approachsim.nav import measurements as meas
 from approachsim.nav import terrain_db as tdb
-from approachsim.nav.base import KalmanFilter, UpdateStatus, optimal_policy, workspace
+from approachsim.nav.base import KalmanFilter, UpdateStatus, optimal_policy
 from approachsim.nav.observations import Observations
 from approachsim.sensors.gnss.elevation import IONO_SHELL_M
 from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
@@ -182,7 +182,8 @@ class RunDatabase:
 
 
 class EpochEngine:
-    """The constants of one navigation system for core/nav/epoch.class_epoch, and its scratch space."""
+    """The constants of one navigation system for core/nav/epoch.py (its rows' constants `rows`, core/nav/
+    groups.Rows), and its scratch space `scr`."""
 
     def __init__(self, system: Any) -> None:
         lay = system.layout
@@ -198,9 +199,10 @@ class EpochEngine:
         p = system.sensors.pseudolite
         self.pl_sigma_states = float(np.sqrt(p.code_noise_m**2 + p.survey_sigma_m**2)) if p is not None else 0.0
         n = lay.n
-        self.h = np.zeros(n)
-        self.b = np.zeros(n)
-        self.ws = workspace(n)
+        self.scr = kg.scratch(n)
+        """The kernels' work arrays (core/nav/groups.Scratch)."""
+        self.h, self.b, self.ws, self.F, self.Qc, self.phi, self.qd = self.scr[:7]
+        """The same arrays by name: core/loop/aiding.loop_epoch's positional arguments (nav/closed_loop.py)."""
         self.codes = np.zeros(_MAX_ROWS, dtype=np.int64)
         self.S = np.zeros(_MAX_ROWS)
         self._nan1 = np.full(1, np.nan)
@@ -213,11 +215,10 @@ class EpochEngine:
         self._gbas = None
         if g is not None:  # the channel-noise budget of channel_sigmas
             bud = g.budget()
-            self._sky_budget = (geo.A_WGS84, IONO_SHELL_M, bud.clock_ephemeris_m, bud.iono_zenith_m,
-                                bud.tropo_zenith_m, bud.multipath_model == "do253", float(bud.multipath_m))
+            self._sky_budget = (IONO_SHELL_M, bud.clock_ephemeris_m, bud.iono_zenith_m, bud.tropo_zenith_m,
+                                bud.multipath_model == "do253", float(bud.multipath_m))
             if bud.gbas is not None:
                 self._gbas = bud.gbas.channel_kernel_args()
-        self.F, self.Qc, self.phi, self.qd = (np.zeros((n, n)) for _ in range(4))
         self.carrier = lay.has("amb")
         """Carrier phase: the rows, states and arc resets of kernels/carrier.py."""
         self.cp_r = float(system.rows.carrier_sigma_m) ** 2 if self.carrier else 0.0
@@ -225,22 +226,24 @@ class EpochEngine:
         self.amb_prior = float(g.carrier.ambiguity_sigma_m) ** 2 if self.carrier else 0.0
         """A float ambiguity's prior variance at a new arc, m^2 (nav/noise.py's P0 of amb)."""
         self._no_new = np.zeros(0, dtype=np.int64)
-        self._phi_tmp = np.zeros((n, n))
         self.loop = em.kernel_loop(system.loop_gains() if lay.has("ac") else None)
         """The damping loop's constant gains (the engine runs constant or no loops only)."""
+        self.rows = kg.Rows(self.lay, self.tx, self.th, self.rwy, float(self.ra_pct), float(self.ra_floor),
+                            self.channel_states, self.pl_states, self.cp_r, self.amb_prior)
+        """The rows' constants (core/nav/groups.Rows)."""
 
     def channel_sigmas(self, el: Array) -> tuple[Array, Array]:
         """The GPS channel states' slow and fast 1-sigma (m) at elevations el (N, k) rad, each element on its own:
         the receiver budget's channel_sigmas_m with nav/noise.py's elevation guard, compiled. Stand-alone:
-        core/nav/epoch.channel_sigmas; GBAS corrections: core/sensors/gnss.gbas_channel_sigmas at
+        core/sensors/gnss.channel_sigmas; GBAS corrections: core/sensors/gnss.gbas_channel_sigmas at
         gbas.REFERENCE_GEOMETRY (the filter's elevation-only channel noise, as nav/noise.py builds it)."""
         el = np.ascontiguousarray(el, dtype=float)
         gse, gmp = np.empty(el.shape), np.empty(el.shape)
         if self._gbas is None:
-            ke.channel_sigmas(el, *self._sky_budget, gse, gmp)
+            gk.channel_sigmas(el, *self._sky_budget, gse, gmp)
         else:
             x, dh, v = (np.full(el.shape[0], g) for g in REFERENCE_GEOMETRY)
-            gbas_channel_sigmas(el, x, dh, v, *self._gbas, gse, gmp)
+            gk.gbas_channel_sigmas(el, x, dh, v, *self._gbas, gse, gmp)
         return gse, gmp
 
     def carrier_channel_sigmas(self, el: Array) -> tuple[Array, Array, Array]:
@@ -270,8 +273,8 @@ class EpochEngine:
         f = system.filter
         return isinstance(f, KalmanFilter) and f.policy is optimal_policy and system.shares_covariance()
 
-    def _obs_args(self, obs: Observations, members: list[int], dbs: list[RunDatabase]) -> tuple:
-        """class_epoch's observation arguments of the members (core/nav/epoch.py)."""
+    def _obs(self, obs: Observations, members: list[int], dbs: list[RunDatabase], ref_agl_m: float = 0.0) -> kg.Obs:
+        """The members' observations for core/nav/epoch.class_epoch (core/nav/groups.Obs)."""
         M = len(members)
         if M == 1:
             i = members[0]
@@ -302,10 +305,7 @@ class EpochEngine:
             dbp = np.stack([d.dbp for d in dbs])
             db_x = dbs[0].db_x
             db_u = np.stack([d.db_u for d in dbs]) if db_x.size else np.zeros((M, 0))
-        return (baro_h, baro_r, radalt_h, self.ra_pct, self.ra_floor), (self.tx, self.th, self.rwy, dbp, db_x, db_u,
-                                                                         rho, r_sv, sig, self.channel_states, cp,
-                                                                         self.cp_r, pl_rho, r_pl, pl_sig,
-                                                                         self.pl_states)
+        return kg.Obs(baro_h, baro_r, radalt_h, ref_agl_m, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho, r_pl, pl_sig)
 
     def epoch(self, X: Array, P: Array, phi: Array, qd: Array, own: bool, ref_y: Array, ins_y: Array,
               obs: Observations, members: list[int], t_s: float, statuses: list[StatusBuffer],
@@ -313,19 +313,18 @@ class EpochEngine:
         """One epoch of the members (indices into obs's runs) with estimates X (M, n) and covariance P, in place
         (core/nav/epoch.class_epoch); each member's status records go to its buffer."""
         M = len(members)
-        first, rest = self._obs_args(obs, members, dbs)
+        o = self._obs(obs, members, dbs, ref_agl_m)
         if self._nu.shape[0] < M:
             self._nu = np.zeros((M, _MAX_ROWS))
         nu = self._nu[:M]
-        k = ke.class_epoch(X, P, phi, qd, self.lay, own, ref_y, ins_y, *first, ref_agl_m, *rest, self.codes, nu,
-                           self.S, self.h, self.b, self.ws)
+        k = ke.class_epoch(X, P, phi, qd, own, ref_y, ins_y, self.rows, o, kg.Out(self.codes, nu, self.S), self.scr)
         for j in range(M):
             statuses[j].add_epoch(self.codes[:k], t_s, nu[j, :k], self.S[:k])
 
     def own(self, X: Array, P: Array, y: Array, f_ned: Array, elevation_rad: Array | None, held: bool, dt: float,
             obs: Observations, i: int, t_s: float, statuses: StatusBuffer, db: RunDatabase,
             new: Array | None = None) -> bool:
-        """The per-run EKF's whole epoch of run i (core/nav/epoch.own_epoch: its error model about its INS state y
+        """The per-run EKF's whole epoch of run i (core/nav/epoch.run_epoch: its error model about its INS state y
         (16,) with the mean specific force f_ned (3,), discretized over dt, then every update), in place on X (1, n)
         and P. False when the model needs the numpy discretization (nothing changed: take the generic path). new (k,):
         carrier phase, the channels whose arc begins here (`new_arcs`; their ambiguities reset)."""
@@ -335,11 +334,9 @@ class EpochEngine:
             new = self._no_new if new is None else np.asarray(new, dtype=np.int64)
         else:
             gio, gio_tau, new = self._none1, 1.0, self._no_new
-        first, rest = self._obs_args(obs, [i], [db])
         nu = self._nu[:1]
-        k = ke.own_epoch(X, P, self.lay, q, gse, gmp, self.loop, held, dt, f_ned, y, self.F, self.Qc, self.phi,
-                         self.qd, *first, *rest, gio, gio_tau, new, self.amb_prior, self.codes, nu, self.S, self.h,
-                         self.b, self.ws)
+        k = ke.run_epoch(X, P, kg.ErrorModel(self.lay, q, gse, gmp, self.loop, gio, gio_tau), y, f_ned, held, dt, new,
+                         self.rows, self._obs(obs, [i], [db]), kg.Out(self.codes, nu, self.S), self.scr)
         if k < 0:
             return False
         statuses.add_epoch(self.codes[:k], t_s, nu[0, :k], self.S[:k])
@@ -348,7 +345,7 @@ class EpochEngine:
     def singletons(self, X: Array, P3: Array, phi2: Array, qd2: Array, held: Array, obs: Observations, t_s: float,
                    dt: float, ins_y: Array, ref_y: Array, ref_agl_m: float, statuses: list[StatusBuffer],
                    db_stack: tuple[Array, Array, Array], new: Array | None = None) -> None:
-        """The shared-mode epoch of N runs each its own class (core/nav/epoch.singleton_epochs), in place on X (N, n)
+        """The shared-mode epoch of N runs each its own class (core/nav/epoch.copies_epoch), in place on X (N, n)
         and P3 (N, n, n); phi2, qd2 (2, n, n) the model without / with the damping loop held, held (N,) int; the
         GPS channel states' Qd at each run's own elevations; db_stack: the runs' databases (`stack`); new (N, k):
         carrier phase, the channels whose arc begins here in each run (`new_arcs`)."""
@@ -394,11 +391,10 @@ class EpochEngine:
         nu = np.zeros((N, _MAX_ROWS))
         S = np.zeros((N, _MAX_ROWS))
         n_rows = np.zeros(N, dtype=np.int64)
-        ke.singleton_epochs(X, P3, phi2, qd2, held, ch_gse, ch_gmp, f_gse, f_gmp, self.qd, self.lay, ref_y,
-                            ref_agl_m, np.ascontiguousarray(ins_y), baro_h, baro_r, radalt_h, self.ra_pct,
-                            self.ra_floor, self.tx, self.th, self.rwy, dbp, db_x, db_u, rho, r_sv, sig,
-                            self.channel_states, cp, self.cp_r, pl_rho, r_pl, pl_sig, self.pl_states, ch_gio, f_gio,
-                            new, self.amb_prior, self._phi_tmp, codes, nu, S, n_rows, self.h, self.b, self.ws)
+        ke.copies_epoch(X, P3, phi2, qd2, held, ref_y, np.ascontiguousarray(ins_y),
+                        kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio),
+                        kg.Obs(baro_h, baro_r, radalt_h, ref_agl_m, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho, r_pl,
+                               pl_sig), new, self.rows, kg.Out(codes, nu, S), n_rows, self.scr)
         for i in range(N):
             k = n_rows[i]
             statuses[i].add_epoch(codes[i, :k], t_s, nu[i, :k], S[i, :k])

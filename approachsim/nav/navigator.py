@@ -27,6 +27,7 @@ import numpy as np
 
 from approachsim import geo
 from approachsim.core.nav import epoch as ke
+from approachsim.core.nav import groups as kg
 from approachsim.core.nav import output as ko
 from approachsim.memo import TruthMemo
 from approachsim.nav import errormodel as em
@@ -483,12 +484,12 @@ class Navigator:
             if done < 0:
                 self.reduced_runs = None
         if done < 0:
-            done = ke.shared_pass(X, P3, eng.lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse,
-                                  ch_gmp, f_gse, f_gmp, ins_y, baro_h, baro_r, radalt_h, eng.ra_pct, eng.ra_floor,
-                                  eng.tx, eng.th, eng.rwy, dbp, db_x, db_u, rho, r_sv, sig, eng.channel_states, cp,
-                                  eng.cp_r, pl_rho, r_pl, pl_sig, eng.pl_states, gio, gio_tau, ch_gio, f_gio, new,
-                                  eng.amb_prior, codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav, self._ic, eng.h,
-                                  eng.b, eng.ws)
+            done = ke.shared_pass(X, P3, kg.ErrorModel(eng.lay, q, gse, gmp, loop, gio, gio_tau),
+                                  kg.Track(dt, ref, ref_cbn, f_ref), held,
+                                  kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio), ins_y,
+                                  kg.Obs(baro_h, baro_r, radalt_h, ref_agl, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho,
+                                         r_pl, pl_sig), new, eng.rows,
+                                  kg.PassOut(codes, nu, S, n_rows, x_out, pd, pnav, p33, pcc, self._ic), eng.scr)
         if done != E:
             self.x[:] = x0
             self.f_sum[:] = 0.0

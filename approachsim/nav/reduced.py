@@ -21,7 +21,7 @@ import numpy as np
 
 from approachsim.core.nav import copies as kcp
 from approachsim.core.nav import epoch as ke
-from approachsim.core.nav import kalman as kk
+from approachsim.core.nav import groups as kg
 from approachsim.core.nav import reduced as kred
 from approachsim.memo import TruthMemo, memoized
 from approachsim.nav import errormodel as em
@@ -219,16 +219,18 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
         nu_r, S_r = np.zeros((1, E, R_r)), np.zeros((1, E, R_r))
         x_r, pd_r, pnav_r = np.zeros((1, E, n_r)), np.zeros((1, E, n_r)), np.zeros((1, E, 9, 9))
         if n_r not in ws:
-            ws[n_r] = (np.zeros(n_r), np.zeros(n_r), kk.workspace(n_r))
-        h, b, w = ws[n_r]
+            ws[n_r] = kg.scratch(n_r)
         sel = (slice(i, i + 1), slice(None), kept)
-        kcp.bank_epochs(Xr, Pr, phi, qd, red.packed, np.ascontiguousarray(ch_gse[sel]),
-                       np.ascontiguousarray(ch_gmp[sel]), f_gse, f_gmp, ref, ref_agl, ins_y[i:i + 1],
-                       baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], eng.ra_pct, eng.ra_floor, eng.tx, eng.th, eng.rwy,
-                       dbp[i:i + 1], db_x, db_u[i:i + 1], np.ascontiguousarray(rho[sel]),
-                       np.ascontiguousarray(r_sv[sel]), np.ascontiguousarray(sig[sel]), eng.channel_states,
-                       pl_rho[i:i + 1], r_pl, pl_sig, eng.pl_states, c_r, nu_r, S_r, n_r_rows, x_r, pd_r, pnav_r, h,
-                       b, w)
+        none = np.zeros((1, E, 0))
+        kcp.bank_epochs(Xr, Pr, phi, qd, ref,
+                        kg.ChannelQd(np.ascontiguousarray(ch_gse[sel]), np.ascontiguousarray(ch_gmp[sel]), none, f_gse,
+                                     f_gmp, np.zeros(E)), ins_y[i:i + 1],
+                        kg.Obs(baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], ref_agl, dbp[i:i + 1], db_x, db_u[i:i + 1],
+                               np.ascontiguousarray(rho[sel]), np.ascontiguousarray(r_sv[sel]),
+                               np.ascontiguousarray(sig[sel]), none, pl_rho[i:i + 1], r_pl, pl_sig),
+                        np.zeros((1, E, 0), np.int64), eng.rows._replace(lay=red.packed),
+                        kg.PassOut(c_r, nu_r, S_r, n_r_rows, x_r, pd_r, pnav_r, np.zeros((1, E, 0, 0)),
+                                   np.zeros((1, 0)), 0), ws[n_r])
         if runs_out is not None:
             runs_out.append(ReducedRun(kept, x_r[0], pd_r[0], pnav_r[0], c_r[0], n_r_rows[0], nu_r[0], S_r[0]))
         # the rows: the reduced channel c is the full layout's kept[c]

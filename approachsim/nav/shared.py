@@ -180,7 +180,7 @@ class SharedCovariance:
 
     def _aid_singletons(self, nav: Any, ref: ins.InsState, t: float, dt_epoch: float, obs: Observations,
                         held: list, models: dict, new: Array) -> None:
-        """`_aid_engine` when every run is its own class: all runs in one core/nav/epoch.singleton_epochs call (each
+        """`_aid_engine` when every run is its own class: all runs in one core/nav/epoch.copies_epoch call (each
         its own covariance, the channel Qd at its own sky)."""
         system = nav.system
         runs = nav.runs

@@ -1,20 +1,21 @@
 """The closed loop's aiding epoch as one compiled call (numba, cache=True): the per-run EKF's whole epoch
-(core/nav/epoch.own_epoch) with what the Navigator does around it at an epoch of a feed-forward run, so that an
+(core/nav/epoch.run_epoch) with what the Navigator does around it at an epoch of a feed-forward run, so that an
 epoch of the closed loop costs one kernel call plus the sensors' one-row records (loop/closed_loop.py `_fast_epoch`).
 
-    k = loop_epoch(nw, X, P, e, <own_epoch's model and observation arguments>, XS, PP, PC, PD, PN, ic)
+    k = loop_epoch(nw, X, P, e, model, held, dt, f_ned, rows, obs, out, scr, (XS, PP, PC, PD, PN, ic))
+                                            the groups of core/nav/groups.py
 
 in order:
 
     f_ned = f_sum / dt                      the interval's mean specific force (Navigator.epoch: (f_sum / dt))
-    k = own_epoch(X, P, ..., y = INS state) predict + every scalar update (core/nav/epoch.py), X (1, n), P (n, n)
+    k = run_epoch(X, P, ..., y = INS state) predict + every scalar update (core/nav/epoch.py), X (1, n), P (n, n)
     when k >= 0 (the model fitted the compiled discretization):
         XS[e] = x, PP[e] = P[0:3, 0:3], PC[e] = P[ic, ic], PD[e] = diag P, PN[e] = P[0:9, 0:9]
                                             the filter snapshot and epoch history (Navigator._snapshot(epoch=True))
         f_sum <- 0;  the estimate in force x[0:9] -> the row's work vector (core/loop/nav_row.py W_XNAV);
         the "baro in the interval" flag W_ANY_BARO <- 0
 
-nw is the closed loop's work vector (core/loop/nav_row.py W_* offsets): the INS state y at W_X, f_sum at W_FSUM.
+nw is the closed loop's work vector (core/layouts.py NAV_WORK): the INS state y at W_X, f_sum at W_FSUM.
 direct_inputs makes that epoch's sensor inputs (baro, radar altimeter, GPS sky + pseudoranges, the channel guard) by
 the sensors' own kernels in one call (closed_loop.py `_direct_inputs`).
 
@@ -31,35 +32,27 @@ from numba import njit
 
 from approachsim.core import layouts
 from approachsim.core.nav import epoch as ke
+from approachsim.core.nav import groups as kg
 from approachsim.core.sensors import baro as bk
 from approachsim.core.sensors import gnss as gk
+from approachsim.core.sensors import gnss_errors as ge
 from approachsim.core.sensors import radalt as rk
 
 
 @njit(cache=True)
-def loop_epoch(nw: np.ndarray, X: np.ndarray, P: np.ndarray, e: int, lay: np.ndarray, q: np.ndarray,
-               gse: np.ndarray, gmp: np.ndarray, loop: np.ndarray, held: bool, dt: float, f_ned: np.ndarray,
-               F: np.ndarray, Qc: np.ndarray, phi: np.ndarray, qd: np.ndarray,
-               baro_h: np.ndarray, baro_r: float,
-               radalt_h: np.ndarray, ra_pct: float, ra_floor: float,
-               tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
-               db_u: np.ndarray,
-               rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
-               pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
-               codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray,
-               h: np.ndarray, b: np.ndarray, ws: tuple,
-               XS: np.ndarray, PP: np.ndarray, PC: np.ndarray, PD: np.ndarray, PN: np.ndarray, ic: int) -> int:
-    """The closed loop's epoch e (module docstring); returns own_epoch's number of rows, or -1 (nothing changed:
-    the model needs the numpy discretization, the caller takes the Navigator's path). f_ned (3,) scratch."""
+def loop_epoch(nw: np.ndarray, X: np.ndarray, P: np.ndarray, e: int, model: kg.ErrorModel, held: bool, dt: float,
+               f_ned: np.ndarray, rows: kg.Rows, obs: kg.Obs, out: kg.Out, scr: kg.Scratch, hist: tuple) -> int:
+    """The closed loop's epoch e (module docstring): core/nav/epoch.run_epoch on the run's INS state in the work
+    vector, then the Navigator's bookkeeping: hist = (XS, PP, PC, PD, PN, ic), the estimate, position block, clock
+    variance, diagonal and navigation block of P after each epoch, and the clock's index. Returns run_epoch's
+    number of rows, or -1 (nothing changed: the model needs the numpy discretization, the caller takes the
+    Navigator's path). f_ned (3,) scratch."""
+    XS, PP, PC, PD, PN, ic = hist
     for c in range(3):
         f_ned[c] = nw[layouts.W_FSUM + c] / dt
-    y = nw[layouts.W_X:layouts.W_X + 16]
-    # no carrier phase on this path (loop/paths.py sends it to the Navigator's): no carrier
-    # rows, no ionosphere states, no new arcs (the engine's own empties, nav/engine.py)
-    k = ke.own_epoch(X, P, lay, q, gse, gmp, loop, held, dt, f_ned, y, F, Qc, phi, qd, baro_h, baro_r, radalt_h,
-                     ra_pct, ra_floor, tx, th, rwy, dbp, db_x, db_u, rho, r_sv, sig, channel_states,
-                     np.zeros((1, 0)), 0.0, pl_rho, r_pl, pl_sig, pl_states,
-                     np.zeros(0), 1.0, np.zeros(0, dtype=np.int64), 0.0, codes, nu_out, S_out, h, b, ws)
+    y = nw[layouts.W_X:layouts.W_X + layouts.NX]
+    # no carrier phase on this path (loop/paths.py sends it to the Navigator's): no new arcs
+    k = ke.run_epoch(X, P, model, y, f_ned, held, dt, np.zeros(0, dtype=np.int64), rows, obs, out, scr)
     if k < 0:
         return k
     n = P.shape[0]
@@ -89,14 +82,12 @@ RAD_TO_DEG = 180.0 / math.pi
 def channel_guard(el: np.ndarray, lo: float, g: np.ndarray, mp_arg: np.ndarray) -> None:
     """The GPS channel states' elevations as the noise model guards them (nav/noise.py): g = max(el, lo) with nan
     read as 0.5 rad, and mp_arg = -degrees(g) / 10, the argument of DO-253's multipath curve
-    (receiver.do253_multipath_sigma_m). numpy's operations one by one (where, maximum, degrees, negative, divide):
-    exact in IEEE arithmetic, the same bits."""
+    (core/sensors/gnss_errors.py guard_elevation, do253_exponent). numpy's operations one by one (where, maximum,
+    degrees, negative, divide): exact in IEEE arithmetic, the same bits."""
     for i in range(el.shape[0]):
-        e = el[i]
-        e = 0.5 if e != e else e
-        e = e if e >= lo else lo
+        e = ge.guard_elevation(el[i], lo)
         g[i] = e
-        mp_arg[i] = -(e * RAD_TO_DEG) / 10.0
+        mp_arg[i] = ge.do253_exponent(e)
 
 
 @njit(cache=True)
@@ -104,21 +95,13 @@ def channel_sigmas(cos_g: np.ndarray, sin_g: np.ndarray, exp_mp: np.ndarray, a_m
                    ce2: float, iono_zenith_m: float, tropo_zenith_m: float, do253: bool, gse: np.ndarray,
                    gmp: np.ndarray) -> None:
     """A stand-alone budget's channel sigmas (receiver.GnssErrorBudget.channel_sigmas_m, m) from numpy's cos, sin of
-    the guarded elevations and exp of mp_arg (channel_guard): x = a cos / (a + h), F = 1 / sqrt(1 - x^2),
-    M = 1.001 / sqrt(0.002001 + sin^2), gse = sqrt(ce^2 + (I_z F)^2 + (T_z M)^2), gmp = 0.13 + 0.53 exp (do253;
-    else gmp is left as it is). The same operations in numpy's order (no transcendental function here: those stay
+    the guarded elevations and exp of mp_arg (channel_guard): core/sensors/gnss_errors.channel_sigmas, gse =
+    sqrt(ce^2 + (I_z F)^2 + (T_z M)^2), gmp = 0.13 + 0.53 exp (do253; else gmp is left as it is); a_m is that
+    module's R (the WGS-84 a). The same operations in numpy's order (no transcendental function here: those stay
     numpy's, whose last bit numba's may not match), the same bits."""
-    den = a_m + shell_m
-    for i in range(cos_g.shape[0]):
-        x = a_m * cos_g[i] / den
-        f = 1.0 / math.sqrt(1.0 - x * x)
-        s = sin_g[i]
-        m = 1.001 / math.sqrt(0.002001 + s * s)
-        fi = iono_zenith_m * f
-        tm = tropo_zenith_m * m
-        gse[i] = math.sqrt(ce2 + fi * fi + tm * tm)
-        if do253:
-            gmp[i] = 0.13 + 0.53 * exp_mp[i]
+    for i in range(cos_g.shape[0]):  # a_m: gnss_errors' R (the same WGS-84 a)
+        gse[i], gmp[i] = ge.channel_sigmas(cos_g[i], sin_g[i], exp_mp[i], shell_m, ce2, iono_zenith_m,
+                                           tropo_zenith_m, do253, gmp[i])
 
 
 HAS_BARO = 1

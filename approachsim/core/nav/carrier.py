@@ -19,12 +19,11 @@ channels; gio, amb of channel c at index + c.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
 from approachsim.core.nav import errormodel as ek
+from approachsim.core.nav import measurements as km
 
 
 @njit(cache=True)
@@ -71,13 +70,7 @@ def carrier_phase(lay: np.ndarray, x_hat: np.ndarray, r_ins: np.ndarray, c_en: n
     """nu = z - g(x_hat) of channel sv's carrier phase phi (m) (module docstring; nav/measurements.carrier_phase's
     arithmetic), and the row into h (n,) when `row`. r_ins, r_sv (3,) ECEF m; c_en (3, 3) ECEF -> NED at the INS."""
     ip = lay[ek.L_DP]
-    d0, d1, d2 = x_hat[ip], x_hat[ip + 1], x_hat[ip + 2]
-    a0 = r_ins[0] - (c_en[0, 0] * d0 + c_en[1, 0] * d1 + c_en[2, 0] * d2) - r_sv[0]
-    a1 = r_ins[1] - (c_en[0, 1] * d0 + c_en[1, 1] * d1 + c_en[2, 1] * d2) - r_sv[1]
-    a2 = r_ins[2] - (c_en[0, 2] * d0 + c_en[1, 2] * d1 + c_en[2, 2] * d2) - r_sv[2]
-    rng_hat = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
-    b0, b1, b2 = r_ins[0] - r_sv[0], r_ins[1] - r_sv[1], r_ins[2] - r_sv[2]
-    rng_ins = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+    a0, a1, a2, rng_hat, rng_ins = km.ranges(x_hat, ip, r_ins, c_en, r_sv)
     ic, ig, io, ia = lay[ek.L_CLK], lay[ek.L_GSE] + sv, lay[ek.L_GIO] + sv, lay[ek.L_AMB] + sv
     lin = -x_hat[ig] + x_hat[io] - x_hat[ia]  # h' x_hat over the states the difference is linear in
     if ic >= 0:
@@ -89,9 +82,7 @@ def carrier_phase(lay: np.ndarray, x_hat: np.ndarray, r_ins: np.ndarray, c_en: n
         h[ig] = -1.0
         h[io] = 1.0
         h[ia] = -1.0
-        u0, u1, u2 = a0 / rng_hat, a1 / rng_hat, a2 / rng_hat
-        for k in range(3):
-            h[ip + k] = c_en[k, 0] * u0 + c_en[k, 1] * u1 + c_en[k, 2] * u2
+        km.los_row(h, ip, c_en, a0, a1, a2, rng_hat, 1.0)
     z = rng_ins - phi
     g_hat = rng_ins - rng_hat + lin
     return z - g_hat

@@ -1,7 +1,12 @@
 """One aiding epoch of the optimal filter as one compiled call (numba, cache=True): the prediction and every
-scalar update of the epoch, for one run or for the runs of a shared-covariance class.
+scalar update of the epoch, for one run, for the runs of a shared-covariance class, or for N copies each its own
+class; and the whole open-loop pass of such copies. Arguments grouped by what they are (core/nav/groups.py: the
+rows' constants, the observations, the outputs, the error model, the scratch).
 
-    n_rows = class_epoch(X, P, phi, qd, lay, own, ref, ins, <observations>, codes, nu_out, S_out, h, b, ws)
+    n_rows = class_epoch(X, P, phi, qd, own, ref, ins, rows, obs, out, scr)
+    n_rows = run_epoch(X, P, model, y, f_ned, held, dt, new, rows, obs, out, scr)    the per-run EKF's whole epoch
+    copies_epoch(X, P3, phi_h, qd_h, which, ref, ins, chan, obs, new, rows, out, n_rows, scr)   N copies, one epoch
+    shared_pass(X, P3, model, track, held, chan, ins, obs, new, rows, out, scr)     N copies, every epoch
 
 Order of the rows (nav/rows.py): baro, radar altimeter, each GNSS channel in channel order, each channel's
 carrier phase (carrier phase only), each pseudolite in unit order; a row exists when member 0's value is finite
@@ -14,16 +19,19 @@ carrier phase (carrier phase only), each pseudolite in unit order; a row exists 
                nu_m of each member at its own INS and current x_hat_m
                S = h' P h + r ; K = P h / S ; x_m <- x_m + K nu_m ; P Joseph (O(n^2), core/nav/kalman.py)
 
-Rows and innovations are kernels/measurements.py's. The numpy paths (nav/navigator.py with nav/rows.py, and
+Rows and innovations are core/nav/measurements.py's. The numpy paths (nav/navigator.py with nav/rows.py, and
 nav/shared.py) are the test oracle (tests/unit/nav/test_epoch_engine.py: equal to 1e-12 relative norm-wise).
 
 Codes of the rows written to `codes`: CODE_BARO, CODE_RADALT, CODE_GPS + channel, CODE_PL + unit, CODE_CP + channel
 (a GNSS channel's carrier phase).
 
-Carrier phase (the layout's gio and amb groups, kernels/carrier.py): the code rows carry -1 at the channel's gio;
+Carrier phase (the layout's gio and amb groups, core/nav/carrier.py): the code rows carry -1 at the channel's gio;
 after every code row, each channel's carrier-phase row (nav/rows.py's order); the float ambiguities of the channels
-whose arc began are reset in the epoch's Phi, Qd before the prediction (own_epoch, singleton_epochs, shared_pass;
-class_epoch's caller otherwise).
+whose arc began are reset in the epoch's Phi, Qd before the prediction (run_epoch, copies_epoch; class_epoch's
+caller otherwise).
+
+A copy's epoch (copies_epoch, and so shared_pass and core/nav/copies.bank_epochs): its model's Qd with the channel
+states' entries at its own sky, its ambiguities reset at its new arcs, then class_epoch in shared mode.
 """
 
 from __future__ import annotations
@@ -38,18 +46,10 @@ from approachsim.core.nav import carrier as kcar
 from approachsim.core.nav import errormodel as ek
 from approachsim.core.nav import kalman as kk
 from approachsim.core.nav import measurements as km
+from approachsim.core.nav.groups import ChannelQd, ErrorModel, Obs, Out, PassOut, Rows, Scratch, Track
 
 CODE_BARO, CODE_RADALT, CODE_GPS, CODE_PL, CODE_CP = 0, 1, 100, 200, 300
 """Row codes (module docstring)."""
-
-
-@njit(cache=True)
-def _c_en(lat: float, lon: float, c: np.ndarray) -> None:
-    """ECEF -> NED rotation at (lat, lon), rad (geo.c_ecef_to_ned), into c (3, 3)."""
-    sl, cl, so, co = math.sin(lat), math.cos(lat), math.sin(lon), math.cos(lon)
-    c[0, 0], c[0, 1], c[0, 2] = -sl * co, -sl * so, cl
-    c[1, 0], c[1, 1], c[1, 2] = -so, co, 0.0
-    c[2, 0], c[2, 1], c[2, 2] = -cl * co, -cl * so, -sl
 
 
 @njit(cache=True)
@@ -73,34 +73,33 @@ def _apply(X: np.ndarray, P: np.ndarray, h: np.ndarray, r: float, nu: np.ndarray
 
 
 @njit(cache=True)
-def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, lay: np.ndarray, own: bool,
-                ref: np.ndarray, ins: np.ndarray,
-                baro_h: np.ndarray, baro_r: float,
-                radalt_h: np.ndarray, ra_pct: float, ra_floor: float, ref_agl: float,
-                tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
-                db_u: np.ndarray,
-                rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
-                cp: np.ndarray, cp_r: float,
-                pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
-                codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray,
-                h: np.ndarray, b: np.ndarray, ws: tuple, csr_ready: bool = False) -> int:
+def _update(X: np.ndarray, P: np.ndarray, h: np.ndarray, r: float, nu: np.ndarray, code: int, k: int, out: Out,
+            b: np.ndarray, kc: np.ndarray) -> int:
+    """The row h with noise variance r (m^2) applied to the members (`_apply`), recorded as row k of out (its code,
+    the members' nu, S); returns k + 1."""
+    out.S[k] = _apply(X, P, h, r, nu, b, kc)
+    out.codes[k] = code
+    for m in range(X.shape[0]):
+        out.nu[m, k] = nu[m]
+    return k + 1
+
+
+@njit(cache=True)
+def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, own: bool, ref: np.ndarray,
+                ins: np.ndarray, rows: Rows, obs: Obs, out: Out, scr: Scratch, csr_ready: bool = False) -> int:
     """Predict and update the M members of a class in place (module docstring); returns the number of rows.
 
-    X (M, n) estimates; P (n, n) the class covariance; phi, qd (n, n) the epoch's model; lay the state layout
-    (kernels.errormodel); own: the per-run EKF (M = 1; ref unused) else shared rows at `ref`; ref (16,), ins
-    (M, 16) packed INS states (kernels.strapdown layout). Observations of the members: baro_h (M,) m (nan: none)
-    with noise variance baro_r m^2; radalt_h (M,) m with sigma = sqrt((ra_pct h)^2 + ra_floor^2) at the measured
-    height (own) or at ref_agl (shared); the filter's terrain tx, th, rwy and each member's database dbp (M, 4),
-    db_x (k,), db_u (M, k) (kernels.measurements); rho (M, s) pseudoranges m (nan: none), r_sv (s, 3) ECEF m,
-    sig (s,) their 1-sigma, channel_states: the rows carry the gse / gmp states; cp (M, s) carrier phases m (nan:
-    none; (M, 0) without carrier phase) with noise variance cp_r m^2; pl_rho (M, p), r_pl (p, 3), pl_sig (p,),
-    pl_states. Out: codes (R,), nu_out (M, R), S_out (R,); scratch h, b (n,), ws (kalman.workspace); csr_ready:
-    ws already holds phi's nonzeros (kalman.csr; the caller's previous class_epoch had this same phi), so they are
-    not collected again (the same numbers either way).
+    X (M, n) estimates; P (n, n) the class covariance; phi, qd (n, n) the epoch's model; own: the per-run EKF
+    (M = 1; ref unused) else shared rows at `ref`; ref (16,), ins (M, 16) packed INS states (core/nav/strapdown
+    layout). rows: the rows' constants; obs: the members' observations (groups.Obs: the radar altimeter's sigma
+    sqrt((ra_pct h)^2 + ra_floor^2) at the measured height (own) or at obs.ref_agl (shared)); out: codes (R,),
+    nu (M, R), S (R,); scr: h, b, ws. csr_ready: scr.ws already holds phi's nonzeros (kalman.csr; the caller's
+    previous class_epoch had this same phi), so they are not collected again (the same numbers either way).
     """
     M = X.shape[0]
     n = X.shape[1]
-    W, v, val, ptr, col = ws
+    lay, h, b = rows.lay, scr.h, scr.b
+    W, v, val, ptr, col = scr.ws
     kc = v
     # predict: x_m <- Phi x_m ; P <- Phi P Phi' + Qd
     if not csr_ready:
@@ -121,10 +120,11 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
     c_ins = np.empty((3, 3))
     c_ref = np.empty((3, 3))
     _ecef(ref, r_ref)
-    _c_en(ref[0], ref[1], c_ref)
+    gk.c_ecef_to_ned(ref[0], ref[1], c_ref)
     k = 0
     empty_u = np.zeros(0)
     # baro
+    baro_h = obs.baro_h
     if baro_h[0] == baro_h[0]:
         if own:
             nu[0], _ = km.baro(lay, X[0], ins[0, 2], baro_h[0], 0.0, h)
@@ -132,177 +132,102 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, l
             km.baro(lay, x0, ref[2], baro_h[0], 0.0, h)
             for m in range(M):
                 nu[m] = km.baro_nu(lay, X[m], ins[m, 2], baro_h[m])
-        S_out[k] = _apply(X, P, h, baro_r, nu, b, kc)
-        codes[k] = CODE_BARO
-        for m in range(M):
-            nu_out[m, k] = nu[m]
-        k += 1
+        k = _update(X, P, h, obs.baro_r, nu, CODE_BARO, k, out, b, kc)
     # radar altimeter
+    radalt_h, db_x, db_u = obs.radalt_h, obs.db_x, obs.db_u
+    tx, th, rwy, dbp = rows.tx, rows.th, rows.rwy, obs.dbp
     if radalt_h[0] == radalt_h[0]:
         u0 = db_u[0] if db_x.shape[0] > 0 else empty_u
         if own:
             hr = radalt_h[0]
             nu[0], _ = km.radalt(lay, X[0], ins[0, 0], ins[0, 1], ins[0, 2], hr, 0.0, tx, th, rwy, dbp[0], db_x, u0,
                                  h)
-            s2 = (ra_pct * hr) ** 2 + ra_floor**2
+            s2 = (rows.ra_pct * hr) ** 2 + rows.ra_floor**2
         else:  # the row at the reference (no database error: it enters only z), sigma at the reference height
-            km.radalt(lay, x0, ref[0], ref[1], ref[2], ref_agl, 0.0, tx, th, rwy, dbp[0], empty_u, empty_u, h)
-            s2 = (ra_pct * ref_agl) ** 2 + ra_floor**2
+            km.radalt(lay, x0, ref[0], ref[1], ref[2], obs.ref_agl, 0.0, tx, th, rwy, dbp[0], empty_u, empty_u, h)
+            s2 = (rows.ra_pct * obs.ref_agl) ** 2 + rows.ra_floor**2
             for m in range(M):
                 um = db_u[m] if db_x.shape[0] > 0 else empty_u
                 nu[m] = km._radalt(lay, X[m], ins[m, 0], ins[m, 1], ins[m, 2], radalt_h[m], tx, th, rwy, dbp[m],
                                    db_x, um, x0, False)
         r_ra = math.sqrt(s2) ** 2  # sigma^2 as nav/rows.py: sqrt((p h)^2 + floor^2) squared
-        S_out[k] = _apply(X, P, h, r_ra, nu, b, kc)
-        codes[k] = CODE_RADALT
-        for m in range(M):
-            nu_out[m, k] = nu[m]
-        k += 1
-    # GNSS channels
+        k = _update(X, P, h, r_ra, nu, CODE_RADALT, k, out, b, kc)
+    # GNSS channels. Each range row's own and shared forms are written out here, not in a helper: a helper with the
+    # members' loop measured 3 us (8 %) slower per shared class epoch (in four forms; benchmarks in the commit).
+    rho, r_sv, cp = obs.rho, obs.r_sv, obs.cp
     i_gio = lay[ek.L_GIO]
     for c in range(rho.shape[1]):
         if rho[0, c] != rho[0, c]:
             continue
-        sv = c if channel_states else -1
+        sv = c if rows.channel_states else -1
         if own:
             _ecef(ins[0], r_ins)
-            _c_en(ins[0, 0], ins[0, 1], c_ins)
+            gk.c_ecef_to_ned(ins[0, 0], ins[0, 1], c_ins)
             nu[0] = km._pseudorange(lay, X[0], r_ins, c_ins, r_sv[c], rho[0, c], sv, -1, h, True)
         else:
             km._pseudorange(lay, x0, r_ref, c_ref, r_sv[c], rho[0, c], sv, -1, h, True)
             for m in range(M):
                 _ecef(ins[m], r_ins)
-                _c_en(ins[m, 0], ins[m, 1], c_ins)
+                gk.c_ecef_to_ned(ins[m, 0], ins[m, 1], c_ins)
                 nu[m] = km._pseudorange(lay, X[m], r_ins, c_ins, r_sv[c], rho[m, c], sv, -1, x0, False)
         if i_gio >= 0 and sv >= 0:  # carrier phase: the code's ionosphere is the gio state, -1 in the row
             h[i_gio + c] = -1.0
             for m in range(M):
                 nu[m] = nu[m] + X[m, i_gio + c]
-        S_out[k] = _apply(X, P, h, sig[c] ** 2, nu, b, kc)
-        codes[k] = CODE_GPS + c
-        for m in range(M):
-            nu_out[m, k] = nu[m]
-        k += 1
-    # GNSS carrier phases (kernels/carrier.py)
+        k = _update(X, P, h, obs.sig[c] ** 2, nu, CODE_GPS + c, k, out, b, kc)
+    # GNSS carrier phases (core/nav/carrier.py)
     for c in range(cp.shape[1]):
         if cp[0, c] != cp[0, c]:
             continue
         if own:
             _ecef(ins[0], r_ins)
-            _c_en(ins[0, 0], ins[0, 1], c_ins)
+            gk.c_ecef_to_ned(ins[0, 0], ins[0, 1], c_ins)
             nu[0] = kcar.carrier_phase(lay, X[0], r_ins, c_ins, r_sv[c], cp[0, c], c, h, True)
         else:
             kcar.carrier_phase(lay, x0, r_ref, c_ref, r_sv[c], cp[0, c], c, h, True)
             for m in range(M):
                 _ecef(ins[m], r_ins)
-                _c_en(ins[m, 0], ins[m, 1], c_ins)
+                gk.c_ecef_to_ned(ins[m, 0], ins[m, 1], c_ins)
                 nu[m] = kcar.carrier_phase(lay, X[m], r_ins, c_ins, r_sv[c], cp[m, c], c, x0, False)
-        S_out[k] = _apply(X, P, h, cp_r, nu, b, kc)
-        codes[k] = CODE_CP + c
-        for m in range(M):
-            nu_out[m, k] = nu[m]
-        k += 1
+        k = _update(X, P, h, rows.cp_r, nu, CODE_CP + c, k, out, b, kc)
     # pseudolites
+    pl_rho, r_pl = obs.pl_rho, obs.r_pl
     for c in range(pl_rho.shape[1]):
         if pl_rho[0, c] != pl_rho[0, c]:
             continue
-        pl = c if pl_states else -1
+        pl = c if rows.pl_states else -1
         if own:
             _ecef(ins[0], r_ins)
-            _c_en(ins[0, 0], ins[0, 1], c_ins)
+            gk.c_ecef_to_ned(ins[0, 0], ins[0, 1], c_ins)
             nu[0] = km._pseudorange(lay, X[0], r_ins, c_ins, r_pl[c], pl_rho[0, c], -1, pl, h, True)
         else:
             km._pseudorange(lay, x0, r_ref, c_ref, r_pl[c], pl_rho[0, c], -1, pl, h, True)
             for m in range(M):
                 _ecef(ins[m], r_ins)
-                _c_en(ins[m, 0], ins[m, 1], c_ins)
+                gk.c_ecef_to_ned(ins[m, 0], ins[m, 1], c_ins)
                 nu[m] = km._pseudorange(lay, X[m], r_ins, c_ins, r_pl[c], pl_rho[m, c], -1, pl, x0, False)
-        S_out[k] = _apply(X, P, h, pl_sig[c] ** 2, nu, b, kc)
-        codes[k] = CODE_PL + c
-        for m in range(M):
-            nu_out[m, k] = nu[m]
-        k += 1
+        k = _update(X, P, h, obs.pl_sig[c] ** 2, nu, CODE_PL + c, k, out, b, kc)
     return k
 
 
 @njit(cache=True)
-def own_epoch(X: np.ndarray, P: np.ndarray, lay: np.ndarray, q: np.ndarray, gse: np.ndarray, gmp: np.ndarray,
-              loop: np.ndarray, held: bool, dt: float, f_ned: np.ndarray, y: np.ndarray, F: np.ndarray,
-              Qc: np.ndarray, phi: np.ndarray, qd: np.ndarray,
-              baro_h: np.ndarray, baro_r: float,
-              radalt_h: np.ndarray, ra_pct: float, ra_floor: float,
-              tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
-              db_u: np.ndarray,
-              rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
-              cp: np.ndarray, cp_r: float,
-              pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
-              gio: np.ndarray, gio_tau: float, new: np.ndarray, amb_prior: float,
-              codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray,
-              h: np.ndarray, b: np.ndarray, ws: tuple) -> int:
-    """The per-run EKF's whole epoch of one run: the error model linearized about its INS state y (16,) (packed,
-    kernels/strapdown.py) with the interval's mean specific force f_ned (3,) NED m/s^2 (kernels.errormodel
-    dynamics: lay, q, gse, gmp, loop, held as there; carrier phase: gio (n_sv,) m and gio_tau s, kernels.carrier),
-    discretized over dt (s) into phi, qd (scratch F, Qc), the ambiguities of the channels with new[c] != 0 reset
-    to amb_prior m^2 (kernels.carrier.reset_ambiguities; new (k,), empty without carrier phase), then class_epoch in
-    own mode (X (1, n), the observation arguments as there). Returns the number of rows, or -1 when the model is
-    too large for the compiled discretization (X, P untouched: the caller takes the numpy path)."""
+def run_epoch(X: np.ndarray, P: np.ndarray, model: ErrorModel, y: np.ndarray, f_ned: np.ndarray, held: bool,
+              dt: float, new: np.ndarray, rows: Rows, obs: Obs, out: Out, scr: Scratch) -> int:
+    """The per-run EKF's whole epoch of one run: the error model (core/nav/errormodel.dynamics, core/nav/carrier.
+    dynamics: model's constants) linearized about its INS state y (16,) (packed, core/nav/strapdown.py) with the
+    interval's mean specific force f_ned (3,) NED m/s^2 and the damping loop held or not, discretized over dt (s)
+    into scr.phi, scr.qd (scratch scr.F, scr.Qc), the ambiguities of the channels with new[c] != 0 reset to
+    rows.amb_prior m^2 (core/nav/carrier.reset_ambiguities; new (k,), empty without carrier phase), then
+    class_epoch in own mode (X (1, n)). Returns the number of rows, or -1 when the model is too large for the
+    compiled discretization (X, P untouched: the caller takes the numpy path)."""
+    F, Qc, phi, qd = scr.F, scr.Qc, scr.phi, scr.qd
     c_bn = y[6:15].reshape(3, 3)
-    ek.dynamics(lay, q, gse, gmp, y[0], y[2], y[3:6], f_ned, c_bn, loop, held, F, Qc)
-    kcar.dynamics(lay, gio, gio_tau, F, Qc)
+    ek.dynamics(model.lay, model.q, model.gse, model.gmp, y[0], y[2], y[3:6], f_ned, c_bn, model.loop, held, F, Qc)
+    kcar.dynamics(model.lay, model.gio, model.gio_tau, F, Qc)
     if not ek.discretize(F, Qc, dt, phi, qd):
         return -1
-    kcar.reset_ambiguities(phi, qd, lay, new, amb_prior)
-    return class_epoch(X, P, phi, qd, lay, True, y, y.reshape(1, 16), baro_h, baro_r, radalt_h, ra_pct, ra_floor,
-                       0.0, tx, th, rwy, dbp, db_x, db_u, rho, r_sv, sig, channel_states, cp, cp_r, pl_rho, r_pl,
-                       pl_sig, pl_states, codes, nu_out, S_out, h, b, ws)
-
-
-@njit(cache=True)
-def singleton_epochs(X: np.ndarray, P3: np.ndarray, phi2: np.ndarray, qd2: np.ndarray, held: np.ndarray,
-                     ch_gse: np.ndarray, ch_gmp: np.ndarray, f_gse: float, f_gmp: float, qd_tmp: np.ndarray,
-                     lay: np.ndarray, ref: np.ndarray, ref_agl: float, ins: np.ndarray,
-                     baro_h: np.ndarray, baro_r: float,
-                     radalt_h: np.ndarray, ra_pct: float, ra_floor: float,
-                     tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
-                     db_u: np.ndarray,
-                     rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
-                     cp: np.ndarray, cp_r: float,
-                     pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
-                     ch_gio: np.ndarray, f_gio: float, new: np.ndarray, amb_prior: float, phi_tmp: np.ndarray,
-                     codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray, n_rows: np.ndarray,
-                     h: np.ndarray, b: np.ndarray, ws: tuple) -> None:
-    """class_epoch in shared mode for N runs that are each their own class (per-run GPS skies, the integrity bank's
-    copies): run i with X[i], P3[i] (its covariance), the model phi2[held[i]], qd2[held[i]] (the damping loop held
-    or not) whose GPS channel states' Qd entries are sigma^2 (1 - exp(-2 dt / tau)) at run i's elevations
-    (ch_gse, ch_gmp (N, k) sigmas, m; f_gse, f_gmp the factors; nothing changed when k = 0), its INS ins[i] and
-    observations row i of every per-run array (r_sv (N, s, 3), sig (N, s), cp (N, s)); the rows at the reference
-    ref (16,) as class_epoch. Carrier phase: the gio states' Qd entries likewise from ch_gio (N, k) and f_gio, and
-    run i's ambiguities with new[i, c] != 0 reset to amb_prior (in phi_tmp (n, n), a copy of its Phi, when it has
-    one; new (N, 0) and ch_gio (N, 0) without carrier phase). Out per run: codes[i], nu_out[i], S_out[i] (R,) and
-    n_rows[i]."""
-    N = X.shape[0]
-    ig, im, io = lay[ek.L_GSE], lay[ek.L_GMP], lay[ek.L_GIO]
-    last = -1  # the model (held) whose Qd is in qd_tmp and whose Phi's nonzeros are in ws (model reuse)
-    for i in range(N):
-        hd = held[i]
-        if last != hd:
-            qd_tmp[:, :] = qd2[hd]
-        if ig >= 0:
-            for c in range(ch_gse.shape[1]):
-                qd_tmp[ig + c, ig + c] = ch_gse[i, c] ** 2 * f_gse
-                qd_tmp[im + c, im + c] = ch_gmp[i, c] ** 2 * f_gmp
-        if io >= 0:
-            for c in range(ch_gio.shape[1]):
-                qd_tmp[io + c, io + c] = ch_gio[i, c] ** 2 * f_gio
-        reset = _any_new(new[i])
-        ready = last == hd and not reset
-        phi = _with_resets(phi2[hd], qd_tmp, lay, new[i], amb_prior, phi_tmp)
-        n_rows[i] = class_epoch(X[i:i + 1], P3[i], phi, qd_tmp, lay, False, ref, ins[i:i + 1],
-                                baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], ra_pct, ra_floor, ref_agl, tx, th, rwy,
-                                dbp[i:i + 1], db_x, db_u[i:i + 1], rho[i:i + 1], r_sv[i], sig[i], channel_states,
-                                cp[i:i + 1], cp_r, pl_rho[i:i + 1], r_pl, pl_sig, pl_states, codes[i],
-                                nu_out[i:i + 1], S_out[i], h, b, ws, ready)
-        last = -1 if reset else hd
+    kcar.reset_ambiguities(phi, qd, model.lay, new, rows.amb_prior)
+    return class_epoch(X, P, phi, qd, True, y, y.reshape(1, 16), rows, obs, out, scr)
 
 
 @njit(cache=True)
@@ -314,19 +239,18 @@ def _any_new(new: np.ndarray) -> bool:
     return False
 
 
-# Model reuse. The copies' loops (singleton_epochs, shared_pass, copies.bank_epochs_carrier) give class_epoch one
-# model after another, mostly the same: a copy's Qd differs from the model's only on the channel states' diagonal,
-# which every copy writes, and its Phi is the model's unless its carrier arcs reset ambiguities. So qd_tmp is copied
-# from the model, and Phi's nonzeros collected (class_epoch's csr_ready), only when the model changed or the
-# previous copy reset (its resets changed qd_tmp, and ws holds the reset Phi's nonzeros): the same arrays as a fresh
-# copy each time, so the same numbers.
+# Model reuse. The copies' loop (copies_epoch) gives class_epoch one model after another, mostly the same: a copy's
+# Qd differs from the model's only on the channel states' diagonal, which every copy writes, and its Phi is the
+# model's unless its carrier arcs reset ambiguities. So qd_tmp is copied from the model, and Phi's nonzeros
+# collected (class_epoch's csr_ready), only when the model changed or the previous copy reset (its resets changed
+# qd_tmp, and ws holds the reset Phi's nonzeros): the same arrays as a fresh copy each time, so the same numbers.
 
 
 @njit(cache=True)
 def _with_resets(phi: np.ndarray, qd: np.ndarray, lay: np.ndarray, new: np.ndarray, prior: float,
                  phi_tmp: np.ndarray) -> np.ndarray:
     """phi itself when no channel of new (k,) begins an arc, else phi_tmp holding phi with those ambiguities reset
-    (kernels.carrier.reset_ambiguities; qd, the caller's own copy, is reset in place)."""
+    (core/nav/carrier.reset_ambiguities; qd, the caller's own copy, is reset in place)."""
     for c in range(new.shape[0]):
         if new[c] != 0:
             phi_tmp[:, :] = phi
@@ -336,113 +260,104 @@ def _with_resets(phi: np.ndarray, qd: np.ndarray, lay: np.ndarray, new: np.ndarr
 
 
 @njit(cache=True)
-def channel_sigmas(el: np.ndarray, a_m: float, shell_m: float, ce_m: float, iono_m: float, tropo_m: float,
-                   do253: bool, mp_m: float, gse: np.ndarray, gmp: np.ndarray) -> None:
-    """The GPS channel states' 1-sigma (m) at elevations el (N, k) rad, into gse, gmp (N, k), element by element
-    (nav/noise.py's numpy formulas; a run's values do not depend on the batch):
-
-        el <- max(el, 2 deg) (nan: 0.5 rad);  F = 1 / sqrt(1 - (a cos el / (a + h_I))^2);  M = 1.001 / sqrt(0.002001
-        + sin^2 el);  gse = sqrt(ce^2 + (I F)^2 + (T M)^2);  gmp = 0.13 + 0.53 exp(-el / 10 deg) (DO-253) or mp_m
-    """
-    lo = math.radians(2.0)
-    for i in range(el.shape[0]):
-        for c in range(el.shape[1]):
-            e = el[i, c]
-            e = 0.5 if e != e else e
-            e = max(e, lo)
-            x = a_m * math.cos(e) / (a_m + shell_m)
-            f = 1.0 / math.sqrt(1.0 - x * x)
-            s = math.sin(e)
-            m = 1.001 / math.sqrt(0.002001 + s * s)
-            gse[i, c] = math.sqrt(ce_m**2 + (iono_m * f) ** 2 + (tropo_m * m) ** 2)
-            gmp[i, c] = 0.13 + 0.53 * math.exp(-math.degrees(e) / 10.0) if do253 else mp_m
+def copies_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndarray, which: np.ndarray,
+                 ref: np.ndarray, ins: np.ndarray, chan: ChannelQd, obs: Obs, new: np.ndarray, rows: Rows, out: Out,
+                 n_rows: np.ndarray, scr: Scratch) -> None:
+    """One epoch of N copies that are each their own shared-covariance class (per-run GPS skies, the integrity bank's
+    copies): copy i with X[i], P3[i] (its covariance) on the model phi_h[which[i]], qd_h[which[i]] (H, n, n) (the
+    damping loop held or not, or the epoch's one model), whose GPS channel states' Qd entries are set at copy i's
+    sky (chan: sigmas (N, k), factors scalars; nothing changed when k = 0) and whose ambiguities with new[i, c] != 0
+    are reset to rows.amb_prior (in scr.phi_tmp, a copy of its Phi, when it has one; new (N, 0) without carrier
+    phase); its INS ins[i] (16,) and its row i of every per-copy observation (obs.r_sv (N, s, 3), obs.sig (N, s));
+    then class_epoch in shared mode at the reference ref (16,). Out per copy: out.codes[i], out.nu[i], out.S[i]
+    (R,) and n_rows[i]. The Qd is built in scr.qd."""
+    N = X.shape[0]
+    lay, qd_tmp = rows.lay, scr.qd
+    ig, im, io = lay[ek.L_GSE], lay[ek.L_GMP], lay[ek.L_GIO]
+    last = -1  # the model whose Qd is in qd_tmp and whose Phi's nonzeros are in ws (model reuse)
+    for i in range(N):
+        hd = which[i]
+        if last != hd:
+            qd_tmp[:, :] = qd_h[hd]
+        if ig >= 0:
+            for c in range(chan.gse.shape[1]):
+                qd_tmp[ig + c, ig + c] = chan.gse[i, c] ** 2 * chan.f_gse
+                qd_tmp[im + c, im + c] = chan.gmp[i, c] ** 2 * chan.f_gmp
+        if io >= 0:
+            for c in range(chan.gio.shape[1]):
+                qd_tmp[io + c, io + c] = chan.gio[i, c] ** 2 * chan.f_gio
+        reset = _any_new(new[i])
+        ready = last == hd and not reset
+        phi = _with_resets(phi_h[hd], qd_tmp, lay, new[i], rows.amb_prior, scr.phi_tmp)
+        obs_i = Obs(obs.baro_h[i:i + 1], obs.baro_r, obs.radalt_h[i:i + 1], obs.ref_agl, obs.dbp[i:i + 1], obs.db_x,
+                    obs.db_u[i:i + 1], obs.rho[i:i + 1], obs.r_sv[i], obs.sig[i], obs.cp[i:i + 1],
+                    obs.pl_rho[i:i + 1], obs.r_pl, obs.pl_sig)
+        n_rows[i] = class_epoch(X[i:i + 1], P3[i], phi, qd_tmp, False, ref, ins[i:i + 1], rows, obs_i,
+                                Out(out.codes[i], out.nu[i:i + 1], out.S[i]), scr, ready)
+        last = -1 if reset else hd
 
 
 @njit(cache=True)
-def shared_pass(X: np.ndarray, P3: np.ndarray, lay: np.ndarray, q: np.ndarray, gse: np.ndarray, gmp: np.ndarray,
-                loop: np.ndarray, dt: np.ndarray, ref: np.ndarray, ref_cbn: np.ndarray, f_ref: np.ndarray,
-                ref_agl: np.ndarray, held: np.ndarray, ch_gse: np.ndarray, ch_gmp: np.ndarray, f_gse: np.ndarray,
-                f_gmp: np.ndarray, ins: np.ndarray,
-                baro_h: np.ndarray, baro_r: np.ndarray,
-                radalt_h: np.ndarray, ra_pct: float, ra_floor: float,
-                tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
-                db_u: np.ndarray,
-                rho: np.ndarray, r_sv: np.ndarray, sig: np.ndarray, channel_states: bool,
-                cp: np.ndarray, cp_r: float,
-                pl_rho: np.ndarray, r_pl: np.ndarray, pl_sig: np.ndarray, pl_states: bool,
-                gio: np.ndarray, gio_tau: float, ch_gio: np.ndarray, f_gio: np.ndarray, new: np.ndarray,
-                amb_prior: float,
-                codes: np.ndarray, nu_out: np.ndarray, S_out: np.ndarray, n_rows: np.ndarray,
-                x_out: np.ndarray, p33_out: np.ndarray, pcc_out: np.ndarray, pd_out: np.ndarray,
-                pnav_out: np.ndarray, ic: int, h: np.ndarray, b: np.ndarray, ws: tuple) -> int:
-    """The whole open-loop pass of N runs that are each their own shared-covariance class (per-run GPS skies, the
-    integrity bank's copies): E epochs of singleton_epochs in one call, the model along the reference made here.
+def pass_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndarray, which: np.ndarray,
+               ref: np.ndarray, ins: np.ndarray, chan: ChannelQd, obs: Obs, new: np.ndarray, rows: Rows,
+               out: PassOut, e: int, scr: Scratch) -> None:
+    """Epoch e of a pass (shared_pass, core/nav/copies.bank_epochs): copies_epoch on the pass's arrays at e (chan,
+    obs, new, ins and which with their (N, E) axes, chan's factors and obs's baro_r, ref_agl, pl_sig (E,)), then
+    every copy's estimate and covariance after the epoch into out[:, e] (x, pd, pnav; p33 and pcc when kept)."""
+    copies_epoch(X, P3, phi_h, qd_h, which[:, e], ref, ins[:, e],
+                 ChannelQd(chan.gse[:, e], chan.gmp[:, e], chan.gio[:, e], chan.f_gse[e], chan.f_gmp[e],
+                           chan.f_gio[e]),
+                 Obs(obs.baro_h[:, e], obs.baro_r[e], obs.radalt_h[:, e], obs.ref_agl[e], obs.dbp, obs.db_x, obs.db_u,
+                     obs.rho[:, e], obs.r_sv[:, e], obs.sig[:, e], obs.cp[:, e], obs.pl_rho[:, e], obs.r_pl,
+                     obs.pl_sig[e]),
+                 new[:, e], rows, Out(out.codes[:, e], out.nu[:, e], out.S[:, e]), out.n_rows[:, e], scr)
+    n = X.shape[1]
+    for i in range(X.shape[0]):
+        P = P3[i]
+        for a in range(n):
+            out.x[i, e, a] = X[i, a]
+            out.pd[i, e, a] = P[a, a]
+        if out.p33.shape[2] > 0:
+            for a in range(3):
+                for c in range(3):
+                    out.p33[i, e, a, c] = P[a, c]
+        for a in range(9):
+            for c in range(9):
+                out.pnav[i, e, a, c] = P[a, c]
+        if out.pcc.shape[1] > 0:
+            out.pcc[i, e] = P[out.ic, out.ic]
 
-    Per epoch e: F, Qc = kernels.errormodel.dynamics at the reference (ref (E, 16) packed truth rows, ref_cbn (E, 3,
-    3), f_ref (E, 3) the interval's mean specific force NED m/s^2; lay, q, gse, gmp, loop the model's arrays), without
-    and (when a run's damping loop held: held (N, E) int) with the loop held; Phi, Qd over dt[e] (s) by Van Loan; then
-    every run i as singleton_epochs (ch_gse, ch_gmp (N, E, k) its channel sigmas, f_gse, f_gmp (E,) their factors;
-    ins (N, E, 16) its INS at the epoch; the observations indexed [i, e]: baro_h (N, E) with baro_r (E,) m^2, radalt_h
-    (N, E), rho (N, E, s), r_sv (N, E, s, 3), sig (N, E, s), pl_rho (N, E, p), pl_sig (E, p); ref_agl (E,) m; db
-    per run). Carrier phase (kernels/carrier.py; empty arrays without): the gio states in the model (gio (n_sv,) m,
-    gio_tau s) with their Qd entries at run i's sky from ch_gio (N, E, k) and f_gio (E,), cp (N, E, s) the carrier
-    phases with variance cp_r m^2, and run i's ambiguities with new[i, e, c] != 0 reset to amb_prior m^2. Out per
-    run and epoch: codes, nu_out, S_out (N, E, R), n_rows (N, E), and after the epoch's updates x_out (N, E, n),
-    p33_out (N, E, 3, 3), pcc_out (N, E) (P[ic, ic]), pd_out (N, E, n), pnav_out (N, E, 9, 9). Returns -1 - e when
-    epoch e's model is too large for the compiled discretization (nothing of epoch e done), else E."""
-    N, n = X.shape
-    E = dt.shape[0]
-    F = np.empty((n, n))
-    Qc = np.empty((n, n))
+
+@njit(cache=True)
+def shared_pass(X: np.ndarray, P3: np.ndarray, model: ErrorModel, track: Track, held: np.ndarray, chan: ChannelQd,
+                ins: np.ndarray, obs: Obs, new: np.ndarray, rows: Rows, out: PassOut, scr: Scratch) -> int:
+    """The whole open-loop pass of N runs that are each their own shared-covariance class (per-run GPS skies, the
+    integrity bank's copies): E epochs of copies_epoch in one call, the model along the reference made here.
+
+    Per epoch e: F, Qc = core/nav/errormodel.dynamics and core/nav/carrier.dynamics at the reference (track: ref[e],
+    ref_cbn[e], f_ref[e]; model's constants) without and (when a run's damping loop held: held (N, E) int) with the
+    loop held; Phi, Qd over track.dt[e] by Van Loan; then pass_epoch: every run i as copies_epoch (chan (N, E, k)
+    its channel sigmas, factors (E,); ins (N, E, 16) its INS at the epoch; obs indexed [i, e], obs.baro_r,
+    obs.ref_agl, obs.pl_sig per epoch; new (N, E, k) its new carrier arcs), and its estimate and covariance after
+    the epoch into out. Returns -1 - e when epoch e's model is too large for the compiled discretization (nothing of
+    epoch e done), else E."""
+    n = X.shape[1]
+    E = track.dt.shape[0]
     phi2 = np.empty((2, n, n))
     qd2 = np.empty((2, n, n))
-    qd_tmp = np.empty((n, n))
-    phi_tmp = np.empty((n, n))
-    ig, im, io = lay[ek.L_GSE], lay[ek.L_GMP], lay[ek.L_GIO]
     for e in range(E):
-        y = ref[e]
+        y = track.ref[e]
         any_held = False
-        for i in range(N):
+        for i in range(held.shape[0]):
             if held[i, e] != 0:
                 any_held = True
         for hd in range(2):
             if hd == 1 and not any_held:
                 break
-            ek.dynamics(lay, q, gse, gmp, y[0], y[2], y[3:6], f_ref[e], ref_cbn[e], loop, hd == 1, F, Qc)
-            kcar.dynamics(lay, gio, gio_tau, F, Qc)
-            if not ek.discretize(F, Qc, dt[e], phi2[hd], qd2[hd]):
+            ek.dynamics(model.lay, model.q, model.gse, model.gmp, y[0], y[2], y[3:6], track.f_ref[e],
+                        track.ref_cbn[e], model.loop, hd == 1, scr.F, scr.Qc)
+            kcar.dynamics(model.lay, model.gio, model.gio_tau, scr.F, scr.Qc)
+            if not ek.discretize(scr.F, scr.Qc, track.dt[e], phi2[hd], qd2[hd]):
                 return -1 - e
-        last = -1  # model reuse (above _with_resets), within the epoch: its models are new
-        for i in range(N):
-            hd = held[i, e]
-            if last != hd:
-                qd_tmp[:, :] = qd2[hd]
-            if ig >= 0:
-                for c in range(ch_gse.shape[2]):
-                    qd_tmp[ig + c, ig + c] = ch_gse[i, e, c] ** 2 * f_gse[e]
-                    qd_tmp[im + c, im + c] = ch_gmp[i, e, c] ** 2 * f_gmp[e]
-            if io >= 0:
-                for c in range(ch_gio.shape[2]):
-                    qd_tmp[io + c, io + c] = ch_gio[i, e, c] ** 2 * f_gio[e]
-            reset = _any_new(new[i, e])
-            ready = last == hd and not reset
-            phi = _with_resets(phi2[hd], qd_tmp, lay, new[i, e], amb_prior, phi_tmp)
-            P = P3[i]
-            n_rows[i, e] = class_epoch(X[i:i + 1], P, phi, qd_tmp, lay, False, y, ins[i, e:e + 1],
-                                       baro_h[i, e:e + 1], baro_r[e], radalt_h[i, e:e + 1], ra_pct, ra_floor,
-                                       ref_agl[e], tx, th, rwy, dbp[i:i + 1], db_x, db_u[i:i + 1], rho[i, e:e + 1],
-                                       r_sv[i, e], sig[i, e], channel_states, cp[i, e:e + 1], cp_r,
-                                       pl_rho[i, e:e + 1], r_pl, pl_sig[e], pl_states, codes[i, e],
-                                       nu_out[i, e:e + 1], S_out[i, e], h, b, ws, ready)
-            last = -1 if reset else hd
-            for a in range(n):
-                x_out[i, e, a] = X[i, a]
-                pd_out[i, e, a] = P[a, a]
-            for a in range(3):
-                for c in range(3):
-                    p33_out[i, e, a, c] = P[a, c]
-            for a in range(9):
-                for c in range(9):
-                    pnav_out[i, e, a, c] = P[a, c]
-            pcc_out[i, e] = P[ic, ic]
+        pass_epoch(X, P3, phi2, qd2, held, y, ins, chan, obs, new, rows, out, e, scr)
     return E

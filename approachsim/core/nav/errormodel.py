@@ -33,6 +33,7 @@ import numpy as np
 from numba import njit
 
 from approachsim.core import geodesy as gk
+from approachsim.core.nav import kalman as kk
 
 L_N, L_DP, L_DV, L_PSI, L_BG, L_BA, L_BB, L_SB, L_CLK, L_AC = range(10)
 L_GSE, L_GMP, L_PMP, L_PTR, L_PCLK, L_RAB, L_RAM, L_TDB, L_NSV, L_NPL = range(10, 20)
@@ -215,21 +216,6 @@ def _find(parent: np.ndarray, i: int) -> int:
 
 
 @njit(cache=True)
-def _csr(A: np.ndarray, ptr: np.ndarray, col: np.ndarray, val: np.ndarray) -> None:
-    """Row-compressed nonzeros of A (m, m): row i's are col[ptr[i]:ptr[i + 1]], val[...] (ptr (m + 1,))."""
-    m = A.shape[0]
-    k = 0
-    for i in range(m):
-        ptr[i] = k
-        for j in range(m):
-            if A[i, j] != 0.0:
-                col[k] = j
-                val[k] = A[i, j]
-                k += 1
-    ptr[m] = k
-
-
-@njit(cache=True)
 def _taylor_van_loan(A: np.ndarray, Q: np.ndarray, phi: np.ndarray, qd: np.ndarray) -> None:
     """Phi0 = sum_{k<=8} A^k / k! and Qd0 = Phi0 E12, E12 the (1, 2) block of sum_{k<=8} M0^k / k!,
     M0 = [[-A, Q], [0, A']] (A = F t0, Q = Qc t0; t0 the scaled step); Qd0 symmetrized, into phi, qd.
@@ -245,8 +231,8 @@ def _taylor_van_loan(A: np.ndarray, Q: np.ndarray, phi: np.ndarray, qd: np.ndarr
     q_ptr = np.empty(m + 1, dtype=np.int64)
     q_col = np.empty(m * m, dtype=np.int64)
     q_val = np.empty(m * m)
-    _csr(A, a_ptr, a_col, a_val)
-    _csr(Q, q_ptr, q_col, q_val)
+    kk.csr(A, a_ptr, a_col, a_val)
+    kk.csr(Q, q_ptr, q_col, q_val)
     G = np.eye(m)  # G_{k-1}
     U = np.zeros((m, m))  # U_{k-1}
     E12t = np.zeros((m, m))  # sum U_k = E12'
@@ -265,11 +251,7 @@ def _taylor_van_loan(A: np.ndarray, Q: np.ndarray, phi: np.ndarray, qd: np.ndarr
                 l = q_col[p]
                 for j in range(m):
                     W[i, j] += c * G[j, l]
-            for p in range(a_ptr[i], a_ptr[i + 1]):
-                a = a_val[p]
-                l = a_col[p]
-                for j in range(m):
-                    W[i, j] += a * U[l, j]
+            kk.row_sums(i, a_ptr, a_col, a_val, U, W)
         for i in range(m):
             for j in range(m):
                 U[i, j] = W[i, j] / k
@@ -278,11 +260,7 @@ def _taylor_van_loan(A: np.ndarray, Q: np.ndarray, phi: np.ndarray, qd: np.ndarr
         for i in range(m):
             for j in range(m):
                 W[i, j] = 0.0
-            for p in range(a_ptr[i], a_ptr[i + 1]):
-                a = a_val[p]
-                l = a_col[p]
-                for j in range(m):
-                    W[i, j] += a * G[l, j]
+            kk.row_sums(i, a_ptr, a_col, a_val, G, W)
         for i in range(m):
             for j in range(m):
                 G[i, j] = W[i, j] / k
@@ -315,29 +293,20 @@ def _square(phi: np.ndarray, qd: np.ndarray, W: np.ndarray, P2: np.ndarray, ptr:
     """One squaring of the Van Loan exponential in blocks: Qd <- Phi Qd Phi' + Qd (symmetrized), Phi <- Phi^2,
     in place. Phi Qd Phi' = Phi W' with W = Phi Qd (Qd symmetric). W, P2 (m, m), ptr, col, val: scratch."""
     m = phi.shape[0]
-    _csr(phi, ptr, col, val)
+    kk.csr(phi, ptr, col, val)
     for i in range(m):  # W = Phi Qd ; P2 = Phi Phi, along the nonzeros of Phi's rows
         for j in range(m):
             W[i, j] = 0.0
             P2[i, j] = 0.0
-        for p in range(ptr[i], ptr[i + 1]):
-            a = val[p]
-            l = col[p]
-            for j in range(m):
-                W[i, j] += a * qd[l, j]
-            for j in range(m):
-                P2[i, j] += a * phi[l, j]
+        kk.row_sums(i, ptr, col, val, qd, W)
+        kk.row_sums(i, ptr, col, val, phi, P2)
     for i in range(m):  # W <- W'
         for j in range(i + 1, m):
             t = W[i, j]
             W[i, j] = W[j, i]
             W[j, i] = t
     for i in range(m):  # Qd += Phi W'
-        for p in range(ptr[i], ptr[i + 1]):
-            a = val[p]
-            l = col[p]
-            for j in range(m):
-                qd[i, j] += a * W[l, j]
+        kk.row_sums(i, ptr, col, val, W, qd)
     _symmetrize(qd)
     phi[:, :] = P2
 

@@ -50,7 +50,7 @@ def csr(A: np.ndarray, ptr: np.ndarray, col: np.ndarray, val: np.ndarray) -> Non
 
 
 @njit(cache=True)
-def _row_sums(i: int, ptr: np.ndarray, col: np.ndarray, val: np.ndarray, B: np.ndarray, out: np.ndarray) -> None:
+def row_sums(i: int, ptr: np.ndarray, col: np.ndarray, val: np.ndarray, B: np.ndarray, out: np.ndarray) -> None:
     """out[i, :] += sum over row i's nonzeros p of val[p] B[col[p], :], added one p after another in p's order;
     four p per pass over the row (the same additions in the same order as one p per pass: the same numbers, with
     a quarter of the loads and stores of out's row)."""
@@ -79,7 +79,7 @@ def _predict_cov(P: np.ndarray, qd: np.ndarray, W: np.ndarray, ptr: np.ndarray, 
     for i in range(n):  # W = Phi P
         for j in range(n):
             W[i, j] = 0.0
-        _row_sums(i, ptr, col, val, P, W)
+        row_sums(i, ptr, col, val, P, W)
     for i in range(n):  # W <- W' = P Phi'
         for j in range(i + 1, n):
             t = W[i, j]
@@ -88,7 +88,7 @@ def _predict_cov(P: np.ndarray, qd: np.ndarray, W: np.ndarray, ptr: np.ndarray, 
     for i in range(n):  # P = Phi W' + Qd
         for j in range(n):
             P[i, j] = qd[i, j]
-        _row_sums(i, ptr, col, val, W, P)
+        row_sums(i, ptr, col, val, W, P)
     for i in range(n):  # the upper triangle, mirrored
         for j in range(i + 1, n):
             P[j, i] = P[i, j]

@@ -109,11 +109,7 @@ def _radalt(lay: np.ndarray, x_hat: np.ndarray, lat: float, lon: float, h_ins: f
             tx: np.ndarray, th: np.ndarray, rwy: np.ndarray, dbp: np.ndarray, db_x: np.ndarray,
             db_u: np.ndarray, h: np.ndarray, row: bool) -> float:
     """nu of the radar-altimeter row (and the row into h when `row`): nav/measurements.radalt's arithmetic."""
-    sl, cl, so, co = math.sin(lat), math.cos(lat), math.sin(lon), math.cos(lon)
-    # C_en rows (geo.c_ecef_to_ned): north, east, down
-    cn = (-sl * co, -sl * so, cl)
-    ce = (-so, co, 0.0)
-    cd = (-cl * co, -cl * so, -sl)
+    cn, ce, cd = gk.ned_axes(lat, lon)  # C_en's rows: north, east, down
     r0, r1, r2 = gk.geodetic_to_ecef(lat, lon, h_ins)
     ip = lay[ek.L_DP]
     d0, d1, d2 = x_hat[ip], x_hat[ip + 1], x_hat[ip + 2]
@@ -158,18 +154,36 @@ def radalt(lay: np.ndarray, x_hat: np.ndarray, lat: float, lon: float, h_ins: fl
 
 
 @njit(cache=True)
+def ranges(x_hat: np.ndarray, ip: int, r_ins: np.ndarray, c_en: np.ndarray,
+           r_tx: np.ndarray) -> tuple[float, float, float, float, float]:
+    """d_hat = r_ins - C' dp_hat - r_tx (ECEF, m; dp_hat = x_hat[ip:ip + 3] NED, C = c_en (3, 3) ECEF -> NED), its
+    length |d_hat| (the range from the corrected position) and |r_ins - r_tx| (from the INS), m: the geometry of
+    the pseudorange and carrier-phase rows (pseudorange; core/nav/carrier.carrier_phase)."""
+    d0, d1, d2 = x_hat[ip], x_hat[ip + 1], x_hat[ip + 2]
+    a0 = r_ins[0] - (c_en[0, 0] * d0 + c_en[1, 0] * d1 + c_en[2, 0] * d2) - r_tx[0]
+    a1 = r_ins[1] - (c_en[0, 1] * d0 + c_en[1, 1] * d1 + c_en[2, 1] * d2) - r_tx[1]
+    a2 = r_ins[2] - (c_en[0, 2] * d0 + c_en[1, 2] * d1 + c_en[2, 2] * d2) - r_tx[2]
+    b0, b1, b2 = r_ins[0] - r_tx[0], r_ins[1] - r_tx[1], r_ins[2] - r_tx[2]
+    return a0, a1, a2, math.sqrt(a0 * a0 + a1 * a1 + a2 * a2), math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+
+
+@njit(cache=True)
+def los_row(h: np.ndarray, ip: int, c_en: np.ndarray, a0: float, a1: float, a2: float, rng_hat: float,
+            scale: float) -> None:
+    """The row's position part h[ip:ip + 3] = (C e) scale, e = d_hat / |d_hat| the unit vector transmitter ->
+    corrected position (ECEF; `ranges`), C = c_en ECEF -> NED: d range / d dp_NED, times scale (1 + T for a
+    pseudolite's troposphere state, else 1)."""
+    u0, u1, u2 = a0 / rng_hat, a1 / rng_hat, a2 / rng_hat
+    for k in range(3):
+        h[ip + k] = (c_en[k, 0] * u0 + c_en[k, 1] * u1 + c_en[k, 2] * u2) * scale
+
+
+@njit(cache=True)
 def _pseudorange(lay: np.ndarray, x_hat: np.ndarray, r_ins: np.ndarray, c_en: np.ndarray, r_tx: np.ndarray,
                  rho: float, sv: int, pl: int, h: np.ndarray, row: bool) -> float:
     """nu of a pseudorange row (and the row into h when `row`): nav/measurements.pseudorange's arithmetic."""
     ip = lay[ek.L_DP]
-    d0, d1, d2 = x_hat[ip], x_hat[ip + 1], x_hat[ip + 2]
-    # d_hat = r_ins - C' dp - r_tx ; the range from the corrected position and from the INS
-    a0 = r_ins[0] - (c_en[0, 0] * d0 + c_en[1, 0] * d1 + c_en[2, 0] * d2) - r_tx[0]
-    a1 = r_ins[1] - (c_en[0, 1] * d0 + c_en[1, 1] * d1 + c_en[2, 1] * d2) - r_tx[1]
-    a2 = r_ins[2] - (c_en[0, 2] * d0 + c_en[1, 2] * d1 + c_en[2, 2] * d2) - r_tx[2]
-    rng_hat = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
-    b0, b1, b2 = r_ins[0] - r_tx[0], r_ins[1] - r_tx[1], r_ins[2] - r_tx[2]
-    rng_ins = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+    a0, a1, a2, rng_hat, rng_ins = ranges(x_hat, ip, r_ins, c_en, r_tx)
     lin = 0.0  # h' x_hat over the states the difference is linear in (clock and channel errors)
     ic = lay[ek.L_CLK]
     if row:
@@ -199,9 +213,7 @@ def _pseudorange(lay: np.ndarray, x_hat: np.ndarray, r_ins: np.ndarray, c_en: np
             if row:
                 h[k + 2 * pl] = -1.0
     if row:  # e' (1 + T) at dp, e the unit vector transmitter -> corrected position, NED
-        u0, u1, u2 = a0 / rng_hat, a1 / rng_hat, a2 / rng_hat
-        for k in range(3):
-            h[ip + k] = (c_en[k, 0] * u0 + c_en[k, 1] * u1 + c_en[k, 2] * u2) * scale
+        los_row(h, ip, c_en, a0, a1, a2, rng_hat, scale)
     z = rng_ins - rho
     g_hat = rng_ins - rng_hat * scale + lin  # exact in dp (and T), linear in the rest
     return z - g_hat

@@ -14,7 +14,7 @@ def lone_states(f_g: Array, f_m: Array, ch_gse: Array, ch_gmp: Array, f_gse: Arr
                 ig: int, im: int, xg: Array, xm: Array, pg: Array, pm: Array, x_out: Array, pd_out: Array) -> None:
     """The dropped channels' gse / gmp states over the E epochs, in place from their start xg, xm, pg, pm (k_d,):
     each epoch x <- 0 + phi x and P <- Qd + phi (0 + phi P) (core/nav/kalman._predict_cov's sums for a lone state,
-    Qd = sigma^2 f as core/nav/epoch.singleton_epochs sets it; phi f_g, f_m (E,), the sigmas ch_gse, ch_gmp (E, k)
+    Qd = sigma^2 f as core/nav/epoch.copies_epoch sets it; phi f_g, f_m (E,), the sigmas ch_gse, ch_gmp (E, k)
     of the run, factors f_gse, f_gmp (E,)); written to x_out, pd_out (E, n) at ig + drop, im + drop."""
     for e in range(f_g.shape[0]):
         for a in range(drop.shape[0]):

@@ -34,6 +34,7 @@ import numpy as np
 from numba import njit
 
 from approachsim.core import geodesy as gk
+from approachsim.core.sensors import imu as ik
 
 NX = 16
 """Columns of the packed INS state."""
@@ -196,27 +197,17 @@ def strapdown(x: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, dt: float, bias
 
 
 @njit(cache=True)
-def imu_increment(m_err: np.ndarray, true_row: np.ndarray, dt: float, c: np.ndarray, out: np.ndarray) -> None:
-    """One affine IMU increment (sensors/imu.py): out = d + M d + c, d = dt * true_row (the rate or specific
-    force of truth sample k-1 held over the interval), M (3, 3) scale factor + misalignment, c (3,) the
-    sample's bias, noise and drift terms."""
-    d0, d1, d2 = dt * true_row[0], dt * true_row[1], dt * true_row[2]
-    for r in range(3):
-        d = d0 if r == 0 else (d1 if r == 1 else d2)
-        out[r] = d + (m_err[r, 0] * d0 + m_err[r, 1] * d1 + m_err[r, 2] * d2) + c[r]
-
-
-@njit(cache=True)
 def inloop_step(k: int, w_ib: np.ndarray, f_body: np.ndarray, affine: bool, m_g: np.ndarray, m_a: np.ndarray,
                 c_g: np.ndarray, c_a: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, dt: float,
                 bias_g: np.ndarray, bias_a: np.ndarray, h_baro: np.ndarray, baro_age: np.ndarray, loop: np.ndarray,
                 x: np.ndarray, f_sum: np.ndarray) -> None:
     """The closed loop's INS step into truth row k for one run: with `affine`, the IMU increments of interval
-    (k-1, k] from truth rows w_ib, f_body (n, 3) and the pre-drawn error terms (imu_increment; M m_g, m_a and
-    c_g, c_a (m, 3) indexed by sample k-1), else the given dtheta, dv (1, 1, 3); then `strapdown` on x (1, 16)."""
+    (k-1, k] from truth rows w_ib, f_body (n, 3) and the pre-drawn error terms (core/sensors/imu.increment; M m_g,
+    m_a and c_g, c_a (m, 3) indexed by sample k-1), else the given dtheta, dv (1, 1, 3); then `strapdown` on x
+    (1, 16)."""
     if affine:
-        imu_increment(m_g, w_ib[k - 1], dt, c_g[k - 1], dtheta[0, 0])
-        imu_increment(m_a, f_body[k - 1], dt, c_a[k - 1], dv[0, 0])
+        ik.increment(m_g, w_ib[k - 1], dt, c_g[k - 1], dtheta[0, 0])
+        ik.increment(m_a, f_body[k - 1], dt, c_a[k - 1], dv[0, 0])
     strapdown(x, dtheta, dv, dt, bias_g, bias_a, h_baro, baro_age, loop, f_sum, np.empty((1, 0, NX)), 0)
 
 

@@ -10,10 +10,11 @@ same sample of a batch bit for bit.
     sv_orbits          satellite positions (and velocities) on circular Kepler orbits at each sky's sample times
     look_angles        range, line of sight, elevation and azimuth of every satellite from the receiver
     sky                look angles, visibility, selection (all / best-PDOP four / a planned four), PDOP, mappings
-    pseudoranges       range + mapped errors + receiver clock for every run, nan where not selected
+    pseudorange_sum    range + scaled error terms + receiver clock for every run, nan where not selected
+    pseudoranges       pseudorange_sum with the stand-alone receiver's terms (clock/ephemeris, iono, tropo, mp, noise)
+    channel_sigmas     the navigation filter's GPS channel-state sigmas of a stand-alone budget, element by element
     gbas_scales        the GBAS-corrected residual's scales and nominal sigma per channel (gnss/gbas.py)
     gbas_channel_sigmas the navigation filter's GPS channel-state sigmas under GBAS, element by element
-    pseudoranges_gbas  range + scaled GBAS residual series + receiver clock for every run
     pseudorange_rates  line-of-sight range rate + clock drift + noise for every run
     best_four_epochs   the best-PDOP four at each of a stack of epochs (best_four: one epoch)
 """
@@ -23,17 +24,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import literal_unroll, njit
 
 from approachsim import geo
+from approachsim.core import geodesy as gd
+from approachsim.core.sensors import gnss_errors as ge
 
-A = geo.A_WGS84
-B = geo.B_WGS84
-E2 = geo.E2_WGS84
-EP2 = E2 / (1.0 - E2)
 OMEGA_E = geo.OMEGA_E
 TWO_PI = 2.0 * math.pi
-RAD_TO_DEG = 180.0 / math.pi
 
 MODE_ALL = 0
 """Selection: every visible channel."""
@@ -76,33 +74,6 @@ def sv_orbits(u0: np.ndarray, raan: np.ndarray, a_m: float, ci: float, si: float
 
 
 @njit(cache=True)
-def geodetic_lat_lon(x: float, y: float, z: float) -> tuple[float, float]:
-    """Geodetic latitude and longitude (rad) of the ECEF point (x, y, z), m: geo.ecef_to_geodetic's Bowring start
-    and two refinements lat = atan2(z, p (1 - e^2 R_E / (R_E + h))), in the same order."""
-    lon = math.atan2(y, x)
-    p = math.hypot(x, y)
-    theta = math.atan2(z * A, p * B)
-    lat = math.atan2(z + EP2 * B * math.pow(math.sin(theta), 3.0), p - E2 * A * math.pow(math.cos(theta), 3.0))
-    for _ in range(2):
-        s = math.sin(lat)
-        r_e = A / math.sqrt(1.0 - E2 * (s * s))
-        c = abs(math.cos(lat))
-        h = p / max(c, 1e-300) - r_e if c > 1e-9 else abs(z) - B
-        lat = math.atan2(z, p * (1.0 - E2 * r_e / (r_e + h)))
-    return lat, lon
-
-
-@njit(cache=True)
-def c_ecef_to_ned(lat: float, lon: float, c: np.ndarray) -> None:
-    """The rotation ECEF -> local NED at (lat, lon), rad, into c (3, 3) (geo.c_ecef_to_ned)."""
-    sl, cl = math.sin(lat), math.cos(lat)
-    so, co = math.sin(lon), math.cos(lon)
-    c[0, 0], c[0, 1], c[0, 2] = -sl * co, -sl * so, cl
-    c[1, 0], c[1, 1], c[1, 2] = -so, co, 0.0
-    c[2, 0], c[2, 1], c[2, 2] = -cl * co, -cl * so, -sl
-
-
-@njit(cache=True)
 def _look(rx: np.ndarray, c: np.ndarray, r_sv: np.ndarray, rng: np.ndarray, u: np.ndarray, el: np.ndarray,
           az: np.ndarray) -> None:
     """One epoch (constellation.look_angles): d = r_sv - r_rx, range |d|, u = d / |d| (ECEF), u_ned = C u,
@@ -136,8 +107,8 @@ def look_angles(r_rx: np.ndarray, r_sv: np.ndarray) -> tuple[np.ndarray, np.ndar
     az = np.empty((n_sky, m, k))
     c = np.empty((3, 3))
     for i in range(m):
-        lat, lon = geodetic_lat_lon(r_rx[i, 0], r_rx[i, 1], r_rx[i, 2])
-        c_ecef_to_ned(lat, lon, c)
+        lat, lon = gd.geodetic_lat_lon(r_rx[i, 0], r_rx[i, 1], r_rx[i, 2])
+        gd.c_ecef_to_ned(lat, lon, c)
         for s in range(n_sky):
             _look(r_rx[i], c, r_sv[s, i], rng[s, i], u[s, i], el[s, i], az[s, i])
     return rng, u, el, az
@@ -276,8 +247,8 @@ def sky(r_rx: np.ndarray, r_sv: np.ndarray, mask_rad: float, mode: int, plan: np
     c = np.empty((3, 3))
     idx = np.empty(k, dtype=np.int64)
     for i in range(m):
-        lat, lon = geodetic_lat_lon(r_rx[i, 0], r_rx[i, 1], r_rx[i, 2])
-        c_ecef_to_ned(lat, lon, c)
+        lat, lon = gd.geodetic_lat_lon(r_rx[i, 0], r_rx[i, 1], r_rx[i, 2])
+        gd.c_ecef_to_ned(lat, lon, c)
         for s in range(n_sky):
             _look(r_rx[i], c, r_sv[s, i], rng[s, i], u[s, i], el[s, i], az[s, i])
             for j in range(k):
@@ -299,12 +270,10 @@ def sky(r_rx: np.ndarray, r_sv: np.ndarray, mask_rad: float, mode: int, plan: np
             pd[s, i] = pdop(u[s, i], sel[s, i])
             for j in range(k):
                 e = el[s, i, j]
-                x = A * math.cos(e) / (A + shell_m)
-                f = 1.0 / math.sqrt(1.0 - x * x)
-                sn = math.sin(e)
-                mt = 1.001 / math.sqrt(0.002001 + sn * sn)
+                f = ge.iono_obliquity(math.cos(e), shell_m)
+                mt = ge.tropo_mapping(math.sin(e))
                 if do253:
-                    msc = 0.13 + 0.53 * math.exp(-(e * RAD_TO_DEG) / 10.0)
+                    msc = ge.do253_multipath_m(e)
                     mps = msc
                 else:
                     msc = 1.0
@@ -319,16 +288,17 @@ def sky(r_rx: np.ndarray, r_sv: np.ndarray, mask_rad: float, mode: int, plan: np
 
 
 @njit(cache=True)
-def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_scale: np.ndarray, sel: np.ndarray,
-                 ce: np.ndarray, iono: np.ndarray, tropo: np.ndarray, mp: np.ndarray, noise: np.ndarray,
-                 bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Pseudoranges (R, m, k) m and validity of every run r (receiver.py; run r on sky r, or on sky 0 when there
-    is one sky for all runs):
+def pseudorange_sum(rng: np.ndarray, sel: np.ndarray, terms: tuple, bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pseudoranges (R, m, k) m and validity of every run r (receiver.py; run r on sky r, or on sky 0 when there is
+    one sky for all runs): the range plus each error term scaled, in the order of `terms`, plus the receiver clock:
 
-        rho = |r_sv - r| + E + F I + M T + s_mp m + n + b_rx      (nan where the channel is not selected)
+        rho = |r_sv - r| + s_1 e_1 + s_2 e_2 + ... + b_rx      (nan where the channel is not selected)
 
-    geometry (S, m, k) from `sky`, errors ce, iono, tropo, mp, noise (R, m, k), receiver clock bias (R, m)."""
-    n_run, m, k = ce.shape
+    rng (S, m, k) and sel from `sky`; terms ((s_t (S, m, k), e_t (R, m, k)), ...) the scales (m per unit, or ones)
+    and the error series; bias (R, m) the receiver clock, m. Stand-alone: `pseudoranges`; GBAS: the scales of
+    gbas_scales with the unit series and the white noise (receiver.py)."""
+    n_run, m = bias.shape[0], bias.shape[1]
+    k = rng.shape[2]
     one_sky = rng.shape[0] == 1
     pr = np.empty((n_run, m, k))
     valid = np.empty((n_run, m, k), dtype=np.bool_)
@@ -337,8 +307,9 @@ def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_sc
         for i in range(m):
             b = bias[r, i]
             for j in range(k):
-                p = (rng[s, i, j] + ce[r, i, j] + f_iono[s, i, j] * iono[r, i, j] + m_tropo[s, i, j] * tropo[r, i, j]
-                     + mp[r, i, j] * mp_scale[s, i, j] + noise[r, i, j])
+                p = rng[s, i, j]
+                for t in literal_unroll(terms):
+                    p = p + t[0][s, i, j] * t[1][r, i, j]
                 v = sel[s, i, j]
                 valid[r, i, j] = v
                 pr[r, i, j] = p + b if v else math.nan
@@ -346,20 +317,36 @@ def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_sc
 
 
 @njit(cache=True)
-def _gbas_terms(e: float, path: float, hfac: float, gad: np.ndarray, n_ref: float, aad: np.ndarray,
-                shell_m: float) -> tuple[float, float, float, float, float]:
-    """The five GBAS scales (ground, iono, tropo, multipath, noise), m, of one channel at elevation e (rad), with
-    path = sigma_vig (x_air + 2 tau v_air) and hfac = sigma_n h0 1e-6 |1 - exp(-dh / h0)| (gbas_scales)."""
-    if e > gad[0]:
-        a = gad[1] + gad[2] * math.exp(-e / gad[3])
-        a2 = gad[4]
-    else:
-        a = gad[5] + gad[6] * math.exp(-e / gad[7])
-        a2 = gad[8]
-    x = A * math.cos(e) / (A + shell_m)
-    sn = math.sin(e)
-    return (math.sqrt(a * a / n_ref + a2 * a2), path / math.sqrt(1.0 - x * x), hfac / math.sqrt(0.002 + sn * sn),
-            0.13 + 0.53 * math.exp(-(e * RAD_TO_DEG) / 10.0), aad[0] + aad[1] * math.exp(-e / aad[2]))
+def pseudoranges(rng: np.ndarray, f_iono: np.ndarray, m_tropo: np.ndarray, mp_scale: np.ndarray, sel: np.ndarray,
+                 ce: np.ndarray, iono: np.ndarray, tropo: np.ndarray, mp: np.ndarray, noise: np.ndarray,
+                 bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The stand-alone receiver's pseudorange_sum (receiver.py):
+
+        rho = |r_sv - r| + E + F I + M T + s_mp m + n + b_rx      (nan where the channel is not selected)
+
+    geometry (S, m, k) from `sky`, errors ce, iono, tropo, mp, noise (R, m, k), receiver clock bias (R, m)."""
+    one = np.ones(rng.shape)
+    return pseudorange_sum(rng, sel, ((one, ce), (f_iono, iono), (m_tropo, tropo), (mp_scale, mp), (one, noise)),
+                           bias)
+
+
+@njit(cache=True)
+def channel_sigmas(el: np.ndarray, shell_m: float, ce_m: float, iono_m: float, tropo_m: float, do253: bool,
+                   mp_m: float, gse: np.ndarray, gmp: np.ndarray) -> None:
+    """The GPS channel states' 1-sigma (m) of a stand-alone budget at elevations el (N, k) rad, into gse, gmp (N, k),
+    element by element (the compiled twin of receiver.GnssErrorBudget.channel_sigmas_m behind nav/noise.py's
+    elevation guard; a run's values do not depend on the batch): gnss_errors.channel_sigmas at
+    el <- guard_elevation(el) (nan: 0.5 rad, at least 2 deg),
+
+        gse = sqrt(ce^2 + (I F)^2 + (T M)^2),  gmp = 0.13 + 0.53 exp(-el / 10 deg) (DO-253) or mp_m
+    """
+    ce2 = ce_m * ce_m
+    for i in range(el.shape[0]):
+        for c in range(el.shape[1]):
+            e = ge.guard_elevation(el[i, c], ge.ELEVATION_FLOOR_RAD)
+            decay = math.exp(ge.do253_exponent(e)) if do253 else 0.0
+            gse[i, c], gmp[i, c] = ge.channel_sigmas(math.cos(e), math.sin(e), decay, shell_m, ce2, iono_m, tropo_m,
+                                                     do253, mp_m)
 
 
 @njit(cache=True)
@@ -373,15 +360,12 @@ def gbas_channel_sigmas(el: np.ndarray, x_air: np.ndarray, dh: np.ndarray, v_air
 
         el <- max(el, 2 deg) (nan: 0.5 rad);  gse = sqrt(ground^2 + iono^2 + tropo^2);  gmp = sqrt(mp^2 + noise^2)
     """
-    lo = math.radians(2.0)
     for i in range(el.shape[0]):
         path = sigma_vig * (x_air[i] + 2.0 * tau_s * v_air[i])
         hfac = sigma_n * h0_m * 1e-6 * abs(-math.expm1(-dh[i] / h0_m))
         for c in range(el.shape[1]):
-            e = el[i, c]
-            e = 0.5 if e != e else e
-            e = max(e, lo)
-            g, io, tr, mp, nz = _gbas_terms(e, path, hfac, gad, n_ref, aad, shell_m)
+            e = ge.guard_elevation(el[i, c], ge.ELEVATION_FLOOR_RAD)
+            g, io, tr, mp, nz = ge.gbas_terms(e, path, hfac, gad, n_ref, aad, shell_m)
             gse[i, c] = math.sqrt(g * g + io * io + tr * tr)
             gmp[i, c] = math.sqrt(mp * mp + nz * nz)
 
@@ -419,7 +403,7 @@ def gbas_scales(el: np.ndarray, r_rx: np.ndarray, h_m: np.ndarray, v_ned: np.nda
             path = sigma_vig * (x_air + 2.0 * tau_s * v_air)
             hfac = sigma_n * h0_m * 1e-6 * abs(-math.expm1(-(h_m[i] - station_h_m) / h0_m))
             for j in range(k):
-                g, io, tr, mp, nz = _gbas_terms(el[s, i, j], path, hfac, gad, n_ref, aad, shell_m)
+                g, io, tr, mp, nz = ge.gbas_terms(el[s, i, j], path, hfac, gad, n_ref, aad, shell_m)
                 s_gnd[s, i, j] = g
                 s_iono[s, i, j] = io
                 s_tropo[s, i, j] = tr
@@ -427,35 +411,6 @@ def gbas_scales(el: np.ndarray, r_rx: np.ndarray, h_m: np.ndarray, v_ned: np.nda
                 s_noise[s, i, j] = nz
                 sigma[s, i, j] = math.sqrt(g * g + io * io + tr * tr + mp * mp + nz * nz + w2)
     return s_gnd, s_iono, s_tropo, s_mp, s_noise, sigma
-
-
-@njit(cache=True)
-def pseudoranges_gbas(rng: np.ndarray, s_gnd: np.ndarray, s_iono: np.ndarray, s_tropo: np.ndarray, s_mp: np.ndarray,
-                      s_noise: np.ndarray, sel: np.ndarray, gnd: np.ndarray, iono: np.ndarray, tropo: np.ndarray,
-                      mp: np.ndarray, noise: np.ndarray, white: np.ndarray,
-                      bias: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """GBAS-corrected pseudoranges (R, m, k) m and validity of every run r (run r on sky r, or on sky 0 for one sky):
-
-        rho = |r_sv - r| + s_gnd g + s_iono I + s_tropo T + s_mp m + s_noise n + w + b_rx   (nan where not selected)
-
-    geometry and scales (S, m, k) from `sky` and `gbas_scales`, unit series and the white noise w (m) (R, m, k),
-    receiver clock bias (R, m)."""
-    n_run, m, k = gnd.shape
-    one_sky = rng.shape[0] == 1
-    pr = np.empty((n_run, m, k))
-    valid = np.empty((n_run, m, k), dtype=np.bool_)
-    for r in range(n_run):
-        s = 0 if one_sky else r
-        for i in range(m):
-            b = bias[r, i]
-            for j in range(k):
-                p = (rng[s, i, j] + s_gnd[s, i, j] * gnd[r, i, j] + s_iono[s, i, j] * iono[r, i, j]
-                     + s_tropo[s, i, j] * tropo[r, i, j] + s_mp[s, i, j] * mp[r, i, j]
-                     + s_noise[s, i, j] * noise[r, i, j] + white[r, i, j])
-                v = sel[s, i, j]
-                valid[r, i, j] = v
-                pr[r, i, j] = p + b if v else math.nan
-    return pr, valid
 
 
 @njit(cache=True)
@@ -470,7 +425,7 @@ def pseudorange_rates(u: np.ndarray, v_sv: np.ndarray, lat: np.ndarray, lon: np.
     c = np.empty((3, 3))
     v_rx = np.empty(3)
     for i in range(m):
-        c_ecef_to_ned(lat[i], lon[i], c)
+        gd.c_ecef_to_ned(lat[i], lon[i], c)
         for q in range(3):
             v_rx[q] = c[0, q] * v_ned[i, 0] + c[1, q] * v_ned[i, 1] + c[2, q] * v_ned[i, 2]
         for r in range(n_run):

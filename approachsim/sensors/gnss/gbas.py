@@ -101,7 +101,7 @@ The iono and tropo terms depend on where the aircraft is; `channel_sigmas_m` tak
 on a 3 deg path at 140 kt: the largest residual such an approach sees (conservative closer in).
 
 `GbasModel` holds the configuration and the numpy formulas, the oracle of the compiled kernels
-(core/sensors/gnss.py gbas_scales, pseudoranges_gbas, and gbas_channel_sigmas: the filter's channel sigmas for a
+(core/sensors/gnss.py gbas_scales, pseudorange_sum, and gbas_channel_sigmas: the filter's channel sigmas for a
 compiled navigation epoch, called with channel_kernel_args()).
 """
 

@@ -533,9 +533,10 @@ class GnssReceiver:
             s_gnd, s_iono, s_tropo, s_mp, s_noise, sigma = gk.gbas_scales(
                 el, r_rx, c(truth.h_m[rows], dtype=float), c(truth.v_ned[rows], dtype=float),
                 *self._gbas_args)  # type: ignore[attr-defined]
-            pr, valid = gk.pseudoranges_gbas(rng, s_gnd, s_iono, s_tropo, s_mp, s_noise, sel, c(series["ground"]),
-                                             c(series["iono"]), c(series["tropo"]), c(series["multipath"]),
-                                             c(series["noise"]), c(series["white"]), c(bias))
+            terms = tuple((sc, c(series[n])) for sc, n in ((s_gnd, "ground"), (s_iono, "iono"), (s_tropo, "tropo"),
+                                                           (s_mp, "multipath"), (s_noise, "noise"),
+                                                           (np.ones(rng.shape), "white")))
+            pr, valid = gk.pseudorange_sum(rng, sel, terms, c(bias))
             if self.carrier is not None:
                 slow, iono = s_gnd * series["ground"] + s_tropo * series["tropo"], s_iono * series["iono"]
         phi = arc = None

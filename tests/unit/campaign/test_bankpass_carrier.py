@@ -1,5 +1,5 @@
 """The integrity bank's compiled reduced-state pass with GPS carrier phase (campaign/bankpass.py,
-core/nav/copies.bank_epochs_carrier) against the path it replaces, NavSystem.run's batched copies on the full
+core/nav/copies.bank_epochs) against the path it replaces, NavSystem.run's batched copies on the full
 state (run_bank(..., compiled=False): Navigator.compiled_pass, core/nav/epoch.shared_pass with the carrier states):
 bit for bit, on the shipped carrier candidate (GBAS, all in view, two pseudolites) and with a channel's carrier
 interrupted by an outage (a new arc: its float ambiguity reset in the copies that measure it, not in the copy that

@@ -2,7 +2,7 @@
 oracle, the Navigator's numpy path around the same per-run EKF epoch (NavInTheLoop.fast_epochs = False): JSBSim
 flies the same seconds of an approach with each, and everything the flight and the navigation give is the same bits.
 
-Why exact and not a floor (tests/floors.py): the compiled epoch is the same core/nav/epoch.own_epoch on the same
+Why exact and not a floor (tests/floors.py): the compiled epoch is the same core/nav/epoch.run_epoch on the same
 inputs (Observations.at's selections made directly from the one-row records, the GPS channel sigmas by the same
 numpy formulas), plus copies and the one division f_sum / dt the numpy path makes too; no operation is reordered, so
 there is no rounding to bound (and none under NUMBA_CPU_NAME=generic either: both paths call the one kernel)."""
