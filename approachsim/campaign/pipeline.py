@@ -351,3 +351,6 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool =
         except Exception as e:
             out.append(RunResult.failed(i, f"{type(e).__name__}: {e}"))
     return out
+
+
+closed_loop_group.kernels = "closed"  # type: ignore[attr-defined]  # its runs' kernels: core/manifests/closed.pkl

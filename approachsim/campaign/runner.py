@@ -31,6 +31,7 @@ from threadpoolctl import threadpool_limits
 from approachsim.campaign.result import RunResult
 from approachsim.campaign.store import CampaignStore
 from approachsim.config import ProfileError
+from approachsim.core.warm import compile_share
 
 RunFn = Callable[[Any, int, int], RunResult]
 GroupFn = Callable[[Any, int, Sequence[int]], list[RunResult]]
@@ -210,10 +211,24 @@ def plan_chunks(todo: Sequence[int], *, workers: int, group_size: int | None, pe
 CRASH = "worker process died while running this run's task (a crash or out of memory)"
 
 
+def kernels_of(fn: Any) -> str | None:
+    """The kernel manifest (core/warm.py) a run or group function names in its `kernels` attribute, looking through
+    functools.partial; None: it names none."""
+    return getattr(fn, "kernels", None) or getattr(getattr(fn, "func", None), "kernels", None)
+
+
 def _pool_round(tasks: list, workers: int, args: tuple, ctx) -> Iterator[tuple[list, list[RunResult] | None]]:
-    """Run tasks on a fresh pool; yields (task, results) or (task, None) for tasks lost to a dead worker."""
+    """Run tasks on a fresh pool; yields (task, results) or (task, None) for tasks lost to a dead worker.
+
+    When the campaign's function names a kernel manifest, each worker first compiles its share of it
+    (core/warm.py): on a cold numba cache the workers compile in parallel instead of each compiling everything."""
     run_fn, group_fn, profile, seed = args
-    with ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=ctx) as pool:
+    n = min(workers, len(tasks))
+    kind = kernels_of(group_fn or run_fn)
+    warm: dict[str, Any] = {}
+    if kind is not None and n > 1 and ctx is not None:
+        warm = {"initializer": compile_share, "initargs": (kind, ctx.Value("i", 0), n)}
+    with ProcessPoolExecutor(max_workers=n, mp_context=ctx, **warm) as pool:
         futures = {pool.submit(run_task, run_fn, group_fn, profile, seed, t): t for t in tasks}
         while futures:
             finished, _ = wait(futures, return_when=FIRST_COMPLETED)

@@ -9,6 +9,7 @@ by this package's sources alone (approachsim/__init__.py), so editing a stage ne
 
     geodesy        WGS-84 radii, geodetic -> ECEF, the simulated world's gravity (geo.py's equations, scalar)
     entry          a dispatcher's compiled entry point, called without numba's per-call typing (numba internals)
+    warm           a campaign's kernels compiled ahead on a cold cache, a share per worker (manifests/*.pkl)
     sensors/       the sensor models' error application (each sensor module's `apply`; oracle `apply_reference`)
         imu, noise, baro, radalt, pseudolite, gnss (orbits, look angles, selection, pseudoranges and rates)
         gnss_errors   each GNSS range-error formula once (DO-229 tropo mapping, iono obliquity, DO-253 multipath,

@@ -116,9 +116,10 @@ def nav_row(k: int, buf: np.ndarray, nw: np.ndarray, cg: np.ndarray, ca: np.ndar
         if hb[0, 0] == hb[0, 0]:
             nw[W_ANY_BARO] = 1.0
         nw[W_HB_AGE] = buf[k - 1, ROW_T] - nw[W_HB_T]
+        # row0 as np.int64, not a literal 0: numba would compile strapdown once more for the literal
         sk.strapdown(nw[W_X:W_X + NX].reshape(1, NX), dth, dv, dt, nw[W_BG:W_BG + 3].reshape(1, 3),
                      nw[W_BA:W_BA + 3].reshape(1, 3), hb, nw[W_HB_AGE:W_HB_AGE + 1], nw[W_LOOP:W_LOOP + 6],
-                     nw[W_FSUM:W_FSUM + 3].reshape(1, 3), np.empty((1, 0, NX)), 0)
+                     nw[W_FSUM:W_FSUM + 3].reshape(1, 3), np.empty((1, 0, NX)), np.int64(0))
         if k % int(nw[W_EPOCH_ROWS]) == 0:
             code |= NAV_EPOCH
     j = baro_j[k]

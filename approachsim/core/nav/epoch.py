@@ -210,7 +210,10 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, o
     return k
 
 
-@njit(cache=True)
+# run_epoch, copies_epoch and pass_epoch are thin wrappers, inlined into their compiled callers (inline="always",
+# numba IR): as functions of their own each was compiled, and its whole callee tree optimized by LLVM, once more
+# (about 8 s of CPU on a cold cache, core/warm.py); the arithmetic is the same, tools/*_identity.py bit for bit.
+@njit(cache=True, inline="always")
 def run_epoch(X: np.ndarray, P: np.ndarray, model: ErrorModel, y: np.ndarray, f_ned: np.ndarray, held: bool,
               dt: float, new: np.ndarray, rows: Rows, obs: Obs, out: Out, scr: Scratch) -> int:
     """The per-run EKF's whole epoch of one run: the error model (core/nav/errormodel.dynamics, core/nav/carrier.
@@ -259,7 +262,7 @@ def _with_resets(phi: np.ndarray, qd: np.ndarray, lay: np.ndarray, new: np.ndarr
     return phi
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def copies_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndarray, which: np.ndarray,
                  ref: np.ndarray, ins: np.ndarray, chan: ChannelQd, obs: Obs, new: np.ndarray, rows: Rows, out: Out,
                  n_rows: np.ndarray, scr: Scratch) -> None:
@@ -297,7 +300,7 @@ def copies_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndar
         last = -1 if reset else hd
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def pass_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndarray, which: np.ndarray,
                ref: np.ndarray, ins: np.ndarray, chan: ChannelQd, obs: Obs, new: np.ndarray, rows: Rows,
                out: PassOut, e: int, scr: Scratch) -> None:
