@@ -41,9 +41,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Validate, run every variant, write and print the comparison."""
+    from approachsim.api import MAX_WORKERS, require_distributed
+    from approachsim.api import SCHEDULER_ADDRESS as _ADDRESS
     from approachsim.campaign.pipeline import PipelineUnavailable, require_stages
     from approachsim.campaign.study import comparison_table, load_study, run_study
-    from approachsim.commands.evaluate import _ADDRESS, MAX_WORKERS, require_distributed
 
     study = load_study(args.study)
     if args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
