@@ -90,6 +90,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ProfileError as e:
         sys.stderr.write(f"approachsim: error: {e}\n")
         return 2
+    except FileNotFoundError as e:  # a file the command needed: one line naming it (or where it was looked for)
+        from approachsim.campaign.runner import missing_path_note
+
+        sys.stderr.write(f"approachsim: error: {e}{missing_path_note(e)}\n")
+        return 2
     except BrokenPipeError:  # output piped into `head` and the like: stop quietly (Python docs, signal note)
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())

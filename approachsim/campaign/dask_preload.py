@@ -17,7 +17,7 @@ from typing import Any
 
 from approachsim.campaign.kernels import load_kernels
 
-log = logging.getLogger("approachsim.dask_preload")
+log = logging.getLogger("distributed.approachsim")  # under "distributed": Dask's logging config shows it
 
 
 async def _load_in_thread() -> None:

@@ -327,8 +327,8 @@ def _dask_task(run_fn: RunFn | None, group_fn: GroupFn | None, profile: Any, see
 
 
 RETRY_REPRODUCED_MAX = 2
-"""A wholly failed task is rerun on another worker (_WorkerHealth) until this many reruns failed there too: the
-failures are then the runs' own (a profile whose approaches fail), and later ones are kept as they come."""
+"""Probes (_WorkerHealth) that may fail on another worker too before wholly failed tasks are taken as the runs' own
+failures (a profile whose approaches fail) and stored as they come, without reruns."""
 
 
 @dataclass
@@ -336,45 +336,57 @@ class _WorkerHealth:
     """Which Dask workers fail every task they get (issue 42: workers whose working directory was gone failed each
     task in milliseconds and so took 238 of 256 runs, all recorded as failed).
 
-    A task whose runs all failed, on a worker that has not completed a run yet, is suspect: it is rerun once on
-    another worker and only the rerun's results are stored. When the rerun completes runs, the first worker is
-    marked bad (named on stderr with its first error) and every later wholly failed task of it is rerun elsewhere
-    too; when the rerun fails as well, the failures are the runs' own (after RETRY_REPRODUCED_MAX such reruns no
-    task is rerun any more: a campaign whose runs all fail costs at most that many extra tasks)."""
+    A task whose runs all failed, on a worker that has not completed a run yet, is suspect. The first such task of a
+    worker is rerun on another worker (a probe) and the worker's next ones are held back until the probe answers:
+    when the probe completes runs, the worker is bad (named on stderr once, with its first error) and its held and
+    later wholly failed tasks are all rerun elsewhere; when the probe fails too, the failures are the runs' own
+    (counted: after RETRY_REPRODUCED_MAX of them nothing is probed any more), its result and the held tasks are
+    stored, or the next held task probes again. A campaign whose runs all fail costs at most RETRY_REPRODUCED_MAX
+    plus one per worker extra tasks; a healthy one none."""
 
     ok: dict[str, int] = field(default_factory=dict)
     """Tasks with a completed run, per worker."""
     bad: dict[str, str] = field(default_factory=dict)
     """Workers found failing every task: their first error."""
     first_error: dict[str, str] = field(default_factory=dict)
+    probing: set[str] = field(default_factory=set)
+    """Workers with a probe in flight."""
+    held: dict[str, list] = field(default_factory=dict)
+    """Per worker under probe, its wholly failed tasks waiting for the probe's answer: (task, results)."""
     reproduced: int = 0
 
-    def suspect(self, worker: str, res: list[RunResult]) -> bool:
-        """Rerun this task elsewhere?"""
-        if not res or any(r.ok for r in res):
-            return False
-        return worker in self.bad or (self.ok.get(worker, 0) == 0 and self.reproduced < RETRY_REPRODUCED_MAX)
-
-    def record(self, worker: str, res: list[RunResult], first_worker: str | None) -> str | None:
-        """Count a stored task's results; first_worker: the worker whose failure this task reran. Returns the line
-        that names a worker found bad (once per worker), else None."""
+    def first(self, worker: str, t: list, res: list[RunResult]) -> str:
+        """What to do with a task's results from its first run: "store", "rerun" (elsewhere), "probe" (rerun
+        elsewhere, the worker's probe) or "hold"."""
         if any(r.ok for r in res):
             self.ok[worker] = self.ok.get(worker, 0) + 1
-        if first_worker is None:
-            return None
-        if not any(r.ok for r in res):
-            self.reproduced += 1
-            return None
-        if first_worker in self.bad:
-            return None
-        self.bad[first_worker] = self.first_error.get(first_worker, "?")
-        return (f"Dask worker {first_worker} failed every task it ran (first: {self.bad[first_worker]}); its tasks "
-                f"are rerun on other workers: fix or restart that worker")
+            return "store"
+        if not res:
+            return "store"
+        self.first_error.setdefault(worker, str(res[0].error))
+        if worker in self.bad:
+            return "rerun"
+        if self.ok.get(worker, 0) > 0 or self.reproduced >= RETRY_REPRODUCED_MAX:
+            return "store"
+        if worker in self.probing:
+            self.held.setdefault(worker, []).append((t, res))
+            return "hold"
+        self.probing.add(worker)
+        return "probe"
 
-    def failed_on(self, worker: str, res: list[RunResult]) -> None:
-        """Remember a worker's first error."""
-        if res:
-            self.first_error.setdefault(worker, str(res[0].error))
+    def answer(self, probed: str, where: str, res: list[RunResult]) -> tuple[str | None, list]:
+        """A probe of worker `probed` came back from worker `where`: (the line naming `probed` when it is found bad,
+        else None; its held tasks to act on: rerun them when bad, else store them or probe again)."""
+        self.probing.discard(probed)
+        if any(r.ok for r in res):
+            self.ok[where] = self.ok.get(where, 0) + 1
+            new = probed not in self.bad
+            self.bad[probed] = self.first_error.get(probed, "?")
+            line = (f"Dask worker {probed} failed every task it ran (first: {self.bad[probed]}); its tasks are rerun "
+                    "on other workers: fix or restart that worker") if new else None
+            return line, self.held.pop(probed, [])
+        self.reproduced += 1
+        return None, self.held.pop(probed, [])
 
 
 def _erred_on(client: Any, key: Any) -> str:
@@ -405,40 +417,64 @@ def _dask(client: Any, tasks: list, args: tuple, warn: Callable[[str], None]) ->
     try:
         run_fn, group_fn, profile, seed = args
         health = _WorkerHealth()
+        origin: dict[Any, tuple[list, str | None]] = {}
+        pending = as_completed()
 
-        def submit(t: list, avoid: set[str]) -> Any:
+        def submit(t: list, avoid: set[str], probe_of: str | None = None) -> bool:
             kw: dict[str, Any] = {}
             if avoid:
                 others = [w for w in client.scheduler_info().get("workers", {}) if w not in avoid]
                 if not others:
-                    return None
+                    return False
                 kw = {"workers": others, "allow_other_workers": False}
-            return client.submit(_dask_task, run_fn, group_fn, profile, seed, t, pure=False, **kw)
+            f = client.submit(_dask_task, run_fn, group_fn, profile, seed, t, pure=False, **kw)
+            origin[f] = (t, probe_of)
+            pending.add(f)
+            return True
 
-        origin: dict[Any, tuple[list, str | None]] = {}
         for t in tasks:
-            origin[submit(t, set())] = (t, None)
-        pending = as_completed(list(origin))
+            submit(t, set())
         for f in pending:
-            t, first = origin.pop(f)
+            t, probe_of = origin.pop(f)
             try:
                 worker, res = f.result()
             except Exception as e:  # noqa: BLE001 - the task itself raised on the worker
                 worker = _erred_on(client, f.key)
                 res = [RunResult.failed(i, f"task failed on Dask worker {worker}: {_one_line(e)}") for i in t]
             f.release()
-            if not any(r.ok for r in res):
-                health.failed_on(worker, res)
-            if first is None and health.suspect(worker, res):
-                g = submit(t, {worker, *health.bad})
-                if g is not None:
-                    origin[g] = (t, worker)
-                    pending.add(g)
+            if probe_of is not None:
+                line, held = health.answer(probe_of, worker, res)
+                if line is not None:
+                    warn(line)
+                yield res
+                for i, (ht, hres) in enumerate(held):
+                    if probe_of in health.bad:
+                        if not submit(ht, {probe_of, *health.bad}):
+                            yield hres
+                    elif i == 0 and health.reproduced < RETRY_REPRODUCED_MAX:
+                        health.probing.add(probe_of)
+                        health.held[probe_of] = held[1:]
+                        if not submit(ht, {probe_of, *health.bad}, probe_of):
+                            health.probing.discard(probe_of)
+                            yield from (r for _, r in health.held.pop(probe_of, []))
+                            yield hres
+                        break
+                    else:
+                        yield hres
+                continue
+            action = health.first(worker, t, res)
+            if action == "rerun" and submit(t, {worker, *health.bad}):
+                continue
+            if action == "probe":
+                if submit(t, {worker, *health.bad}, worker):
                     continue
-            line = health.record(worker, res, first)
-            if line is not None:
-                warn(line)
+                health.probing.discard(worker)
+            if action == "hold":
+                continue
             yield res
+        for held in health.held.values():  # nothing left to answer them (cannot happen: a probe is in flight)
+            for _, hres in held:
+                yield hres
     finally:
         client.close()
 

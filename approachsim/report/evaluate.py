@@ -28,6 +28,7 @@ import html
 import io
 import multiprocessing
 import os
+import re
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
@@ -479,6 +480,33 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
     path = out_dir / "report.html"
     path.write_text("\n".join(parts), encoding="utf-8")
     return path
+
+
+_IMG = re.compile(r"<img alt='([^']+)' src='data:image/png;base64,([A-Za-z0-9+/=]*)'>")
+
+
+def report_problems(out_dir: Path) -> list[str]:
+    """What is wrong with DIR/report.html's figures, one line each (empty: nothing), without rendering the page:
+    every embedded figure names its file "(file NAME.png)", that file is in DIR and holds the embedded bytes, and
+    no figure file named on the page is missing."""
+    out_dir = Path(out_dir)
+    page = (out_dir / "report.html").read_text(encoding="utf-8")
+    problems = []
+    embedded = _IMG.findall(page)
+    if not embedded:
+        problems.append("report.html embeds no figure")
+    for name, b64 in embedded:
+        f = out_dir / f"{name}.png"
+        if f"(file {name}.png)" not in page:
+            problems.append(f"figure {name}: its caption does not name its file {name}.png")
+        if not f.is_file():
+            problems.append(f"figure {name}: no file {str(f)!r}")
+        elif f.read_bytes() != base64.b64decode(b64):
+            problems.append(f"figure {name}: {str(f)!r} is not the figure embedded in report.html")
+    for name in re.findall(r"\(file ([^()\s]+)\.png\)", page):
+        if not (out_dir / f"{name}.png").is_file():
+            problems.append(f"report.html names {name}.png, which is not in {str(out_dir)!r}")
+    return problems
 
 
 def _plain_tick(v: float, _pos: int | None = None) -> str:
