@@ -16,7 +16,7 @@ stays light:
 __version__ = "0.1.0"
 
 API = ("EvaluationResult", "ProfileError", "ProfileSpec", "StudyResult", "evaluate_profile", "integrity_risk",
-       "load_profile", "merge", "shipped_profiles", "study")
+       "load_profile", "merge", "shipped_profiles", "study", "study_file")
 """The names of approachsim.api exported here (approachsim.api.__all__)."""
 
 

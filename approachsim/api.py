@@ -51,6 +51,7 @@ __all__ = [
     "merge",
     "shipped_profiles",
     "study",
+    "study_file",
 ]
 
 MAX_RUNS = 100000
@@ -493,7 +494,7 @@ def study(
     list of values; variant names "key=value,...") and the explicit `variants` (name -> {dotted key: value}), every
     variant validated before anything runs and evaluated with the same seed and runs. out: each variant into
     out/<variant>/ and study.json, study.csv, study.png (None: in memory)."""
-    from approachsim.campaign.study import MODES, comparison_rows, evaluate_variants, make_study, write_study
+    from approachsim.campaign.study import MODES, make_study
 
     b = load_profile(base)
     runs = b.profile.run.runs if runs is None else runs
@@ -518,9 +519,27 @@ def study(
     out_p = None if out is None else Path(out)
     if out_p is not None and out_p.exists() and not out_p.is_dir():
         raise ProfileError(f"out: {str(out_p)!r} exists and is not a directory")
-    from approachsim.campaign.pipeline import require_stages
+    return _run_study(st, b, out_p, workers=workers, scheduler=scheduler, resume=resume, progress=progress)
 
-    require_stages(mode)
+
+def study_file(path: str | Path, *, out: str | Path, workers: int | None = None, scheduler: str | None = None,
+               resume: bool = False, progress: bool = True) -> StudyResult:
+    """A study file (TOML: a base profile, [axes] and [[variant]]; docs/profiles.md) run into out as `approachsim
+    study` runs it (the command is a thin layer over this function): every variant into out/<variant>/, then
+    study.json, study.csv and study.png."""
+    from approachsim.campaign.study import load_study
+
+    st = load_study(path)
+    base = ProfileSpec.from_file(st.base) if st.base is not None else None
+    return _run_study(st, base, Path(out), workers=workers, scheduler=scheduler, resume=resume, progress=progress)
+
+
+def _run_study(st: Any, base: ProfileSpec | None, out_p: Path | None, *, workers: int | None, scheduler: str | None,
+               resume: bool, progress: bool) -> StudyResult:
+    from approachsim.campaign.pipeline import require_stages
+    from approachsim.campaign.study import comparison_rows, evaluate_variants, write_study
+
+    require_stages(st.mode)
     evs = evaluate_variants(st, out_p, workers=workers, scheduler=scheduler, resume=resume, progress=progress)
     rows = comparison_rows(st, [ev.summary for ev in evs])
     if out_p is not None:
@@ -530,8 +549,9 @@ def study(
         write_study_figure(out_p, rows)
     evals = {}
     for v, ev in zip(st.variants, evs, strict=True):
-        vspec = ProfileSpec(data=_variant_data(b, v), source=b.source, profile=v.profile,
-                            settings=b.settings + tuple(v.settings))
+        data = _variant_data(base, v) if base is not None else {}
+        vspec = ProfileSpec(data=data, source=None if base is None else base.source, profile=v.profile,
+                            settings=(() if base is None else base.settings) + tuple(v.settings))
         evals[v.name] = EvaluationResult(profile=vspec, summary=ev.summary, details=ev.details, results=ev.results,
                                          out_dir=None if out_p is None else out_p / v.slug, wall_s=ev.wall_s,
                                          warnings=ev.warnings)

@@ -112,3 +112,21 @@ def test_worked_trade_study(capsys):
             assert gbas < 3.0 < 5.0 < alone, (grade, cat, gbas, alone)
     assert all(ev.summary["runs"] == 2 and ev.failed_runs == 0 for ev in st.evaluations.values())
     assert "nav-4.0+gbas" in capsys.readouterr().out
+
+
+def test_the_study_command_and_the_api_give_the_same_comparison(tmp_path, capsys):
+    """`approachsim study FILE` (a thin layer over api.study_file) and api.study with the same variants in code: the
+    same comparison rows, every number equal (2 variants x 2 open-loop runs)."""
+    f = tmp_path / "wind.toml"
+    f.write_text('profile = "default"\nruns = 2\nseed = 4\nmode = "open"\n'
+                 '[axes]\n"environment.wind_speed_kt" = [0, 20]\n'
+                 '[[variant]]\nname = "acc"\nset = { "evaluation.integrity" = false }\n')
+    assert main(["study", str(f), "--out", str(tmp_path / "cli"), "--workers", "1"]) == 0
+    rows = json.loads((tmp_path / "cli" / "study.json").read_text())["comparison"]
+    st = asim.study("default", {"acc": {"evaluation.integrity": False}},
+                    axes={"environment.wind_speed_kt": [0, 20]}, runs=2, seed=4, mode="open", workers=1,
+                    progress=False)
+    assert [r["variant"] for r in rows] == ["wind_speed_kt=0", "wind_speed_kt=20", "acc"] and st.rows == rows
+    assert (tmp_path / "cli" / "study.png").is_file() and (tmp_path / "cli" / "acc" / "summary.json").is_file()
+    assert st.evaluations["acc"].profile.settings == (("evaluation.integrity", False),)
+    assert st.rows[0]["CATI_lateral_1sigma_ft"] != st.rows[1]["CATI_lateral_1sigma_ft"]  # the wind reaches the runs
