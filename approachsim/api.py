@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import copy
 import math
+import operator
 import os
 import re
 import tomllib
@@ -202,20 +203,15 @@ def check_campaign(profile: Profile, *, runs: int | None, seed: int | None, mode
     (prefix "--" for the command line's names: `--runs: must be in [1, 100000], got 0`)."""
     from approachsim.campaign.shards import parse_shard, shard_runs
 
-    runs = profile.run.runs if runs is None else runs
-    if isinstance(runs, bool) or not isinstance(runs, int) or not 1 <= runs <= MAX_RUNS:
-        raise ProfileError(f"{prefix}runs: must be in [1, {MAX_RUNS}], got {runs}")
-    seed = profile.run.seed if seed is None else seed
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63:
-        raise ProfileError(f"{prefix}seed: must be in [0, 2^63), got {seed}")
+    runs = _checked_int(profile.run.runs if runs is None else runs, 1, MAX_RUNS, f"{prefix}runs")
+    seed = _checked_int(profile.run.seed if seed is None else seed, 0, 2**63 - 1, f"{prefix}seed")
     mode = profile.run.mode if mode is None else mode
     if mode not in ("closed", "open"):
         raise ProfileError(f"{prefix}mode: must be 'closed' or 'open', got {mode!r}")
     if land and mode != "closed":
         raise ProfileError(f"{prefix}land: landing runs are flown closed loop only (each run lands on its own "
                            f"navigation); use {prefix}mode closed (the mode is {mode})")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or not 1 <= workers <= MAX_WORKERS):
+    if workers is not None and (_integer(workers) is None or not 1 <= workers <= MAX_WORKERS):
         raise ProfileError(f"{prefix}workers: must be in [1, {MAX_WORKERS}], got {workers}")
     if scheduler is not None:
         if workers is not None:
@@ -249,6 +245,25 @@ def check_campaign(profile: Profile, *, runs: int | None, seed: int | None, mode
         raise ProfileError(f"{prefix}resume: needs {prefix}out, the directory of the campaign to continue")
     return CampaignOptions(runs=runs, seed=seed, mode=mode, land=bool(land), workers=workers, scheduler=scheduler,
                            out=out_p, resume=bool(resume), shard=k_n)
+
+
+def _integer(v: Any) -> int | None:
+    """v as an int when it is an integer (numpy's too, not a bool), else None."""
+    if isinstance(v, bool):
+        return None
+    try:
+        return operator.index(v)
+    except TypeError:
+        return None
+
+
+def _checked_int(v: Any, lo: int, hi: int, name: str) -> int:
+    """v as an int in [lo, hi]; ProfileError naming it otherwise (the command line's wording)."""
+    i = _integer(v)
+    if i is None or not lo <= i <= hi:
+        rng = f"[{lo}, 2^63)" if hi == 2**63 - 1 else f"[{lo}, {hi}]"
+        raise ProfileError(f"{name}: must be in {rng}, got {v}")
+    return i
 
 
 def require_distributed(prefix: str = "--") -> None:
@@ -497,12 +512,8 @@ def study(
     from approachsim.campaign.study import MODES, make_study
 
     b = load_profile(base)
-    runs = b.profile.run.runs if runs is None else runs
-    if isinstance(runs, bool) or not isinstance(runs, int) or not 1 <= runs <= MAX_RUNS:
-        raise ProfileError(f"runs: must be in [1, {MAX_RUNS}], got {runs}")
-    seed = b.profile.run.seed if seed is None else seed
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63:
-        raise ProfileError(f"seed: must be in [0, 2^63), got {seed}")
+    runs = _checked_int(b.profile.run.runs if runs is None else runs, 1, MAX_RUNS, "runs")
+    seed = _checked_int(b.profile.run.seed if seed is None else seed, 0, 2**63 - 1, "seed")
     mode = b.profile.run.mode if mode is None else mode
     if mode not in MODES:
         raise ProfileError(f"mode: must be one of {', '.join(MODES)}, got {mode!r}")
