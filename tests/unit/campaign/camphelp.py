@@ -77,3 +77,15 @@ def counted_fail_run(profile: dict, seed: int, run: int) -> RunResult:
     """A run that always fails (its own failure, on any worker), counted in CALLS."""
     CALLS.append(run)
     raise RuntimeError(f"diverged in run {run}")
+
+
+def _cannot_load() -> None:
+    raise ImportError("No module named 'approachsim' (this worker's environment)")
+
+
+class Unloadable:
+    """A "profile" a worker cannot unpickle: the task fails on the worker before any run starts (a worker without the
+    package installed)."""
+
+    def __reduce__(self):
+        return _cannot_load, ()

@@ -322,3 +322,20 @@ def test_the_dask_preload_loads_the_kernels_on_every_worker_before_a_task(monkey
         assert len(loaded) == 2 and not any(main for _, main in loaded)
         res = _run({}, run_fn=synth_run, runs=4, scheduler=cluster.scheduler_address)
     assert len(res.ok) == 4 and len(loaded) == 2
+
+
+def test_a_task_that_cannot_start_fails_its_runs_with_the_reason_and_the_campaign_completes():
+    """A task that cannot be unpickled (a worker without the package; here the scheduler, which deserializes the
+    graph first in this Dask version) raises on the cluster, not in a run: its runs fail with the cluster's reason and
+    where it happened (the worker's address, '?' when no worker got it), and the campaign goes on to the end."""
+    from camphelp import Unloadable
+
+    with _cluster(2) as cluster:
+        addresses = {w.address for w in cluster.workers.values()}
+        res = run_campaign(Unloadable(), seed=1, runs=4, run_fn=synth_run, per_task=1,
+                           scheduler=cluster.scheduler_address, progress=False)
+    assert [r.run for r in res.failed] == [0, 1, 2, 3] and not res.warnings
+    for r in res.failed:
+        head, _, rest = r.error.partition(": ")
+        assert head.removeprefix("task failed on Dask worker ") in addresses | {"?"}, r.error
+        assert "No module named 'approachsim'" in rest or "deserialization" in rest, r.error
