@@ -1,7 +1,8 @@
-"""Command line: `approachsim fly | sense | navigate | evaluate | integrity-risk | study | regress | reproduce |
+"""Command line: `approachsim fly | sense | navigate | evaluate | merge | integrity-risk | study | regress | reproduce |
 profiles`.
 
-Each sub-command lives in its own module under approachsim/commands/, with `register(subparsers)`.
+Each sub-command lives in its own module under approachsim/commands/, with `register(subparsers)`; evaluate, merge,
+study and integrity-risk are thin layers over the Python API (approachsim/api.py).
 User mistakes (bad profile, bad option) exit with status 2 and one line naming the field, never a traceback.
 """
 
@@ -22,6 +23,7 @@ COMMAND_MODULES = (
     "approachsim.commands.navigate",
     "approachsim.commands.reproduce",
     "approachsim.commands.evaluate",
+    "approachsim.commands.merge",
     "approachsim.commands.integrity_risk",
     "approachsim.commands.study",
     "approachsim.commands.regress",
@@ -87,6 +89,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(args.func(args) or 0)
     except ProfileError as e:
         sys.stderr.write(f"approachsim: error: {e}\n")
+        return 2
+    except FileNotFoundError as e:  # a file the command needed: one line naming it (or where it was looked for)
+        from approachsim.campaign.runner import missing_path_note
+
+        sys.stderr.write(f"approachsim: error: {e}{missing_path_note(e)}\n")
         return 2
     except BrokenPipeError:  # output piped into `head` and the like: stop quietly (Python docs, signal note)
         devnull = os.open(os.devnull, os.O_WRONLY)

@@ -119,6 +119,55 @@ def _f(x: float | None, fmt: str = "6.2f") -> str:
     return "   --" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, fmt)
 
 
+HEADLINE_COLUMNS = (
+    ("category", "category", None),
+    ("height_ft", "DH ft", None),
+    ("lateral_1sigma_ft", "lateral 1σ ft", ".2f"),
+    ("lateral_1sigma_upper_ft", "upper bound", ".2f"),
+    ("limit_lateral_1sigma_ft", "limit", ".1f"),
+    ("lateral_verdict", "lateral", None),
+    ("vertical_1sigma_ft", "vertical 1σ ft", ".2f"),
+    ("vertical_1sigma_upper_ft", "upper bound", ".2f"),
+    ("limit_vertical_1sigma_ft", "limit", ".1f"),
+    ("vertical_verdict", "vertical", None),
+    ("failures_verdict", "failed runs", None),
+    ("integrity_verdict", "integrity", None),
+    ("verdict", "verdict", None),
+    ("runs_needed", "runs to decide", None),
+)
+"""The verdict contract's headline table (report.html's first table, the API's verdict rows): per category the key,
+the column heading and the number format (None: as it is). The numbers are summary.json's, formatted as the printed
+verdict table formats them (1-sigma and upper bounds to 0.01 ft, limits to 0.1 ft)."""
+
+
+def headline_rows(summary: dict, det: dict) -> list[dict]:
+    """Per category (summary.json order) the verdict contract as plain data: decision height, per axis the FAA
+    1-sigma with its one-sided upper bound, the limit and that axis's verdict, the failed-runs criterion's and (when
+    in the verdict) integrity's verdicts, the category's verdict and the runs that would likely decide it; the keys
+    of HEADLINE_COLUMNS, the numbers summary.json's own."""
+    rows = []
+    for cat, e in summary["decision_heights"].items():
+        c = det["categories"][cat]
+        b = c["bounds_ft"]
+        rows.append({
+            "category": cat,
+            "height_ft": e["height_ft"],
+            "lateral_1sigma_ft": e["lateral_1sigma_ft"],
+            "lateral_1sigma_upper_ft": e["lateral_1sigma_upper_ft"],
+            "limit_lateral_1sigma_ft": e["limit_lateral_1sigma_ft"],
+            "lateral_verdict": b["lateral"]["verdict"],
+            "vertical_1sigma_ft": e["vertical_1sigma_ft"],
+            "vertical_1sigma_upper_ft": e["vertical_1sigma_upper_ft"],
+            "limit_vertical_1sigma_ft": e["limit_vertical_1sigma_ft"],
+            "vertical_verdict": b["vertical"]["verdict"],
+            "failures_verdict": c["failures"]["verdict"],
+            "integrity_verdict": c.get("integrity_verdict"),
+            "verdict": e["verdict"],
+            "runs_needed": e["runs_needed"],
+        })
+    return rows
+
+
 def verdict_table(summary: dict, det: dict) -> str:
     """The printed verdict: per category the FAA 1-sigma (RMS) with its upper confidence bound and limit, the
     ICAO 95 % beside, the verdict and the runs that would likely decide an indeterminate one."""

@@ -24,9 +24,9 @@ import numpy as np
 from approachsim.campaign.result import RunResult
 from approachsim.config import ProfileError
 
-IDENTITY_KEYS = ("profile_digest", "seed", "mode", "land")
+IDENTITY_KEYS = ("profile_digest", "seed", "mode", "land", "shard")
 """What must match for --resume to continue a campaign (the number of runs may grow); "land" is present (true)
-only in landing campaigns (evaluate --land)."""
+only in landing campaigns (evaluate --land), "shard" ([k, n]) only in a shard's store (campaign/shards.py)."""
 
 
 def profile_digest(profile: Any) -> str:
@@ -111,26 +111,44 @@ class CampaignStore:
 
     def write_tables(self, results: list[RunResult]) -> None:
         """runs.parquet (one row per run) and heights.parquet (the per-run arrays, long form)."""
-        import pyarrow as pa
         import pyarrow.parquet as pq
 
-        names = sorted({k for r in results for k in r.scalars})
-        cols: dict[str, Any] = {
-            "run": pa.array([r.run for r in results], pa.int64()),
-            "ok": pa.array([r.ok for r in results], pa.bool_()),
-            "error": pa.array([r.error for r in results], pa.string()),
-        }
-        for k in names:
-            cols[k] = pa.array([r.scalars.get(k, np.nan) for r in results], pa.float64())
-        pq.write_table(pa.table(cols), self.dir / "runs.parquet")
-        with_arrays = [r for r in results if r.ok and r.arrays]
-        if with_arrays:
-            anames = list(with_arrays[0].arrays)
-            m = len(with_arrays[0].arrays[anames[0]])
-            long = {
-                "run": np.repeat([r.run for r in with_arrays], m),
-                "index": np.tile(np.arange(m), len(with_arrays)),
-            }
-            for a in anames:
-                long[a] = np.concatenate([np.asarray(r.arrays[a], dtype=float) for r in with_arrays])
-            pq.write_table(pa.table(long), self.dir / "heights.parquet")
+        pq.write_table(runs_table(results), self.dir / "runs.parquet")
+        heights = heights_table(results)
+        if heights is not None:
+            pq.write_table(heights, self.dir / "heights.parquet")
+
+
+def runs_table(results: list[RunResult]) -> Any:
+    """The per-run table as a pyarrow Table: `run`, `ok`, `error` and every scalar (SI, the unit in the name), one
+    row per run in the order given; what runs.parquet holds (and the API's `runs` DataFrame)."""
+    import pyarrow as pa
+
+    names = sorted({k for r in results for k in r.scalars})
+    cols: dict[str, Any] = {
+        "run": pa.array([r.run for r in results], pa.int64()),
+        "ok": pa.array([r.ok for r in results], pa.bool_()),
+        "error": pa.array([r.error for r in results], pa.string()),
+    }
+    for k in names:
+        cols[k] = pa.array([r.scalars.get(k, np.nan) for r in results], pa.float64())
+    return pa.table(cols)
+
+
+def heights_table(results: list[RunResult]) -> Any:
+    """The completed runs' arrays on the height grid in long form (`run`, `index`, one column per array) as a
+    pyarrow Table, or None when no completed run has arrays; what heights.parquet holds."""
+    import pyarrow as pa
+
+    with_arrays = [r for r in results if r.ok and r.arrays]
+    if not with_arrays:
+        return None
+    anames = list(with_arrays[0].arrays)
+    m = len(with_arrays[0].arrays[anames[0]])
+    long = {
+        "run": np.repeat([r.run for r in with_arrays], m),
+        "index": np.tile(np.arange(m), len(with_arrays)),
+    }
+    for a in anames:
+        long[a] = np.concatenate([np.asarray(r.arrays[a], dtype=float) for r in with_arrays])
+    return pa.table(long)

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from approachsim.campaign.evaluation import evaluate_profile
+from approachsim.campaign.evaluation import Evaluation, evaluate_profile
 from approachsim.campaign.pipeline import spec_for
 from approachsim.config import ProfileError, Section
 from approachsim.profile import Profile, parse_profile
@@ -57,7 +57,8 @@ class Study:
     """A validated study file."""
 
     name: str
-    base: Path
+    base: Path | None
+    """The base profile's file (None: a profile built in code, approachsim.api)."""
     runs: int
     seed: int
     mode: str
@@ -81,11 +82,13 @@ def _fmt(v: Any) -> str:
     return f"{v:g}" if isinstance(v, float) else str(v)
 
 
-def _variant(base_data: dict, base_path: Path, name: str, settings: list[tuple[str, Any]], field: str) -> Variant:
+def _variant(base_data: dict, base_path: Path | None, name: str, settings: list[tuple[str, Any]],
+             field: str) -> Variant:
     data = copy.deepcopy(base_data)
     for dotted, value in settings:
         _set(data, dotted, value, field)
-    data["name"] = f"{base_data.get('name', base_path.stem)}[{name}]"
+    stem = base_path.stem if base_path is not None else "profile"
+    data["name"] = f"{base_data.get('name', stem)}[{name}]"
     try:
         prof = parse_profile(data, source=base_path)
     except ProfileError as e:
@@ -123,12 +126,29 @@ def load_study(path: str | Path) -> Study:
     axes = top.raw("axes", {})
     if not isinstance(axes, dict):
         raise ProfileError(f"axes: must be a table of profile fields -> lists of values, got {axes!r}")
-    flat_axes = dict(_flatten(axes))
-    variants: list[Variant] = []
-    axis_names = sorted(flat_axes)
+    explicit = []
+    for i, vs in enumerate(top.sections("variant")):
+        vname = vs.string("name", f"variant{i}")
+        sets = vs.raw("set")
+        if not isinstance(sets, dict) or not sets:
+            raise ProfileError(f"{vs.path}.set: must be a non-empty table of profile fields, got {sets!r}")
+        vs.done()
+        explicit.append((vname, list(_flatten(sets)), f"{vs.path}.set"))
+    top.done()
+    return make_study(name, base_data, base, axes=dict(_flatten(axes)), variants=explicit, runs=runs, seed=seed,
+                      mode=mode)
+
+
+def make_study(name: str, base_data: dict, base: Path | None, *, axes: dict[str, Any],
+               variants: list[tuple[str, list[tuple[str, Any]], str]], runs: int, seed: int, mode: str) -> Study:
+    """A validated Study from the base profile's TOML data: the full factorial over `axes` (dotted profile field ->
+    list of values; variants named "key=value,...") and the explicit `variants` (name, [(dotted field, value)], the
+    field to name in an error). Every variant's profile is validated here; ProfileError names the bad field."""
+    variants_out: list[Variant] = []
+    axis_names = sorted(axes)
     axis_values = []
     for key in axis_names:
-        vals = flat_axes[key]
+        vals = axes[key]
         if not isinstance(vals, list) or not vals:
             raise ProfileError(f"axes.{key}: must be a non-empty list of values, got {vals!r}")
         axis_values.append(vals)
@@ -136,25 +156,19 @@ def load_study(path: str | Path) -> Study:
         for combo in itertools.product(*axis_values):
             settings = list(zip(axis_names, combo, strict=True))
             vname = ",".join(f"{k.rsplit('.', 1)[-1]}={_fmt(v)}" for k, v in settings)
-            variants.append(_variant(base_data, base, vname, settings, f"axes.{'/'.join(axis_names)}"))
-    for i, vs in enumerate(top.sections("variant")):
-        vname = vs.string("name", f"variant{i}")
-        sets = vs.raw("set")
-        if not isinstance(sets, dict) or not sets:
-            raise ProfileError(f"{vs.path}.set: must be a non-empty table of profile fields, got {sets!r}")
-        vs.done()
-        variants.append(_variant(base_data, base, vname, list(_flatten(sets)), f"{vs.path}.set"))
-    top.done()
-    if not variants:
+            variants_out.append(_variant(base_data, base, vname, settings, f"axes.{'/'.join(axis_names)}"))
+    for vname, settings, field in variants:
+        variants_out.append(_variant(base_data, base, vname, settings, field))
+    if not variants_out:
         raise ProfileError("study: needs [axes] or at least one [[variant]]")
-    names = [v.name for v in variants]
+    names = [v.name for v in variants_out]
     dup = next((n for n in names if names.count(n) > 1), None)
     if dup is not None:
         raise ProfileError(f"variant: two variants are named {dup!r}")
-    slugs = [v.slug for v in variants]
+    slugs = [v.slug for v in variants_out]
     if len(set(slugs)) != len(slugs):
         raise ProfileError("variant: two variant names map to the same directory name; rename one")
-    return Study(name=name, base=base, runs=runs, seed=seed, mode=mode, variants=tuple(variants))
+    return Study(name=name, base=base, runs=runs, seed=seed, mode=mode, variants=tuple(variants_out))
 
 
 def _base_profile(study_path: Path, ref: str) -> Path:
@@ -196,6 +210,54 @@ def comparison_rows(study: Study, summaries: list[dict]) -> list[dict]:
     return rows
 
 
+def evaluate_variants(
+    study: Study,
+    out_dir: Path | None,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    resume: bool = False,
+    progress: bool = True,
+    spec_fn: Any = None,
+) -> list[Evaluation]:
+    """Evaluate every variant (the same seed and runs: common random numbers) into out_dir/<variant slug>/ (None:
+    in memory); the evaluations in variant order. spec_fn(profile, mode) -> PipelineSpec (default pipeline.spec_for)."""
+    spec_fn = spec_fn or spec_for
+    if out_dir is not None:
+        Path(out_dir).mkdir(parents=True, exist_ok=True)
+    out = []
+    for i, v in enumerate(study.variants, start=1):
+        if progress:
+            sys.stderr.write(f"study {study.name}: variant {i}/{len(study.variants)} {v.name} ({study.runs} runs)\n")
+            sys.stderr.flush()
+        out.append(evaluate_profile(
+            v.profile, runs=study.runs, seed=study.seed, mode=study.mode,
+            out_dir=None if out_dir is None else Path(out_dir) / v.slug,
+            workers=workers, scheduler=scheduler, resume=resume, progress=progress,
+            spec=spec_fn(v.profile, study.mode),
+        ))
+    return out
+
+
+def write_study(study: Study, out_dir: Path, rows: list[dict]) -> None:
+    """DIR/study.json (the study, its variants and the comparison rows) and DIR/study.csv (the rows)."""
+    import csv
+    import json
+
+    out_dir = Path(out_dir)
+    doc = {
+        "study": study.name, "base_profile": None if study.base is None else str(study.base), "runs": study.runs,
+        "seed": study.seed, "mode": study.mode,
+        "variants": [{"name": v.name, "dir": v.slug, "set": dict(v.settings)} for v in study.variants],
+        "comparison": rows,
+    }
+    (out_dir / "study.json").write_text(json.dumps(doc, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+    with open(out_dir / "study.csv", "w", newline="", encoding="utf-8") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+
+
 def run_study(
     study: Study,
     out_dir: Path,
@@ -210,35 +272,10 @@ def run_study(
 
     spec_fn(profile, mode) -> PipelineSpec (default: the real pipeline, pipeline.spec_for).
     """
-    import csv
-    import json
-
-    spec_fn = spec_fn or spec_for
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    summaries = []
-    for i, v in enumerate(study.variants, start=1):
-        if progress:
-            sys.stderr.write(f"study {study.name}: variant {i}/{len(study.variants)} {v.name} ({study.runs} runs)\n")
-            sys.stderr.flush()
-        ev = evaluate_profile(
-            v.profile, runs=study.runs, seed=study.seed, mode=study.mode, out_dir=out_dir / v.slug,
-            workers=workers, scheduler=scheduler, resume=resume, progress=progress,
-            spec=spec_fn(v.profile, study.mode),
-        )
-        summaries.append(ev.summary)
-    rows = comparison_rows(study, summaries)
-    doc = {
-        "study": study.name, "base_profile": str(study.base), "runs": study.runs, "seed": study.seed,
-        "mode": study.mode,
-        "variants": [{"name": v.name, "dir": v.slug, "set": dict(v.settings)} for v in study.variants],
-        "comparison": rows,
-    }
-    (out_dir / "study.json").write_text(json.dumps(doc, indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    with open(out_dir / "study.csv", "w", newline="", encoding="utf-8") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    evs = evaluate_variants(study, out_dir, workers=workers, scheduler=scheduler, resume=resume, progress=progress,
+                            spec_fn=spec_fn)
+    rows = comparison_rows(study, [ev.summary for ev in evs])
+    write_study(study, Path(out_dir), rows)
     return rows
 
 

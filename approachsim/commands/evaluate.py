@@ -15,17 +15,15 @@ completed, with one line giving the first failure's reason.
 from __future__ import annotations
 
 import argparse
-import os
 import re
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from approachsim.config import ProfileError
 
-MAX_RUNS = 100000
-MAX_WORKERS = 1024
-_ADDRESS = re.compile(r"^(tcp|tls|inproc|ws|wss|ucx)://\S+$|^[A-Za-z0-9_.\-\[\]:]+:\d+$")
-
+if TYPE_CHECKING:  # pragma: no cover
+    from approachsim.api import CampaignOptions
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the `evaluate` sub-command."""
@@ -40,7 +38,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         examples=["approachsim evaluate profiles/default.toml --runs 4 --out out/quick",
                   "approachsim evaluate ~/approaches/default.toml --runs 200 --out out/full --workers 2",
                   "approachsim evaluate ~/approaches/default.toml --out out/full --resume",
-                  "approachsim evaluate profiles/default.toml --runs 50 --land --out out/landing"],
+                  "approachsim evaluate profiles/default.toml --runs 50 --land --out out/landing",
+                  "approachsim evaluate profiles/default.toml --runs 300 --shard 2/3 --out out/shard2"],
     )
     p.add_argument("profile", type=Path, help="approach profile (TOML)")
     p.add_argument("--runs", type=int, default=None, help="Monte Carlo runs (default: the profile's run.runs)")
@@ -55,18 +54,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler (tcp://host:port)")
     p.add_argument("--resume", action="store_true", help="continue the campaign in --out, keeping finished runs")
     p.add_argument("--overwrite", action="store_true", help="start afresh in --out, discarding a campaign there")
+    p.add_argument("--shard", default=None, metavar="K/N",
+                   help="run only shard K of N (a contiguous slice of the runs, the same seeds as the whole "
+                        "campaign) into --out; merge the N shard directories with `approachsim merge`")
     p.add_argument("--no-report", action="store_true", help="skip figures and report.html")
     p.add_argument("--require", default=None, metavar="CAT",
                    help='exit 1 unless this category\'s verdict is meets ("CAT I", "CAT II" or "CAT III"): a CI gate')
     p.set_defaults(func=run)
-
-
-def require_distributed() -> None:
-    """--scheduler needs dask.distributed (the optional `dask` extra); ProfileError saying how to install it."""
-    import importlib.util
-
-    if importlib.util.find_spec("distributed") is None:
-        raise ProfileError("--scheduler: needs dask.distributed, not installed: pip install approachsim[dask]")
 
 
 def parse_require(text: str | None) -> str | None:
@@ -85,86 +79,79 @@ def parse_require(text: str | None) -> str | None:
     raise ProfileError(f"--require: must be one of {', '.join(repr(c) for c in CATEGORIES)}, got {text!r}")
 
 
-def check_options(args: argparse.Namespace, profile) -> tuple[int, int, str, Path]:
-    """Validate the options against the profile: (runs, seed, mode, out); ProfileError names the option."""
-    runs = profile.run.runs if args.runs is None else args.runs
-    if not 1 <= runs <= MAX_RUNS:
-        raise ProfileError(f"--runs: must be in [1, {MAX_RUNS}], got {runs}")
-    seed = profile.run.seed if args.seed is None else args.seed
-    if not 0 <= seed < 2**63:
-        raise ProfileError(f"--seed: must be in [0, 2^63), got {seed}")
-    mode = profile.run.mode if args.mode is None else args.mode
-    if getattr(args, "land", False) and mode != "closed":
-        raise ProfileError("--land: landing runs are flown closed loop only (each run lands on its own navigation); "
-                           f"use --mode closed (the mode is {mode})")
-    if args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
-        raise ProfileError(f"--workers: must be in [1, {MAX_WORKERS}], got {args.workers}")
-    if args.scheduler is not None:
-        if args.workers is not None:
-            raise ProfileError("--workers: not used with --scheduler (the Dask cluster has its own workers)")
-        if not _ADDRESS.match(args.scheduler):
-            raise ProfileError(f"--scheduler: must be an address like tcp://host:8786, got {args.scheduler!r}")
-        require_distributed()
+def check_options(args: argparse.Namespace, profile: Any) -> CampaignOptions:
+    """Validate the options against the profile (api.check_campaign with the options' names); ProfileError names the
+    option."""
+    from approachsim.api import check_campaign
+
     out = args.out if args.out is not None else Path(f"evaluate-{profile.name}")
-    if out.exists() and not out.is_dir():
-        raise ProfileError(f"--out: {str(out)!r} exists and is not a directory")
-    if args.resume and args.overwrite:
-        raise ProfileError("--overwrite: cannot be combined with --resume")
-    jl = out / "runs.jsonl"
-    if args.resume and not jl.is_file():
-        raise ProfileError(
-            f"--resume: no campaign to resume in {str(out)!r} (no runs.jsonl); drop --resume to start one"
-        )
-    if not args.resume and not args.overwrite and jl.is_file() and jl.stat().st_size > 0:
-        raise ProfileError(
-            f"--out: {str(out)!r} already holds a campaign; add --resume to continue it, --overwrite to discard it, "
-            "or choose another --out"
-        )
-    return runs, seed, mode, out
+    o = check_campaign(profile, runs=args.runs, seed=args.seed, mode=args.mode, land=getattr(args, "land", False),
+                       workers=args.workers, scheduler=args.scheduler, out=out, resume=args.resume,
+                       overwrite=args.overwrite, shard=getattr(args, "shard", None), prefix="--")
+    if o.shard is not None and getattr(args, "require", None) is not None:
+        raise ProfileError("--require: a shard has no verdict; give --require to `approachsim merge`")
+    return o
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the campaign, write the outputs, print the verdict table."""
-    from approachsim.campaign.evaluation import evaluate_profile
-    from approachsim.campaign.outputs import verdict_table
-    from approachsim.campaign.pipeline import PipelineUnavailable, spec_for
-    from approachsim.profile import load_profile
+    """Run the campaign (api.evaluate_profile), write the outputs, print the verdict table."""
+    from approachsim import api
+    from approachsim.campaign.pipeline import PipelineUnavailable
     from approachsim.sensors.baro import temperature_note
 
-    profile = load_profile(args.profile)
-    runs, seed, mode, out = check_options(args, profile)
+    spec = api.ProfileSpec.from_file(args.profile)
+    profile = spec.profile
+    o = check_options(args, profile)
     if (b := profile.sensors.baro) is not None and (note := temperature_note(
             profile.environment.isa_dev_k, profile.runway.elevation_m, b.bias_sigma_m, b.temperature_correction)):
         sys.stderr.write(f"approachsim evaluate: note: {note}\n")
     require = parse_require(getattr(args, "require", None))
     try:
-        spec = spec_for(profile, mode, land=getattr(args, "land", False))
+        res = api.evaluate_profile(spec, runs=o.runs, seed=o.seed, mode=o.mode, land=o.land, out=o.out,
+                                   workers=o.workers, scheduler=o.scheduler, resume=o.resume, overwrite=args.overwrite,
+                                   shard=o.shard, report=not args.no_report and o.shard is None)
     except PipelineUnavailable as e:
         sys.stderr.write(f"approachsim evaluate: {e}\n")
         return 1
-    ev = evaluate_profile(
-        profile, runs=runs, seed=seed, mode=mode, out_dir=out, workers=args.workers or os.cpu_count(),
-        scheduler=args.scheduler, resume=args.resume, spec=spec,
-    )
-    summary, det = ev.summary, ev.details
-    failed = [r for r in ev.results if not r.ok]
-    if not args.no_report:
-        from approachsim.report.evaluate import write_report
+    if o.shard is not None:
+        return report_shard(res, o.shard, o.out, args.profile)
+    return report_campaign(res, o.out, report=not args.no_report, require=require, command="evaluate")
 
-        write_report(out, ev.results, summary, det)
+
+def report_shard(res: Any, shard: tuple[int, int], out: Path, profile_path: Path) -> int:
+    """Print what a shard did and how to merge; 3 when none of its runs completed."""
+    failed = [r for r in res.results if not r.ok]
+    first, last = res.results[0].run, res.results[-1].run
+    print(f"shard {shard[0]}/{shard[1]}: runs {first}-{last}, {len(res.results) - len(failed)} completed, "
+          f"{len(failed)} failed; wrote {out}")
+    print(f"merge the {shard[1]} shard directories with: approachsim merge {profile_path} SHARD_DIR... --out DIR")
+    if failed and len(failed) == len(res.results):
+        sys.stderr.write(f"approachsim evaluate: no run of shard {shard[0]}/{shard[1]} completed; first: run "
+                         f"{failed[0].run}: {failed[0].error}\n")
+        return 3
+    return 0
+
+
+def report_campaign(res: Any, out: Path, *, report: bool, require: str | None, command: str) -> int:
+    """Print the verdict table and the paths; the exit status (docs/contract.md: 3 no run completed, 1 the
+    --require'd category not met, else 0)."""
+    from approachsim.campaign.outputs import verdict_table
+
+    summary, det = res.summary, res.details
+    failed = [r for r in res.results if not r.ok]
     print(verdict_table(summary, det))
     if failed:
         print(f"{len(failed)} run(s) failed; first: run {failed[0].run}: {failed[0].error}")
-    print(f"wrote {out / 'summary.json'}" + ("" if args.no_report else f", {out / 'report.html'}"))
-    if failed and len(failed) == len(ev.results):
+    print(f"wrote {out / 'summary.json'}" + (f", {out / 'report.html'}" if report else ""))
+    if failed and len(failed) == len(res.results):
         sys.stderr.write(
-            f"approachsim evaluate: no run completed ({len(failed)} failed); first: run {failed[0].run}: "
+            f"approachsim {command}: no run completed ({len(failed)} failed); first: run {failed[0].run}: "
             f"{failed[0].error}\n"
         )
         return 3
     if require is not None:
         v = summary["decision_heights"][require]["verdict"]
         if v != "meets":
-            sys.stderr.write(f"approachsim evaluate: --require {require}: verdict is {v}, not meets\n")
+            sys.stderr.write(f"approachsim {command}: --require {require}: verdict is {v}, not meets\n")
             return 1
     return 0

@@ -12,7 +12,6 @@ Writes DIR/integrity_risk.json (docs/contract.md) and prints one line per catego
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from pathlib import Path
@@ -64,34 +63,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def check_options(args: argparse.Namespace, profile: object) -> dict:
     """Validate the options (ProfileError naming the option); the keyword arguments of integrity_risk."""
-    from approachsim.campaign.integrity_risk import MODES, modes_for
+    from approachsim.api import check_risk
 
-    if not 10 <= args.samples <= 1_000_000:
-        raise ProfileError(f"--samples: must be in [10, 1000000], got {args.samples}")
-    if args.max_calls is not None and args.max_calls < args.samples:
-        raise ProfileError(f"--max-calls: must be at least --samples ({args.samples}), got {args.max_calls}")
-    if not 2 <= args.fault_free_runs <= 100_000:
-        raise ProfileError(f"--fault-free-runs: must be in [2, 100000], got {args.fault_free_runs}")
-    if not 1 <= args.truths <= 1000:
-        raise ProfileError(f"--truths: must be in [1, 1000], got {args.truths}")
-    if args.workers is not None and not 1 <= args.workers <= 1024:
-        raise ProfileError(f"--workers: must be in [1, 1024], got {args.workers}")
-    seed = profile.run.seed if args.seed is None else args.seed  # type: ignore[attr-defined]
-    if not 0 <= seed < 2**63:
-        raise ProfileError(f"--seed: must be in [0, 2^63), got {seed}")
-    names = None if args.modes is None else [m.strip() for m in args.modes.split(",") if m.strip()]
-    try:
-        modes_for(profile, names)
-    except ValueError as e:
-        raise ProfileError(f"--modes: {e}") from None
-    if profile.sensors.gnss is None:  # type: ignore[attr-defined]
-        raise ProfileError("profile: integrity-risk needs a GPS receiver ([sensors.gnss]): the bank monitors GPS")
-    if names is not None and not names:
-        raise ProfileError(f"--modes: name at least one of {', '.join(MODES)}")
-    return {"modes": names, "method": args.method, "samples": args.samples, "max_calls": args.max_calls,
-            "fault_free_runs": args.fault_free_runs, "truths": args.truths, "seed": seed, "workers": args.workers,
-            "sensor_modes": bool(getattr(args, "sensor_modes", False)),
-            "second_level": bool(getattr(args, "second_level", False))}
+    return check_risk(profile,  # type: ignore[arg-type]
+                      modes=None if args.modes is None else args.modes.split(","), method=args.method,
+                      samples=args.samples, max_calls=args.max_calls, fault_free_runs=args.fault_free_runs,
+                      truths=args.truths, seed=args.seed, workers=args.workers,
+                      sensor_modes=bool(getattr(args, "sensor_modes", False)),
+                      second_level=bool(getattr(args, "second_level", False)), prefix="--")
 
 
 def _fmt(x: float | None) -> str:
@@ -99,20 +78,18 @@ def _fmt(x: float | None) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the study, write integrity_risk.json, print the table."""
-    from approachsim.campaign.integrity_risk import integrity_risk
+    """Run the study (api.integrity_risk), write integrity_risk.json, print the table."""
+    from approachsim import api
     from approachsim.commands.evaluate import parse_require
-    from approachsim.profile import load_profile
 
-    profile = load_profile(args.profile)
+    spec = api.ProfileSpec.from_file(args.profile)
+    profile = spec.profile
     kw = check_options(args, profile)
     require = parse_require(args.require)
     out = args.out if args.out is not None else Path(f"integrity-risk-{profile.name}")
     if out.exists() and not out.is_dir():
         raise ProfileError(f"--out: {str(out)!r} exists and is not a directory")
-    res = integrity_risk(profile, log=lambda s: print(s, file=sys.stderr, flush=True), **kw)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "integrity_risk.json").write_text(json.dumps(_clean(res), indent=1, allow_nan=False) + "\n")
+    res = api.integrity_risk(spec, out=out, log=lambda s: print(s, file=sys.stderr, flush=True), **kw)
     print(f"{'category':9} {'P(HMI)':>9} {'upper':>9} {'allocation':>12}  verdict     P(FA)/15s upper  (allocation)")
     for cat, c in res["categories"].items():
         print(f"{cat:9} {_fmt(c['p_hmi']):>9} {_fmt(c['p_hmi_upper']):>9} {_fmt(c['allocation']):>7} "
@@ -134,20 +111,3 @@ def run(args: argparse.Namespace) -> int:
                          f"{c['allocation']:g} ({c['allocation_unit']})\n")
         return 1
     return 0
-
-
-def _clean(x: object) -> object:
-    """JSON-ready: numpy scalars as Python numbers, nan and inf as None (the contract's strict JSON)."""
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_clean(v) for v in x]
-    if isinstance(x, bool | str) or x is None:
-        return x
-    try:
-        f = float(x)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        return str(x)
-    if not math.isfinite(f):
-        return None
-    return int(f) if isinstance(x, int) else f

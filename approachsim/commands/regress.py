@@ -60,7 +60,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _check(args: argparse.Namespace) -> list[Path]:
-    from approachsim.commands.evaluate import MAX_WORKERS
+    from approachsim.api import MAX_WORKERS
 
     if args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
         raise ProfileError(f"--workers: must be in [1, {MAX_WORKERS}], got {args.workers}")

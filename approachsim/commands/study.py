@@ -40,10 +40,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Validate, run every variant, write and print the comparison."""
+    """Validate, run every variant (api.study_file), write and print the comparison."""
+    from approachsim.api import MAX_WORKERS, require_distributed
+    from approachsim.api import SCHEDULER_ADDRESS as _ADDRESS
     from approachsim.campaign.pipeline import PipelineUnavailable, require_stages
-    from approachsim.campaign.study import comparison_table, load_study, run_study
-    from approachsim.commands.evaluate import _ADDRESS, MAX_WORKERS, require_distributed
+    from approachsim.campaign.study import comparison_table, load_study
 
     study = load_study(args.study)
     if args.workers is not None and not 1 <= args.workers <= MAX_WORKERS:
@@ -59,14 +60,14 @@ def run(args: argparse.Namespace) -> int:
             f"--resume: no study to resume in {str(args.out)!r} (no variant has a runs.jsonl); drop --resume to start"
         )
     try:
-        require_stages()
+        require_stages(study.mode)
     except PipelineUnavailable as e:
         sys.stderr.write(f"approachsim study: {e}\n")
         return 1
-    rows = run_study(study, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume)
-    from approachsim.report.evaluate import write_study_figure
+    from approachsim import api
 
-    write_study_figure(args.out, rows)
+    rows = api.study_file(args.study, out=args.out, workers=args.workers, scheduler=args.scheduler,
+                          resume=args.resume).rows
     print(f"study {study.name}: {len(rows)} variants x {study.runs} runs, seed {study.seed}, {study.mode} loop")
     print(comparison_table(rows))
     print(f"wrote {args.out / 'study.csv'}, {args.out / 'study.json'}, {args.out / 'study.png'}")

@@ -28,6 +28,7 @@ import html
 import io
 import multiprocessing
 import os
+import re
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
@@ -39,7 +40,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, MaxNLocator
 
 from approachsim import units
-from approachsim.campaign.outputs import verdict_table
+from approachsim.campaign.outputs import HEADLINE_COLUMNS, headline_rows, verdict_table
 from approachsim.campaign.result import RunResult
 from approachsim.evaluate.limits import CATEGORIES, LIMITS
 from approachsim.evaluate.score import CATEGORY_KEYS, HEIGHT_GRID_FT
@@ -354,9 +355,10 @@ FIGURE_CAPTIONS = {
 """Per report figure: its heading and its caption (what it shows, how to read it)."""
 
 
-def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: dict) -> Path:
-    """Write the figures and DIR/report.html (verdict table first, images embedded); returns its path."""
-    out_dir = Path(out_dir)
+def evaluation_figures(results: list[RunResult], summary: dict, det: dict,
+                       series: list[dict[str, np.ndarray]]) -> dict[str, Figure]:
+    """The report's figures by name (FIGURE_CAPTIONS, integrity's and touchdown's captions), not yet rendered:
+    series are the time series of the runs that kept them (DIR/series/, or the runs' own in memory)."""
     dh_ft = {c: float(summary["decision_heights"][c]["height_ft"]) for c in CATEGORIES}
     imgs = {
         "errors_vs_height": fig_errors_vs_height(results, dh_ft),
@@ -366,21 +368,57 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
     if integ_figs:  # integrity on: the solution-separation levels replace the covariance K_V / K_H ones
         imgs.update(integ_figs)
     else:
-        imgs["stanford"] = fig_stanford(_series(out_dir), det, dh_ft)
+        imgs["stanford"] = fig_stanford(series, det, dh_ft)
         imgs["availability"] = fig_availability(results)
-    sky = next((x for x in _series(out_dir) if "pdop" in x), None)
+    sky = next((x for x in series if "pdop" in x), None)
     if sky is not None:
         imgs["sky_dop"] = fig_sky(sky)
     imgs.update(touchdown_figures(results, det))  # landing campaigns (evaluate --land)
+    return imgs
+
+
+def series_of(out_dir: Path | None, results: list[RunResult]) -> list[dict[str, np.ndarray]]:
+    """The kept time series: DIR/series/*.parquet when out_dir has them, else the runs' own (in run order)."""
+    if out_dir is not None:
+        found = _series(Path(out_dir))
+        if found:
+            return found
+    return [{k: np.asarray(v, dtype=float) for k, v in r.series.items()}
+            for r in sorted(results, key=lambda r: r.run) if r.series]
+
+
+def _headline(summary: dict, det: dict) -> str:
+    """The verdict contract's table (outputs.headline_rows): every cell that shows a number carries summary.json's
+    value in data-value, and each cell its key in data-key, so a test (or a script) can read the page exactly."""
+    head = "".join(f"<th>{html.escape(title)}</th>" for _, title, _ in HEADLINE_COLUMNS)
+    body = []
+    for row in headline_rows(summary, det):
+        cells = []
+        for key, _, fmt in HEADLINE_COLUMNS:
+            v = row[key]
+            attrs = f" data-key='{html.escape(row['category'])}|{key}'"
+            if isinstance(v, float | int) and not isinstance(v, bool):
+                attrs += f" data-value='{v!r}'"
+                text = format(v, fmt) if fmt else str(v)
+            else:
+                text = "--" if v is None else html.escape(str(v))
+            style = f" class='v-{v}'" if key.endswith("verdict") and isinstance(v, str) else ""
+            cells.append(f"<td{attrs}{style}>{text}</td>")
+        body.append("<tr>" + "".join(cells) + "</tr>")
+    return f"<table id='verdict'><tr>{head}</tr>{''.join(body)}</table>"
+
+
+def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: dict) -> Path:
+    """Write the figures and DIR/report.html (the verdict contract's table first, images embedded); returns its
+    path."""
+    out_dir = Path(out_dir)
+    imgs = evaluation_figures(results, summary, det, series_of(out_dir, results))
     b64 = _render_all(imgs, out_dir)
-    verdict_rows = []
+    other_rows = []
     for cat, e in summary["decision_heights"].items():
         lim = det["categories"][cat]["limits_ft"]
-        verdict_rows.append([
-            cat, e["height_ft"], e["lateral_1sigma_ft"], lim["lateral_1sigma_ft"], e["vertical_1sigma_ft"],
-            lim["vertical_1sigma_ft"], e["lateral_95_ft"], lim["lateral_95_ft"], e["vertical_95_ft"],
-            lim["vertical_95_ft"], e["meets"],
-        ])
+        other_rows.append([cat, e["height_ft"], e["lateral_95_ft"], lim["lateral_95_ft"], e["vertical_95_ft"],
+                           lim["vertical_95_ft"]])
     detail_rows = []
     for cat, c in det["categories"].items():
         for comp in ("lateral", "vertical", "along", "vpl", "hpl", "lpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert"):
@@ -402,15 +440,24 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
         "<style>body{font-family:sans-serif;margin:2em;max-width:1200px}table{border-collapse:collapse;"
         "margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}"
         "img{max-width:100%}figure{margin:0 0 2em 0}figcaption{max-width:900px;color:#333;font-size:0.95em}"
+        "td.v-meets{background:#d6f5d6}td.v-fails{background:#f7d4d4}td.v-indeterminate{background:#fff2c2}"
+        "#verdict td:first-child{text-align:left;font-weight:bold}"
         "</style></head><body>",
         f"<h1>{html.escape(title)}</h1>",
-        f"<p><b>Best category met: {html.escape(str(summary['best_category'] or 'none'))}</b> &mdash; "
-        f"{summary['runs']} runs ({summary['failed_runs']} failed), seed {summary['seed']}, "
-        f"{'closed' if summary['closed_loop'] else 'open'} loop. 1-sigma = RMS over runs, bias included. "
-        f"Verdict uses: {html.escape(det['verdict_limits'])}.</p>",
-        _table(["category", "DH ft", "lateral 1σ ft", "FAA limit", "vertical 1σ ft", "FAA limit", "lateral 95% ft",
-                "ICAO 95%", "vertical 95% ft", "ICAO 95%", "meets"], verdict_rows),
+        "<h2>Verdict</h2>",
+        _headline(summary, det),
+        f"<p id='best'><b>Best category: <span data-key='best_category'>"
+        f"{html.escape(str(summary['best_category'] or 'none'))}</span></b>; failed runs: <b><span "
+        f"data-key='failed_runs' data-value='{summary['failed_runs']}'>{summary['failed_runs']}</span></b> of "
+        f"{summary['runs']}; seed {summary['seed']}, {'closed' if summary['closed_loop'] else 'open'} loop.</p>",
+        f"<p>1-sigma = RMS over the completed runs, bias included (ft). A category meets when the one-sided "
+        f"{det.get('confidence', 0.95):.0%} upper confidence bound of both axes is within the FAA limit (and the "
+        "failed runs and, where listed, integrity meet), fails when a lower bound is beyond it, and is indeterminate "
+        "otherwise, with the runs that would likely decide it. The same numbers as summary.json and the printed "
+        f"table. Verdict uses: {html.escape(det['verdict_limits'])}.</p>",
         *(f"<p><b>{html.escape(n)}</b></p>" for n in verdict_table(summary, det).splitlines() if n.startswith("note:")),
+        "<h2>ICAO 95 % accuracy (beside the verdict unless it uses faa+icao), ft</h2>",
+        _table(["category", "DH ft", "lateral 95% ft", "ICAO 95%", "vertical 95% ft", "ICAO 95%"], other_rows),
         "<h2>Statistics at decision height (ft; 95 % intervals for the number of runs)</h2>",
         _table(["category", "error", "n", "RMS", "RMS lo", "RMS hi", "mean", "std", "95%", "95% lo", "95% hi"],
                detail_rows),
@@ -435,6 +482,33 @@ def write_report(out_dir: Path, results: list[RunResult], summary: dict, det: di
     return path
 
 
+_IMG = re.compile(r"<img alt='([^']+)' src='data:image/png;base64,([A-Za-z0-9+/=]*)'>")
+
+
+def report_problems(out_dir: Path) -> list[str]:
+    """What is wrong with DIR/report.html's figures, one line each (empty: nothing), without rendering the page:
+    every embedded figure names its file "(file NAME.png)", that file is in DIR and holds the embedded bytes, and
+    no figure file named on the page is missing."""
+    out_dir = Path(out_dir)
+    page = (out_dir / "report.html").read_text(encoding="utf-8")
+    problems = []
+    embedded = _IMG.findall(page)
+    if not embedded:
+        problems.append("report.html embeds no figure")
+    for name, b64 in embedded:
+        f = out_dir / f"{name}.png"
+        if f"(file {name}.png)" not in page:
+            problems.append(f"figure {name}: its caption does not name its file {name}.png")
+        if not f.is_file():
+            problems.append(f"figure {name}: no file {str(f)!r}")
+        elif f.read_bytes() != base64.b64decode(b64):
+            problems.append(f"figure {name}: {str(f)!r} is not the figure embedded in report.html")
+    for name in re.findall(r"\(file ([^()\s]+)\.png\)", page):
+        if not (out_dir / f"{name}.png").is_file():
+            problems.append(f"report.html names {name}.png, which is not in {str(out_dir)!r}")
+    return problems
+
+
 def _plain_tick(v: float, _pos: int | None = None) -> str:
     """A log-axis tick as a plain number (0.3, 1, 30), not 3x10^1."""
     return f"{v:g}"
@@ -448,6 +522,14 @@ def _minor_tick(v: float, _pos: int | None = None) -> str:
 
 def write_study_figure(out_dir: Path, rows: list[dict]) -> Path:
     """DIR/study.png: lateral and vertical 1-sigma error at each decision height per variant, with limits."""
+    path = Path(out_dir) / "study.png"
+    study_figure(rows).savefig(path, dpi=110)
+    return path
+
+
+def study_figure(rows: list[dict]) -> Figure:
+    """Lateral and vertical 1-sigma error at each decision height per variant (campaign.study.comparison_rows), on
+    a log scale, with the FAA limits dashed."""
     fig = Figure(figsize=(max(8.0, 1.2 * len(rows) + 4.0), 7), constrained_layout=True)
     axes = fig.subplots(2, 1, sharex=True)
     x = np.arange(len(rows))
@@ -468,6 +550,4 @@ def write_study_figure(out_dir: Path, rows: list[dict]) -> Path:
     axes[0].set_title("1-sigma error (RMS over runs) at each decision height per variant; dashed: FAA limits",
                       fontsize=10)
     axes[1].set_xticks(x, [r["variant"] for r in rows], rotation=30, ha="right", fontsize=8)
-    path = Path(out_dir) / "study.png"
-    fig.savefig(path, dpi=110)
-    return path
+    return fig

@@ -14,7 +14,7 @@ from approachsim.cli import build_parser, main
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT = str(ROOT / "profiles" / "default.toml")
-COMMANDS = ("fly", "sense", "navigate", "evaluate", "integrity-risk", "study", "regress", "profiles")
+COMMANDS = ("fly", "sense", "navigate", "evaluate", "merge", "integrity-risk", "study", "regress", "profiles")
 
 
 def _one_line(err: str, needle: str) -> None:

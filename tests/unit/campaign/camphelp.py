@@ -56,3 +56,36 @@ def dask_probe_run(profile: dict, seed: int, run: int) -> RunResult:
     blas = [p["num_threads"] for p in threadpool_info() if p.get("user_api") == "blas"]
     return RunResult(run=run, ok=True, scalars={"held": float(len(get_worker().data)),
                                                 "blas_threads": float(max(blas, default=1))})
+
+
+def bad_worker_run(profile: dict, seed: int, run: int) -> RunResult:
+    """synth_run, except on the Dask worker named profile["bad_worker"], where every run raises the bare
+    FileNotFoundError a worker whose working directory was deleted raises (issue 42), in a millisecond."""
+    from distributed import get_worker
+
+    if get_worker().name == profile["bad_worker"]:
+        raise FileNotFoundError(2, "No such file or directory")
+    time.sleep(profile.get("sleep_s", 0.0))
+    return synth_run(profile, seed, run)
+
+
+CALLS: list[int] = []
+"""Runs started by counted_fail_run in this process (Dask workers in threads of the test process)."""
+
+
+def counted_fail_run(profile: dict, seed: int, run: int) -> RunResult:
+    """A run that always fails (its own failure, on any worker), counted in CALLS."""
+    CALLS.append(run)
+    raise RuntimeError(f"diverged in run {run}")
+
+
+def _cannot_load() -> None:
+    raise ImportError("No module named 'approachsim' (this worker's environment)")
+
+
+class Unloadable:
+    """A "profile" a worker cannot unpickle: the task fails on the worker before any run starts (a worker without the
+    package installed)."""
+
+    def __reduce__(self):
+        return _cannot_load, ()

@@ -15,10 +15,11 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
-from camphelp import dask_probe_run, synth_group, synth_run
+from camphelp import bad_worker_run, dask_probe_run, synth_group, synth_run
 
 from approachsim.campaign.result import RunResult
-from approachsim.campaign.runner import plan_chunks, run_campaign
+from approachsim.campaign.runner import RETRY_REPRODUCED_MAX, missing_path_note, plan_chunks, run_campaign
+from approachsim.campaign.shards import merge_store, parse_shard, read_shards, shard_runs
 from approachsim.campaign.store import CampaignStore
 from approachsim.config import ProfileError
 
@@ -184,3 +185,157 @@ def test_resume_refuses_another_campaign_and_can_grow(tmp_path):
     grown = run_campaign({}, seed=5, runs=10, run_fn=synth_run, workers=1, out_dir=tmp_path, meta=meta,
                          resume=True, progress=False)
     assert grown.newly_run == 4 and len(grown.results) == 10
+
+
+def _cluster(n: int):
+    import distributed
+
+    return distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=False, protocol="tcp://",
+                                    host="127.0.0.1", dashboard_address=":0")
+
+
+def test_a_dask_worker_failing_every_task_is_named_and_its_tasks_rerun_elsewhere():
+    """Issue 42: a worker that raises on every task (its working directory gone) took most tasks, because it failed
+    each in milliseconds, and the campaign recorded them as failed runs with a bare "No such file or directory".
+    Now its wholly failed tasks are rerun on the other worker, the results are those of a healthy campaign bit for
+    bit, and the worker is named once with its error (which says where it happened)."""
+    with _cluster(2) as cluster:
+        bad = cluster.workers[1].address
+        err = io.StringIO()
+        res = run_campaign({"bad_worker": 1, "sleep_s": 0.02}, seed=4, runs=16, run_fn=bad_worker_run, per_task=1,
+                           scheduler=cluster.scheduler_address, progress_stream=err)
+    healthy = _run({}, run_fn=synth_run, seed=4, runs=16, workers=1)
+    assert not res.failed and _same(res.results, healthy.results)
+    assert len(res.warnings) == 1, res.warnings
+    w = res.warnings[0]
+    assert w.startswith(f"Dask worker {bad} failed every task it ran (first: FileNotFoundError: [Errno 2] No such "
+                        "file or directory (on ")
+    assert "working directory" in w and w.endswith("its tasks are rerun on other workers: fix or restart that worker")
+    assert f"approachsim: {w}" in err.getvalue()
+
+
+def test_runs_that_fail_everywhere_stay_failed_after_a_bounded_number_of_reruns():
+    """A profile whose runs all fail is not a bad worker: the runs stay failed with their own reasons, no worker is
+    named, and the probes that found it out cost at most RETRY_REPRODUCED_MAX + one per worker extra runs."""
+    import camphelp
+
+    camphelp.CALLS.clear()
+    with _cluster(2) as cluster:
+        res = run_campaign({}, seed=4, runs=12, run_fn=camphelp.counted_fail_run, per_task=1,
+                           scheduler=cluster.scheduler_address, progress=False)
+    assert len(res.failed) == 12 and not res.warnings
+    assert [r.error for r in res.failed] == [f"RuntimeError: diverged in run {i}" for i in range(12)]
+    assert 12 + 1 <= len(camphelp.CALLS) <= 12 + RETRY_REPRODUCED_MAX + 2, camphelp.CALLS
+
+
+def test_an_error_without_a_file_name_says_where(monkeypatch, tmp_path):
+    assert missing_path_note(FileNotFoundError(2, "No such file or directory", "x.toml")) == ""
+    assert missing_path_note(ValueError("x")) == ""
+    note = missing_path_note(FileNotFoundError(2, "No such file or directory"))
+    assert f"working directory {os.getcwd()!r}; the failing call named no file" in note
+    gone = tmp_path / "gone"
+
+    def no_cwd() -> str:
+        raise FileNotFoundError(2, "No such file or directory")
+
+    monkeypatch.setattr(os, "getcwd", no_cwd)
+    monkeypatch.setenv("PWD", str(gone))
+    note = missing_path_note(FileNotFoundError(2, "No such file or directory"))
+    assert f"its working directory {str(gone)!r} no longer exists; restart the process" in note
+
+
+def test_shards_partition_the_runs():
+    assert [shard_runs(10, k, 3) for k in (1, 2, 3)] == [[0, 1, 2], [3, 4, 5], [6, 7, 8, 9]]
+    for runs in (1, 7, 100):
+        for n in range(1, min(runs, 9) + 1):
+            parts = [shard_runs(runs, k, n) for k in range(1, n + 1)]
+            assert sum(parts, []) == list(range(runs)) and max(map(len, parts)) - min(map(len, parts)) <= 1
+    assert parse_shard("2/3") == (2, 3) and parse_shard(" 1 / 1 ") == (1, 1)
+    for bad in ("0/3", "4/3", "3", "a/b", "1/0"):
+        with pytest.raises(ProfileError, match="^--shard: must be K/N"):
+            parse_shard(bad)
+    with pytest.raises(ProfileError, match="^--shard: 5 shards for 4 runs"):
+        shard_runs(4, 1, 5)
+
+
+def test_three_shards_merged_equal_one_campaign_bit_for_bit(tmp_path):
+    """Shards on other executors and chunkings (a local pool of 2, grouped runs) merged: the run store of the single
+    campaign, file for file (runs.jsonl in run order, the single campaign's in the order runs finished)."""
+    prof, seed, runs = {"series_runs": 5}, 3, 11
+    meta = {"profile_digest": "d", "seed": seed, "mode": "open"}
+    one = run_campaign(prof, seed=seed, runs=runs, run_fn=synth_run, workers=1, out_dir=tmp_path / "one", meta=meta,
+                       progress=False)
+    dirs = [tmp_path / f"shard{k}" for k in (1, 2, 3)]
+    for k, d in enumerate(dirs, start=1):
+        part = run_campaign(prof, seed=seed, runs=runs, group_fn=synth_group, group_size=4, workers=2, out_dir=d,
+                            meta={**meta, "shard": [k, 3]}, only=shard_runs(runs, k, 3), progress=False)
+        assert [r.run for r in part.results] == shard_runs(runs, k, 3)
+    got_meta, results, _ = read_shards(list(reversed(dirs)))
+    assert _same(results, one.results) and got_meta == meta
+    merge_store(dirs, tmp_path / "merged", got_meta, results)
+    a, b = tmp_path / "one", tmp_path / "merged"
+    series = [f"series/run_{i:06d}.parquet" for i in range(5)]
+    for name in ("runs.parquet", "heights.parquet", "campaign.json", *series):
+        assert (a / name).read_bytes() == (b / name).read_bytes(), name
+    assert sorted((b / "series").iterdir()) == [b / "series" / f"run_{i:06d}.parquet" for i in range(5)]
+    assert sorted((a / "runs.jsonl").read_text().splitlines()) == sorted((b / "runs.jsonl").read_text().splitlines())
+    # a shard resumed is the same shard; another shard, another campaign
+    run_campaign(prof, seed=seed, runs=runs, run_fn=synth_run, workers=1, out_dir=dirs[0],
+                 meta={**meta, "shard": [1, 3]}, only=shard_runs(runs, 1, 3), resume=True, progress=False)
+    with pytest.raises(ProfileError, match=r"different campaign \(shard \[1, 3\], now \[2, 3\]\)"):
+        run_campaign(prof, seed=seed, runs=runs, run_fn=synth_run, workers=1, out_dir=dirs[0],
+                     meta={**meta, "shard": [2, 3]}, only=shard_runs(runs, 2, 3), resume=True, progress=False)
+    # what merge refuses, one line naming the directory
+    with pytest.raises(ProfileError, match=r"shard\(s\) 3/3 missing: give all 3"):
+        read_shards(dirs[:2])
+    with pytest.raises(ProfileError, match=r"are both shard 1/3"):
+        read_shards([dirs[0], dirs[0], dirs[2]])
+    with pytest.raises(ProfileError, match=r"is not a shard"):
+        read_shards([a])
+    with pytest.raises(ProfileError, match=r"^SHARD_DIR: no such file .*nowhere/campaign\.json'$"):
+        read_shards([tmp_path / "nowhere"])
+    lines = (dirs[1] / "runs.jsonl").read_text().splitlines()
+    (dirs[1] / "runs.jsonl").write_text("\n".join(lines[:-1]) + "\n")
+    with pytest.raises(ProfileError, match=r"shard 2/3 in .* is unfinished \(1 of its 4 runs missing, first \d\); "
+                                           r"finish it with evaluate --shard 2/3 --resume"):
+        read_shards(dirs)
+
+
+def test_the_dask_preload_loads_the_kernels_on_every_worker_before_a_task(monkeypatch):
+    """campaign/dask_preload.py: as a worker plugin (and `dask worker --preload`), it runs kernels.load_kernels on
+    each worker, in a thread (the worker's event loop stays free), before the client submits anything."""
+    import threading
+
+    from distributed import Client
+
+    from approachsim.campaign import dask_preload
+
+    loaded: list[tuple[str, bool]] = []
+
+    def fake_load() -> float:
+        loaded.append((threading.current_thread().name, threading.current_thread() is threading.main_thread()))
+        return 0.0
+
+    monkeypatch.setattr(dask_preload, "load_kernels", fake_load)
+    with _cluster(2) as cluster, Client(cluster.scheduler_address) as client:
+        client.register_plugin(dask_preload.KernelPreload())
+        assert len(loaded) == 2 and not any(main for _, main in loaded)
+        res = _run({}, run_fn=synth_run, runs=4, scheduler=cluster.scheduler_address)
+    assert len(res.ok) == 4 and len(loaded) == 2
+
+
+def test_a_task_that_cannot_start_fails_its_runs_with_the_reason_and_the_campaign_completes():
+    """A task that cannot be unpickled (a worker without the package; here the scheduler, which deserializes the
+    graph first in this Dask version) raises on the cluster, not in a run: its runs fail with the cluster's reason and
+    where it happened (the worker's address, '?' when no worker got it), and the campaign goes on to the end."""
+    from camphelp import Unloadable
+
+    with _cluster(2) as cluster:
+        addresses = {w.address for w in cluster.workers.values()}
+        res = run_campaign(Unloadable(), seed=1, runs=4, run_fn=synth_run, per_task=1,
+                           scheduler=cluster.scheduler_address, progress=False)
+    assert [r.run for r in res.failed] == [0, 1, 2, 3] and not res.warnings
+    for r in res.failed:
+        head, _, rest = r.error.partition(": ")
+        assert head.removeprefix("task failed on Dask worker ") in addresses | {"?"}, r.error
+        assert "No module named 'approachsim'" in rest or "deserialization" in rest, r.error

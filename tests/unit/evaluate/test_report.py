@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from html.parser import HTMLParser
 
 import numpy as np
 from evalpairs import cross_axis_ned, make_nav, make_truth
@@ -14,7 +15,7 @@ from approachsim.campaign.result import RunResult
 from approachsim.campaign.store import CampaignStore
 from approachsim.evaluate.config import EvaluationConfig
 from approachsim.evaluate.score import score_run
-from approachsim.report.evaluate import write_report
+from approachsim.report.evaluate import report_problems, write_report
 
 
 def test_outputs_and_report(tmp_path):
@@ -72,3 +73,80 @@ def test_outputs_and_report(tmp_path):
     store.write_series(RunResult(run=0, ok=True, series=ser))
     page = write_report(tmp_path, results, summary, det).read_text()
     assert page.count("data:image/png;base64,") == 5 and (tmp_path / "sky_dop.png").is_file()
+
+
+class _Cells(HTMLParser):
+    """The cells of the page's first table: (data-key, data-value or None, text), and the tables' ids in order."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.tables: list[str | None] = []
+        self.cells: list[tuple[str | None, str | None, str]] = []
+        self._cell: dict | None = None
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag == "table":
+            self.tables.append(a.get("id"))
+        if tag == "td" and len(self.tables) == 1:
+            self._cell = {"key": a.get("data-key"), "value": a.get("data-value"), "text": ""}
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell["text"] += data
+
+    def handle_endtag(self, tag):
+        if tag == "td" and self._cell is not None:
+            self.cells.append((self._cell["key"], self._cell["value"], self._cell["text"]))
+            self._cell = None
+
+
+def test_report_leads_with_the_verdict_contract(tmp_path):
+    """report.html's first table is the verdict contract: per category and axis summary.json's 1-sigma, upper bound
+    and limit (the exact values in data-value, shown as the printed table shows them), details.json's verdict per
+    axis, the category's verdict; best category and failed runs beside it; every figure it names is in DIR."""
+    cfg = EvaluationConfig()
+    truth = make_truth(hz=4.0)
+    rng = np.random.default_rng(7)
+    results = []
+    for i in range(14):  # CAT I meets (3 ft / 0.6 ft), CAT III's vertical 1 ft limit is beyond reach
+        e = rng.normal(0.0, 3.0) * units.FT * cross_axis_ned() + np.array([0.0, 0.0, rng.normal(0.0, 0.6)])
+        sc, arr, ser = score_run(truth, make_nav(truth, e, sigma_ned_m=(2.0, 2.0, 1.0)), cfg, keep_series=i < 2)
+        results.append(RunResult(run=i, ok=True, scalars=sc, arrays=arr, series=ser))
+    store = CampaignStore(tmp_path)
+    store.start({"seed": 1}, resume=False)
+    store.append(results)
+    summary, det = evaluate_results(results, cfg, profile="synthetic", seed=1, closed_loop=False)
+    write_json(tmp_path / "summary.json", summary)
+    page = write_report(tmp_path, results, summary, det).read_text()
+    p = _Cells()
+    p.feed(page)
+    assert p.tables[0] == "verdict" and page.index("id='verdict'") < page.index("<img")
+    back = json.loads((tmp_path / "summary.json").read_text())
+    printed = verdict_table(back, det).splitlines()
+    cells = {k: (v, t) for k, v, t in p.cells}
+    verdicts = {c: e["verdict"] for c, e in back["decision_heights"].items()}
+    assert verdicts == {"CAT I": "meets", "CAT II": "meets", "CAT III": "fails"}  # the numbers decide, not a default
+    assert len(p.cells) == 3 * 14
+    for cat, e in back["decision_heights"].items():
+        for axis in ("lateral", "vertical"):
+            for key in (f"{axis}_1sigma_ft", f"{axis}_1sigma_upper_ft", f"limit_{axis}_1sigma_ft"):
+                value, text = cells[f"{cat}|{key}"]
+                assert float(value) == e[key]  # the exact number summary.json holds
+                assert text == format(e[key], ".1f" if key.startswith("limit") else ".2f")
+            assert cells[f"{cat}|{axis}_verdict"][1] == det["categories"][cat]["bounds_ft"][axis]["verdict"]
+            # the same figures as the printed table's row of the category
+            row = next(ln for ln in printed if ln.startswith(f"{cat} "))
+            assert f"{e[f'{axis}_1sigma_ft']:7.2f} {e[f'{axis}_1sigma_upper_ft']:7.2f}" in row
+        assert cells[f"{cat}|verdict"][1] == e["verdict"] and e["verdict"] in printed[2 + list(verdicts).index(cat)]
+        assert cells[f"{cat}|failures_verdict"][1] == "meets"
+    assert f"data-key='best_category'>{back['best_category']}<" in page
+    assert f"data-key='failed_runs' data-value='{back['failed_runs']}'" in page and back["best_category"] == "CAT II"
+    assert report_problems(tmp_path) == []
+    (tmp_path / "histograms_dh.png").unlink()
+    (tmp_path / "stanford.png").write_bytes(b"not the figure")
+    assert sorted(report_problems(tmp_path)) == [
+        f"figure histograms_dh: no file {str(tmp_path / 'histograms_dh.png')!r}",
+        f"figure stanford: {str(tmp_path / 'stanford.png')!r} is not the figure embedded in report.html",
+        f"report.html names histograms_dh.png, which is not in {str(tmp_path)!r}",
+    ]
