@@ -16,7 +16,7 @@ from approachsim.campaign.kernels import compile_note, mark_compiled
 from approachsim.campaign.outputs import evaluate_results, write_json
 from approachsim.campaign.pipeline import PipelineSpec, spec_for
 from approachsim.campaign.result import RunResult
-from approachsim.campaign.runner import run_campaign
+from approachsim.campaign.runner import Display, run_campaign
 from approachsim.campaign.shards import merge_store, read_shards, shard_runs, write_shard_record
 from approachsim.campaign.store import profile_digest
 
@@ -72,8 +72,8 @@ def evaluate_profile(
     only = None if shard is None else shard_runs(runs, *shard)
     res = run_campaign(
         profile, seed=seed, runs=runs, group_fn=spec.group_fn, group_size=spec.group_size, out_dir=out_dir,
-        meta=meta, resume=resume, workers=workers, scheduler=scheduler, progress=progress, only=only,
-        warmup=compile_note(kind(mode, spec.land)),
+        meta=meta, resume=resume, workers=workers, scheduler=scheduler, only=only,
+        progress=Display(enabled=progress, warmup=compile_note(kind(mode, spec.land))),
     )
     if any(r.ok for r in res.results):
         mark_compiled(kind(mode, spec.land))

@@ -495,6 +495,17 @@ def _dask(client: Any, tasks: list, args: tuple, warn: Callable[[str], None]) ->
 
 
 @dataclass(frozen=True)
+class Display:
+    """How a campaign shows its progress: enabled, the stream (None: stderr), the campaign's label (empty: the
+    profile's name) and the words shown until the first runs finish (Progress.warmup, e.g. that kernels compile)."""
+
+    enabled: bool = True
+    stream: TextIO | None = None
+    label: str = ""
+    warmup: str | None = None
+
+
+@dataclass(frozen=True)
 class CampaignResult:
     """All runs of a campaign in run order (0..runs-1); newly_run counts the runs executed this time."""
 
@@ -527,26 +538,24 @@ def run_campaign(
     workers: int | None = None,
     scheduler: str | None = None,
     per_task: int | None = None,
-    progress: bool = True,
-    progress_stream: TextIO | None = None,
-    progress_label: str = "",
+    progress: bool | Display = True,
     scheduler_timeout_s: float = 10.0,
     only: Sequence[int] | None = None,
-    warmup: str | None = None,
 ) -> CampaignResult:
     """Run runs 0..runs-1 (those not already in out_dir when resuming) and return them all, in order.
 
     only: run just these run indices of the campaign of `runs` (a shard, campaign/shards.py); they draw the same
-    random numbers as in the whole campaign, and only they are returned and stored. warmup: the progress display's
-    words until the first runs finish (Progress.warmup).
+    random numbers as in the whole campaign, and only they are returned and stored. progress: whether to show it, or
+    a Display (its stream, label and warmup words).
 
     Exactly one of run_fn / group_fn (with group_size). workers: local processes (default all cores; 1 runs
     in this process). scheduler: address of an existing Dask scheduler instead of the local pool.
-    progress_label names the campaign in the progress display (default: the profile's name, which for a study
+    The progress display names the campaign by Display.label (default: the profile's name, which for a study
     variant is "<base>[<variant>]").
     """
     if (run_fn is None) == (group_fn is None):
         raise ValueError("give exactly one of run_fn and group_fn")
+    show = progress if isinstance(progress, Display) else Display(enabled=progress)
     if group_fn is not None and not group_size:
         raise ValueError("group_fn needs group_size")
     workers = workers or os.cpu_count() or 1
@@ -566,8 +575,8 @@ def run_campaign(
     tasks = plan_chunks(todo, workers=workers, group_size=group_size if group_fn else None, per_task=per_task)
     # a group function gets some runs of one group: a run's result must not depend on which others it gets
     bar = Progress(total=len(wanted), done=len(done), failed=sum(not r.ok for r in done.values()),
-                   stream=progress_stream, enabled=progress, label=progress_label or str(getattr(profile, "name", "")),
-                   warmup=warmup if todo else None)
+                   stream=show.stream, enabled=show.enabled, label=show.label or str(getattr(profile, "name", "")),
+                   warmup=show.warmup if todo else None)
     t0 = time.monotonic()
     bar.start()
     args = (run_fn, group_fn, profile, seed)
@@ -575,7 +584,7 @@ def run_campaign(
 
     def warn(line: str) -> None:
         warnings.append(line)
-        s = progress_stream or sys.stderr
+        s = show.stream or sys.stderr
         s.write(f"approachsim: {line}\n")
         s.flush()
 

@@ -348,7 +348,7 @@ class NavInTheLoop:
             self._hb[0, 0] = self.h_baro_hold
             self._hb_age[0] = truth.t_s[k - 1] - self.h_baro_t
             self._hb_interval[(k - 1) % self.epoch_rows] = self.h_baro_hold
-            sk.inloop_step(k, truth.w_ib_body, truth.f_body, affine, m_g, m_a, c_g, c_a, self._dth, self._dv,
+            sk.inloop_step(k, truth.w_ib_body, truth.f_body, affine, (m_g, m_a, c_g, c_a), self._dth, self._dv,
                            self.dt, self._bg, self._ba, self._hb, self._hb_age, self._loop, navigator.x,
                            navigator.f_sum)
             if k % self.epoch_rows == 0:

@@ -197,14 +197,14 @@ def strapdown(x: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, dt: float, bias
 
 
 @njit(cache=True)
-def inloop_step(k: int, w_ib: np.ndarray, f_body: np.ndarray, affine: bool, m_g: np.ndarray, m_a: np.ndarray,
-                c_g: np.ndarray, c_a: np.ndarray, dtheta: np.ndarray, dv: np.ndarray, dt: float,
-                bias_g: np.ndarray, bias_a: np.ndarray, h_baro: np.ndarray, baro_age: np.ndarray, loop: np.ndarray,
-                x: np.ndarray, f_sum: np.ndarray) -> None:
+def inloop_step(k: int, w_ib: np.ndarray, f_body: np.ndarray, affine: bool, imu: tuple, dtheta: np.ndarray,
+                dv: np.ndarray, dt: float, bias_g: np.ndarray, bias_a: np.ndarray, h_baro: np.ndarray,
+                baro_age: np.ndarray, loop: np.ndarray, x: np.ndarray, f_sum: np.ndarray) -> None:
     """The closed loop's INS step into truth row k for one run: with `affine`, the IMU increments of interval
-    (k-1, k] from truth rows w_ib, f_body (n, 3) and the pre-drawn error terms (core/sensors/imu.increment; M m_g,
-    m_a and c_g, c_a (m, 3) indexed by sample k-1), else the given dtheta, dv (1, 1, 3); then `strapdown` on x
-    (1, 16)."""
+    (k-1, k] from truth rows w_ib, f_body (n, 3) and the pre-drawn error terms imu = (m_g, m_a, c_g, c_a)
+    (core/sensors/imu.increment; M (3, 3) and c (m, 3) indexed by sample k-1), else the given dtheta, dv (1, 1, 3);
+    then `strapdown` on x (1, 16)."""
+    m_g, m_a, c_g, c_a = imu
     if affine:
         ik.increment(m_g, w_ib[k - 1], dt, c_g[k - 1], dtheta[0, 0])
         ik.increment(m_a, f_body[k - 1], dt, c_a[k - 1], dv[0, 0])

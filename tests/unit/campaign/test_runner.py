@@ -18,7 +18,13 @@ import pytest
 from camphelp import bad_worker_run, dask_probe_run, synth_group, synth_run
 
 from approachsim.campaign.result import RunResult
-from approachsim.campaign.runner import RETRY_REPRODUCED_MAX, missing_path_note, plan_chunks, run_campaign
+from approachsim.campaign.runner import (
+    RETRY_REPRODUCED_MAX,
+    Display,
+    missing_path_note,
+    plan_chunks,
+    run_campaign,
+)
 from approachsim.campaign.shards import merge_store, parse_shard, read_shards, shard_runs
 from approachsim.campaign.store import CampaignStore
 from approachsim.config import ProfileError
@@ -96,7 +102,7 @@ def test_bad_scheduler_address_is_a_user_error():
 def test_a_raising_run_is_recorded_and_the_rest_complete(tmp_path):
     err = io.StringIO()
     res = run_campaign({"fail_runs": (3, 17)}, seed=1, runs=20, run_fn=synth_run, workers=2, out_dir=tmp_path,
-                       progress_stream=err)
+                       progress=Display(stream=err))
     assert [r.run for r in res.failed] == [3, 17]
     assert res.failed[0].error == "RuntimeError: synthetic failure in run 3 (second line)"
     assert len(res.ok) == 18
@@ -203,7 +209,7 @@ def test_a_dask_worker_failing_every_task_is_named_and_its_tasks_rerun_elsewhere
         bad = cluster.workers[1].address
         err = io.StringIO()
         res = run_campaign({"bad_worker": 1, "sleep_s": 0.02}, seed=4, runs=16, run_fn=bad_worker_run, per_task=1,
-                           scheduler=cluster.scheduler_address, progress_stream=err)
+                           scheduler=cluster.scheduler_address, progress=Display(stream=err))
     healthy = _run({}, run_fn=synth_run, seed=4, runs=16, workers=1)
     assert not res.failed and _same(res.results, healthy.results)
     assert len(res.warnings) == 1, res.warnings
