@@ -50,9 +50,19 @@ def evaluate_profile(
     )
     summary, det = evaluate_results(
         res.results, profile.evaluation, profile=profile.name, seed=seed, closed_loop=spec.closed_loop,
-        land=spec.land,
+        land=spec.land, gnss_service=_service_label(profile),
     )
     det["wall_s"] = res.wall_s
     write_json(Path(out_dir) / "summary.json", summary)
     write_json(Path(out_dir) / "details.json", det)
     return Evaluation(res.results, summary, det, res.wall_s)
+
+
+def _service_label(profile: Any) -> str | None:
+    """The GNSS service's label for summary.json (sensors/gnss/service.py; "military (PPS)" named), None without."""
+    g = profile.sensors.gnss
+    if g is None:
+        return None
+    if g.service is not None:
+        return g.service.label
+    return f"code preset {g.code}" + (" (military, PPS)" if g.code == "P(Y)" else "")

@@ -122,6 +122,9 @@ def _score(
     )
     if gnss is not None:
         scalars.update(_geometry_at_dh(gnss, scalars))
+        g = profile.sensors.gnss
+        if g is not None and g.service is not None:
+            scalars.update(_lpv200_at_dh(gnss, scalars, g.service.sbas))
     if series is not None and gnss is not None:
         series = {**series, **_geometry_series(gnss, series["t_s"])}
     counts = {}
@@ -174,6 +177,25 @@ def _geometry_at_dh(gnss: Any, scalars: dict) -> dict:
     if gnss.epoch_offset_s is not None:
         out["gnss_epoch_offset_h"] = float(gnss.epoch_offset_s) / 3600.0
     return out
+
+
+def _lpv200_at_dh(gnss: Any, scalars: dict, sbas: bool) -> dict:
+    """One run's LPV-200 columns (evaluate/lpv.py) from a GNSS service's record: the WLS protection levels with
+    the broadcast sigmas (integrity/sbas.py) at the CAT I crossing's latest GNSS sample, LPV-200 available there,
+    the fraction of GNSS epochs available up to it, and whether the service is SBAS (an integrity basis)."""
+    import numpy as np
+
+    from approachsim.integrity.sbas import lpv200_available, protection_levels  # stage (module docstring)
+
+    t = scalars.get("cat1_t_s")
+    if t is None or not np.isfinite(t):
+        return {}
+    vpl, hpl = protection_levels(np.asarray(gnss.elevation_rad), np.asarray(gnss.azimuth_rad),
+                                 np.asarray(gnss.valid), np.asarray(gnss.sigma_m))
+    j = int(np.clip(np.searchsorted(gnss.t_s, t, side="right") - 1, 0, len(gnss.t_s) - 1))
+    ok = lpv200_available(vpl, hpl)
+    return {"lpv200_vpl_m": float(vpl[j]), "lpv200_hpl_m": float(hpl[j]), "lpv200_avail_dh": float(ok[j]),
+            "lpv200_avail_fraction": float(np.mean(ok[: j + 1])), "lpv200_sbas": float(sbas)}
 
 
 def _gnss_closed_loop(source: Any, truth: Any) -> Any:

@@ -5,11 +5,17 @@ UDRE = GIVE = 3 m, AAD-B, no degradation; DFMC with sigma_DFRE 0.912 m), and the
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+from approachsim.config import ProfileError
 from approachsim.core.sensors import gnss_errors as ge
+from approachsim.profile import load_profile, parse_profile
 from approachsim.sensors.gnss.service import (
     DFRE_SIGMA_M,
     GIVE_M,
@@ -133,3 +139,56 @@ def test_truth_is_overbounded() -> None:
             assert np.all(var <= bcast * (1 + 1e-12))
             if truth == "broadcast":
                 np.testing.assert_allclose(var[0, 0], bcast[0, 0], rtol=1e-12)
+
+
+# --- the profile keys: one line naming the field, exit 2 at the command line (docs/contract.md) --------------------
+
+PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+SBAS = PROFILES / "sbas-lpv200.toml"
+
+
+def _profile(drop: tuple[str, ...] = (), **gnss: object):
+    d = tomllib.loads(SBAS.read_text(encoding="utf-8"))
+    for k in drop:
+        d["sensors"]["gnss"].pop(k, None)
+    d["sensors"]["gnss"].update(gnss)
+    return parse_profile(d, source=SBAS)
+
+
+@pytest.mark.parametrize(("drop", "gnss", "field"), [
+    ((), {"service": "glonass-k"}, "sensors.gnss.service"),
+    ((), {"udre_index": 14}, "sensors.gnss.udre_index"),
+    ((), {"give_index": -1}, "sensors.gnss.give_index"),
+    ((), {"dfrei": 4}, "sensors.gnss.dfrei"),
+    (("udre_index", "give_index", "aad"), {"service": "dfmc-sbas", "dfrei": 16}, "sensors.gnss.dfrei"),
+    ((), {"service": "dfmc"}, "sensors.gnss.udre_index"),  # SBAS correction keys with a service without SBAS
+    ((), {"corrections": "sbas"}, "sensors.gnss.corrections"),
+    ((), {"corrections": "gbas"}, "sensors.gnss.corrections"),
+    ((), {"code": "C/A"}, "sensors.gnss.code"),
+    ((), {"aad": "ED-259A"}, "sensors.gnss.aad"),
+    ((), {"truth": "optimistic"}, "sensors.gnss.truth"),
+    (("service",), {}, "sensors.gnss.udre_index"),  # SBAS keys with no service at all
+])
+def test_bad_service_keys_name_the_field(drop, gnss, field) -> None:
+    with pytest.raises(ProfileError) as e:
+        _profile(drop, **gnss)
+    msg = str(e.value)
+    assert msg.startswith(field + ":") and "\n" not in msg, msg
+
+
+def test_shipped_profiles_parse() -> None:
+    s = _profile().sensors.gnss
+    assert s.service.service == "sbas-l1" and s.selection == "all" and s.service.sbas
+    d = load_profile(PROFILES / "dfmc-sbas.toml").sensors.gnss.service
+    assert (d.service, d.aad, d.dfrei) == ("dfmc-sbas", "ED-259A", 4)
+
+
+def test_bad_service_exits_2(tmp_path) -> None:
+    """The command line: an unknown service is one line on stderr and exit status 2."""
+    text = SBAS.read_text(encoding="utf-8").replace('service = "sbas-l1"', 'service = "sbas-l5"')
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text, encoding="utf-8")
+    r = subprocess.run([sys.executable, "-m", "approachsim", "evaluate", str(bad), "--runs", "1", "--out",
+                        str(tmp_path / "o")], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 2
+    assert r.stderr.strip().count("\n") == 0 and "sensors.gnss.service" in r.stderr
