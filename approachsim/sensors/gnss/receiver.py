@@ -393,6 +393,9 @@ class GnssReceiver:
                 "air": base.gauss_markov(z[:, 2 * k:3 * k], 1.0, AIR_TAU_S, dt),
                 "iono_field": base.gauss_markov(z[:, 3 * k:3 * k + 3], 1.0, IONO_TAU_S, dt),
                 "tropo": base.gauss_markov(z[:, 3 * k + 3:3 * k + 4], 1.0, TROPO_TAU_S, dt),
+                # per-channel tropo (truth = "broadcast" only) from a child stream: the other draws stay as they are
+                "tropo_local": base.gauss_markov(substream(g, "service_tropo").standard_normal((m, k)), 1.0,
+                                                 TROPO_TAU_S, dt),
                 # a child stream, as GBAS's white noise: a shorter record's draws are a longer one's prefix
                 "noise": b.code_noise_m * substream(g, "service_white").standard_normal((m, k)),
             }

@@ -45,7 +45,7 @@ Broadcast terms:
 Truth (sensors/gnss/receiver.py draws it): the broadcast sigmas are overbounds (they must bound the tails of every
 satellite's error at 1e-7), so the errors a receiver sees are smaller. The truth is drawn from correlated
 processes at a fraction of each broadcast term ([sensors.gnss] truth = "nominal"; "broadcast" draws every term at
-its full broadcast sigma: the filter's own model, for consistency checks):
+its full broadcast sigma and independent per channel: the filter's own model, for consistency checks):
 
   range    per satellite, Gauss-Markov; SBAS correction residual (fast + long-term) 0.3 sigma_flt / sigma_DFRE,
            tau 600 s; stand-alone broadcast clock and ephemeris 0.3 sigma_URA (0.72 m: the measured GPS signal-in-
@@ -313,23 +313,29 @@ class ServiceModel:
         return float(ge.pierce_distance_m(GRADIENT_REFERENCE_EL_RAD, IONO_SHELL_M))
 
     def truth_scales(self, el_rad: Array, az_rad: Array) -> dict[str, Array]:
-        """The truth's per-channel scales (m per unit series) at elevations / azimuths (..., k), rad: range, tropo,
-        air (times the unit Gauss-Markov series), and the iono field's common, east and north gradient and local
-        scales (times the field's unit series: iono slant = c a + ge (sin az) g_e + ... ; module docstring)."""
+        """The truth's per-channel scales (m per unit series) at elevations / azimuths (..., k), rad: range, air,
+        tropo (common zenith) and tropo_local (per channel), and the iono field's common, east and north gradient and
+        local scales (times the field's unit series; module docstring). truth = "broadcast" is the filter's own
+        model: every term independent per channel at its broadcast sigma."""
         fr, fi, ft, fa = self.truth_fractions()
         t = self.terms_m(el_rad)
         w0, wg, wl = IONO_FIELD_WEIGHTS
         iono = fi * t[..., 1]
-        if self.dual_frequency:  # the higher-order residual: per channel only
-            common = grad = np.zeros_like(iono)
+        tropo = ft * t[..., 2]
+        zero = np.zeros_like(iono)
+        if self.truth == "broadcast" or self.dual_frequency:
+            # the filter's own model (every term independent per channel), or the higher-order residual
+            common = grad = zero
             local = iono
         else:
             g = iono * math.sqrt(wg) * t[..., 4] / self.gradient_reference_m()
             common, local = iono * math.sqrt(w0), iono * math.sqrt(1.0 - w0 - wg)
             grad = g
+        tropo_c, tropo_l = (zero, tropo) if self.truth == "broadcast" else (tropo, zero)
         az = np.asarray(az_rad, dtype=float)
-        return {"range": fr * t[..., 0], "tropo": ft * t[..., 2], "air": fa * t[..., 3], "iono_common": common,
-                "iono_east": grad * np.sin(az), "iono_north": grad * np.cos(az), "iono_local": local}
+        return {"range": fr * t[..., 0], "tropo": tropo_c, "tropo_local": tropo_l, "air": fa * t[..., 3],
+                "iono_common": common, "iono_east": grad * np.sin(az), "iono_north": grad * np.cos(az),
+                "iono_local": local}
 
     def truth_errors(self, series: Mapping[str, Array], el_rad: Array,
                      az_rad: Array | None) -> tuple[Array, Array, Array, Array]:
@@ -342,4 +348,5 @@ class ServiceModel:
         f = np.asarray(series["iono_field"])
         iono = (sc["iono_common"] * f[..., 0:1] + sc["iono_east"] * f[..., 1:2] + sc["iono_north"] * f[..., 2:3]
                 + sc["iono_local"] * series["iono_local"])
-        return sc["range"] * series["range"], iono, sc["tropo"] * series["tropo"], sc["air"] * series["air"]
+        tropo = sc["tropo"] * series["tropo"] + sc["tropo_local"] * series["tropo_local"]
+        return sc["range"] * series["range"], iono, tropo, sc["air"] * series["air"]

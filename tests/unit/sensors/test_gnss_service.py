@@ -125,7 +125,8 @@ def test_ed259a_airborne() -> None:
 
 def test_truth_is_overbounded() -> None:
     """Under truth = "nominal" every term's truth sigma is below its broadcast sigma (the iono field's variance is at
-    most 1 at the 5 deg pierce distance), and under "broadcast" the truth variance equals the broadcast at 5 deg."""
+    most 1 at the 5 deg pierce distance), and under "broadcast" (the filter's model: independent channels) the truth
+    variance equals the broadcast at every elevation."""
     el = np.radians(np.array([[5.0, 20.0, 45.0, 90.0]]))
     az = np.radians(np.array([[0.0, 90.0, 200.0, 300.0]]))
     for name in ("sbas-l1", "l1ca", "dfmc-sbas"):
@@ -134,11 +135,12 @@ def test_truth_is_overbounded() -> None:
             sc = s.truth_scales(el, az)
             t = s.terms_m(el)
             iono_var = sc["iono_common"] ** 2 + sc["iono_east"] ** 2 + sc["iono_north"] ** 2 + sc["iono_local"] ** 2
-            var = sc["range"] ** 2 + iono_var + sc["tropo"] ** 2 + sc["air"] ** 2
+            var = sc["range"] ** 2 + iono_var + sc["tropo"] ** 2 + sc["tropo_local"] ** 2 + sc["air"] ** 2
             bcast = (t[..., :4] ** 2).sum(-1)
             assert np.all(var <= bcast * (1 + 1e-12))
             if truth == "broadcast":
-                np.testing.assert_allclose(var[0, 0], bcast[0, 0], rtol=1e-12)
+                np.testing.assert_allclose(var, bcast, rtol=1e-12)
+                assert not np.any(sc["iono_common"]) and not np.any(sc["tropo"])
 
 
 # --- the profile keys: one line naming the field, exit 2 at the command line (docs/contract.md) --------------------
