@@ -47,6 +47,19 @@ the aircraft's distance, height and speed relative to the GBAS reference point (
 carrier-phase noise the smoothing passes (gbas.CARRIER_NOISE_M, budget code_noise_m), from normals drawn after all
 the others. The record's sigma_m is the corrected nominal sigma there.
 
+Services (the profile's [sensors.gnss] service; service.py gives the models and their sources): SBAS L1, DFMC SBAS,
+DFMC, stand-alone L1 C/A and the military P(Y) replace the code presets by
+
+    rho_i = |r_sv,i - r| + b_rx + s_r R_i + F(el_i) V(ipp_i) + s_t T + s_a A_i + w_i
+
+R the per-satellite range residual (SBAS correction / broadcast ephemeris and clock), V the vertical ionospheric
+residual at the satellite's pierce point, one field (common part, planar gradient, local part) seen through the
+obliquity F (the iono-free services: the higher-order residual per channel), T one tropospheric zenith residual
+mapped by M(el), A the 100 s smoothed airborne error, w the 2 mm carrier noise; the scales are fractions of the
+broadcast sigmas (truth = "nominal") or the broadcast sigmas themselves with every term per channel (truth =
+"broadcast"). The record's sigma_m is then DO-229's broadcast sigma_i, which the filter and the SBAS protection
+levels (integrity/sbas.py) use.
+
 Epoch: every run's sky is the constellation at epoch_utc + its own offset (errors.constants["epoch_offset_s"],
 drawn by the sensor suite from the run's "gnss_epoch" stream); a batch of runs with offsets gives per-run geometry
 (r_sv_ecef, elevation, azimuth, visible, valid, sigma, pdop with a leading run axis). No offset: one sky.
