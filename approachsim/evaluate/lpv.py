@@ -29,7 +29,7 @@ import numpy as np
 
 from approachsim.evaluate.config import EvaluationConfig
 from approachsim.evaluate.stats import quantile_lower_rank, quantile_upper_rank
-from approachsim.evaluate.verdict import ICAO_MIN_RUNS, clopper_pearson, failure_verdict
+from approachsim.evaluate.verdict import ICAO_MIN_RUNS, _runs_for_availability, clopper_pearson, failure_verdict
 from approachsim.integrity.sbas import (
     LPV200_DH_FT,
     LPV200_HAL_M,
@@ -59,6 +59,20 @@ def _p95_bounds(x: np.ndarray, level: float) -> tuple[float, float, float]:
 
 def _axis(p_lo: float, p_hi: float, limit: float) -> str:
     return "fails" if p_lo > limit else ("meets" if p_hi <= limit else "indeterminate")
+
+
+def _runs_needed(verdict: str, acc: list[str], integ: str, k: int, n: int, level: float) -> int | None:
+    """Runs at which the bounds would likely decide an indeterminate verdict at the same observed rates: the 59 the
+    95th percentile's order statistic needs, and the runs at which availability's lower bound would reach 0.99 (about
+    299 with every run available); None when decided or out of reach."""
+    if verdict != "indeterminate":
+        return None
+    needs = []
+    if "indeterminate" in acc:
+        needs.append(max(ICAO_MIN_RUNS, n + 1))
+    if integ == "indeterminate":
+        needs.append(_runs_for_availability(k, n, REQUIRED_AVAILABILITY, level))
+    return None if not needs or any(x is None for x in needs) else max(needs)
 
 
 def lpv200_summary(columns: Mapping[str, np.ndarray], cfg: EvaluationConfig, *, runs: int,
@@ -106,5 +120,5 @@ def lpv200_summary(columns: Mapping[str, np.ndarray], cfg: EvaluationConfig, *, 
         "integrity_verdict": integ,
         "verdict": verdict,
         "meets": verdict == "meets",
-        "runs_needed": ICAO_MIN_RUNS if verdict == "indeterminate" and n < ICAO_MIN_RUNS else None,
+        "runs_needed": _runs_needed(verdict, acc, integ, k, n, level),
     }

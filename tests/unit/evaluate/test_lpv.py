@@ -39,3 +39,10 @@ def test_no_sbas_no_integrity_and_unavailable_fails() -> None:
 
 def test_absent_without_service() -> None:
     assert lpv200_summary({"cat1_vertical_m": np.zeros(3)}, EvaluationConfig(), runs=3, failed_runs=0) is None
+
+
+def test_all_available_needs_about_300_runs() -> None:
+    """Every one of 200 runs available: the Clopper-Pearson lower bound is 0.985 < 0.99, so integrity is
+    indeterminate and about 300 runs would decide it (0.95^(1/n) >= 0.99 from n = 299)."""
+    s = lpv200_summary(_cols(200, 0.5, 1.0, True), EvaluationConfig(), runs=200, failed_runs=0)
+    assert s["integrity_verdict"] == "indeterminate" and 299 <= s["runs_needed"] <= 320
