@@ -104,6 +104,10 @@ def lpv200_summary(columns: Mapping[str, np.ndarray], cfg: EvaluationConfig, *, 
     vpl = np.asarray(columns["lpv200_vpl_m"], dtype=float)
     hpl = np.asarray(columns["lpv200_hpl_m"], dtype=float)
     frac = np.asarray(columns.get("lpv200_avail_fraction", np.full(1, np.nan)), dtype=float)
+    snap_v = np.asarray(columns.get("lpv200_snapshot_vertical_m", np.full(1, np.nan)), dtype=float)
+    snap_h = np.asarray(columns.get("lpv200_snapshot_horizontal_m", np.full(1, np.nan)), dtype=float)
+    sv95 = float(np.percentile(np.abs(snap_v[np.isfinite(snap_v)]), 95.0)) if np.isfinite(snap_v).any() else None
+    sh95 = float(np.percentile(snap_h[np.isfinite(snap_h)], 95.0)) if np.isfinite(snap_h).any() else None
     return {
         "height_ft": int(LPV200_DH_FT),
         "integrity_basis": "SBAS (RTCA DO-229 App. J protection levels)" if sbas else None,
@@ -116,6 +120,7 @@ def lpv200_summary(columns: Mapping[str, np.ndarray], cfg: EvaluationConfig, *, 
         "availability_dh": _num(k / n) if n else None, "availability_dh_lower": _num(a_lo),
         "availability_approach_mean": _num(float(np.nanmean(frac))) if np.isfinite(frac).any() else None,
         "required_availability": REQUIRED_AVAILABILITY,
+        "snapshot_vertical_95_m": sv95, "snapshot_horizontal_95_m": sh95,
         "accuracy_verdict": "fails" if "fails" in acc else ("meets" if acc == ["meets", "meets"] else "indeterminate"),
         "integrity_verdict": integ,
         "verdict": verdict,

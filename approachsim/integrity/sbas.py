@@ -69,6 +69,19 @@ def protection_levels(el_rad: Array, az_rad: Array, used: Array, sigma_m: Array,
     return np.where(np.isfinite(vpl), vpl, np.inf), np.where(np.isfinite(hpl), hpl, np.inf)
 
 
+def snapshot_error_enu(el_rad: Array, az_rad: Array, used: Array, sigma_m: Array, range_error_m: Array) -> Array:
+    """(..., 3) east, north, up error (m) of the weighted least-squares snapshot fix whose pseudoranges carry the
+    errors range_error_m (..., k) (nan for unused channels): dx = (G' W G)^-1 G' W e, the position part (the clock
+    absorbs the common error). What a stand-alone SBAS receiver's position error is: the figure the WAAS
+    performance reports' 95 % accuracies describe."""
+    g = geometry_enu(np.nan_to_num(el_rad), np.nan_to_num(az_rad))
+    u = np.asarray(used, dtype=bool) & np.isfinite(range_error_m)
+    w = np.where(u, 1.0 / np.where(u, np.asarray(sigma_m, dtype=float), 1.0) ** 2, 0.0)
+    c = wls_covariance(el_rad, az_rad, u, sigma_m)
+    b = np.einsum("...ki,...k,...k->...i", g, w, np.where(u, range_error_m, 0.0))
+    return np.einsum("...ij,...j->...i", c, b)[..., :3]
+
+
 def lpv200_available(vpl_m: Array, hpl_m: Array) -> Array:
     """LPV-200 available: VPL <= 35 m and HPL <= 40 m (a service is available when its PLs are within the alert
     limits; standards reference 1.5)."""

@@ -58,3 +58,19 @@ def test_batched_epochs_and_scaling() -> None:
     vpl, hpl = protection_levels(e2, a2, np.ones((2, 8), bool), s2)
     np.testing.assert_allclose(vpl[1], 2.0 * vpl[0], rtol=COND_FLOOR)
     np.testing.assert_allclose(hpl[1], 2.0 * hpl[0], rtol=COND_FLOOR)
+
+
+def test_snapshot_error_is_the_wls_of_the_range_errors() -> None:
+    """A range error that is a pure position offset dx (e = G dx) comes back as dx (the clock column absorbs a
+    common error; the fix is exact on a consistent system), and equals the independent lstsq fix otherwise."""
+    from approachsim.integrity.sbas import geometry_enu, snapshot_error_enu
+
+    el, az = np.radians(EL_DEG), np.radians(AZ_DEG)
+    g = geometry_enu(el, az)
+    dx = np.array([1.5, -2.0, 3.0, 7.0])
+    got = snapshot_error_enu(el, az, np.ones(8, bool), SIGMA_M, g @ dx)
+    np.testing.assert_allclose(got, dx[:3], rtol=0, atol=COND_FLOOR * 10.0)
+    e = np.random.default_rng(3).standard_normal(8) * SIGMA_M
+    ref = np.linalg.lstsq(g / SIGMA_M[:, None], e / SIGMA_M, rcond=None)[0][:3]
+    np.testing.assert_allclose(snapshot_error_enu(el, az, np.ones(8, bool), SIGMA_M, e), ref, rtol=0,
+                               atol=COND_FLOOR * 10.0)
