@@ -42,7 +42,8 @@ def evaluate_results(
     groups = None if closed_loop else np.array([r.run // cfg.flight_group for r in results if r.ok])
     res = verdicts(cols, cfg, runs=len(results), failed_runs=failed, groups=groups)
     summary = contract_summary(
-        res, profile=profile, runs=len(results), seed=seed, closed_loop=closed_loop, failed_runs=failed
+        res, profile=profile, runs=len(results), seed=seed, closed_loop=closed_loop, failed_runs=failed,
+        gnss_service=gnss_service, lpv200=lpv200_summary(cols, cfg, runs=len(results), failed_runs=failed),
     )
     # imported here: integrity_campaign imports the bank, which imports the navigation stage, and importing this
     # module must not need a stage (campaign/pipeline.py require_stages reports a missing one first)
@@ -58,8 +59,6 @@ def evaluate_results(
     geom = gnss_geometry([r.run for r in results if r.ok], cols)
     if geom is not None:
         det["gnss_geometry"] = geom
-    summary["gnss_service"] = gnss_service
-    summary["lpv200"] = lpv200_summary(cols, cfg, runs=len(results), failed_runs=failed)
     if land:
         det["touchdown"] = touchdown_details(cols, runs=len(results), failed_runs=failed, level=cfg.confidence)
         summary["touchdown"] = touchdown_summary(det["touchdown"])
