@@ -332,7 +332,7 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
     rates = _rates(top.section("rates"))
     run = _run(top.section("run"))
     evaluation = parse_evaluation(top.section("evaluation"))
-    sensors = parse_sensors(top.section("sensors"))
+    sensors = parse_sensors(top.section("sensors"), site_rad=(runway.threshold_lat_rad, runway.threshold_lon_rad))
     fault_items = top.sections("faults")
     duration = _run_duration_estimate_s(runway, aircraft, env, source) if fault_items else None
     faults = parse_faults(fault_items, sensors, duration_s=duration, imu_hz=rates.imu_hz)

@@ -5,12 +5,12 @@ under-claims (the diagnosis behind tests/integration/test_nav_consistency_jsbsim
         [--slow-tau-s TAU]
 
 The profile is flown once on truth; RUNS seeded sensor realizations and open-loop navigation runs (the shared
-covariance, as campaigns run) follow on that truth. Printed per state (dp N E D m, dv N E D m/s, psi N E D rad): the
-run-averaged e^2 / P over the approach after its first quarter (1 for a consistent filter; below 1 the filter
-over-claims), the fraction of epochs whose run average is inside the two-sided 95 % chi2(RUNS)/RUNS bounds, and the
-filter's mean sigma. --set changes a profile key for this run (dotted path, a TOML value: --set
-sensors.gnss.multipath_model='"nrc1995"'). --slow-tau-s sets the truth's clock/ephemeris, iono and tropo time
-constants to TAU (the filter keeps its own: it models the three as one Gauss-Markov state at the shortest,
+covariance, as campaigns run) follow on that truth. Printed per state (dp N E D m, dv N E D m/s, psi N E D rad; clk
+the receiver clock bias, m): the run-averaged e^2 / P over the approach after its first quarter (1 for a consistent
+filter; below 1 the filter over-claims), the fraction of epochs whose run average is inside the two-sided 95 %
+chi2(RUNS)/RUNS bounds, and the filter's mean sigma. --set changes a profile key for this run (dotted path, a TOML
+value: --set sensors.gnss.multipath_model='"nrc1995"'). --slow-tau-s sets the truth's clock/ephemeris, iono and tropo
+time constants to TAU (the filter keeps its own: it models the three as one Gauss-Markov state at the shortest,
 nav/noise.py): with TAU = 1800 the truth drifts as fast as the filter assumes.
 """
 
@@ -77,6 +77,15 @@ def main() -> None:
     rs = nav.run(truth, recs, [stream(a.seed, r, "nav") for r in range(a.runs)], shared_covariance=True, states=st)
     e = np.stack([r.true_error_nav for r in rs])
     d = np.diagonal(np.stack([r.P_nav for r in rs]), axis1=2, axis2=3)
+    lay = rs[0].layout
+    if lay.has("clk") and "gnss" in recs:  # the receiver clock bias: the filter's clk state against the truth's
+        g = recs["gnss"]
+        t_g, cb = np.asarray(g.t_s), np.asarray(g.clock_bias_m).reshape(a.runs, -1)
+        ic = lay.i("clk")
+        idx = [np.clip(np.searchsorted(t_g, r.t_epoch_s + 1e-9, side="right") - 1, 0, t_g.size - 1) for r in rs]
+        ec = np.stack([r.x[:, ic] - cb[i, j] for i, (r, j) in enumerate(zip(rs, idx, strict=True))])
+        e = np.concatenate([e, ec[..., None]], axis=-1)
+        d = np.concatenate([d, np.stack([r.P_diag[:, ic] for r in rs])[..., None]], axis=-1)
     z = (e**2 / d).mean(axis=0)
     later = slice(z.shape[0] // 4, z.shape[0])
     lo, hi = chi2.ppf([0.025, 0.975], a.runs) / a.runs
@@ -84,7 +93,7 @@ def main() -> None:
           f"{hi:.2f}]" + "".join(f"; {s}" for s in a.set)
           + (f"; truth slow taus {a.slow_tau_s:g} s" if a.slow_tau_s is not None else ""))
     print(f"  {'state':6s} {'e^2/P':>6s} {'inside':>7s} {'below':>6s} {'above':>6s} {'sigma':>10s}")
-    for c, name in enumerate(STATES):
+    for c, name in enumerate(STATES + ("clk",) if z.shape[1] > len(STATES) else STATES):
         zc = z[later, c]
         print(f"  {name:6s} {zc.mean():6.2f} {np.mean((zc >= lo) & (zc <= hi)):7.2f} {np.mean(zc < lo):6.2f} "
               f"{np.mean(zc > hi):6.2f} {np.sqrt(d[:, later, c]).mean():10.3g}")

@@ -153,6 +153,15 @@ def exercise() -> dict[str, list[Key]]:
     _RECORD.clear()
     parse_profile(copy.deepcopy(full), source=PROFILES_DIR / "default.toml")
     profile_keys = list(_RECORD.values())
+    # a GNSS service's keys (sensors/gnss/service.py) are read only with a service, which excludes the code presets'
+    _RECORD.clear()
+    svc = copy.deepcopy(base)
+    for k in ("code", "multipath_model", "multipath_tau_s", "clock_ephemeris"):
+        svc["sensors"]["gnss"].pop(k, None)
+    svc["sensors"]["gnss"]["service"] = "sbas-l1"
+    parse_profile(svc, source=PROFILES_DIR / "default.toml")
+    seen = {(k.key, k.table) for k in profile_keys}
+    profile_keys += [k for k in _RECORD.values() if (k.key, k.table) not in seen]
 
     _RECORD.clear()
     with tempfile.TemporaryDirectory() as d:

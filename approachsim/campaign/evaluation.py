@@ -90,7 +90,7 @@ def score_campaign(profile: Any, results: list[RunResult], *, seed: int, closed_
                    wall_s: float | None, out_dir: Path | None) -> tuple[dict, dict]:
     """(summary, details) of all the campaign's runs in run order; written to out_dir when given."""
     summary, det = evaluate_results(results, profile.evaluation, profile=profile.name, seed=seed,
-                                    closed_loop=closed_loop, land=land)
+                                    closed_loop=closed_loop, land=land, gnss_service=_service_label(profile))
     det["wall_s"] = wall_s
     if out_dir is not None:
         write_json(Path(out_dir) / "summary.json", summary)
@@ -107,3 +107,13 @@ def merge_shards(profile: Any, dirs: Sequence[Path], out_dir: Path) -> Evaluatio
     summary, det = score_campaign(profile, results, seed=int(meta["seed"]), closed_loop=meta["mode"] == "closed",
                                   land=land, wall_s=wall, out_dir=out_dir)
     return Evaluation(results, summary, det, wall)
+
+
+def _service_label(profile: Any) -> str | None:
+    """The GNSS service's label for summary.json (sensors/gnss/service.py; "military (PPS)" named), None without."""
+    g = profile.sensors.gnss
+    if g is None:
+        return None
+    if g.service is not None:
+        return g.service.label
+    return f"code preset {g.code}" + (" (military, PPS)" if g.code == "P(Y)" else "")

@@ -16,6 +16,7 @@ import numpy as np
 
 from approachsim.campaign.result import RunResult
 from approachsim.evaluate.config import EvaluationConfig
+from approachsim.evaluate.lpv import lpv200_summary
 from approachsim.evaluate.stats import MIN_GROUPS
 from approachsim.evaluate.summary import contract_summary, details, gnss_geometry, verdicts
 from approachsim.evaluate.touchdown import touchdown_details, touchdown_summary
@@ -30,17 +31,19 @@ def columns(results: list[RunResult]) -> dict[str, np.ndarray]:
 
 def evaluate_results(
     results: list[RunResult], cfg: EvaluationConfig, *, profile: str, seed: int, closed_loop: bool,
-    land: bool = False,
+    land: bool = False, gnss_service: str | None = None,
 ) -> tuple[dict, dict]:
     """(summary, details) of a finished campaign; land: a landing campaign, whose touchdown statistics go to
-    details.json "touchdown" and their headline to summary.json "touchdown" (docs/contract.md)."""
+    details.json "touchdown" and their headline to summary.json "touchdown" (docs/contract.md); gnss_service: the
+    receiver's GNSS service label (summary.json "gnss_service"; None: a code preset) and its "lpv200" verdict."""
     cols = columns(results)
     failed = sum(not r.ok for r in results)
     # open loop: the runs of one flight group share one flown truth (pipeline.open_loop_group)
     groups = None if closed_loop else np.array([r.run // cfg.flight_group for r in results if r.ok])
     res = verdicts(cols, cfg, runs=len(results), failed_runs=failed, groups=groups)
     summary = contract_summary(
-        res, profile=profile, runs=len(results), seed=seed, closed_loop=closed_loop, failed_runs=failed
+        res, profile=profile, runs=len(results), seed=seed, closed_loop=closed_loop, failed_runs=failed,
+        gnss_service=gnss_service, lpv200=lpv200_summary(cols, cfg, runs=len(results), failed_runs=failed),
     )
     # imported here: integrity_campaign imports the bank, which imports the navigation stage, and importing this
     # module must not need a stage (campaign/pipeline.py require_stages reports a missing one first)
@@ -233,6 +236,20 @@ def verdict_table(summary: dict, det: dict) -> str:
             "time-averaged RMS over the approach, as in Gray & Maybeck's Tables 3-6 (An integrated GPS/INS/Baro and "
             "radar altimeter system for aircraft precision approach landings), ft: "
             + ", ".join(f"{k.replace('_', ' ')} {_f(v, '.2f').strip()}" for k, v in ta.items())
+        )
+    if summary.get("gnss_service"):
+        lines.append(f"GNSS service: {summary['gnss_service']}")
+    lp = summary.get("lpv200")
+    if lp:
+        lines.append(
+            f"LPV-200 at {lp['height_ft']} ft: vert 95% {_f(lp['vertical_95_m'], '.2f').strip()} m (upper "
+            f"{_f(lp['vertical_95_upper_m'], '.2f').strip()}, limit {lp['limit_vertical_95_m']:g}), hor 95% "
+            f"{_f(lp['horizontal_95_m'], '.2f').strip()} m (upper {_f(lp['horizontal_95_upper_m'], '.2f').strip()}, "
+            f"limit {lp['limit_horizontal_95_m']:g}), VPL/HPL median {_f(lp['vpl_median_m'], '.1f').strip()}/"
+            f"{_f(lp['hpl_median_m'], '.1f').strip()} m (VAL/HAL {lp['val_m']:g}/{lp['hal_m']:g}), available at DH "
+            f"{_f(lp['availability_dh'], '.3f').strip()} (lower {_f(lp['availability_dh_lower'], '.3f').strip()}), "
+            f"integrity basis {lp['integrity_basis'] or 'none (stand-alone: fault-free WLS levels only)'}: "
+            f"{lp['verdict']}"
         )
     best = summary["best_category"] or "none"
     lines.append(

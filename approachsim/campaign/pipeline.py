@@ -122,6 +122,9 @@ def _score(
     )
     if gnss is not None:
         scalars.update(_geometry_at_dh(gnss, scalars))
+        g = profile.sensors.gnss
+        if g is not None and g.service is not None:
+            scalars.update(_lpv200_at_dh(gnss, scalars, g.service.sbas, truth))
     if series is not None and gnss is not None:
         series = {**series, **_geometry_series(gnss, series["t_s"])}
     counts = {}
@@ -174,6 +177,37 @@ def _geometry_at_dh(gnss: Any, scalars: dict) -> dict:
     if gnss.epoch_offset_s is not None:
         out["gnss_epoch_offset_h"] = float(gnss.epoch_offset_s) / 3600.0
     return out
+
+
+def _lpv200_at_dh(gnss: Any, scalars: dict, sbas: bool, truth: Any) -> dict:
+    """One run's LPV-200 columns (evaluate/lpv.py) from a GNSS service's record: the WLS protection levels with
+    the broadcast sigmas (integrity/sbas.py) at the CAT I crossing's latest GNSS sample, LPV-200 available there,
+    the fraction of GNSS epochs available up to it, whether the service is SBAS (an integrity basis), and the
+    snapshot WLS fix's vertical and horizontal error there (a stand-alone receiver's position error, the figure
+    published SBAS accuracies describe; the navigation error blends it with the INS, baro and radar altimeter)."""
+    import numpy as np
+
+    from approachsim.integrity.sbas import (  # stage (module docstring)
+        lpv200_available,
+        protection_levels,
+        snapshot_error_enu,
+    )
+
+    t = scalars.get("cat1_t_s")
+    if t is None or not np.isfinite(t):
+        return {}
+    vpl, hpl = protection_levels(np.asarray(gnss.elevation_rad), np.asarray(gnss.azimuth_rad),
+                                 np.asarray(gnss.valid), np.asarray(gnss.sigma_m))
+    j = int(np.clip(np.searchsorted(gnss.t_s, t, side="right") - 1, 0, len(gnss.t_s) - 1))
+    ok = lpv200_available(vpl, hpl)
+    k = int(np.clip(np.searchsorted(truth.t_s, gnss.t_s[j], side="left"), 0, len(truth.t_s) - 1))
+    r_sv = np.asarray(gnss.r_sv_ecef)[j]
+    err = np.asarray(gnss.pseudorange_m)[j] - np.linalg.norm(r_sv - truth.r_ecef[k], axis=-1)
+    d = snapshot_error_enu(np.asarray(gnss.elevation_rad)[j], np.asarray(gnss.azimuth_rad)[j],
+                           np.asarray(gnss.valid)[j], np.asarray(gnss.sigma_m)[j], err)
+    return {"lpv200_vpl_m": float(vpl[j]), "lpv200_hpl_m": float(hpl[j]), "lpv200_avail_dh": float(ok[j]),
+            "lpv200_avail_fraction": float(np.mean(ok[: j + 1])), "lpv200_sbas": float(sbas),
+            "lpv200_snapshot_vertical_m": float(d[2]), "lpv200_snapshot_horizontal_m": float(np.hypot(d[0], d[1]))}
 
 
 def _gnss_closed_loop(source: Any, truth: Any) -> Any:

@@ -44,6 +44,24 @@ def register(sub: argparse._SubParsersAction) -> None:
     pi.set_defaults(func=run_init)
 
 
+def gnss_label(path: Path) -> str:
+    """The GNSS receiver a profile file flies, in words (a military one says so): its [sensors.gnss] service, or the
+    code preset (P(Y) by default), read from the file without building the profile."""
+    import tomllib
+
+    from approachsim.sensors.gnss.service import SERVICE_LABELS
+
+    g = tomllib.loads(path.read_text(encoding="utf-8")).get("sensors", {}).get("gnss", {})
+    if g.get("enabled", True) is False:
+        return "none"
+    if "service" in g:
+        return SERVICE_LABELS.get(str(g["service"]), str(g["service"]))
+    if g.get("corrections") == "gbas":
+        return "GBAS-corrected L1 (RTCA DO-253 / ICAO Annex 10 App. B)"
+    code = str(g.get("code", "P(Y)"))
+    return f"code preset {code}" + (", military (PPS)" if code == "P(Y)" else "")
+
+
 def run_list(args: argparse.Namespace) -> int:
     """Print the shipped profiles."""
     from approachsim.resources import shipped_profiles
@@ -51,7 +69,7 @@ def run_list(args: argparse.Namespace) -> int:
     profiles = shipped_profiles()
     width = max(len(s.name) for s in profiles)
     for s in profiles:
-        print(f"{s.name:{width}}  {s.description}")
+        print(f"{s.name:{width}}  {s.description} [GNSS: {gnss_label(s.path)}]")
     print(f"\n(in {profiles[0].path.parent}; copy one with: approachsim profiles init NAME DIR)")
     return 0
 

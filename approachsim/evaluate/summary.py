@@ -82,9 +82,11 @@ def integrity_criterion(columns: Mapping[str, np.ndarray], category: str, cfg: E
 
 
 def contract_summary(
-    results: list[CategoryResult], *, profile: str, runs: int, seed: int, closed_loop: bool, failed_runs: int
+    results: list[CategoryResult], *, profile: str, runs: int, seed: int, closed_loop: bool, failed_runs: int,
+    gnss_service: str | None = None, lpv200: dict | None = None,
 ) -> dict:
-    """summary.json, exactly the contract's keys."""
+    """summary.json, exactly the contract's keys; gnss_service the receiver's label, lpv200 evaluate/lpv.py's
+    lpv200_summary (None: no GNSS service)."""
     dhs = {}
     for r in results:
         dhs[r.category] = {
@@ -110,6 +112,8 @@ def contract_summary(
         "decision_heights": dhs,
         "best_category": best_category(results),
         "failed_runs": int(failed_runs),
+        "gnss_service": gnss_service,
+        "lpv200": lpv200,
     }
 
 

@@ -83,6 +83,8 @@ def _direct_unavailable(source: Any) -> str | None:
     if g is not None:
         if g.rx.budget.gbas is not None:
             return "GBAS corrections: the receiver's records"
+        if g.rx.budget.service is not None:
+            return "a GNSS service (sensors/gnss/service.py): the receiver's records"
         if g.rx.carrier is not None:
             return "carrier phase: the receiver's records"
         if g.per_run or g.errors.batched:
@@ -120,9 +122,10 @@ def choose(source: Any) -> LoopPath:
     g = None if b is None else b.budget()
     if epoch == "generic" or g is None or source.nav.layout.n_sv == 0:
         sigmas = "none"
-    elif g.gbas is not None or not source.compiled_sigmas:
+    elif g.gbas is not None or g.service is not None or not source.compiled_sigmas:
         sigmas = "numpy"
-        reasons.append(("sigmas", "GBAS channel sigmas" if g.gbas is not None else "compiled_sigmas = False"))
+        reasons.append(("sigmas", "GBAS channel sigmas" if g.gbas is not None else (
+            "a GNSS service's broadcast sigmas" if g.service is not None else "compiled_sigmas = False")))
     else:
         sigmas = "compiled"
     return LoopPath(row, epoch, baro_path, sigmas, tuple(reasons))

@@ -213,12 +213,15 @@ class EpochEngine:
         self._pl_sig = np.full(lay.n_pl, self.pl_sigma_states)  # with pseudolite states: code noise + survey
         self._nu = np.zeros((1, _MAX_ROWS))
         self._gbas = None
+        self._service = None
         if g is not None:  # the channel-noise budget of channel_sigmas
             bud = g.budget()
             self._sky_budget = (IONO_SHELL_M, bud.clock_ephemeris_m, bud.iono_zenith_m, bud.tropo_zenith_m,
                                 bud.multipath_model == "do253", float(bud.multipath_m))
             if bud.gbas is not None:
                 self._gbas = bud.gbas.channel_kernel_args()
+            if bud.service is not None:  # a civil service's broadcast sigmas (sensors/gnss/service.py)
+                self._service = bud.service.params()
         self.carrier = lay.has("amb")
         """Carrier phase: the rows, states and arc resets of kernels/carrier.py."""
         self.cp_r = float(system.rows.carrier_sigma_m) ** 2 if self.carrier else 0.0
@@ -239,7 +242,9 @@ class EpochEngine:
         gbas.REFERENCE_GEOMETRY (the filter's elevation-only channel noise, as nav/noise.py builds it)."""
         el = np.ascontiguousarray(el, dtype=float)
         gse, gmp = np.empty(el.shape), np.empty(el.shape)
-        if self._gbas is None:
+        if self._service is not None:
+            gk.service_channel_sigmas(el, self._service, True, gse, gmp, np.empty(el.shape))
+        elif self._gbas is None:
             gk.channel_sigmas(el, *self._sky_budget, gse, gmp)
         else:
             x, dh, v = (np.full(el.shape[0], g) for g in REFERENCE_GEOMETRY)

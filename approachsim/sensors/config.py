@@ -29,6 +29,16 @@ from approachsim.sensors.gnss.receiver import (
     GnssErrorBudget,
     make_budget,
 )
+from approachsim.sensors.gnss.service import AADS as SERVICE_AADS
+from approachsim.sensors.gnss.service import (
+    DFRE_SIGMA_M,
+    GIVE_M,
+    SERVICES,
+    TRUTHS,
+    UDRE_M,
+    URA_M,
+    ServiceModel,
+)
 from approachsim.sensors.presets import PRESETS
 from approachsim.sensors.radalt import RADALT_CORRELATED_1SIGMA_M
 
@@ -101,6 +111,9 @@ class GnssConfig:
     """[sensors.gnss.gbas]: the ground station and airborne equipment (set exactly when corrections = "gbas")."""
     carrier: CarrierModel | None = None
     """carrier_phase = true: L1 carrier phase with float ambiguities (sensors/gnss/carrier.py); None: code only."""
+    service: ServiceModel | None = None
+    """[sensors.gnss] service: a civil (or the military) GNSS service with its broadcast sigmas and their truth
+    (sensors/gnss/service.py); None: the code presets (`code`)."""
     budget_scale: float = 1.0
     """Factor on every 1-sigma of the stand-alone ranging budget (clock/ephemeris, iono, tropo, multipath, code
     noise), correlation times unchanged: a study that states its GPS as a position accuracy (Gray & Maybeck's
@@ -109,7 +122,8 @@ class GnssConfig:
     def budget(self) -> GnssErrorBudget:
         """The error budget these settings select (code preset, multipath model, clock/ephemeris budget, GBAS
         corrections), its 1-sigma terms times budget_scale."""
-        b = make_budget(self.code, self.multipath_model, self.clock_ephemeris, self.multipath_tau_s, self.gbas)
+        b = make_budget(self.code, self.multipath_model, self.clock_ephemeris, self.multipath_tau_s, self.gbas,
+                        self.service)
         if self.budget_scale == 1.0:
             return b
         k = self.budget_scale
@@ -171,8 +185,10 @@ def _enabled(s: Section, default: bool) -> bool:
     return s.boolean("enabled", default)
 
 
-def parse_sensors(s: Section) -> SensorsConfig:
-    """Parse [sensors]; absent sub-tables take the defaults; `enabled = false` removes a sensor."""
+def parse_sensors(s: Section, site_rad: tuple[float, float] | None = None) -> SensorsConfig:
+    """Parse [sensors]; absent sub-tables take the defaults; `enabled = false` removes a sensor. site_rad: the
+    approach's (latitude, longitude), rad (the runway threshold): a stand-alone L1 C/A service's Klobuchar bound
+    depends on its geomagnetic latitude (None: 45 deg N, 0 deg E)."""
     imu_s = s.section("imu")
     grade = imu_s.string("grade", "nav-2.0", choices=tuple(PRESETS))
     imu = ImuConfig(
@@ -218,9 +234,10 @@ def parse_sensors(s: Section) -> SensorsConfig:
             parse_epoch(epoch)
         except ValueError as e:
             raise ProfileError(f"{g.path}.epoch_utc: {e}") from None
+        service = _parse_service(g, site_rad)
         gnss = GnssConfig(
             code=(code := g.string("code", "P(Y)", choices=tuple(CODE_PRESETS))),
-            selection=g.string("selection", "best4", choices=SELECTIONS),
+            selection=g.string("selection", "best4" if service is None else "all", choices=SELECTIONS),
             mask_rad=math.radians(g.number("mask_deg", 5.0, lo=0.0, hi=45.0, unit="deg")),
             rate_hz=g.number("rate_hz", 1.0, lo=0.1, hi=100.0, unit="Hz"),
             epoch_utc=epoch,
@@ -236,11 +253,15 @@ def parse_sensors(s: Section) -> SensorsConfig:
             multipath_tau_s=g.number("multipath_tau_s", make_budget(code, mp).multipath_tau_s, lo=0.0,
                                      lo_open=True, hi=1e5, unit="s"),
             clock_ephemeris=g.string("clock_ephemeris", "current", choices=tuple(CLOCK_EPHEMERIS_M)),
-            corrections=(corr := g.string("corrections", "none", choices=CORRECTIONS)),
+            corrections=(corr := _corrections(g, service)),
             gbas=_parse_gbas(g, corr),
             carrier=_parse_carrier(g),
             budget_scale=g.number("budget_scale", 1.0, lo=0.0, lo_open=True, hi=10.0),
+            service=service,
         )
+        if service is not None and gnss.carrier is not None:
+            raise ProfileError(f"{g.path}.carrier_phase: not modelled with a GNSS service (service is "
+                               f"{service.service!r}); remove carrier_phase or service")
         if corr == "gbas" and gnss.budget_scale != 1.0:
             raise ProfileError(f"{g.path}.budget_scale: scales the stand-alone budget only (corrections is \"gbas\")")
         if gnss.epoch == "fixed" and g.has("epoch_window_h"):
@@ -277,6 +298,74 @@ def parse_sensors(s: Section) -> SensorsConfig:
     p.done()
     s.done()
     return SensorsConfig(imu=imu, baro=baro, radalt=radalt, gnss=gnss, pseudolite=pseudolite)
+
+
+CODE_PRESET_KEYS = ("code", "multipath_model", "multipath_tau_s", "clock_ephemeris", "budget_scale")
+"""[sensors.gnss] keys of the code presets' stand-alone budget (receiver.py), not used with a service."""
+SBAS_L1_KEYS = ("udre_index", "give_index", "delta_udre", "eps_fc_m", "eps_rrc_m", "eps_ltc_m", "eps_er_m",
+                "rss_udre")
+"""[sensors.gnss] keys of the SBAS L1 correction model (service = "sbas-l1" only)."""
+
+
+def _corrections(g: Section, service: ServiceModel | None) -> str:
+    """[sensors.gnss] corrections: "none" or "gbas"; "sbas" is a service, and a service carries its corrections."""
+    raw = g.raw("corrections", "none")
+    if raw == "sbas":
+        raise ProfileError(f"{g.path}.corrections: SBAS is a GNSS service: set service = \"sbas-l1\" (L1) or "
+                           f"\"dfmc-sbas\" (L1/L5) instead")
+    corr = g.string("corrections", "none", choices=CORRECTIONS)
+    if service is not None and corr != "none":
+        raise ProfileError(f"{g.path}.corrections: a GNSS service carries its own corrections (service is "
+                           f"{service.service!r}); remove corrections")
+    return corr
+
+
+def _parse_service(g: Section, site_rad: tuple[float, float] | None) -> ServiceModel | None:
+    """[sensors.gnss] service and its keys (sensors/gnss/service.py); a key of a model the service does not have is
+    an error naming it (an SBAS correction key without an SBAS service, a code-preset key with a service)."""
+    if not g.has("service"):
+        for k in (*SBAS_L1_KEYS, "dfrei", "aad", "ura_m", "truth"):
+            if g.has(k):
+                raise ProfileError(f"{g.path}.{k}: only used with a GNSS service (service = "
+                                   f"{' | '.join(repr(x) for x in SERVICES)}); none is set")
+        return None
+    name = g.string("service", choices=SERVICES)
+    for k in CODE_PRESET_KEYS:
+        if g.has(k):
+            raise ProfileError(f"{g.path}.{k}: a code-preset key, not used with service = {name!r} (the service sets "
+                               f"the signal and its error model); remove it")
+    if name != "sbas-l1":
+        for k in SBAS_L1_KEYS:
+            if g.has(k):
+                why = ("its SBAS corrections are DFMC: set dfrei" if name == "dfmc-sbas"
+                       else "it has no SBAS correction model: use service = \"sbas-l1\"")
+                raise ProfileError(f"{g.path}.{k}: an SBAS L1 correction key, but service is {name!r} ({why})")
+    if name != "dfmc-sbas" and g.has("dfrei"):
+        raise ProfileError(f"{g.path}.dfrei: a DFMC SBAS correction key, but service is {name!r} (no DFMC SBAS "
+                           f"corrections: use service = \"dfmc-sbas\")")
+    if name in ("sbas-l1", "dfmc-sbas") and g.has("ura_m"):
+        raise ProfileError(f"{g.path}.ura_m: the stand-alone range sigma, but service {name!r} has SBAS corrections")
+    dual = name in ("dfmc-sbas", "dfmc", "py-pps")
+    aad = g.string("aad", "ED-259A" if name in ("dfmc-sbas", "dfmc") else "B", choices=SERVICE_AADS)
+    if aad == "ED-259A" and not dual:
+        raise ProfileError(f"{g.path}.aad: the ED-259A airborne model is dual-frequency; service {name!r} is single "
+                           f"frequency (use \"A\" or \"B\")")
+    model = ServiceModel(
+        service=name,
+        udre_index=g.integer("udre_index", 5, lo=0, hi=len(UDRE_M) - 1),
+        give_index=g.integer("give_index", 9, lo=0, hi=len(GIVE_M) - 1),
+        delta_udre=g.number("delta_udre", 1.0, lo=1.0, hi=100.0),
+        eps_fc_m=g.number("eps_fc_m", 0.0, lo=0.0, hi=100.0, unit="m"),
+        eps_rrc_m=g.number("eps_rrc_m", 0.0, lo=0.0, hi=100.0, unit="m"),
+        eps_ltc_m=g.number("eps_ltc_m", 0.0, lo=0.0, hi=100.0, unit="m"),
+        eps_er_m=g.number("eps_er_m", 0.0, lo=0.0, hi=100.0, unit="m"),
+        rss_udre=g.boolean("rss_udre", False),
+        dfrei=g.integer("dfrei", 4, lo=1, hi=len(DFRE_SIGMA_M)),
+        aad=aad,
+        ura_m=g.number("ura_m", URA_M, lo=0.0, lo_open=True, hi=100.0, unit="m"),
+        truth=g.string("truth", "nominal", choices=TRUTHS),
+    )
+    return model if site_rad is None else model.at_site(*site_rad)
 
 
 CARRIER_KEYS = ("carrier_multipath_m", "carrier_multipath_tau_s", "carrier_noise_m", "carrier_ambiguity_sigma_m")

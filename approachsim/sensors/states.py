@@ -125,12 +125,18 @@ def _series(at: _At, sensor: str, key: str) -> Array | None:
 
 def _gnss_el(at: _At, e: base.SensorErrors, j: int) -> Array:
     """Elevations (rad) of the 24 channels at sample j: (24,) on one sky, (N, 24) on per-run skies."""
+    return _gnss_look(at, e, j)[0]
+
+
+def _gnss_look(at: _At, e: base.SensorErrors, j: int) -> tuple[Array, Array]:
+    """Elevations and azimuths (rad) of the 24 channels at sample j: (24,) on one sky, (N, 24) on per-run skies."""
     rx = at.suite.sensors["gnss"]
     r = at.truth.r_ecef[e.rows[j]][None]
     off = e.constants.get("epoch_offset_s")  # each run its own sky (receiver.py): elevations per run
     offs = np.zeros(1) if off is None else np.atleast_1d(np.asarray(off, dtype=float))
-    el = np.stack([look_angles(r, rx.geometry_constellation(o).positions_ecef(e.t_s[j:j + 1]))[2][0] for o in offs])
-    return el[0] if off is None else el
+    look = [look_angles(r, rx.geometry_constellation(o).positions_ecef(e.t_s[j:j + 1])) for o in offs]
+    el, az = np.stack([a[2][0] for a in look]), np.stack([a[3][0] for a in look])
+    return (el[0], az[0]) if off is None else (el, az)
 
 
 def _channels(at: _At) -> tuple[Array, ...] | None:
@@ -142,13 +148,13 @@ def _channels(at: _At) -> tuple[Array, ...] | None:
         return None
     e, j = s
     rx = at.suite.sensors["gnss"]
-    el = _gnss_el(at, e, j)
+    el, az = _gnss_look(at, e, j)
     ser = {k: np.asarray(v)[:, j] for k, v in e.series.items() if k != "rate_noise"}
     geom = rx.station_geometry(at.truth, e.rows[j:j + 1]) if rx.budget.gbas is not None else (None, None, None)
     if getattr(rx, "carrier", None) is not None:
         slow, iono, fast = rx.carrier_channel_errors(ser, el, *geom)
         return slow, fast, iono
-    return rx.channel_errors(ser, el, *geom)
+    return rx.channel_errors(ser, el, *geom, az_rad=az)
 
 
 def _gio(at: _At) -> Array | None:

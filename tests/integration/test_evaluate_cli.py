@@ -103,8 +103,10 @@ def test_open_loop_evaluation_end_to_end(tmp_path, capsys):
     assert code == 0
     s = json.loads((out / "summary.json").read_text())
     assert set(s) == {"schema", "profile", "runs", "seed", "closed_loop", "decision_heights", "best_category",
-                      "failed_runs"}
+                      "failed_runs", "gnss_service", "lpv200"}  # the last two: docs/contract.md, issue 38
     assert (s["profile"], s["runs"], s["seed"], s["closed_loop"], s["failed_runs"]) == ("default", 2, 3, False, 0)
+    # the default's Gray & Maybeck code preset is labelled military and has no broadcast sigmas to judge LPV-200 with
+    assert (s["gnss_service"], s["lpv200"]) == ("code preset P(Y) (military, PPS)", None)
     import numpy as np
     from scipy import stats as sps
 

@@ -13,6 +13,8 @@ same sample of a batch bit for bit.
     pseudorange_sum    range + scaled error terms + receiver clock for every run, nan where not selected
     pseudoranges       pseudorange_sum with the stand-alone receiver's terms (clock/ephemeris, iono, tropo, mp, noise)
     channel_sigmas     the navigation filter's GPS channel-state sigmas of a stand-alone budget, element by element
+    service_channel_sigmas  the filter's channel-state sigmas of a civil service (broadcast), element by element
+    service_channel_terms   a civil service's broadcast range / iono / tropo / air sigmas, pierce distance
     gbas_scales        the GBAS-corrected residual's scales and nominal sigma per channel (gnss/gbas.py)
     gbas_channel_sigmas the navigation filter's GPS channel-state sigmas under GBAS, element by element
     pseudorange_rates  line-of-sight range rate + clock drift + noise for every run
@@ -347,6 +349,37 @@ def channel_sigmas(el: np.ndarray, shell_m: float, ce_m: float, iono_m: float, t
             decay = math.exp(ge.do253_exponent(e)) if do253 else 0.0
             gse[i, c], gmp[i, c] = ge.channel_sigmas(math.cos(e), math.sin(e), decay, shell_m, ce2, iono_m, tropo_m,
                                                      do253, mp_m)
+
+
+@njit(cache=True)
+def service_channel_sigmas(el: np.ndarray, p: np.ndarray, guard: bool, gse: np.ndarray, gmp: np.ndarray,
+                           total: np.ndarray) -> None:
+    """A civil service's broadcast channel sigmas (m) at elevations el (N, k) rad, into gse, gmp, total (N, k),
+    element by element: gnss_errors.service_sigmas (slow, fast) and their RSS, DO-229's sigma_i; with guard, el <-
+    guard_elevation(el) (nav/noise.py's: nan 0.5 rad, at least 2 deg), else nan stays nan."""
+    for i in range(el.shape[0]):
+        for c in range(el.shape[1]):
+            e = ge.guard_elevation(el[i, c], ge.ELEVATION_FLOOR_RAD) if guard else el[i, c]
+            s, f = ge.service_sigmas(e, p)
+            gse[i, c] = s
+            gmp[i, c] = f
+            total[i, c] = math.sqrt(s * s + f * f)
+
+
+@njit(cache=True)
+def service_channel_terms(el: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
+    """A civil service's broadcast 1-sigmas per channel at elevations el (N, k) rad into out (N, k, 5): range, iono,
+    tropo, air (gnss_errors.service_terms, m) and the pierce point's ground distance (gnss_errors.pierce_distance_m,
+    m, at the shell p[6]); the truth model's scales (sensors/gnss/service.py)."""
+    for i in range(el.shape[0]):
+        for c in range(el.shape[1]):
+            e = el[i, c]
+            r, io, t, a = ge.service_terms(e, p)
+            out[i, c, 0] = r
+            out[i, c, 1] = io
+            out[i, c, 2] = t
+            out[i, c, 3] = a
+            out[i, c, 4] = ge.pierce_distance_m(e, p[6])
 
 
 @njit(cache=True)

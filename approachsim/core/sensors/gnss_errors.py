@@ -9,6 +9,13 @@ gbas_channel_sigmas) and the closed loop's (core/loop/aiding.py channel_sigmas).
     do253_multipath_m  airframe multipath sigma_mp(el)                   RTCA DO-253 / DO-229 (Stanford MAAST)
     channel_sigmas     the filter's slow / fast channel-state sigmas     stand-alone budget (nav/noise.py)
     gbas_terms         the five GBAS-corrected residual scales           ICAO Annex 10 App. B, DO-253 (gnss/gbas.py)
+    sbas_sigma_flt     SBAS fast + long-term correction sigma_flt         RTCA DO-229 App. J J.2.1 (MAAST udre2flt)
+    mops_tropo_sigma_m sigma_tropo = 0.12 m M(el)                          RTCA DO-229 A.4.2.4
+    sigma_air_m        airborne smoothed-code sigma_air, AAD-A / AAD-B    RTCA DO-229 J.2.4; ED-259A airborne model
+    iono_free_residual_m  L1/L5 iono-free higher-order iono residual      EUROCAE ED-259A (MAAST init_mops)
+    iono_free_gamma    noise amplification of the iono-free combination   (f1^4 + f2^4) / (f1^2 - f2^2)^2
+    pierce_distance_m  user-to-pierce-point ground distance               RTCA DO-229 A.4.4.10.1
+    service_terms, service_sigmas  a civil service's broadcast sigma_i   DO-229 App. J J.1 (sensors/gnss/service.py)
 
 Some take cos el, sin el or the multipath curve's exponential instead of el: the closed loop gives numpy's values
 of those (core/loop/aiding.py), so that its numbers are the numpy budget's to the bit; the other kernels give
@@ -116,3 +123,126 @@ def gbas_terms(e: float, path: float, hfac: float, gad: np.ndarray, n_ref: float
     sn = math.sin(e)
     return (math.sqrt(a * a / n_ref + a2 * a2), path / obliquity_root(math.cos(e), shell_m),
             hfac / math.sqrt(0.002 + sn * sn), do253_multipath_m(e), aad[0] + aad[1] * math.exp(-e / aad[2]))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Civil services (sensors/gnss/service.py): the broadcast per-satellite 1-sigma of RTCA DO-229 Appendix J (SBAS L1),
+# EUROCAE ED-259A (DFMC L1/L5), stand-alone L1 C/A with the Klobuchar bound, and the military L1/L2 P(Y) set.
+# ---------------------------------------------------------------------------------------------------------------
+
+MOPS_TROPO_ZENITH_M = 0.12
+"""sigma_TVE, the vertical residual of the MOPS tropospheric model, m (RTCA DO-229 A.4.2.4; MAAST af_trpmops)."""
+AIR_AAD_A = 0
+"""air_model: multipath + AAD-A receiver noise 0.15 + 0.43 exp(-el / 6.9 deg) m."""
+AIR_AAD_B = 1
+"""air_model: multipath + AAD-B receiver noise 0.11 + 0.13 exp(-el / 4 deg) m."""
+AIR_ED259A = 2
+"""air_model: the ED-259A dual-frequency airborne model, already iono-free (gamma not applied)."""
+IONO_L1 = 0
+"""iono_model: single frequency, F_pp times the vertical bound (sigma_UIVE or the Klobuchar tau_vert)."""
+IONO_FREE = 1
+"""iono_model: iono-free combination, the higher-order residual 40 / (261 + el_deg^2) + 0.018 m."""
+
+SERVICE_FIELDS = ("iono_model", "sigma_range_m", "sigma_vertical_iono_m", "tropo_zenith_m", "air_model", "gamma",
+                  "shell_m")
+"""The layout of a service's parameter vector (service_sigmas' `p`), by name (sensors/gnss/service.py packs it)."""
+
+
+@njit(cache=True)
+def sbas_sigma_flt(sigma_udre: float, delta_udre: float, eps_fc: float, eps_rrc: float, eps_ltc: float,
+                   eps_er: float, rss: bool) -> float:
+    """sigma_flt, m, of the SBAS fast and long-term corrections (RTCA DO-229 App. J J.2.1; MAAST udre2flt):
+
+        RSS_UDRE = 0:  sigma_flt = sigma_UDRE dUDRE + eps_fc + eps_rrc + eps_ltc + eps_er
+        RSS_UDRE = 1:  sigma_flt = sqrt((sigma_UDRE dUDRE)^2 + eps_fc^2 + eps_rrc^2 + eps_ltc^2 + eps_er^2)
+
+    sigma_UDRE from the broadcast UDRE index (UDRE / 3.29), dUDRE the message-27/28 factor, the eps the degradation
+    terms (fast correction, range-rate correction, long-term correction, en-route), m."""
+    s = sigma_udre * delta_udre
+    if rss:
+        return math.sqrt(s * s + eps_fc * eps_fc + eps_rrc * eps_rrc + eps_ltc * eps_ltc + eps_er * eps_er)
+    return s + eps_fc + eps_rrc + eps_ltc + eps_er
+
+
+@njit(cache=True)
+def mops_tropo_sigma_m(sin_el: float) -> float:
+    """sigma_tropo = 0.12 m x 1.001 / sqrt(0.002001 + sin^2 el), m (RTCA DO-229 A.4.2.4; MAAST af_trpmops, RTKLIB
+    sbstropcorr, GPSTk MOPSTropModel)."""
+    return MOPS_TROPO_ZENITH_M * tropo_mapping(sin_el)
+
+
+@njit(cache=True)
+def aad_noise_m(el_deg: float, air_model: int) -> float:
+    """Airborne receiver noise (100 s smoothed code), m: AAD-A 0.15 + 0.43 exp(-el / 6.9 deg), AAD-B
+    0.11 + 0.13 exp(-el / 4 deg) (RTCA DO-229 J.2.4 / ICAO Annex 10 App. B; MAAST init_aadb, init_cnmp_mops)."""
+    if air_model == AIR_AAD_A:
+        return 0.15 + 0.43 * math.exp(-el_deg / 6.9)
+    return 0.11 + 0.13 * math.exp(-el_deg / 4.0)
+
+
+@njit(cache=True)
+def sigma_air_m(el_rad: float, air_model: int) -> float:
+    """sigma_air, m, of one frequency's smoothed code: sqrt(sigma_mp^2 + sigma_noise^2), the DO-253 / DO-229 airframe
+    multipath 0.13 + 0.53 exp(-el / 10 deg) and aad_noise_m (RTCA DO-229 J.2.4; MAAST af_cnmp_mops). With
+    AIR_ED259A, the ED-259A dual-frequency airborne model (already iono-free):
+    sqrt(0.4^2 + (0.34 + 0.40 exp(-el / 14 deg))^2) (EUROCAE ED-259A as in Stanford's ARAIM code, af_cnmp_259a)."""
+    el_deg = el_rad * RAD_TO_DEG
+    if air_model == AIR_ED259A:
+        a = 0.34 + 0.40 * math.exp(-el_deg / 14.0)
+        return math.sqrt(0.16 + a * a)
+    mp = do253_multipath_m(el_rad)
+    n = aad_noise_m(el_deg, air_model)
+    return math.sqrt(mp * mp + n * n)
+
+
+@njit(cache=True)
+def iono_free_residual_m(el_rad: float) -> float:
+    """The higher-order ionospheric residual of an L1/L5 iono-free combination, 40 / (261 + el_deg^2) + 0.018 m
+    (EUROCAE ED-259A as in MAAST init_mops)."""
+    el_deg = el_rad * RAD_TO_DEG
+    return 40.0 / (261.0 + el_deg * el_deg) + 0.018
+
+
+@njit(cache=True)
+def iono_free_gamma(f1_hz: float, f2_hz: float) -> float:
+    """Noise and multipath amplification of the iono-free combination, sqrt((f1^4 + f2^4) / (f1^2 - f2^2)^2):
+    2.588 for L1/L5, 2.978 for L1/L2 (MAAST usrprocess; independent errors on the two frequencies)."""
+    a, b = f1_hz * f1_hz, f2_hz * f2_hz
+    return math.sqrt((a * a + b * b) / ((a - b) * (a - b)))
+
+
+@njit(cache=True)
+def pierce_distance_m(el_rad: float, shell_m: float) -> float:
+    """Ground distance (m) from the user to the ionospheric pierce point on the thin shell at shell_m:
+    R psi, psi = pi/2 - el - asin(R cos el / (R + h_I)) the Earth-central angle (RTCA DO-229 A.4.4.10.1)."""
+    return A * (0.5 * math.pi - el_rad - math.asin(A * math.cos(el_rad) / (A + shell_m)))
+
+
+@njit(cache=True)
+def service_terms(el_rad: float, p: np.ndarray) -> tuple[float, float, float, float]:
+    """The broadcast 1-sigmas (m) of one satellite at elevation el_rad of the service with parameters p
+    (SERVICE_FIELDS): (range, ionosphere, troposphere, airborne):
+
+        range  sigma_flt (SBAS L1), sigma_DFRE (DFMC SBAS) or sigma_URA (stand-alone)
+        iono   F_pp sigma_vertical (IONO_L1: sigma_UIVE, or the Klobuchar tau_vert), F_pp at h_I = shell_m
+               (RTCA DO-229 J.2.3), or the iono-free higher-order residual (IONO_FREE; ED-259A)
+        tropo  tropo_zenith_m x 1.001 / sqrt(0.002001 + sin^2 el) (DO-229 A.4.2.4)
+        air    gamma sigma_air (AAD-A / AAD-B; gamma 1 on L1, 2.588 L1/L5, 2.978 L1/L2) or ED-259A's"""
+    if p[0] == IONO_L1:
+        iono = p[2] * iono_obliquity(math.cos(el_rad), p[6])
+    else:
+        iono = iono_free_residual_m(el_rad)
+    air_model = int(p[4])
+    air = sigma_air_m(el_rad, air_model)
+    if air_model != AIR_ED259A:
+        air *= p[5]
+    return p[1], iono, p[3] * tropo_mapping(math.sin(el_rad)), air
+
+
+@njit(cache=True)
+def service_sigmas(el_rad: float, p: np.ndarray) -> tuple[float, float]:
+    """(slow, fast) broadcast 1-sigmas (m) of one satellite (service_terms): the navigation filter's channel states
+    (nav/noise.py), slow = sqrt(range^2 + iono^2 + tropo^2), fast = air. Their RSS is DO-229's
+    sigma_i^2 = sigma_flt^2 + sigma_UIRE^2 + sigma_air^2 + sigma_tropo^2 (App. J J.1)."""
+    r, i, t, a = service_terms(el_rad, p)
+    return math.sqrt(r * r + i * i + t * t), a

@@ -47,6 +47,19 @@ the aircraft's distance, height and speed relative to the GBAS reference point (
 carrier-phase noise the smoothing passes (gbas.CARRIER_NOISE_M, budget code_noise_m), from normals drawn after all
 the others. The record's sigma_m is the corrected nominal sigma there.
 
+Services (the profile's [sensors.gnss] service; service.py gives the models and their sources): SBAS L1, DFMC SBAS,
+DFMC, stand-alone L1 C/A and the military P(Y) replace the code presets by
+
+    rho_i = |r_sv,i - r| + b_rx + s_r R_i + F(el_i) V(ipp_i) + s_t T + s_a A_i + w_i
+
+R the per-satellite range residual (SBAS correction / broadcast ephemeris and clock), V the vertical ionospheric
+residual at the satellite's pierce point, one field (common part, planar gradient, local part) seen through the
+obliquity F (the iono-free services: the higher-order residual per channel), T one tropospheric zenith residual
+mapped by M(el), A the 100 s smoothed airborne error, w the 2 mm carrier noise; the scales are fractions of the
+broadcast sigmas (truth = "nominal") or the broadcast sigmas themselves with every term per channel (truth =
+"broadcast"). The record's sigma_m is then DO-229's broadcast sigma_i, which the filter and the SBAS protection
+levels (integrity/sbas.py) use.
+
 Epoch: every run's sky is the constellation at epoch_utc + its own offset (errors.constants["epoch_offset_s"],
 drawn by the sensor suite from the run's "gnss_epoch" stream); a batch of runs with offsets gives per-run geometry
 (r_sv_ecef, elevation, azimuth, visible, valid, sigma, pdop with a leading run axis). No offset: one sky.
@@ -101,6 +114,7 @@ from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.gnss.constellation import Constellation, dops, look_angles
 from approachsim.sensors.gnss.elevation import IONO_SHELL_M, do253_multipath_sigma_m, iono_obliquity, tropo_mapping
 from approachsim.sensors.gnss.gbas import CARRIER_NOISE_M, SMOOTHING_TAU_S, GbasModel, station_geometry
+from approachsim.sensors.gnss.service import AIR_TAU_S, IONO_TAU_S, TROPO_TAU_S, ServiceModel
 
 Array = np.ndarray
 
@@ -139,6 +153,12 @@ class GnssErrorBudget:
     """GBAS corrections (gbas.py): every stand-alone term above but the multipath curve is replaced, code_noise_m is
     the white carrier-phase noise left on the smoothed code (make_budget); None: stand-alone ranging."""
 
+    service: ServiceModel | None = None
+    """A civil (or military) GNSS service (service.py): broadcast sigmas for the filter and the protection levels,
+    truth drawn from correlated processes they overbound; every stand-alone field above is then unused but
+    code_noise_m, the white carrier-phase noise left on the 100 s smoothed code (make_budget). None: the code
+    presets."""
+
     @property
     def corrections(self) -> str:
         """"none" or "gbas"."""
@@ -154,6 +174,8 @@ class GnssErrorBudget:
     def slow_tau_s(self) -> float:
         """Correlation time (s) of the navigation filter's slow channel state: the shortest of the slow terms'
         (stand-alone: clock/ephemeris, iono, tropo; GBAS: ground, iono, tropo residuals)."""
+        if self.service is not None:
+            return self.service.slow_tau_s
         first = self.clock_ephemeris_tau_s if self.gbas is None else self.gbas.ground_tau_s
         return min(first, self.iono_tau_s, self.tropo_tau_s)
 
@@ -171,6 +193,8 @@ class GnssErrorBudget:
         I_z F; GBAS sqrt(gnd^2 + tropo^2), iono (gbas.GbasModel.carrier_channel_sigmas_m)."""
         if self.gbas is not None:
             return self.gbas.carrier_channel_sigmas_m(el_rad, x_air_m, dh_m, v_air_mps)
+        if self.service is not None:
+            raise ValueError("carrier phase is not modelled with a GNSS service (sensors/gnss/service.py)")
         slow = np.sqrt(self.clock_ephemeris_m**2 + (self.tropo_zenith_m * tropo_mapping(el_rad)) ** 2)
         gmp = self.multipath_sigma_m(el_rad) if self.multipath_model == "do253" else self.multipath_m
         return slow, self.iono_zenith_m * iono_obliquity(el_rad), gmp
@@ -186,6 +210,9 @@ class GnssErrorBudget:
         (None: gbas.REFERENCE_GEOMETRY)."""
         if self.gbas is not None:
             return self.gbas.channel_sigmas_m(el_rad, x_air_m, dh_m, v_air_mps)
+        if self.service is not None:  # the broadcast sigmas (service.py), nav/noise.py's guard already applied
+            slow, fast, _ = self.service.channel_sigmas_m(el_rad, guard=False)
+            return slow, fast
         gse = np.sqrt(self.clock_ephemeris_m**2 + (self.iono_zenith_m * iono_obliquity(el_rad)) ** 2
                       + (self.tropo_zenith_m * tropo_mapping(el_rad)) ** 2)
         gmp = self.multipath_sigma_m(el_rad) if self.multipath_model == "do253" else self.multipath_m
@@ -193,11 +220,14 @@ class GnssErrorBudget:
 
 
 def make_budget(code: str, multipath_model: str = "nrc1995", clock_ephemeris: str = "nrc1995",
-                multipath_tau_s: float | None = None, gbas: GbasModel | None = None) -> GnssErrorBudget:
+                multipath_tau_s: float | None = None, gbas: GbasModel | None = None,
+                service: ServiceModel | None = None) -> GnssErrorBudget:
     """The code preset with the chosen multipath model and clock/ephemeris budget (module docstring); tau None:
     the model's default (preset 60 s for nrc1995, DO253_MULTIPATH_TAU_S for do253). With `gbas` the GBAS-corrected
     budget (gbas.py): the stand-alone fields are kept (unused by the sensor), code_noise_m is the white carrier-phase
-    noise left on the smoothed code (gbas.CARRIER_NOISE_M) and the airframe multipath must be "do253"."""
+    noise left on the smoothed code (gbas.CARRIER_NOISE_M) and the airframe multipath must be "do253". With `service`
+    (service.py) the service's budget: code_noise_m the same carrier-phase noise, the multipath time the 100 s
+    smoothing (the stand-alone fields are kept, unused)."""
     if multipath_model not in MULTIPATH_MODELS:
         raise ValueError(f"multipath_model must be one of {', '.join(MULTIPATH_MODELS)}; got {multipath_model!r}")
     if clock_ephemeris not in CLOCK_EPHEMERIS_M:
@@ -210,6 +240,11 @@ def make_budget(code: str, multipath_model: str = "nrc1995", clock_ephemeris: st
         multipath_tau_s = DO253_MULTIPATH_TAU_S if multipath_model == "do253" else b.multipath_tau_s
     b = replace(b, multipath_model=multipath_model, clock_ephemeris_m=CLOCK_EPHEMERIS_M[clock_ephemeris],
                 multipath_tau_s=multipath_tau_s)
+    if service is not None:
+        if gbas is not None:
+            raise ValueError("a GNSS service carries its own corrections: no GBAS with it")
+        return replace(b, code_noise_m=CARRIER_NOISE_M, multipath_tau_s=AIR_TAU_S, iono_tau_s=IONO_TAU_S,
+                       tropo_tau_s=TROPO_TAU_S, clock_ephemeris_tau_s=service.range_tau_s, service=service)
     return b if gbas is None else replace(b, code_noise_m=CARRIER_NOISE_M, gbas=gbas)
 
 
@@ -338,6 +373,8 @@ class GnssReceiver:
             return out
 
         def code(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
+            if b.service is not None:
+                return service(g, m, dt)
             z = g.standard_normal((m, (6 if self.doppler else 5) * k))
             extra = {"rate_noise": self.doppler_noise_mps * z[:, 5 * k : 6 * k]} if self.doppler else {}
             if b.gbas is not None:
@@ -356,6 +393,24 @@ class GnssReceiver:
                 "tropo_zenith": base.gauss_markov(z[:, 2 * k : 3 * k], b.tropo_zenith_m, b.tropo_tau_s, dt),
                 "multipath": base.gauss_markov(z[:, 3 * k : 4 * k], mp_sigma, b.multipath_tau_s, dt),
                 "noise": b.code_noise_m * z[:, 4 * k : 5 * k],
+            }
+
+        def service(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
+            # service.py: unit Gauss-Markov series, scaled at each channel's elevation in apply
+            sv = b.service
+            z = g.standard_normal((m, (4 if self.doppler else 3) * k + 4))
+            extra = {"rate_noise": self.doppler_noise_mps * z[:, 3 * k + 4:]} if self.doppler else {}
+            return extra | {
+                "range": base.gauss_markov(z[:, 0:k], 1.0, sv.range_tau_s, dt),
+                "iono_local": base.gauss_markov(z[:, k:2 * k], 1.0, IONO_TAU_S, dt),
+                "air": base.gauss_markov(z[:, 2 * k:3 * k], 1.0, AIR_TAU_S, dt),
+                "iono_field": base.gauss_markov(z[:, 3 * k:3 * k + 3], 1.0, IONO_TAU_S, dt),
+                "tropo": base.gauss_markov(z[:, 3 * k + 3:3 * k + 4], 1.0, TROPO_TAU_S, dt),
+                # per-channel tropo (truth = "broadcast" only) from a child stream: the other draws stay as they are
+                "tropo_local": base.gauss_markov(substream(g, "service_tropo").standard_normal((m, k)), 1.0,
+                                                 TROPO_TAU_S, dt),
+                # a child stream, as GBAS's white noise: a shorter record's draws are a longer one's prefix
+                "noise": b.code_noise_m * substream(g, "service_white").standard_normal((m, k)),
             }
 
         return base.make_errors(t_s, self.rate_hz, rng, one)
@@ -421,12 +476,17 @@ class GnssReceiver:
                                 np.asarray(self.station_ecef), self.station_h_m)
 
     def channel_errors(self, series: Mapping[str, Array], el_rad: Array, x_air_m: Array | None = None,
-                       dh_m: Array | None = None, v_air_mps: Array | None = None) -> tuple[Array, Array]:
+                       dh_m: Array | None = None, v_air_mps: Array | None = None,
+                       az_rad: Array | None = None) -> tuple[Array, Array]:
         """The realized errors (m) of the navigation filter's slow and fast channel states (sensors/states.py) from
         one sample's error series (name -> (..., 24)) at elevations el_rad (rad): stand-alone E + F I + M T and the
         (scaled) multipath; GBAS s_gnd g + s_iono I + s_tropo T and s_mp m + s_noise n at the aircraft's geometry
-        (x_air_m, dh_m, v_air_mps, broadcast against el_rad)."""
+        (x_air_m, dh_m, v_air_mps, broadcast against el_rad); a service (service.py): range + iono + tropo and the
+        airborne error, at the azimuths az_rad too (the iono field's gradient)."""
         b = self.budget
+        if b.service is not None:
+            r, io, tr, air = b.service.truth_errors(series, el_rad, az_rad)
+            return r + io + tr, air
         if b.gbas is None:
             slow = series["clock_ephemeris"] + iono_obliquity(el_rad) * series["iono_zenith"] + (
                 tropo_mapping(el_rad) * series["tropo_zenith"])
@@ -455,6 +515,8 @@ class GnssReceiver:
         b = self.budget
         if b.gbas is not None:
             return b.gbas.sigma_m(el_rad, x_air_m, dh_m, v_air_mps)
+        if b.service is not None:  # DO-229's broadcast sigma_i (service.py)
+            return b.service.sigma_m(el_rad)
         return np.sqrt(
             b.clock_ephemeris_m**2 + (b.iono_zenith_m * iono_obliquity(el_rad)) ** 2
             + (b.tropo_zenith_m * tropo_mapping(el_rad)) ** 2 + b.multipath_sigma_m(el_rad) ** 2
@@ -522,7 +584,15 @@ class GnssReceiver:
             r_rx, c(r_sv), float(self.mask_rad), mode, c(plan), IONO_SHELL_M,
             b.multipath_model == "do253", float(b.multipath_m), b.clock_ephemeris_m**2, float(b.iono_zenith_m),
             float(b.tropo_zenith_m), b.code_noise_m**2)
-        if b.gbas is None:
+        if b.service is not None:  # service.py: the correlated truth; the record's sigma the broadcast sigma_i
+            r_, io, tr, air = b.service.truth_errors(series, el, az)
+            full = (bias.shape[0],) + rng.shape[1:]
+            one = np.ones(rng.shape)
+            pr, valid = gk.pseudorange_sum(rng, sel, ((one, c(np.broadcast_to(r_ + io + tr, full))),
+                                                      (one, c(np.broadcast_to(air, full))), (one, c(series["noise"]))),
+                                           c(bias))
+            sigma = b.service.sigma_m(el)
+        elif b.gbas is None:
             pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, c(series["clock_ephemeris"]),
                                         c(series["iono_zenith"]), c(series["tropo_zenith"]), c(series["multipath"]),
                                         c(series["noise"]), c(bias))
@@ -575,7 +645,10 @@ class GnssReceiver:
         s = errors.series
         el = geo_["el"]
         geom: tuple[Array | None, ...] = (None, None, None)
-        if self.budget.gbas is not None:
+        if self.budget.service is not None:
+            r_, io, tr, air = self.budget.service.truth_errors(s, el, geo_["az"])
+            pr = geo_["range"] + r_ + io + tr + air + s["noise"]
+        elif self.budget.gbas is not None:
             geom = tuple(a[:, None] for a in self.station_geometry(truth, errors.rows))  # (m, 1) against (.., m, k)
             sc = self.budget.gbas.scales(el, *geom)
             pr = (geo_["range"] + sc["ground"] * s["ground"] + sc["iono"] * s["iono"] + sc["tropo"] * s["tropo"]
@@ -717,7 +790,8 @@ class PreparedGnss:
         ValueError unless a one-run, one-sky, stand-alone code receiver."""
         if self._direct is None:
             rx, e = self.rx, self.errors
-            if rx.budget.gbas is not None or rx.carrier is not None or self.per_run or e.batched:
+            if (rx.budget.gbas is not None or rx.budget.service is not None or rx.carrier is not None or self.per_run
+                    or e.batched):
                 raise ValueError("channels_one: a one-run stand-alone code receiver only")
             b = rx.budget
             self._direct = ({"all": gk.MODE_ALL, "best4": gk.MODE_BEST4, "best4-fixed": gk.MODE_PLANNED}[rx.selection],

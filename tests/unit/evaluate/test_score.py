@@ -87,7 +87,7 @@ def test_known_gaussian_campaign_matches_known_values():
 def test_summary_has_exactly_the_contract_keys():
     s, det = _campaign([_e(1.0, 0.5)] * 2)
     assert set(s) == {"schema", "profile", "runs", "seed", "closed_loop", "decision_heights", "best_category",
-                      "failed_runs"}
+                      "failed_runs", "gnss_service", "lpv200"}  # the last two: docs/contract.md, issue 38
     assert s["schema"] == "approachsim.summary/1"
     assert list(s["decision_heights"]) == ["CAT I", "CAT II", "CAT III"]
     for cat, h, lims in (("CAT I", 200, (28.1, 6.8)), ("CAT II", 100, (8.6, 2.8)), ("CAT III", 50, (6.8, 1.0))):
