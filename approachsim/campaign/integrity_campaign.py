@@ -255,6 +255,8 @@ def campaign_integrity(columns: Mapping[str, Array], counts: Mapping[str, Array]
         entry: dict = {
             "in_verdict": cat in cfg.integrity,
             "requirement": {**{k: _num(v) for k, v in describe(req).items()},
+                            "model": req.model, "source": req.source,
+                            "availability_covers": req.availability_covers,
                             "integrity_risk": req.integrity_risk, "exposure_s": req.exposure_s,
                             "continuity_risk_per_15s": req.continuity_risk_per_15s,
                             "availability": req.availability, "hmi_rate_per_epoch_allowed": allowed},
