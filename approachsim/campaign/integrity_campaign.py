@@ -8,6 +8,8 @@ epochs from evaluation.timeavg_settle_s after the run start down to the category
 K factors, Annex 10 alert limits at the aircraft's distance and height, exclusion at the first detection).
 Scalars, prefix `<cat key>_int_`: epochs, available epochs, available at the DH (the last epoch of the
 window), misleading (MI: output error > PL) and hazardously misleading (HMI: error > AL while PL < AL) epochs,
+HMI in the category's window before the DH (hmi_window_scalars: CAT II / III the last 15 s vertical / 30 s
+lateral; CAT I the approach), the bank's fault-mode count,
 Stanford region counts per axis, detection epochs and detection onsets (a false alert when no fault was
 injected), the excluded channel, and for the first injected fault ([[faults]]) its onset, the delay from the
 onset to the detection, the time to alert (detection minus the first epoch at which the unprotected main
@@ -105,6 +107,23 @@ def first_fault(profile: Any, channel_prn: Array | None = None) -> tuple[float, 
     return float(f.start_s), ch
 
 
+def hmi_window_scalars(s: CategoryIntegrity, t: Array, req: Any) -> dict[str, float]:
+    """HMI in the category's window before the DH (issue 41): `hmi_window` 1 when an epoch within the last
+    req.hmi_window_s() = (15, 30) s (vertical, lateral) before the last epoch above the DH had the output's error on
+    that axis beyond its alert limit while the service was available (PL < AL on both axes), else 0;
+    `hmi_window_epochs` the count of such epochs. CAT I (no window: per approach): any HMI epoch of the approach."""
+    err = np.abs(s.err_m) if s.err_m is not None else np.zeros_like(s.al_m)
+    haz = (err > s.al_m) & s.available[:, None]  # (e, 2) per axis
+    w = req.hmi_window_s()
+    if w is None:
+        inside = np.ones_like(haz)
+    else:
+        age = t[-1] - t  # seconds before the last epoch above the DH
+        inside = np.stack([age < w[0], age < w[1]], axis=1)
+    n = int(np.sum(np.any(haz & inside, axis=1)))
+    return {"hmi_window": float(n > 0), "hmi_window_epochs": float(n)}
+
+
 def _fault_scalars(s: CategoryIntegrity, t: Array, onset_s: float, fault_ch: int) -> dict[str, float]:
     """Delay, time to alert, exceeded / missed and right exclusion of one category for the injected fault."""
     if not math.isfinite(onset_s):
@@ -165,6 +184,7 @@ def run_integrity(ep: BankEpochs, cfg: Any, *, epoch_hz: float, t0_s: float, ons
             for reg, c in stanford_counts(err[:, a], s.pl_m[:, a], s.al_m[:, a]).items():
                 v[f"{name}_{reg}"] = float(c)
             counts[f"{key}_stanford_{name}"] = stanford_hist(err[:, a], s.pl_m[:, a])
+        v.update(hmi_window_scalars(s, t, req))
         v.update(_fault_scalars(s, t, onset_s, fault_ch))
         scalars.update({f"{key}_int_{k}": x for k, x in v.items()})
         if height_grid_m is not None:
@@ -290,6 +310,13 @@ def campaign_integrity(columns: Mapping[str, Array], counts: Mapping[str, Array]
                            "probability_per_approach_lower": _num(p_lo),
                            "rate_per_epoch_upper": _num(_cp(np.nansum(c), n_ep, level)[1]),
                            "rate_per_epoch_lower": _num(_cp(np.nansum(c), n_ep, level)[0])}
+        hw = col("hmi_window")
+        if hw.size:
+            kw = int(np.sum(hw > 0))
+            w_lo, w_hi = _cp(kw, n_runs, level)
+            entry["hmi"].update({"window_s": None if req.hmi_window_s() is None else list(req.hmi_window_s()),
+                                 "window_runs_with": kw, "window_probability_per_approach_lower": _num(w_lo),
+                                 "window_probability_per_approach_upper": _num(w_hi)})
         entry["hmi"]["rate_per_epoch_allowed"] = allowed
         entry["hmi"]["allowed_per_approach"] = req.hmi_probability_allowed
         entry["stanford"] = {

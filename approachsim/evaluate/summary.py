@@ -77,8 +77,14 @@ def integrity_criterion(columns: Mapping[str, np.ndarray], category: str, cfg: E
     ok = np.isfinite(dh)
     hmi = _col(columns, f"{key}_int_hmi")
     hmi_runs = int(np.sum(hmi[ok] > 0)) if hmi.size == dh.size else int(np.sum(hmi > 0))
+    window = None
+    if req.hmi_window_s() is not None:  # CAT II / III: the event is HMI in the window before the DH
+        hw = _col(columns, f"{key}_int_hmi_window")
+        # runs stored before the window existed carry no evidence of a windowed event: never `exceeds` from them
+        window = int(np.sum(hw[ok] > 0)) if hw.size == dh.size else int(np.sum(hw > 0))
     return integrity_verdict(
         int(dh[ok].sum()), int(ok.sum()), hmi_runs, req.availability, req.hmi_probability_allowed, cfg.confidence,
+        hmi_window_approaches=window,
     )
 
 

@@ -270,3 +270,54 @@ def test_summary_json_extension_carries_the_per_approach_integrity():
     assert e["hmi"] == "not shown" and e["approaches"] == 50 and e["hmi_approaches"] == 0
     assert e["hmi_probability_upper"] == pytest.approx(1 - 0.05 ** (1 / 50)) and e["hmi_allowed"] == 1e-9
     assert s["decision_heights"]["CAT II"]["runs_needed"] == iv.runs_needed > 2.99e9
+
+
+def _spike_run(before_dh_s: float, axis: int = 0, size_m: float = 12.0):
+    """One constructed run (300 epochs at 1 Hz, 900 m to 0 at 3 m/s, clean sub-filters so nothing is detected,
+    PL ~ 9 m < the 10 m VAL and 17 m LAL: available) with one epoch's error beyond the CAT III alert limit on
+    `axis`, `before_dh_s` before the last epoch above the CAT III DH (50 ft)."""
+    n = 300
+    ep = _epochs(n=n)
+    ep = BankEpochs(ep.t_s, ep.e0, ep.p0, ep.ek, ep.pk, ep.channels, -np.linspace(900.0, 0.0, n) / math.tan(
+        math.radians(3.0)), np.linspace(900.0, 0.0, n))
+    last = int(np.flatnonzero(ep.height_m >= CFG.dh_m("CAT III"))[-1])
+    e0 = np.zeros((n, 2))
+    e0[last - int(before_dh_s), axis] = size_m + (0.0 if axis == 0 else 8.0)  # 12 m > VAL 10; 20 m > LAL 17
+    ek = np.repeat(e0[:, None, :], 4, axis=1)  # every sub-solution carries it: no separation, no detection
+    ep = BankEpochs(ep.t_s, e0, ep.p0, ek, ep.pk, ep.channels, ep.along_m, ep.height_m)
+    s, _, _ = run_integrity(ep, CFG, epoch_hz=1.0, t0_s=0.0)
+    return s
+
+
+def _verdict_of(runs: list[dict], cat: str):
+    from approachsim.evaluate.summary import integrity_criterion
+
+    cols = {k: np.array([r[k] for r in runs]) for k in runs[0]}
+    return integrity_criterion(cols, cat, CFG)
+
+
+@pytest.mark.parametrize("axis", [0, 1])
+def test_hmi_outside_the_window_is_not_shown_never_exceeds(axis):
+    """Issue 41 acceptance: HMI only at DH - 100 s gives CAT III `not shown`, never `exceeds` (per-epoch counting
+    called it `fails`); inside the window (DH - 5 s) it gives `exceeds`, the lower bound of 20 of 20 approaches,
+    0.05^(1/20) = 0.86, being above 1e-9. CAT I counts per approach: HMI at DH - 100 s (still above CAT I's DH)
+    beyond its scaled alert limit is its event."""
+    far = _spike_run(100.0, axis)
+    assert far["cat3_int_hmi"] == 1 and far["cat3_int_avail_epochs"] == far["cat3_int_epochs"]
+    assert far["cat3_int_hmi_window"] == 0 and far["cat3_int_detect_epochs"] == 0
+    v = _verdict_of([far] * 20, "CAT III")
+    assert v.hmi_finding == "not shown" and v.hmi_verdict == "indeterminate"
+    assert v.hmi_approaches == 20 and v.hmi_window_approaches == 0 and v.runs_needed is None
+    # CAT I counts per approach, against its alert limit scaled with height (Table B-69: 34 m at 1030 ft here)
+    assert _verdict_of([far] * 20, "CAT I").hmi_approaches == 0
+    if axis == 0:
+        big = _spike_run(100.0, axis, 50.0)
+        assert big["cat1_int_hmi_window"] == 1 and _verdict_of([big] * 20, "CAT I").hmi_finding == "exceeds"
+    near = _spike_run(5.0, axis)
+    assert near["cat3_int_hmi_window"] == 1
+    v = _verdict_of([near] * 20, "CAT III")
+    assert v.hmi_finding == "exceeds" and v.verdict == "fails"
+    assert v.hmi_window_lower == pytest.approx(0.05 ** (1 / 20)) and v.hmi_window_lower > 1e-9
+    # the lateral window is 30 s, the vertical 15 s: at DH - 20 s only a lateral HMI is inside
+    mid = _spike_run(20.0, axis)
+    assert mid["cat3_int_hmi_window"] == float(axis == 1)
