@@ -268,8 +268,9 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
     exclude the first detection's suspect for good."""
     sel = np.ones(ep.t_s.shape, bool) if window is None else np.asarray(window, bool)
     n_modes = max(ep.ek.shape[1], 1)
+    # K_md with the mode count: the faulted allocation is shared by the n_modes monitored modes (requirements.p_md)
     r = separation(ep.e0[sel], ep.p0[sel], ep.ek[sel], ep.pk[sel], req.k_ff(), req.k_fa(epoch_hz, 2 * n_modes),
-                   req.k_md()) if ep.ek.shape[1] else _no_modes(ep, sel, req)
+                   req.k_md(n_modes)) if ep.ek.shape[1] else _no_modes(ep, sel, req)
     al = np.stack([vertical_alert_limit_m(req, ep.height_m[sel]), lateral_alert_limit_m(req, ep.along_m[sel])],
                   axis=1)
     t = ep.t_s[sel]

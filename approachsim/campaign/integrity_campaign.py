@@ -8,6 +8,8 @@ epochs from evaluation.timeavg_settle_s after the run start down to the category
 K factors, Annex 10 alert limits at the aircraft's distance and height, exclusion at the first detection).
 Scalars, prefix `<cat key>_int_`: epochs, available epochs, available at the DH (the last epoch of the
 window), misleading (MI: output error > PL) and hazardously misleading (HMI: error > AL while PL < AL) epochs,
+HMI in the category's window before the DH (hmi_window_scalars: CAT II / III the last 15 s vertical / 30 s
+lateral; CAT I the approach), the bank's fault-mode count,
 Stanford region counts per axis, detection epochs and detection onsets (a false alert when no fault was
 injected), the excluded channel, and for the first injected fault ([[faults]]) its onset, the delay from the
 onset to the detection, the time to alert (detection minus the first epoch at which the unprotected main
@@ -18,10 +20,13 @@ histogram per category and axis (`counts`, summed over runs into the Stanford di
 grid of score.HEIGHT_GRID_FT, the availability margin min(AL - PL) and the distance to the threshold.
 
 Campaign (campaign_integrity): per category availability (fraction of epochs, and of runs at the DH) with
-Clopper-Pearson one-sided bounds, MI / HMI counts with the one-sided upper bound of their per-epoch rates
-(epochs treated as independent: optimistic for errors correlated over tens of seconds, so the run counts
-are given too), the false-alert rate per 15 s of fault-free campaigns with its Poisson upper bound against
-the continuity allocation, and time-to-alert statistics with missed detections.
+Clopper-Pearson one-sided bounds; MI, HMI and false alerts counted per approach (a run: its ~250 epochs are
+strongly correlated and are not independent samples), each with Clopper-Pearson bounds of its per-approach
+probability (HMI against the allocation per approach, false alerts against the continuity allocation over the
+approach's scored time); the epoch counts and per-epoch rates of before are kept beside them for comparison
+(optimistic by about the correlation length in epochs); time-to-alert statistics with missed detections, the
+time to alert counted from error > PL (TTA_DEFINITION), and the missed-detection probability P_md the allocation
+asks per fault mode (requirements.p_md with the bank's mode count), not a fixed 99 %.
 """
 
 from __future__ import annotations
@@ -49,6 +54,11 @@ STANFORD_EDGES_M = np.logspace(-2.0, 3.0, 41)
 """Bin edges of the per-run (error, protection level) histograms, m (both axes; values outside are put in
 the end bins, a PL of inf in the last)."""
 NB = STANFORD_EDGES_M.size - 1
+
+TTA_DEFINITION = ("detection time minus the first epoch at which the unprotected main solution's error exceeded its "
+                  "protection level (error > PL); stricter than the standard's time to alert, which counts from "
+                  "error > alert limit (ICAO Annex 10 / DO-245A), since PL < AL wherever the service is available")
+"""What `time_to_alert` measures (details.json), in words a report can print."""
 
 REGIONS = ("normal", "mi", "hmi", "unavailable")
 """Stanford regions counted per axis (standards.md 1.6): available PE <= PL; MI PL < PE <= AL; HMI PE > AL
@@ -95,6 +105,23 @@ def first_fault(profile: Any, channel_prn: Array | None = None) -> tuple[float, 
         hits = np.flatnonzero(np.asarray(channel_prn) == f.channel)
         ch = int(hits[0]) if hits.size else -1
     return float(f.start_s), ch
+
+
+def hmi_window_scalars(s: CategoryIntegrity, t: Array, req: Any) -> dict[str, float]:
+    """HMI in the category's window before the DH (issue 41): `hmi_window` 1 when an epoch within the last
+    req.hmi_window_s() = (15, 30) s (vertical, lateral) before the last epoch above the DH had the output's error on
+    that axis beyond its alert limit while the service was available (PL < AL on both axes), else 0;
+    `hmi_window_epochs` the count of such epochs. CAT I (no window: per approach): any HMI epoch of the approach."""
+    err = np.abs(s.err_m) if s.err_m is not None else np.zeros_like(s.al_m)
+    haz = (err > s.al_m) & s.available[:, None]  # (e, 2) per axis
+    w = req.hmi_window_s()
+    if w is None:
+        inside = np.ones_like(haz)
+    else:
+        age = t[-1] - t  # seconds before the last epoch above the DH
+        inside = np.stack([age < w[0], age < w[1]], axis=1)
+    n = int(np.sum(np.any(haz & inside, axis=1)))
+    return {"hmi_window": float(n > 0), "hmi_window_epochs": float(n)}
 
 
 def _fault_scalars(s: CategoryIntegrity, t: Array, onset_s: float, fault_ch: int) -> dict[str, float]:
@@ -152,11 +179,12 @@ def run_integrity(ep: BankEpochs, cfg: Any, *, epoch_hz: float, t0_s: float, ons
              "detect_events": float(np.sum(det & ~np.r_[False, det[:-1]])),
              "excluded_channel": float(s.excluded_channel), "t_detect_s": s.t_detect_s,
              "vpl_dh_m": float(s.pl_m[-1, 0]), "lpl_dh_m": float(s.pl_m[-1, 1]),
-             "vert_dh_m": float(err[-1, 0]), "lat_dh_m": float(err[-1, 1])}
+             "vert_dh_m": float(err[-1, 0]), "lat_dh_m": float(err[-1, 1]), "modes": float(ep.ek.shape[1])}
         for a, name in ((0, "v"), (1, "l")):
             for reg, c in stanford_counts(err[:, a], s.pl_m[:, a], s.al_m[:, a]).items():
                 v[f"{name}_{reg}"] = float(c)
             counts[f"{key}_stanford_{name}"] = stanford_hist(err[:, a], s.pl_m[:, a])
+        v.update(hmi_window_scalars(s, t, req))
         v.update(_fault_scalars(s, t, onset_s, fault_ch))
         scalars.update({f"{key}_int_{k}": x for k, x in v.items()})
         if height_grid_m is not None:
@@ -252,9 +280,17 @@ def campaign_integrity(columns: Mapping[str, Array], counts: Mapping[str, Array]
         dlo, dhi = _cp(np.nansum(dh), dh.size, level)
         is_faulted = (f"{key}_int_onset_s" in columns) if faulted is None else faulted
         allowed = req.hmi_rate_per_epoch(epoch_hz)
+        n_runs = int(ep.size)
+        modes = col("modes")
+        modes = modes[np.isfinite(modes)]
+        n_modes = max(1, int(np.median(modes))) if modes.size else 1  # the bank's fault modes (a typical run)
         entry: dict = {
             "in_verdict": cat in cfg.integrity,
-            "requirement": {**{k: _num(v) for k, v in describe(req).items()},
+            "requirement": {**{k: _num(v) for k, v in describe(req, n_modes=n_modes).items()},
+                            "hmi_probability_allowed": req.hmi_probability_allowed,
+                            "hmi_window_s": None if req.hmi_window_s() is None else list(req.hmi_window_s()),
+                            "model": req.model, "source": req.source,
+                            "availability_covers": req.availability_covers,
                             "integrity_risk": req.integrity_risk, "exposure_s": req.exposure_s,
                             "continuity_risk_per_15s": req.continuity_risk_per_15s,
                             "availability": req.availability, "hmi_rate_per_epoch_allowed": allowed},
@@ -264,12 +300,25 @@ def campaign_integrity(columns: Mapping[str, Array], counts: Mapping[str, Array]
                                 "fraction": _num(np.nanmean(dh)), "lower": _num(dlo), "upper": _num(dhi)},
             "pl_at_dh_m": {"vertical": _dist(col("vpl_dh_m")), "lateral": _dist(col("lpl_dh_m"))},
         }
+        entry["fault_modes"] = _dist(col("modes"))
         for name in ("mi", "hmi"):
             c = col(name)
-            entry[name] = {"count": int(np.nansum(c)), "runs_with": int(np.sum(c > 0)),
+            k = int(np.sum(c > 0))
+            p_lo, p_hi = _cp(k, n_runs, level)
+            entry[name] = {"count": int(np.nansum(c)), "runs_with": k,
+                           "approaches": n_runs, "probability_per_approach_upper": _num(p_hi),
+                           "probability_per_approach_lower": _num(p_lo),
                            "rate_per_epoch_upper": _num(_cp(np.nansum(c), n_ep, level)[1]),
                            "rate_per_epoch_lower": _num(_cp(np.nansum(c), n_ep, level)[0])}
+        hw = col("hmi_window")
+        if hw.size:
+            kw = int(np.sum(hw > 0))
+            w_lo, w_hi = _cp(kw, n_runs, level)
+            entry["hmi"].update({"window_s": None if req.hmi_window_s() is None else list(req.hmi_window_s()),
+                                 "window_runs_with": kw, "window_probability_per_approach_lower": _num(w_lo),
+                                 "window_probability_per_approach_upper": _num(w_hi)})
         entry["hmi"]["rate_per_epoch_allowed"] = allowed
+        entry["hmi"]["allowed_per_approach"] = req.hmi_probability_allowed
         entry["stanford"] = {
             axis: {reg: int(np.nansum(col(f"{a}_{reg}"))) for reg in REGIONS}
             for a, axis in (("v", "vertical"), ("l", "lateral"))
@@ -278,12 +327,17 @@ def campaign_integrity(columns: Mapping[str, Array], counts: Mapping[str, Array]
                                   for a, axis in (("v", "vertical"), ("l", "lateral"))}
         windows = n_ep / (15.0 * epoch_hz)
         ev = float(np.nansum(col("detect_events")))
+        fa_runs = int(np.sum(col("detect_events") > 0))
+        t_run = n_ep / (epoch_hz * n_runs) if n_runs else 0.0  # scored seconds per approach
         entry["false_alert"] = None if is_faulted else {
             "alerts": int(ev), "windows_15s": _num(windows),
             "rate_per_15s": _num(ev / windows) if windows else None,
             "rate_per_15s_upper": _num(poisson_upper(ev, level) / windows) if windows else None,
             "allocation_per_15s": req.continuity_risk_per_15s,
-            "runs_with": int(np.sum(col("detect_events") > 0)),
+            "runs_with": fa_runs, "approaches": n_runs,
+            "probability_per_approach_upper": _num(_cp(fa_runs, n_runs, level)[1]),
+            "allocation_per_approach": _num(-math.expm1(t_run / 15.0 * math.log1p(-req.continuity_risk_per_15s))),
+            "scored_s_per_approach": _num(t_run),
         }
         if is_faulted:
             tta = col("tta_s")
@@ -299,6 +353,10 @@ def campaign_integrity(columns: Mapping[str, Array], counts: Mapping[str, Array]
                 "fraction_within_tta_lower": _num(_cp(within.sum(), exceeded.sum(), level)[0])
                 if exceeded.any() else None,
                 "delay_after_onset_s": _dist(col("delay_s")), "tta_s": _dist(tta[exceeded & ~missed]),
+                "definition": TTA_DEFINITION,
+                "late_or_missed_upper": _num(1.0 - _cp(within.sum(), exceeded.sum(), level)[0])
+                if exceeded.any() else None,
+                "p_md_allocated": req.p_md(n_modes),
             }
         v = (verdicts or {}).get(cat)
         if v is not None:
@@ -306,6 +364,7 @@ def campaign_integrity(columns: Mapping[str, Array], counts: Mapping[str, Array]
             entry["runs_needed"] = v.runs_needed
             entry["availability_verdict"] = v.availability_verdict
             entry["hmi_verdict"] = v.hmi_verdict
+            entry["hmi_finding"] = v.hmi_finding
         cats[cat] = entry
     out["categories"] = cats
     fde = np.asarray(columns.get("fde_epochs", np.empty(0)), float)

@@ -69,16 +69,39 @@ def verdicts(
 
 
 def integrity_criterion(columns: Mapping[str, np.ndarray], category: str, cfg: EvaluationConfig) -> IntegrityVerdict:
-    """The integrity criterion of `category` from the bank's per-run columns (campaign.integrity_campaign)."""
+    """The integrity criterion of `category` from the bank's per-run columns (campaign.integrity_campaign), counted
+    per approach: a run with any HMI epoch is one approach with HMI (evaluate/verdict.py)."""
     key = CATEGORY_KEYS[category]
     req = REQUIREMENTS[category]
     dh = _col(columns, f"{key}_int_avail_dh")
-    dh = dh[np.isfinite(dh)]
+    ok = np.isfinite(dh)
+    hmi = _col(columns, f"{key}_int_hmi")
+    hmi_runs = int(np.sum(hmi[ok] > 0)) if hmi.size == dh.size else int(np.sum(hmi > 0))
+    window = None
+    if req.hmi_window_s() is not None:  # CAT II / III: the event is HMI in the window before the DH
+        hw = _col(columns, f"{key}_int_hmi_window")
+        # runs stored before the window existed carry no evidence of a windowed event: never `exceeds` from them
+        window = int(np.sum(hw[ok] > 0)) if hw.size == dh.size else int(np.sum(hw > 0))
     return integrity_verdict(
-        int(dh.sum()), int(dh.size), int(np.nansum(_col(columns, f"{key}_int_hmi"))),
-        int(np.nansum(_col(columns, f"{key}_int_epochs"))), req.availability, req.hmi_rate_per_epoch(1.0),
-        cfg.confidence,
+        int(dh[ok].sum()), int(ok.sum()), hmi_runs, req.availability, req.hmi_probability_allowed, cfg.confidence,
+        hmi_window_approaches=window,
     )
+
+
+def integrity_summary(v: IntegrityVerdict) -> dict:
+    """summary.json `decision_heights.<CAT>.integrity` (docs/contract.md): the criterion counted per approach."""
+    return {
+        "verdict": v.verdict,
+        "hmi": v.hmi_finding,
+        "approaches": v.approaches,
+        "hmi_approaches": v.hmi_approaches,
+        "hmi_window_approaches": v.hmi_window_approaches,
+        "hmi_probability_upper": _num(v.hmi_probability_upper),
+        "hmi_window_probability_lower": _num(v.hmi_window_lower),
+        "hmi_allowed": _num(v.hmi_allowed),
+        "availability_dh_lower": _num(v.availability_dh_lower),
+        "availability": v.availability_verdict,
+    }
 
 
 def contract_summary(
@@ -103,6 +126,8 @@ def contract_summary(
             "vertical_1sigma_upper_ft": _num(r.vertical_axis.rms_upper_ft),
             "runs_needed": r.runs_needed,
         }
+        if r.integrity is not None:  # extension (issue 41): the integrity criterion, counted per approach
+            dhs[r.category]["integrity"] = integrity_summary(r.integrity)
     return {
         "schema": SCHEMA,
         "profile": profile,

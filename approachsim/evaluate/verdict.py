@@ -22,11 +22,18 @@ Each criterion is judged on one-sided confidence bounds at the profile's evaluat
 * Integrity (categories listed in evaluation.integrity; integrity_verdict): availability at the decision
   height (runs whose protection levels were inside the alert limits at their last epoch before the DH) meets
   when its Clopper-Pearson lower bound reaches the category's requirement (0.99, the lower end of ICAO
-  Annex 10 Vol I Table 3.7.2.4-1's range; integrity.requirements) and fails when its upper bound is below it;
-  hazardously misleading information meets when there is none and the upper bound of its per-epoch rate is
-  within the allowed rate (the integrity risk spread over the exposure's epochs), fails when the lower
-  bound exceeds it (any HMI epoch at the run counts a campaign reaches), and is indeterminate otherwise
-  (no HMI, but too few epochs to bound a 1e-9 risk: the usual outcome; its runs_needed says how many).
+  Annex 10 Vol I Table 3.7.2.4-1's range; integrity.requirements) and fails when its upper bound is below it.
+  Hazardously misleading information is counted per approach (a run), never per epoch: the ~250 filter epochs of
+  one approach are strongly correlated (errors move over tens of seconds) and are not independent samples of
+  anything. The integrity event of a run is HMI in its window: CAT I anywhere in the approach (its allocation is
+  2e-7 per approach, 150 s); CAT II / III in the last 15 s (vertical) / 30 s (lateral) before the DH (the
+  exposures of the 1e-9 allocation, DO-245A GSL D via Pullen). The HMI finding, on one-sided Clopper-Pearson
+  bounds of a per-approach probability against the allocation (IntegrityRequirement.hmi_probability_allowed):
+  `shown` (meets) when no run had HMI anywhere and the upper bound from the runs is within the allocation
+  (conservative: the whole approach contains the window); `exceeds` (fails) only when the lower bound of the
+  windowed event's probability is above it; `not shown` (indeterminate) otherwise, so HMI outside the window
+  alone is at most `not shown`. With zero events the upper bound is 1 - (1 - level)^(1/n), so showing 1e-9 at
+  95 % takes ln(0.05) / ln(1 - 1e-9) = 3.0e9 approaches (runs_needed).
 
 The category fails when any criterion fails, meets when all meet, and is indeterminate otherwise.
 runs_needed (indeterminate only): the completed-run count at which the bounds would likely decide it if
@@ -78,9 +85,13 @@ class AxisVerdict:
     """Estimated between-group correlation of the error (None: no groups; nan: too few groups to estimate)."""
 
 
+HMI_FINDINGS = {"meets": "shown", "indeterminate": "not shown", "fails": "exceeds"}
+"""The HMI criterion's verdict in the words of an integrity allocation."""
+
+
 @dataclass(frozen=True)
 class IntegrityVerdict:
-    """The integrity criterion of one category: availability at the DH and HMI (module docstring)."""
+    """The integrity criterion of one category: availability at the DH and HMI per approach (module docstring)."""
 
     availability_verdict: str
     hmi_verdict: str
@@ -88,7 +99,29 @@ class IntegrityVerdict:
     runs_needed: int | None
     availability_dh_lower: float
     availability_dh_upper: float
-    hmi_rate_upper: float
+    hmi_probability_upper: float
+    """Upper bound of the per-approach probability of HMI anywhere in the approach."""
+    approaches: int = 0
+    """Runs (approaches) scored by the bank."""
+    hmi_approaches: int = 0
+    """Runs with at least one HMI epoch anywhere in the approach."""
+    hmi_window_approaches: int | None = None
+    """Runs with HMI inside the category's window before the DH (None: the window is the whole approach)."""
+    hmi_window_lower: float = 0.0
+    """Lower bound of the per-approach probability of the windowed event."""
+    hmi_allowed: float = math.nan
+    """The allocation the bounds are compared with (per approach, or per window before the DH)."""
+
+    @property
+    def hmi_finding(self) -> str:
+        """`shown`, `not shown` or `exceeds` (module docstring)."""
+        return HMI_FINDINGS[self.hmi_verdict]
+
+
+def runs_to_show(allowed: float, level: float = 0.95) -> int:
+    """Approaches without any event at which the Clopper-Pearson upper bound 1 - (1 - level)^(1/n) reaches
+    `allowed`: ceil(ln(1 - level) / ln(1 - allowed))."""
+    return int(math.ceil(math.log(1.0 - level) / math.log1p(-allowed)))
 
 
 def _runs_for_availability(k: int, n: int, required: float, level: float) -> int | None:
@@ -102,17 +135,22 @@ def _runs_for_availability(k: int, n: int, required: float, level: float) -> int
     return None
 
 
-def integrity_verdict(available_dh: int, runs_dh: int, hmi: int, epochs: int, required_availability: float,
-                      allowed_hmi_rate: float, level: float = 0.95) -> IntegrityVerdict:
-    """The integrity criterion (module docstring) from the runs available at the DH (of runs_dh) and the HMI
-    epochs (of all epochs). runs_needed: runs at which the bounds would decide towards meets at the same
-    observed rates (the HMI part: epochs / (epochs per run) to bound the allowed rate with none observed)."""
+def integrity_verdict(available_dh: int, runs_dh: int, hmi_approaches: int, required_availability: float,
+                      allowed_hmi: float, level: float = 0.95, *, hmi_window_approaches: int | None = None
+                      ) -> IntegrityVerdict:
+    """The integrity criterion (module docstring) from the runs available at the DH (of runs_dh, the approaches
+    the bank scored), the approaches with HMI anywhere and, for a windowed category, those with HMI inside its
+    window (None: the window is the whole approach). allowed_hmi: the allocation per approach (per window).
+    runs_needed: approaches at which the bounds would decide towards meets at the same observed fractions (the
+    HMI part: runs_to_show, with none observed)."""
     a_lo, a_hi = clopper_pearson(available_dh, runs_dh, level)
     av = "meets" if runs_dh > 0 and a_lo >= required_availability else (
         "fails" if runs_dh > 0 and a_hi < required_availability else "indeterminate")
-    h_lo, h_hi = clopper_pearson(hmi, epochs, level)
-    hv = "fails" if hmi > 0 and h_lo > allowed_hmi_rate else (
-        "meets" if hmi == 0 and epochs > 0 and h_hi <= allowed_hmi_rate else "indeterminate")
+    win = hmi_approaches if hmi_window_approaches is None else hmi_window_approaches
+    h_hi = clopper_pearson(hmi_approaches, runs_dh, level)[1]
+    w_lo = clopper_pearson(win, runs_dh, level)[0]
+    hv = "fails" if win > 0 and w_lo > allowed_hmi else (
+        "meets" if hmi_approaches == 0 and runs_dh > 0 and h_hi <= allowed_hmi else "indeterminate")
     v = _combine([av, hv])
     need = None
     if v == "indeterminate":
@@ -120,12 +158,10 @@ def integrity_verdict(available_dh: int, runs_dh: int, hmi: int, epochs: int, re
         if av == "indeterminate":
             needs.append(_runs_for_availability(available_dh, runs_dh, required_availability, level))
         if hv == "indeterminate":
-            per_run = epochs / runs_dh if runs_dh else 0.0
-            # zero events: the upper bound is 1 - (1 - level)^(1/N) ~ -ln(1 - level) / N
-            n_ep = -math.log(1.0 - level) / allowed_hmi_rate
-            needs.append(int(math.ceil(n_ep / per_run)) if hmi == 0 and per_run > 0 else None)
+            needs.append(runs_to_show(allowed_hmi, level) if hmi_approaches == 0 else None)
         need = None if not needs or any(x is None for x in needs) else max(needs)
-    return IntegrityVerdict(av, hv, v, need, a_lo, a_hi, h_hi)
+    return IntegrityVerdict(av, hv, v, need, a_lo, a_hi, h_hi, int(runs_dh), int(hmi_approaches),
+                            hmi_window_approaches, w_lo, allowed_hmi)
 
 
 @dataclass(frozen=True)

@@ -1,16 +1,30 @@
-"""Integrity requirements per approach category and the multipliers and thresholds derived from them.
+"""The one requirements table: integrity, alert limits and continuity per approach category, what each row models,
+and the multipliers and thresholds derived from it. evaluate/limits.py takes its alert limits from here.
 
-Numbers (the project's reference notes, integrity-envelope.md sec. 1-3, with their confidence marks):
+Rows (the project's reference notes, integrity-envelope.md sec. 1-3, with their confidence marks):
 
-| category | integrity risk | exposure | TTA | continuity risk | LAL / VAL at DH |
+| row | models | integrity risk (exposure vert. / lat.) | TTA | continuity | LAL / VAL at DH |
 |---|---|---|---|---|---|
-| CAT I (GAST-C) | 2e-7 / approach [S] | 150 s [S] | 6 s [V] | 8e-6 / 15 s [V] | 40 / 10 m, scaled (*) [V] |
-| CAT II, III (GAST-D) | 1e-9 / 15 s (vert.) [S] | 15 s | 2 s [S] | 8e-6 / 15 s [S] | 17 / 10 m [S] |
+| CAT I | GAST-C, LAAS-style PL | 2e-7 / approach (150 s) [S] | 6 s [V] | 8e-6 / 15 s [V] | 40 / 10 m (*) [V] |
+| CAT II, III | GSL D/E AL, LAAS-style PL | 1e-9 / 15 s v., 30 s lat. [S] | 2 s [S] | 8e-6 / 15 s [S] | 17 / 10 m [S] |
+| (LPV-200) | reserved for the civil GNSS issue (SBAS, DO-229): a row in ROWS, not a category | | | | |
 
 (*) with distance and height, Annex 10 App. B Tables B-68 / B-69.
 
 [V]: ICAO Annex 10 Vol I (2006 copy); [S]: RTCA DO-245A Table 2-1 via Pullen (Stanford) slides: check against
 the standards before a certification claim rests on them.
+
+What "LAAS-style 1e-9 PL, not GAST-D" means: the CAT II / III rows bound the error by one protection level per axis
+at the 1e-9 allocation (fault-free K_ff sigma, faulted max_k (T_k + K_md sigma_k) over the airborne bank's modes)
+and compare it with GAST-D's 17 / 10 m alert limits. GAST-D itself does not work that way: its integrity rests on
+ground and airborne monitors (ionospheric gradients, geometry screening with D_V, dual smoothing) and the
+autoland's total-system allocation, none of which is modelled. The older LAAS performance-type limits (CAT II/IIIA
+17.3 / 5.3 m, CAT IIIB 15.5 / 5.2 m, integrity-envelope.md 1b) were used by evaluate/limits.py until issue 41 and
+are in no row now.
+
+Availability (IntegrityRequirement.availability, `availability_covers`): PL < AL with the bank's fault modes, which
+in `approachsim evaluate` are single GPS satellite (channel) faults only: no baro, radar-altimeter, pseudolite,
+constellation-wide or ground-subsystem fault is among the hypotheses the PL protects against.
 
 Derived here (each a function with its equation):
 
@@ -23,12 +37,19 @@ Derived here (each a function with its equation):
   over the epochs in 15 s (1 Hz filter: 15) and the monitors' tests: P_fa = C / (15 f n_tests); the
   chi-square residual threshold chi2.isf(P_fa, dof) and the solution-separation threshold
   K_fa = Q^-1(P_fa / 2);
-* missed-detection multiplier K_md = Q^-1(P_H1 / (N_es P_fault)) with the prior probability of a satellite
-  fault per approach P_fault (1e-5 per satellite, the ARAIM ISM value [S]).
+* missed-detection probability P_md = P_H1,axis / (N_es n_modes P_fault) and multiplier K_md = Q^-1(P_md): the
+  faulted allocation spread over the n_modes monitored fault modes, each with the prior probability of a
+  satellite fault per approach P_fault (1e-5 per satellite, the ARAIM ISM value [S]) (ARAIM ADD: the H1 budget
+  is shared by the modes in proportion to their priors).
 
-With the CAT I numbers this gives K_ff = 6.00 (a two-sided tail of 2e-9 per effective sample), K_md = 3.54 and,
-at 1 Hz with six tests, K_fa = 5.35; CAT II/III K_ff = 6.63, K_md = 4.50: against the SBAS K_V = 5.33 (1e-7)
-the project used for every category before.
+With the CAT I numbers this gives K_ff = 6.00 (a two-sided tail of 2e-9 per effective sample), K_md = 3.54 for one
+mode and, at 1 Hz with six tests, K_fa = 5.35; CAT II/III K_ff = 6.63, P_md = 3.3e-6 and K_md = 4.50 for one mode,
+P_md = 3.3e-7 and K_md = 4.97 for ten: against the SBAS K_V = 5.33 (1e-7) the project used for every category
+before (still the covariance-only factor, COVARIANCE_K_V, when integrity is off: no fault hypothesis).
+
+Alert limits (vertical_alert_limit_m, lateral_alert_limit_m) and the HMI windows (hmi_window_s): the CAT II / III
+integrity event is counted in the last 15 s (vertical) / 30 s (lateral) before the decision height, the exposure
+its allocation is stated over; CAT I's over the approach (its 150 s).
 """
 
 from __future__ import annotations
@@ -49,6 +70,11 @@ def _q_inv(p: float) -> float:
     """Q^-1(p) = norm.isf(p), kept per p: the bank and the scoring ask for the same few quantiles every run (225
     scipy calls of ~0.2 ms a 25-run group)."""
     return float(norm.isf(p))
+
+
+AVAILABILITY_COVERS = ("single GPS satellite (channel) faults only: no baro, radar-altimeter, pseudolite, "
+                       "constellation-wide or ground-subsystem fault")
+"""The fault modes `approachsim evaluate`'s availability (PL < AL from the solution-separation bank) covers."""
 
 
 @dataclass(frozen=True)
@@ -72,10 +98,40 @@ class IntegrityRequirement:
     availability: float = 0.99
     """Availability the category must reach at the decision height: the lower end of ICAO Annex 10 Vol I
     Table 3.7.2.4-1's 0.99 to 0.99999 range (APV and CAT I [V]; the same range is used for CAT II / III)."""
+    lateral_exposure_s: float | None = None
+    """Lateral exposure, s (None: exposure_s). CAT II / III: 30 s (DO-245A GSL D via Pullen [S])."""
+    model: str = ""
+    """What the row models (module docstring), in words a report can print."""
+    source: str = ""
+    """Where its numbers come from, with their confidence marks."""
+    availability_covers: str = AVAILABILITY_COVERS
+    """The fault modes the availability (PL < AL) protects against."""
+
+    @property
+    def vertical_exposure_s(self) -> float:
+        """Vertical exposure, s: the window the vertical integrity event is counted in before the DH."""
+        return self.exposure_s
+
+    @property
+    def lateral_window_s(self) -> float:
+        """Lateral exposure, s: the window the lateral integrity event is counted in before the DH."""
+        return self.exposure_s if self.lateral_exposure_s is None else self.lateral_exposure_s
+
+    def hmi_window_s(self) -> tuple[float, float] | None:
+        """(vertical, lateral) windows before the DH in which HMI is the integrity event, s; None: the whole
+        scored approach (CAT I: its allocation is per approach)."""
+        return None if self.scaled else (self.vertical_exposure_s, self.lateral_window_s)
+
+    @property
+    def hmi_probability_allowed(self) -> float:
+        """Allowed probability of the integrity event per approach: HMI anywhere in the approach (CAT I) or in the
+        windows before the DH (CAT II / III, hmi_window_s): the row's integrity risk over its exposure."""
+        return self.integrity_risk
 
     def hmi_rate_per_epoch(self, epoch_hz: float) -> float:
         """Allowed rate of hazardously misleading epochs: the integrity risk over the exposure spread over its
-        epochs, integrity_risk / (exposure_s epoch_hz) (union bound: any misleading epoch is an event)."""
+        epochs, integrity_risk / (exposure_s epoch_hz) (union bound: any misleading epoch is an event). Epoch
+        counting, kept in details.json for comparison; the verdict counts per approach (hmi_probability_allowed)."""
         return self.integrity_risk / max(1.0, self.exposure_s * epoch_hz)
 
     @property
@@ -105,18 +161,49 @@ class IntegrityRequirement:
         """Solution-separation threshold multiplier K_fa = Q^-1(P_fa / 2) (two-sided)."""
         return _q_inv(self.p_fa(epoch_hz, n_tests) / 2.0)
 
-    def k_md(self) -> float:
-        """Missed-detection multiplier K_md = Q^-1(P_H1,axis / (N_es P_fault)), at least 0."""
-        p = self.p_h0_axis() / (self.n_es * self.p_fault_per_sat)
-        return _q_inv(min(p, 0.5))
+    def p_md(self, n_modes: int = 1) -> float:
+        """Missed-detection probability the allocation asks of each mode's detector per effective sample:
+        P_md = P_H1,axis / (N_es n_modes P_fault), at most 0.5 (module docstring)."""
+        if n_modes < 1:
+            raise ValueError("n_modes must be >= 1")
+        return min(self.p_h0_axis() / (self.n_es * n_modes * self.p_fault_per_sat), 0.5)
+
+    def k_md(self, n_modes: int = 1) -> float:
+        """Missed-detection multiplier K_md = Q^-1(P_md(n_modes)), at least 0."""
+        return _q_inv(self.p_md(n_modes))
 
 
-REQUIREMENTS = MappingProxyType({
-    "CAT I": IntegrityRequirement("CAT I", 2e-7, 150.0, 6.0, 8e-6, 40.0, 10.0, True),
-    "CAT II": IntegrityRequirement("CAT II", 1e-9, 15.0, 2.0, 8e-6, 17.0, 10.0, False),
-    "CAT III": IntegrityRequirement("CAT III", 1e-9, 15.0, 2.0, 8e-6, 17.0, 10.0, False),
+_CAT1_SOURCE = ("ICAO Annex 10 Vol I Table 3.7.2.4-1 and App. B Tables B-68 / B-69 (AL, TTA, continuity [V]); "
+                "integrity 2e-7 per approach and 150 s exposure: DO-245A Table 2-1 GSL C via Pullen [S]")
+_CAT23_SOURCE = ("RTCA DO-245A Table 2-1 GSL D / E via Pullen (Stanford) slides [S]: LAL 17 m, VAL 10 m, "
+                 "P(LoI) 1e-9 per 15 s vertical / 30 s lateral, TTA 2 s, continuity 8e-6 per 15 s")
+_CAT23_MODEL = "DO-245A GSL D/E alert limits with a LAAS-style 1e-9 protection level (not GAST-D)"
+
+ROWS = MappingProxyType({
+    "CAT I": IntegrityRequirement(
+        "CAT I", 2e-7, 150.0, 6.0, 8e-6, 40.0, 10.0, True,
+        model="GBAS CAT I (GAST-C) allocation with a LAAS-style protection level", source=_CAT1_SOURCE),
+    "CAT II": IntegrityRequirement(
+        "CAT II", 1e-9, 15.0, 2.0, 8e-6, 17.0, 10.0, False, lateral_exposure_s=30.0,
+        model=_CAT23_MODEL, source=_CAT23_SOURCE),
+    "CAT III": IntegrityRequirement(
+        "CAT III", 1e-9, 15.0, 2.0, 8e-6, 17.0, 10.0, False, lateral_exposure_s=30.0,
+        model=_CAT23_MODEL, source=_CAT23_SOURCE),
+    # "LPV-200": the civil GNSS issue (38) adds its row here (SBAS, DO-229; Annex 10 Table 3.7.2.4-1: HAL 40 m,
+    # VAL 35 m, 2e-7 per approach, 150 s, TTA 6 s, 8e-6 / 15 s), with its own summary key, not as a category.
 })
-"""Integrity requirements by category (module docstring table)."""
+"""Every modelled row of the one requirements table (module docstring), by name."""
+
+REQUIREMENTS = MappingProxyType({c: ROWS[c] for c in ("CAT I", "CAT II", "CAT III")})
+"""The row each approach category is scored against (evaluate and integrity alike)."""
+
+COVARIANCE_K_V = 5.33
+"""Vertical factor of the covariance-only protection level K_V sqrt(P_DD) (SBAS DO-229 App. J precision approach,
+MAAST init_mops.m; a two-sided 1e-7 fault-free tail). Used only with integrity off: no fault hypothesis, so not
+integrity evidence, and not any category's allocation (K_ff above)."""
+COVARIANCE_K_H = 6.0
+"""Horizontal factor of the covariance-only protection level K_H d_major (SBAS DO-229 App. J; 2e-9 along the
+major axis). Used only with integrity off (COVARIANCE_K_V)."""
 
 
 def lateral_alert_limit_m(req: IntegrityRequirement, distance_m: np.ndarray | float) -> np.ndarray:
@@ -145,11 +232,17 @@ def gaussian_tail_two_sided(k: float) -> float:
     return float(2.0 * norm.sf(k))
 
 
-def describe(req: IntegrityRequirement, epoch_hz: float = 1.0, n_tests: int = 1) -> dict[str, float]:
-    """The derived numbers of one category (for reports): K_ff, K_md, K_fa, P_fa, N_es."""
+def describe(req: IntegrityRequirement, epoch_hz: float = 1.0, n_tests: int = 1, n_modes: int = 1
+             ) -> dict[str, float]:
+    """The derived numbers of one category (for reports): K_ff, K_md and P_md for n_modes fault modes, K_fa, P_fa,
+    N_es, the exposures."""
     return {
         "k_ff": req.k_ff(),
-        "k_md": req.k_md(),
+        "k_md": req.k_md(n_modes),
+        "p_md": req.p_md(n_modes),
+        "n_modes": float(n_modes),
+        "vertical_exposure_s": req.vertical_exposure_s,
+        "lateral_exposure_s": req.lateral_window_s,
         "k_fa": req.k_fa(epoch_hz, n_tests),
         "p_fa_per_test_epoch": req.p_fa(epoch_hz, n_tests),
         "n_es": req.n_es,

@@ -56,7 +56,7 @@ def test_fault_free_constructed_run_counts():
     req = REQUIREMENTS["CAT I"]
     # PL_H1 = K_fa sigma_ss + K_md sigma_k, sigma_ss = sqrt(1.44 - 1)
     k_fa = req.k_fa(1.0, 2 * 4)
-    pl_h1 = k_fa * math.sqrt(0.44) + req.k_md() * 1.2
+    pl_h1 = k_fa * math.sqrt(0.44) + req.k_md(4) * 1.2  # K_md with the 4 modes (issue 41)
     assert s["cat1_int_vpl_dh_m"] == pytest.approx(max(pl_h1, req.k_ff() * 1.0))
     n1 = int(np.sum(ep.height_m >= 200 * 0.3048))
     assert s["cat1_int_epochs"] == n1
@@ -93,7 +93,7 @@ def test_fault_detected_excluded_and_time_to_alert():
     assert s["cat1_int_delay_s"] == t_det - 30
     assert s["cat1_int_excluded_channel"] == 5 and s["cat1_int_right"] == 1.0
     # the main error passes its PL (max(PL_H0, PL_H1)) after the detection: detected before (tta < 0)
-    pl = max(req.k_ff(), thr + req.k_md() * 1.2)
+    pl = max(req.k_ff(), thr + req.k_md(4) * 1.2)
     t_exceed = 30 + math.floor(pl / 0.5)
     assert s["cat1_int_tta_s"] == pytest.approx(t_det - t_exceed)
     assert s["cat1_int_exceeded"] == 1.0 and s["cat1_int_missed"] == 0.0
@@ -133,21 +133,50 @@ def test_campaign_bounds_are_clopper_pearson_and_poisson():
     assert poisson_upper(0, 0.95) == pytest.approx(-math.log(0.05))
 
 
+def test_campaign_counts_per_approach():
+    """Issue 41 item 4: MI, HMI and false alerts counted per approach, with Clopper-Pearson bounds on runs; the
+    false-alert allocation over the approach's scored time; a run of 250 epochs with 3 HMI epochs is one approach."""
+    cols = _columns(runs=400, detect=2)
+    cols["cat2_int_hmi"][:2] = [3.0, 1.0]  # two approaches with HMI, four epochs
+    cols["cat2_int_modes"] = np.full(400, 9.0)
+    out = campaign_integrity(cols, {}, CFG)["categories"]["CAT II"]
+    assert out["hmi"]["count"] == 4 and out["hmi"]["runs_with"] == 2 and out["hmi"]["approaches"] == 400
+    assert out["hmi"]["probability_per_approach_lower"] == pytest.approx(sps.beta.ppf(0.05, 2, 399))
+    assert out["hmi"]["probability_per_approach_upper"] == pytest.approx(sps.beta.ppf(0.95, 3, 398))
+    assert out["hmi"]["allowed_per_approach"] == 1e-9
+    fa = out["false_alert"]
+    assert fa["runs_with"] == 2 and fa["probability_per_approach_upper"] == pytest.approx(sps.beta.ppf(0.95, 3, 398))
+    # 250 s scored per approach at 1 Hz: 1 - (1 - 8e-6)^(250 / 15) = 1.333e-4
+    assert fa["allocation_per_approach"] == pytest.approx(1 - (1 - 8e-6) ** (250 / 15), rel=1e-9)
+    req = out["requirement"]
+    assert req["n_modes"] == 9 and req["p_md"] == pytest.approx(1e-9 / 4 / (7.5 * 9 * 1e-5))
+    assert req["hmi_window_s"] == [15.0, 30.0] and "not GAST-D" in req["model"]
+
+
 def test_integrity_verdict_cases():
-    allowed = REQUIREMENTS["CAT II"].hmi_rate_per_epoch(1.0)
-    # 20 runs all available at the DH, no HMI: lower bound 0.86 < 0.99 and 5000 epochs cannot bound 7e-11
-    v = integrity_verdict(20, 20, 0, 5000, 0.99, allowed)
+    """Counted per approach (issue 41 item 4): the allocation is per approach, so the bound is on runs."""
+    allowed = REQUIREMENTS["CAT II"].hmi_probability_allowed
+    assert allowed == 1e-9
+    # 20 runs all available at the DH, no HMI: lower bound 0.86 < 0.99 and 20 approaches cannot bound 1e-9
+    v = integrity_verdict(20, 20, 0, 0.99, allowed)
     assert (v.availability_verdict, v.hmi_verdict, v.verdict) == ("indeterminate", "indeterminate", "indeterminate")
-    assert v.runs_needed == math.ceil(-math.log(0.05) / allowed / 250)
+    assert v.hmi_finding == "not shown"
+    # approaches, not epochs: 1 - 0.05^(1/n) <= 1e-9 at n = ln(0.05) / ln(1 - 1e-9) = 2.996e9 (was 1.8e8 runs when
+    # 250 epochs a run counted as independent samples)
+    assert v.runs_needed == math.ceil(math.log(0.05) / math.log1p(-1e-9))
+    assert 2.99e9 < v.runs_needed < 3.0e9
+    assert v.hmi_probability_upper == pytest.approx(1 - 0.05 ** (1 / 20))
     # 5 of 20 available: upper bound below 0.99 -> fails
-    assert integrity_verdict(5, 20, 0, 5000, 0.99, allowed).verdict == "fails"
-    # any HMI epoch: the lower bound of its rate is far above 1e-9 -> fails
-    assert integrity_verdict(20, 20, 1, 5000, 0.99, allowed).hmi_verdict == "fails"
+    assert integrity_verdict(5, 20, 0, 0.99, allowed).verdict == "fails"
+    # one approach with HMI (CAT I: the window is the approach): lower bound 1 - 0.95^(1/20) = 2.6e-3 > 1e-9
+    v = integrity_verdict(20, 20, 1, 0.99, allowed)
+    assert v.hmi_verdict == "fails" and v.hmi_finding == "exceeds"
+    assert v.hmi_window_lower == pytest.approx(1 - 0.95 ** (1 / 20))
     # a loose allowance a campaign can reach: meets
-    v = integrity_verdict(400, 400, 0, 100000, 0.99, 1e-3)
-    assert v.verdict == "meets" and v.runs_needed is None
+    v = integrity_verdict(400, 400, 0, 0.99, 1e-2)
+    assert v.verdict == "meets" and v.runs_needed is None and v.hmi_finding == "shown"
     # availability alone undecided: runs_needed is where 0.05^(1/n) reaches 0.99
-    v = integrity_verdict(100, 100, 0, 100000, 0.99, 1e-3)
+    v = integrity_verdict(100, 100, 0, 0.99, 1e-1)
     assert v.availability_verdict == "indeterminate" and v.runs_needed == pytest.approx(299, abs=3)
 
 
@@ -155,13 +184,13 @@ def test_integrity_blocks_meets_and_decides_runs_needed():
     rng = np.random.default_rng(3)
     lat, ver = rng.normal(0, 1.0, 200), rng.normal(0, 0.3, 200)  # far inside the CAT I limits (28.1 / 6.8 ft)
     assert category_verdict("CAT I", 200, lat, ver).verdict == "meets"
-    undecided = integrity_verdict(100, 100, 0, 100000, 0.99, 1e-3)
+    undecided = integrity_verdict(100, 100, 0, 0.99, 1e-1)
     r = category_verdict("CAT I", 200, lat, ver, integrity=undecided)
     assert r.verdict == "indeterminate" and not r.meets
     assert r.runs_needed == undecided.runs_needed  # the deciding criterion
-    r = category_verdict("CAT I", 200, lat, ver, integrity=integrity_verdict(5, 20, 0, 5000, 0.99, 1e-3))
+    r = category_verdict("CAT I", 200, lat, ver, integrity=integrity_verdict(5, 20, 0, 0.99, 1e-1))
     assert r.verdict == "fails"
-    r = category_verdict("CAT I", 200, lat, ver, integrity=integrity_verdict(400, 400, 0, 100000, 0.99, 1e-3))
+    r = category_verdict("CAT I", 200, lat, ver, integrity=integrity_verdict(400, 400, 0, 0.99, 1e-2))
     assert r.verdict == "meets"
 
 
@@ -225,3 +254,70 @@ def test_integrity_figures_from_a_constructed_faulted_campaign():
     assert set(figs) == {"integrity_stanford", "integrity_availability", "integrity_tta"}
     assert len(figs["integrity_stanford"].axes) == 7  # 2 axes x 3 categories + the colour bar
     assert len(integrity_rows(det)) == 3
+
+
+def test_summary_json_extension_carries_the_per_approach_integrity():
+    """summary.json decision_heights.<CAT>.integrity (docs/contract.md): only where integrity is in the verdict."""
+    from approachsim.evaluate.summary import contract_summary
+
+    rng = np.random.default_rng(5)
+    lat, ver = rng.normal(0, 1.0, 50), rng.normal(0, 0.3, 50)
+    iv = integrity_verdict(50, 50, 0, 0.99, 1e-9)
+    rs = [category_verdict("CAT I", 200, lat, ver), category_verdict("CAT II", 100, lat, ver, integrity=iv)]
+    s = contract_summary(rs, profile="p", runs=50, seed=1, closed_loop=True, failed_runs=0)
+    assert "integrity" not in s["decision_heights"]["CAT I"]
+    e = s["decision_heights"]["CAT II"]["integrity"]
+    assert e["hmi"] == "not shown" and e["approaches"] == 50 and e["hmi_approaches"] == 0
+    assert e["hmi_probability_upper"] == pytest.approx(1 - 0.05 ** (1 / 50)) and e["hmi_allowed"] == 1e-9
+    assert s["decision_heights"]["CAT II"]["runs_needed"] == iv.runs_needed > 2.99e9
+
+
+def _spike_run(before_dh_s: float, axis: int = 0, size_m: float = 12.0):
+    """One constructed run (300 epochs at 1 Hz, 900 m to 0 at 3 m/s, clean sub-filters so nothing is detected,
+    PL ~ 9 m < the 10 m VAL and 17 m LAL: available) with one epoch's error beyond the CAT III alert limit on
+    `axis`, `before_dh_s` before the last epoch above the CAT III DH (50 ft)."""
+    n = 300
+    ep = _epochs(n=n)
+    ep = BankEpochs(ep.t_s, ep.e0, ep.p0, ep.ek, ep.pk, ep.channels, -np.linspace(900.0, 0.0, n) / math.tan(
+        math.radians(3.0)), np.linspace(900.0, 0.0, n))
+    last = int(np.flatnonzero(ep.height_m >= CFG.dh_m("CAT III"))[-1])
+    e0 = np.zeros((n, 2))
+    e0[last - int(before_dh_s), axis] = size_m + (0.0 if axis == 0 else 8.0)  # 12 m > VAL 10; 20 m > LAL 17
+    ek = np.repeat(e0[:, None, :], 4, axis=1)  # every sub-solution carries it: no separation, no detection
+    ep = BankEpochs(ep.t_s, e0, ep.p0, ek, ep.pk, ep.channels, ep.along_m, ep.height_m)
+    s, _, _ = run_integrity(ep, CFG, epoch_hz=1.0, t0_s=0.0)
+    return s
+
+
+def _verdict_of(runs: list[dict], cat: str):
+    from approachsim.evaluate.summary import integrity_criterion
+
+    cols = {k: np.array([r[k] for r in runs]) for k in runs[0]}
+    return integrity_criterion(cols, cat, CFG)
+
+
+@pytest.mark.parametrize("axis", [0, 1])
+def test_hmi_outside_the_window_is_not_shown_never_exceeds(axis):
+    """Issue 41 acceptance: HMI only at DH - 100 s gives CAT III `not shown`, never `exceeds` (per-epoch counting
+    called it `fails`); inside the window (DH - 5 s) it gives `exceeds`, the lower bound of 20 of 20 approaches,
+    0.05^(1/20) = 0.86, being above 1e-9. CAT I counts per approach: HMI at DH - 100 s (still above CAT I's DH)
+    beyond its scaled alert limit is its event."""
+    far = _spike_run(100.0, axis)
+    assert far["cat3_int_hmi"] == 1 and far["cat3_int_avail_epochs"] == far["cat3_int_epochs"]
+    assert far["cat3_int_hmi_window"] == 0 and far["cat3_int_detect_epochs"] == 0
+    v = _verdict_of([far] * 20, "CAT III")
+    assert v.hmi_finding == "not shown" and v.hmi_verdict == "indeterminate"
+    assert v.hmi_approaches == 20 and v.hmi_window_approaches == 0 and v.runs_needed is None
+    # CAT I counts per approach, against its alert limit scaled with height (Table B-69: 34 m at 1030 ft here)
+    assert _verdict_of([far] * 20, "CAT I").hmi_approaches == 0
+    if axis == 0:
+        big = _spike_run(100.0, axis, 50.0)
+        assert big["cat1_int_hmi_window"] == 1 and _verdict_of([big] * 20, "CAT I").hmi_finding == "exceeds"
+    near = _spike_run(5.0, axis)
+    assert near["cat3_int_hmi_window"] == 1
+    v = _verdict_of([near] * 20, "CAT III")
+    assert v.hmi_finding == "exceeds" and v.verdict == "fails"
+    assert v.hmi_window_lower == pytest.approx(0.05 ** (1 / 20)) and v.hmi_window_lower > 1e-9
+    # the lateral window is 30 s, the vertical 15 s: at DH - 20 s only a lateral HMI is inside
+    mid = _spike_run(20.0, axis)
+    assert mid["cat3_int_hmi_window"] == float(axis == 1)

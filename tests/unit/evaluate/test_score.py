@@ -95,20 +95,23 @@ def test_summary_has_exactly_the_contract_keys():
         assert set(e) == CONTRACT_DH_KEYS
         assert e["height_ft"] == h
         assert (e["limit_lateral_1sigma_ft"], e["limit_vertical_1sigma_ft"]) == lims
-    assert det["categories"]["CAT III"]["limits_ft"]["vertical_al_ft"] == pytest.approx(5.2 / units.FT)
+    # alert limits from the one requirements table (issue 41: were the LAAS 15.5 / 5.2 m at CAT III)
+    assert det["categories"]["CAT III"]["limits_ft"]["vertical_al_ft"] == pytest.approx(10.0 / units.FT)
+    assert det["categories"]["CAT III"]["limits_ft"]["horizontal_al_ft"] == pytest.approx(17.0 / units.FT)
 
 
 def test_integrity_counts_and_availability_with_known_covariance():
     truth = make_truth(hz=4.0)
-    # sigma_D = 0.98 m -> VPL 5.22 m > CAT III VAL 5.2 m: unavailable; < CAT II VAL 5.3 m: available
-    nav = make_nav(truth, _e(0.0, 1.0), sigma_ned_m=(1.0, 1.0, 0.98))
+    # sigma_N = sigma_E = 3 m -> HPL 18 m > CAT II / III HAL 17 m: unavailable; < CAT I HAL 40 m: available
+    nav = make_nav(truth, _e(0.0, 1.0), sigma_ned_m=(3.0, 3.0, 0.98))
     sc, arrays, _ = score_run(truth, nav, CFG)
     assert sc["cat1_vpl_m"] == pytest.approx(5.33 * 0.98)
-    assert sc["cat1_hpl_m"] == pytest.approx(6.0)
-    assert sc["cat3_availability"] == 0.0 and sc["cat2_availability"] == 1.0  # exact: a count over a count, 0 or all
+    assert sc["cat1_hpl_m"] == pytest.approx(18.0)
+    assert sc["cat3_availability"] == 0.0 and sc["cat2_availability"] == 0.0  # exact: a count over a count
+    assert sc["cat1_availability"] == 1.0
     k = int(sc["cat1_v_normal"] + sc["cat1_v_mi"] + sc["cat1_v_hmi"] + sc["cat1_v_unavailable"])
     assert k == sc["cat1_v_normal"] > 0  # 0.3 m error < 5.22 m VPL < 10 m VAL at every epoch
-    assert sc["cat3_v_unavailable"] > 0 and sc["cat3_v_normal"] == 0
+    assert sc["cat3_h_unavailable"] > 0 and sc["cat3_h_normal"] == 0
     # a 12 m vertical error under a 5.33 m VPL (sigma 1 m): hazardously misleading against the 10 m CAT I VAL
     sc2, _, _ = score_run(truth, make_nav(truth, np.array([0.0, 0.0, -12.0])), CFG)
     assert sc2["cat1_v_hmi"] == k and sc2["cat1_v_normal"] == 0

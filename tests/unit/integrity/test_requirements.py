@@ -57,3 +57,34 @@ def test_false_alert_threshold_meets_the_continuity_budget():
 
     assert chi2.sf(CAT1.chi2_threshold(1, 1.0, 6), 1) == pytest.approx(p, rel=1e-6)
     assert 2 * norm.sf(CAT1.k_fa(1.0, 6)) == pytest.approx(p, rel=1e-6)
+
+
+def test_one_table_for_evaluate_and_integrity():
+    """Issue 41 item 5: evaluate's alert limits and covariance factors are the requirements table's, every row says
+    what it models and where its numbers come from, and availability names the fault modes it covers."""
+    from approachsim.evaluate.limits import K_H_PA, K_V_PA, LIMITS
+    from approachsim.integrity.requirements import COVARIANCE_K_H, COVARIANCE_K_V, ROWS
+
+    for cat, lim in LIMITS.items():
+        r = REQUIREMENTS[cat]
+        assert lim.horizontal_al_m == pytest.approx(r.lal_m, abs=1e-12)
+        assert lim.vertical_al_m == pytest.approx(r.val_m, abs=1e-12)
+        assert ROWS[cat] is r and r.model and r.source
+        assert "GPS satellite" in r.availability_covers and "baro" in r.availability_covers
+    assert (K_V_PA, K_H_PA) == (COVARIANCE_K_V, COVARIANCE_K_H) == (5.33, 6.0)
+    for cat in ("CAT II", "CAT III"):
+        r = REQUIREMENTS[cat]
+        assert "LAAS-style" in r.model and "not GAST-D" in r.model
+        assert (r.lal_m, r.val_m) == (17.0, 10.0)
+        assert r.hmi_window_s() == (15.0, 30.0)
+    assert REQUIREMENTS["CAT I"].hmi_window_s() is None  # per approach
+
+
+@pytest.mark.parametrize("n_modes", [1, 10])
+def test_k_md_spreads_the_faulted_allocation_over_the_modes(n_modes):
+    """P_md = P_H1,axis / (N_es n_modes P_sat): CAT II / III 2.5e-10 / (7.5 x 1e-5) = 3.3e-6 for one mode (the
+    issue's figure), 3.3e-7 for ten; K_md = Q^-1(P_md) = 4.50 / 4.97."""
+    r = REQUIREMENTS["CAT II"]
+    assert r.p_md(n_modes) == pytest.approx(1e-9 / 4 / (7.5 * n_modes * 1e-5), rel=1e-12)
+    assert norm.sf(r.k_md(n_modes)) == pytest.approx(r.p_md(n_modes), rel=1e-9)
+    assert r.k_md(n_modes) == pytest.approx({1: 4.504, 10: 4.971}[n_modes], abs=1e-3)
