@@ -7,7 +7,7 @@ Rows (the project's reference notes, integrity-envelope.md sec. 1-3, with their 
 |---|---|---|---|---|---|
 | CAT I | GAST-C, LAAS-style PL | 2e-7 / approach (150 s) [S] | 6 s [V] | 8e-6 / 15 s [V] | 40 / 10 m (*) [V] |
 | CAT II, III | GSL D/E AL, LAAS-style PL | 1e-9 / 15 s v., 30 s lat. [S] | 2 s [S] | 8e-6 / 15 s [S] | 17 / 10 m [S] |
-| (LPV-200) | reserved for the civil GNSS issue (SBAS, DO-229): a row in ROWS, not a category | | | | |
+| LPV-200 | SBAS, DO-229 App. J PLs | 2e-7 / approach (150 s) [V] | 6 s [V] | 8e-6 / 15 s [V] | 40 / 35 m [V] |
 
 (*) with distance and height, Annex 10 App. B Tables B-68 / B-69.
 
@@ -189,8 +189,12 @@ ROWS = MappingProxyType({
     "CAT III": IntegrityRequirement(
         "CAT III", 1e-9, 15.0, 2.0, 8e-6, 17.0, 10.0, False, lateral_exposure_s=30.0,
         model=_CAT23_MODEL, source=_CAT23_SOURCE),
-    # "LPV-200": the civil GNSS issue (38) adds its row here (SBAS, DO-229; Annex 10 Table 3.7.2.4-1: HAL 40 m,
-    # VAL 35 m, 2e-7 per approach, 150 s, TTA 6 s, 8e-6 / 15 s), with its own summary key, not as a category.
+    "LPV-200": IntegrityRequirement(
+        "LPV-200", 2e-7, 150.0, 6.0, 8e-6, 40.0, 35.0, False,
+        model="SBAS LPV-200 with the DO-229 App. J protection levels (VPL = 5.33 d_V, HPL = 6.0 d_major): its own "
+              "summary key (evaluate/lpv.py), not a category",
+        source="ICAO Annex 10 Vol I Table 3.7.2.4-1 (APV / LPV-200: HAL 40 m, VAL 35 m, 2e-7 per approach, TTA 6 s, "
+               "continuity 8e-6 / 15 s) [V]"),
 })
 """Every modelled row of the one requirements table (module docstring), by name."""
 

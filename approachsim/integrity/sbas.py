@@ -19,16 +19,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from approachsim.integrity.requirements import COVARIANCE_K_H, COVARIANCE_K_V, ROWS
+
 Array = np.ndarray
 
-K_V_PA = 5.33
-"""VPL multiplier for precision approach (MAAST init_mops MOPS_KV_PA)."""
-K_H_PA = 6.0
-"""HPL multiplier for precision approach (MAAST init_mops MOPS_KH_PA)."""
-LPV200_VAL_M = 35.0
-"""LPV-200 vertical alert limit, m."""
-LPV200_HAL_M = 40.0
-"""LPV-200 horizontal alert limit, m."""
+K_V_PA = COVARIANCE_K_V
+"""VPL multiplier for precision approach (MAAST init_mops MOPS_KV_PA; integrity.requirements)."""
+K_H_PA = COVARIANCE_K_H
+"""HPL multiplier for precision approach (MAAST init_mops MOPS_KH_PA; integrity.requirements)."""
+LPV200_VAL_M = ROWS["LPV-200"].val_m
+"""LPV-200 vertical alert limit, m (the requirements table's row)."""
+LPV200_HAL_M = ROWS["LPV-200"].lal_m
+"""LPV-200 horizontal alert limit, m (the requirements table's row)."""
 LPV200_VERTICAL_95_M = 4.0
 """LPV-200 vertical accuracy, 95 %, m."""
 LPV200_HORIZONTAL_95_M = 16.0
