@@ -8,7 +8,7 @@ a 20 kt crosswind, flight technical error against the straight glide path cone.
     [--law classic|tecs] [--workers N]
     python tools/autoland_figures.py paired --a tecs.json --b classic.json --out paired.json  # laws, same seeds, A - B
     crosswind only: [--wind-kt KT] [--turbulence none|light|moderate|severe] (default light)
-                    [--decrab aircraft|full] (full: no bank allowance, the sideslip decrab before the partial one)
+                    [--decrab aircraft|full] (full: no sideslip or bank limit, the decrab before the partial one)
 
 Every flight flies on the true state (no navigation in the loop), seeded: envelope case i, seed 1000 + i, runs
 0..seeds-1 (the envelope test's seed is run 0); crosswind and FTE: seed 1, runs 0..N-1 of the default profile.
@@ -140,7 +140,8 @@ def _xwind_job(args: tuple) -> list[dict]:
     approach = Approach(parse_profile(_xwind_profile(law, speed_kt, turb), source=DEFAULT), land=True)
     if decrab == "full":  # the full sideslip decrab: no bank allowance, the whole wind correction as sideslip
         ac = approach.aircraft
-        approach.aircraft = dataclasses.replace(ac, gains=dataclasses.replace(ac.gains, align_bank_max_rad=math.inf))
+        approach.aircraft = dataclasses.replace(ac, gains=dataclasses.replace(ac.gains, align_bank_max_rad=math.inf,
+                                                                               align_sideslip_max_rad=math.inf))
     arms = approach.main_gear_lever_arms_m
     out = []
     for r in runs:
@@ -175,6 +176,7 @@ def crosswind(runs: int, law: str | None, workers: int, speed_kt: float, turb: s
         "outboard_gear_y_ft": st("td_outboard_gear_y_m", ft),
         "drift_deg": st("td_gear_slip_rad", deg), "crab_deg": st("td_crab_rad", deg),
         "bank_deg": st("td_bank_rad", deg), "sink_fps": st("td_sink_mps", fps),
+        "pitch_deg": st("td_pitch_rad", deg), "cas_kt": st("td_cas_mps", 1.0 / units.KT),
         "imu_x_ft": st("td_imu_x_m", ft), "imu_sink_fps": st("td_imu_sink_mps", fps),
         "flight_field_x_ft": st("flight_td_x_m", ft), "flight_field_sink_fps": st("flight_td_sink_mps", fps),
         "drift_over_5deg": int(sum(abs(r["td_gear_slip_rad"]) * deg > 5.0 for r in td)),

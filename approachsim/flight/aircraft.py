@@ -108,6 +108,10 @@ def _gains(s: Section) -> AutopilotGains:
         align_bank_max_rad=math.radians(s.number("align_bank_max_deg", math.inf, lo=0.0, hi=90.0, lo_open=True,
                                                  unit="deg")),
         align_cas_mps=s.number("align_design_cas_kt", 0.0, lo=0.0, hi=300.0, unit="kt") * units.KT,
+        align_sideslip_max_rad=math.radians(s.number("align_sideslip_max_deg", math.inf, lo=0.0, hi=30.0,
+                                                     lo_open=True, unit="deg")),
+        flare_t_path_s=s.number("flare_t_path_s", 0.0, lo=0.0, hi=10.0, unit="s"),
+        flare_k_v=s.number("flare_k_v", 0.0, lo=0.0, hi=1.0),
     )
     s.done()
     return g

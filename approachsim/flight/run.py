@@ -232,6 +232,13 @@ class Approach:
         return self._gear
 
     @property
+    def gear_arm_m(self) -> float:
+        """Distance along the body x axis from the IMU (the guidance point) back to the main gears' centre, m: the
+        autopilot steers the main gear onto the centreline in the runway alignment and flares on its height and
+        sink rate (main_gear_lever_arms_m; 10.11 m for the 737)."""
+        return float(-np.mean(self.main_gear_lever_arms_m[:, 0]))
+
+    @property
     def linearization(self) -> Linearization:
         """FGLinearization in still air (the profile's temperature and pressure), trimmed on the glidepath
         1000 ft above the threshold (the top of the scored segment), approach configuration (computed once)."""
@@ -424,7 +431,8 @@ class Approach:
         const = imu_point_constants(np.array(lever), ic.lat_rad, rw, dt)
         trim = Trim(theta_rad=fdm["attitude/theta-rad"], throttle=fdm["fcs/throttle-cmd-norm[0]"],
                     cas_mps=ac.approach_speed_mps)
-        ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m, rw.threshold_lat_rad), dt)
+        ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m, rw.threshold_lat_rad), dt,
+                       gear_arm_m=self.gear_arm_m)
         monitor = StabilityMonitor(rw.glidepath_rad, rw.tch_m, ac.approach_speed_mps, dt,
                                    curvature=ap.cone.curvature)
         turb = None
