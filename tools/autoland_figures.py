@@ -148,7 +148,7 @@ def _xwind_job(args: tuple) -> list[dict]:
         res = approach.fly(seed=1, run=r)
         row = {"run": r, "termination": res.termination, "ok": res.ok}
         if res.termination == "touchdown":
-            row.update(touchdown_scalars(res.truth, arms))
+            row.update(touchdown_scalars(res.truth, arms, approach.ground_contact_m))
             row["flight_td_x_m"], row["flight_td_sink_mps"] = res.touchdown_x_m, res.touchdown_sink_mps
         out.append(row)
     return out
@@ -177,6 +177,8 @@ def crosswind(runs: int, law: str | None, workers: int, speed_kt: float, turb: s
         "drift_deg": st("td_gear_slip_rad", deg), "crab_deg": st("td_crab_rad", deg),
         "bank_deg": st("td_bank_rad", deg), "sink_fps": st("td_sink_mps", fps),
         "pitch_deg": st("td_pitch_rad", deg), "cas_kt": st("td_cas_mps", 1.0 / units.KT),
+        **({"contact_bank_deg": st("td_contact_bank_rad", deg), "contact_margin_deg": st("td_contact_margin_rad", deg)}
+           if td and all(math.isfinite(r.get("td_contact_bank_rad", math.nan)) for r in td) else {}),
         "imu_x_ft": st("td_imu_x_m", ft), "imu_sink_fps": st("td_imu_sink_mps", fps),
         "flight_field_x_ft": st("flight_td_x_m", ft), "flight_field_sink_fps": st("flight_td_sink_mps", fps),
         "drift_over_5deg": int(sum(abs(r["td_gear_slip_rad"]) * deg > 5.0 for r in td)),
