@@ -7,6 +7,8 @@ a 20 kt crosswind, flight technical error against the straight glide path cone.
     python tools/autoland_figures.py pair --a partial.json --b full.json          # paired: two crosswind outputs
     [--law classic|tecs] [--workers N]
     python tools/autoland_figures.py paired --a tecs.json --b classic.json --out paired.json  # laws, same seeds, A - B
+    python tools/autoland_figures.py dispersed --runs 200 --out disp.json        # landings over SMAC's wind / glide
+                                                                                 # slope dispersions (average risk)
     crosswind only: [--wind-kt KT] [--turbulence none|light|moderate|severe] (default light)
                     [--decrab aircraft|full] (full: no sideslip or bank limit, the decrab before the partial one)
 
@@ -37,7 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from approachsim import units  # noqa: E402
-from approachsim.evaluate.touchdown import touchdown_scalars  # noqa: E402
+from approachsim.evaluate.touchdown import SCALARS, touchdown_details, touchdown_scalars  # noqa: E402
 from approachsim.flight.envelope_study import admissible, cases, measure, profile_dict  # noqa: E402
 from approachsim.flight.run import Approach  # noqa: E402
 from approachsim.glidepath import GlidePath  # noqa: E402
@@ -184,8 +186,87 @@ def crosswind(runs: int, law: str | None, workers: int, speed_kt: float, turb: s
         "drift_over_5deg": int(sum(abs(r["td_gear_slip_rad"]) * deg > 5.0 for r in td)),
         # the bank criterion in use (12 deg at 1e-8, evaluate/touchdown.py): its distance from the mean in sd
         "bank_z_12deg": float((12.0 - abs(st("td_bank_rad", deg)["mean"])) / st("td_bank_rad", deg)["sd"]),
+        "criteria": _criteria(td, runs, runs - len(td)),
         "rows": rows,
     }
+
+
+def _criteria(td: list[dict], runs: int, failed: int) -> dict:
+    """The touchdown criteria (evaluate/touchdown.py CRITERIA, 95 %) over landing rows: per criterion the outcome,
+    z of the limit, the normal tail probability and its upper bound, the exceedances."""
+    cols = {k: np.array([r.get(k, math.nan) for r in td], dtype=float) for k in SCALARS}
+    det = touchdown_details(cols, runs=runs, failed_runs=failed, level=0.95)
+    out = {}
+    for key, c in det["criteria"].items():
+        nrm = c.get("normal") or {}
+        out[key] = {"outcome": c["outcome"], "probability_required": c["probability_required"],
+                    "z_required": c["z_required"], "exceedances": c["exceedances"], "z": nrm.get("z_limit"),
+                    "p": nrm.get("probability"), "p_upper": nrm.get("probability_upper"),
+                    "normality_rejected": (nrm.get("normality") or {}).get("rejected")}
+    return out
+
+
+# Dispersed conditions (the "average risk" population): ONERA SMAC's Monte Carlo dispersions (its CALC/MCpar.m,
+# [S], docs/touchdown.md): headwind component at 33 ft normal, mean 7.5 kt, sd 7.3 kt, clipped at a 10 kt tailwind
+# and (here) at the 737 envelope's 25 kt headwind where SMAC clips at 30; crosswind normal, sd 7 kt, clipped at
+# +-20 kt; glide slope 3 deg +-0.15 (drawn uniform: the script's distribution is not in the notes, [U]).
+HEAD_MEAN_KT, HEAD_SD_KT, HEAD_MIN_KT, HEAD_MAX_KT = 7.5, 7.3, -10.0, 25.0
+CROSS_SD_KT, CROSS_MAX_KT = 7.0, 20.0
+GP_DEG, GP_HALF_DEG = 3.0, 0.15
+
+
+def dispersed_condition(seed: int, run: int) -> tuple[float, float, float]:
+    """(headwind kt, crosswind from the right kt, glidepath deg) of run `run`: its own generator, seeded by
+    (seed, run), so that a run's condition does not depend on the others."""
+    rng = np.random.default_rng([seed, run, 40])
+    head = float(np.clip(rng.normal(HEAD_MEAN_KT, HEAD_SD_KT), HEAD_MIN_KT, HEAD_MAX_KT))
+    cross = float(np.clip(rng.normal(0.0, CROSS_SD_KT), -CROSS_MAX_KT, CROSS_MAX_KT))
+    gp = float(rng.uniform(GP_DEG - GP_HALF_DEG, GP_DEG + GP_HALF_DEG))
+    return head, cross, gp
+
+
+def _dispersed_job(args: tuple) -> list[dict]:
+    runs, seed, turb = args
+    out = []
+    for r in runs:
+        head, cross, gp = dispersed_condition(seed, r)
+        d = copy.deepcopy(BASE)
+        hdg = float(d["runway"]["heading_true_deg"])
+        d["runway"]["glidepath_deg"] = gp
+        d["environment"].update(wind_speed_kt=math.hypot(head, cross),
+                                wind_from_deg=(hdg + math.degrees(math.atan2(cross, head))) % 360.0, turbulence=turb)
+        approach = Approach(parse_profile(d, source=DEFAULT), land=True)
+        res = approach.fly(seed=1, run=r)
+        row = {"run": r, "headwind_kt": head, "crosswind_kt": cross, "glidepath_deg": gp,
+               "termination": res.termination, "ok": res.ok}
+        if res.termination == "touchdown":
+            row.update(touchdown_scalars(res.truth, approach.main_gear_lever_arms_m, approach.ground_contact_m))
+        out.append(row)
+    return out
+
+
+def dispersed(runs: int, workers: int, turb: str, seed: int = 40) -> dict:
+    """Landings over the dispersed conditions above, one condition per run, and the touchdown criteria over
+    them (average risk, with the light turbulence of the default profile)."""
+    chunks = [list(range(i, runs, workers * 4)) for i in range(workers * 4)]
+    with ProcessPoolExecutor(workers) as ex:
+        rows = sorted((r for rs in ex.map(_dispersed_job, [(c, seed, turb) for c in chunks]) for r in rs),
+                      key=lambda r: r["run"])
+    td = [r for r in rows if r["termination"] == "touchdown"]
+    deg, ft, fps = 180.0 / math.pi, 1.0 / units.FT, 1.0 / units.FPS
+
+    def st(key: str, f: float) -> dict:
+        v = np.array([r[key] for r in td]) * f
+        return {"mean": float(v.mean()), "sd": float(v.std(ddof=1)), "min": float(v.min()), "max": float(v.max())}
+
+    return {"landings": runs, "completed": len(td), "failed": runs - len(td), "turbulence": turb, "seed": seed,
+            "failures": sorted({r["termination"] for r in rows if r["termination"] != "touchdown"}),
+            "conditions": {"headwind_kt": st("headwind_kt", 1.0), "crosswind_kt": st("crosswind_kt", 1.0),
+                           "glidepath_deg": st("glidepath_deg", 1.0)},
+            "gear_x_ft": st("td_x_m", ft), "gear_y_ft": st("td_y_m", ft), "sink_fps": st("td_sink_mps", fps),
+            "bank_deg": st("td_bank_rad", deg), "drift_deg": st("td_gear_slip_rad", deg),
+            "pitch_deg": st("td_pitch_rad", deg), "contact_margin_deg": st("td_contact_margin_rad", deg),
+            "criteria": _criteria(td, runs, runs - len(td)), "rows": rows}
 
 
 def _fte_job(args: tuple) -> list[dict]:
@@ -275,7 +356,7 @@ def pair(a_path: Path, b_path: Path) -> dict:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("what", choices=["envelope", "crosswind", "fte", "paired", "pair"])
+    p.add_argument("what", choices=["envelope", "crosswind", "fte", "paired", "pair", "dispersed"])
     p.add_argument("--a", type=Path, help="paired: law A's envelope or fte output; pair: a crosswind output")
     p.add_argument("--b", type=Path, help="paired / pair: the other output on the same seeds")
     p.add_argument("--seeds", type=int, default=20)
@@ -298,6 +379,8 @@ def main() -> None:
         res = crosswind(a.runs, a.law, a.workers, a.wind_kt, a.turbulence or "light", a.decrab)
     elif a.what == "pair":
         res = pair(a.a, a.b)
+    elif a.what == "dispersed":
+        res = dispersed(a.runs, a.workers, a.turbulence or "light")
     else:
         res = fte(a.runs, a.law, a.workers)
     res["wall_s"] = time.time() - t0
