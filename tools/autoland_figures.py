@@ -9,6 +9,8 @@ a 20 kt crosswind, flight technical error against the straight glide path cone.
     python tools/autoland_figures.py paired --a tecs.json --b classic.json --out paired.json  # laws, same seeds, A - B
     python tools/autoland_figures.py dispersed --runs 200 --out disp.json        # landings over SMAC's wind / glide
                                                                                  # slope dispersions (average risk)
+    python tools/autoland_figures.py levels --runs 80 --out lev.json             # crosswind levels 0-20 kt, combined
+                                                                                 # by SMAC's crosswind law
     crosswind only: [--wind-kt KT] [--turbulence none|light|moderate|severe] (default light)
                     [--decrab aircraft|full] (full: no sideslip or bank limit, the decrab before the partial one)
 
@@ -269,6 +271,37 @@ def dispersed(runs: int, workers: int, turb: str, seed: int = 40) -> dict:
             "criteria": _criteria(td, runs, runs - len(td)), "rows": rows}
 
 
+def levels(runs: int, workers: int, turb: str, kts: tuple[float, ...] = (0.0, 5.0, 10.0, 15.0, 20.0)) -> dict:
+    """Average risk the way the 757/767 autoland certification combined its runs (Shakarian, AIAA 83-2193, [S]):
+    `runs` landings per crosswind level (crosswind mode, from the right; the left mirrors it), the criteria's
+    normal-tail probability per level, and their sum weighted by the probability of the level's bin under SMAC's
+    crosswind law N(0, 7 kt) clipped at +-20 kt (bins halfway between the levels, the clipped mass in the last).
+    The weighted sum of the per-level 95 % upper bounds is reported beside it (each level's bound holds at 95 %;
+    their weighted sum is conservative, not itself a 95 % bound). The limit risk is the largest level's."""
+    edges = [0.0] + [0.5 * (a + b) for a, b in zip(kts[:-1], kts[1:], strict=True)] + [math.inf]
+    cdf = stats.norm(0.0, CROSS_SD_KT).cdf
+    w = [2.0 * (cdf(min(hi, CROSS_MAX_KT)) - cdf(lo)) + (2.0 * (1.0 - cdf(CROSS_MAX_KT)) if hi == math.inf else 0.0)
+         for lo, hi in zip(edges[:-1], edges[1:], strict=True)]
+    per = {}
+    for kt in kts:
+        r = crosswind(runs, None, workers, kt, turb)
+        per[f"{kt:g}"] = {"criteria": r["criteria"], "sink_fps": r["sink_fps"], "gear_y_ft": r["gear_y_ft"],
+                          "bank_deg": r["bank_deg"], "failed": r["failed"]}
+    avg = {}
+    for key in per[f"{kts[0]:g}"]["criteria"]:
+        ps = [per[f"{kt:g}"]["criteria"][key]["p"] for kt in kts]
+        ups = [per[f"{kt:g}"]["criteria"][key]["p_upper"] for kt in kts]
+        ok = all(p is not None for p in ps + ups)
+        avg[key] = {"average_p": float(sum(wi * p for wi, p in zip(w, ps, strict=True))) if ok else None,
+                    "average_p_upper_sum": float(sum(wi * u for wi, u in zip(w, ups, strict=True))) if ok else None,
+                    "limit_p": ps[-1], "limit_p_upper": ups[-1],
+                    "probability_required": per[f"{kts[-1]:g}"]["criteria"][key]["probability_required"],
+                    "normality_rejected_at": [kt for kt in kts
+                                              if per[f"{kt:g}"]["criteria"][key]["normality_rejected"]]}
+    return {"runs_per_level": runs, "levels_kt": list(kts), "weights": w, "turbulence": turb, "levels": per,
+            "average_vs_limit": avg}
+
+
 def _fte_job(args: tuple) -> list[dict]:
     runs, law, turb = args
     d = copy.deepcopy(BASE)
@@ -356,7 +389,7 @@ def pair(a_path: Path, b_path: Path) -> dict:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("what", choices=["envelope", "crosswind", "fte", "paired", "pair", "dispersed"])
+    p.add_argument("what", choices=["envelope", "crosswind", "fte", "paired", "pair", "dispersed", "levels"])
     p.add_argument("--a", type=Path, help="paired: law A's envelope or fte output; pair: a crosswind output")
     p.add_argument("--b", type=Path, help="paired / pair: the other output on the same seeds")
     p.add_argument("--seeds", type=int, default=20)
@@ -381,6 +414,8 @@ def main() -> None:
         res = pair(a.a, a.b)
     elif a.what == "dispersed":
         res = dispersed(a.runs, a.workers, a.turbulence or "light")
+    elif a.what == "levels":
+        res = levels(a.runs, a.workers, a.turbulence or "light")
     else:
         res = fte(a.runs, a.law, a.workers)
     res["wall_s"] = time.time() - t0
