@@ -134,21 +134,26 @@ AP_GAINS = ("k_theta", "k_q", "k_gs_p", "k_gs_d", "k_gs_i", "k_v_p", "k_v_i", "t
             "tecs_thr_per_rad", "tecs_k_thr_damp", "tecs_k_thr_i", "tecs_k_pitch_damp", "tecs_k_pitch_i",
             "tecs_seb_ff", "tecs_spd_weight", "tecs_rate_tau_s", "tecs_sink_max_mps", "tecs_climb_max_mps",
             "tecs_vert_acc_mps2", "align_height_m", "align_tau_s", "k_r_align", "k_beta_align", "k_phi_align",
-            "k_da_align", "align_bank_max_rad", "align_cas_mps")
+            "k_da_align", "align_bank_max_rad", "align_cas_mps", "align_sideslip_max_rad", "flare_t_path_s",
+            "flare_k_v")
 """flight.design.AutopilotGains fields, in the order of the autopilot parameter vector."""
 AP_PAR = Layout(_scalars(*AP_GAINS, "theta0_rad", "throttle0", "cas0_mps", "cos_heading", "sin_heading",
-                         "heading_rad", "tan_gp", "x_gpi_m", "cone_a", "cone_b", "cone_c", "conv_per_east_m", "dt_s"))
+                         "heading_rad", "tan_gp", "x_gpi_m", "cone_a", "cone_b", "cone_c", "conv_per_east_m",
+                         "gear_arm_m", "dt_s"))
 (AP_K_THETA, AP_K_Q, AP_K_GS_P, AP_K_GS_D, AP_K_GS_I, AP_K_V_P, AP_K_V_I, AP_TAU_V, AP_K_PHI, AP_K_P, AP_K_BETA,
  AP_K_LOC_P, AP_K_LOC_D, AP_K_LOC_I, AP_BANK_LIMIT, AP_PITCH_LIMIT, AP_TAU_WIND, AP_FLARE_H, AP_TD_SINK,
  AP_K_FLARE, AP_K_FLARE_I, AP_RETARD_H, AP_TECS, AP_T_H, AP_T_V, AP_K_THR, AP_K_TD, AP_K_TI, AP_K_PD, AP_K_PI,
  AP_SEB_FF, AP_SPD_W, AP_RATE_TAU, AP_SINK_MAX, AP_CLIMB_MAX, AP_VERT_ACC, AP_ALIGN_H, AP_ALIGN_TAU, AP_K_R_ALIGN,
- AP_K_BETA_ALIGN, AP_K_PHI_ALIGN, AP_K_DA_ALIGN, AP_ALIGN_BANK_MAX, AP_ALIGN_CAS, AP_THETA0, AP_THR0, AP_CAS0, AP_CH,
- AP_SH, AP_HEADING, AP_TAN_GP, AP_X_GPI, AP_CONE_A, AP_CONE_B, AP_CONE_C, AP_CONV, AP_DT) = AP_PAR.starts()
+ AP_K_BETA_ALIGN, AP_K_PHI_ALIGN, AP_K_DA_ALIGN, AP_ALIGN_BANK_MAX, AP_ALIGN_CAS, AP_ALIGN_BETA_MAX, AP_FLARE_T_PATH,
+ AP_FLARE_K_V, AP_THETA0, AP_THR0, AP_CAS0, AP_CH, AP_SH, AP_HEADING, AP_TAN_GP, AP_X_GPI, AP_CONE_A, AP_CONE_B,
+ AP_CONE_C, AP_CONV, AP_GEAR_ARM, AP_DT) = AP_PAR.starts()
 N_AP_PAR = AP_PAR.size
 AP_STATE = Layout(_scalars("int_d", "int_y", "e_f", "wind", "int_e", "flaring", "theta_flare0", "int_flare",
-                           "theta_c", "v_lag", "int_t", "int_b", "flare_tau", "flare_h_off", "aligning"))
+                           "theta_c", "v_lag", "int_t", "int_b", "flare_tau", "flare_h_off", "aligning",
+                           "flare_sink0", "flare_v0"))
 (APS_INT_D, APS_INT_Y, APS_E_F, APS_WIND, APS_INT_E, APS_FLARING, APS_THETA_FLARE0, APS_INT_FLARE,
- APS_THETA_C, APS_V_LAG, APS_INT_T, APS_INT_B, APS_FLARE_TAU, APS_FLARE_H_OFF, APS_ALIGNING) = AP_STATE.starts()
+ APS_THETA_C, APS_V_LAG, APS_INT_T, APS_INT_B, APS_FLARE_TAU, APS_FLARE_H_OFF, APS_ALIGNING,
+ APS_FLARE_SINK0, APS_FLARE_V0) = AP_STATE.starts()
 N_AP_STATE = AP_STATE.size
 
 # --- Dryden turbulence: W20, dt, wind-axes rotation, the intensity table's altitudes and the level's row; state ---

@@ -70,7 +70,7 @@ Array = np.ndarray
 SCALARS = (
     "td_t_s", "td_x_m", "td_y_m", "td_left_gear_y_m", "td_right_gear_y_m", "td_outboard_gear_y_m", "td_sink_mps",
     "td_gear_height_m", "td_imu_x_m", "td_imu_y_m", "td_imu_sink_mps", "td_bank_rad", "td_pitch_rad", "td_crab_rad",
-    "td_gear_slip_rad", "td_cas_mps",
+    "td_gear_slip_rad", "td_cas_mps", "td_contact_bank_rad", "td_contact_margin_rad",
 )
 """The per-run touchdown scalars (runs.parquet columns of a landing campaign), SI."""
 
@@ -111,10 +111,37 @@ def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
-def touchdown_scalars(truth: Truth, main_gear_body_m: Array) -> dict[str, float]:
+def contact_bank_rad(theta_rad: float, d_body_m: Array) -> Array:
+    """Bank angle (rad) at which points touch the ground plane the main gear of their side stands on, at pitch
+    theta, rolling towards them: d_body_m (k, 3) the points' offsets from that gear's contact point, body axes
+    (x forward, y outboard, z down), m. The point's height above the ground is
+        h(phi) = sin(theta) d_x - cos(theta) (sin(phi) |d_y| + cos(phi) d_z)
+    (rows of C_nb with the heading dropped), zero where A sin(phi) + B cos(phi) = C, A = cos(theta) |d_y|,
+    B = cos(theta) d_z, C = sin(theta) d_x: phi = asin(C / R) - atan2(B, A), R = hypot(A, B). At theta = 0 a point
+    h_0 = -d_z above the ground and |d_y| outboard touches at atan(h_0 / |d_y|); a nose-up pitch raises a point
+    ahead of the gear (the nacelle) and lowers one behind it (a swept wingtip)."""
+    d = np.atleast_2d(np.asarray(d_body_m, dtype=float))
+    ct, st = math.cos(theta_rad), math.sin(theta_rad)
+    a, b, c = ct * np.abs(d[:, 1]), ct * d[:, 2], st * d[:, 0]
+    r = np.hypot(a, b)
+    return np.arcsin(np.clip(c / r, -1.0, 1.0)) - np.arctan2(b, a)
+
+
+def contact_offsets_m(points_struct_m: Array, gear_struct_m: Array, compression_m: float) -> Array:
+    """(k, 3) body-axis offsets (x forward, y right, z down), m, of right-wing points from the right main gear's
+    contact point, both given in JSBSim's structural frame (x aft, y right, z up), with the gear strut compressed
+    by compression_m (the body comes that much closer to the ground)."""
+    p = np.atleast_2d(np.asarray(points_struct_m, dtype=float))
+    g = np.asarray(gear_struct_m, dtype=float)
+    return np.column_stack((-(p[:, 0] - g[0]), p[:, 1] - g[1], -(p[:, 2] - g[2]) + compression_m))
+
+
+def touchdown_scalars(truth: Truth, main_gear_body_m: Array, contact_body_m: Array | None = None) -> dict[str, float]:
     """The run's touchdown quantities (SCALARS, SI) from the last row of a landing run's truth (the touchdown row)
     and the left and right main-gear contact points relative to the IMU, (2, 3) body axes (x forward, y right,
-    z down), m."""
+    z down), m. contact_body_m: the right wing's ground-contact points' offsets from the right main gear
+    (contact_offsets_m; the left wing's mirror them): the contact bank at the touchdown pitch on the low wing's
+    side and the margin to it (nan without them)."""
     k = len(truth) - 1
     heading = truth.runway.heading_rad
     pos, vel = gear_state(truth.r_rwy[k], truth.v_ned[k], truth.euler_rad[k], truth.w_ib_body[k], heading,
@@ -141,7 +168,17 @@ def touchdown_scalars(truth: Truth, main_gear_body_m: Array) -> dict[str, float]
         "td_crab_rad": _wrap(psi - heading),
         "td_gear_slip_rad": _wrap(track - psi),
         "td_cas_mps": float(truth.airspeed_mps[k]),
+        **_contact(theta, phi, contact_body_m),
     }
+
+
+def _contact(theta: float, phi: float, contact_body_m: Array | None) -> dict[str, float]:
+    """td_contact_bank_rad (the smallest bank at which a low-wing point touches, at pitch theta) and
+    td_contact_margin_rad (that less |bank|; < 0: contact)."""
+    if contact_body_m is None:
+        return {"td_contact_bank_rad": math.nan, "td_contact_margin_rad": math.nan}
+    limit = float(np.min(contact_bank_rad(theta, contact_body_m)))
+    return {"td_contact_bank_rad": limit, "td_contact_margin_rad": limit - abs(phi)}
 
 
 # --- criteria ----------------------------------------------------------------------------------------------------
@@ -221,6 +258,14 @@ CRITERIA = (
     Criterion("bank", "td_bank_rad", "abs_above", math.radians(12.0), "deg", 1e-8, "S",
               SMAC + "p5 = prob(|PHI| > 12 deg), roll angle at touchdown, average risk < 1e-8",
               "bank angle above 12 deg at touchdown"),
+    Criterion("ground_contact", "td_contact_margin_rad", "below", 0.0, "deg", 1e-8, "U",
+              "the aircraft's own ground-contact bank: the low wing's nacelle or wingtip touching the runway at the "
+              "touchdown pitch with the main gear strut at its static compression (the aircraft file's "
+              "[ground_contact] points: the JSBSim model's engine stations, span and gear, and a nacelle clearance "
+              "and wing outline not yet read in a Boeing ground-clearance table, U). Probability: the bank "
+              "criterion's 1e-8 (" + SMAC + "p5, the roll angle standing for wing or nacelle contact)",
+              "low-wing nacelle or wingtip below the runway at touchdown (bank beyond the contact bank at the "
+              "touchdown pitch; unverified geometry)"),
     Criterion("gear_slip", "td_gear_slip_rad", "abs_above", math.radians(14.0), "deg", 1e-6, "S",
               SMAC + "p6 = prob(|SSTP| > 14 deg), main landing gear sideslip angle at touchdown, average risk "
               "< 1e-6",
@@ -246,6 +291,9 @@ QUANTITIES = {
     "td_crab_rad": ("crab_deg", "deg", "heading minus runway heading"),
     "td_gear_slip_rad": ("gear_slip_deg", "deg", "main-gear ground track minus heading"),
     "td_cas_mps": ("cas_kt", "kt", "calibrated airspeed"),
+    "td_contact_bank_rad": ("contact_bank_deg", "deg", "bank at which the low wing's nacelle or wingtip touches the "
+                            "runway at the touchdown pitch (gear strut at its static compression)"),
+    "td_contact_margin_rad": ("contact_margin_deg", "deg", "contact bank less the bank at touchdown"),
 }
 """Per-run column -> (details.json name, display unit, what) of the quantities summarised."""
 

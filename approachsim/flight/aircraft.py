@@ -41,6 +41,19 @@ class Aircraft:
     source: Path
     limits: ApproachLimits
     """The approach limits of the aircraft file's [envelope] table (flight.envelope)."""
+    ground_contact: GroundContact | None = None
+    """The aircraft file's [ground_contact] table (None: no ground-contact criterion)."""
+
+
+@dataclass(frozen=True)
+class GroundContact:
+    """Points of the right wing that touch the runway first in a banked touchdown (the left wing's are their
+    mirror), in JSBSim's structural frame (x aft, y right, z up), m, and the main gear's strut compression at which
+    the contact bank is taken, m (aircraft file [ground_contact])."""
+
+    points_struct_m: tuple[tuple[float, float, float], ...]
+    names: tuple[str, ...]
+    gear_compression_m: float
 
 
 def aircraft_dirs(profile: Profile | None) -> list[Path]:
@@ -108,9 +121,24 @@ def _gains(s: Section) -> AutopilotGains:
         align_bank_max_rad=math.radians(s.number("align_bank_max_deg", math.inf, lo=0.0, hi=90.0, lo_open=True,
                                                  unit="deg")),
         align_cas_mps=s.number("align_design_cas_kt", 0.0, lo=0.0, hi=300.0, unit="kt") * units.KT,
+        align_sideslip_max_rad=math.radians(s.number("align_sideslip_max_deg", math.inf, lo=0.0, hi=30.0,
+                                                     lo_open=True, unit="deg")),
+        flare_t_path_s=s.number("flare_t_path_s", 0.0, lo=0.0, hi=10.0, unit="s"),
+        flare_k_v=s.number("flare_k_v", 0.0, lo=0.0, hi=1.0),
     )
     s.done()
     return g
+
+
+def _ground_contact(s: Section) -> GroundContact:
+    names = ("nacelle", "wingtip")
+    pts = tuple(tuple(s.number(f"{n}_{c}_in", unit="in") * IN for c in "xyz") for n in names)
+    comp = s.number("gear_compression_in", 0.0, lo=0.0, hi=40.0, unit="in") * IN
+    s.done()
+    for n, p in zip(names, pts, strict=True):
+        if p[1] <= 0.0:
+            raise ProfileError(f"{s.path}.{n}_y_in: must be positive (the right wing's point)")
+    return GroundContact(points_struct_m=pts, names=names, gear_compression_m=comp)  # type: ignore[arg-type]
 
 
 def _limits(s: Section) -> ApproachLimits:
@@ -152,6 +180,7 @@ def parse_aircraft(data: dict, source: Path) -> Aircraft:
     imu.done()
     gains = _gains(top.section("autopilot", default_empty=False))
     limits = _limits(top.section("envelope", default_empty=False))
+    contact = _ground_contact(top.section("ground_contact")) if top.has("ground_contact") else None
     top.done()
     return Aircraft(
         name=name,
@@ -164,6 +193,7 @@ def parse_aircraft(data: dict, source: Path) -> Aircraft:
         gains=gains,
         source=source,
         limits=limits,
+        ground_contact=contact,
     )
 
 
@@ -191,4 +221,5 @@ def load_aircraft(profile: Profile) -> Aircraft:
             ac.gains, tecs=choice.autopilot_law == "tecs"),
         source=ac.source,
         limits=ac.limits,
+        ground_contact=ac.ground_contact,
     )

@@ -44,24 +44,38 @@ K_TP / K_TI = K_EP / K_EI.
 
 Landing runs (h_gear: main-gear height above the terrain, the radio altitude) add:
 
-* an exponential flare from flare_height (Stevens & Lewis style, approachsim's reference notes sec. 5): the sink-rate
-  command h'_c = -(h_gear - h_off) / tau with tau and h_off set at flare entry from the sink rate h'_0 there, so that
-  the command starts at the aircraft's sink rate (continuity: h_f - h_off = tau h'_0) and ends at the touchdown
-  sink (h_off = -tau sink_td):  tau = h_f / (h'_0 - sink_td);  theta_c = theta_entry + k_flare e + k_flare_i int e,
-  e = h'_c - h' (> 0: sinking too fast); the throttle to idle below retard_height.
-* a decrab (runway alignment) below align_height: the rudder turns the heading onto the runway's and holds the
-  sideslip that the crosswind then needs (the 737 FCTM's sideslip technique: "prior to the flare the airplane
-  centerline is aligned on or parallel to the runway centerline", upwind wing low; the localizer loop banks into
-  the wind): r_c = -(crab - crab_res) / tau_align,  dr = k_r_align (r - r_c) + k_beta_align beta,
+* an exponential flare from flare_height (Stevens & Lewis style, approachsim's reference notes sec. 5) on the main
+  gear's height: the sink-rate command h'_c = -(h_gear - h_off) / tau with tau and h_off set at flare entry from the
+  sink rate s_0 there, so that the command starts at the aircraft's sink rate (continuity: h_f - h_off = tau s_0)
+  and ends at the touchdown sink (h_off = -tau s_td): tau = h_f / (s_0 - s_td). The sink rate fed back is the
+  guidance point's, s = v_down (the main gear's, l_g behind it, adds l_g q: a non-minimum-phase term that, fed back,
+  would cancel the pitch loop's rate damping), and the pitch command feeds the commanded path forward:
+      s_c = (h_gear - h_off) / tau,  e = s - s_c  (> 0: sinking too fast)
+      theta_c = theta_entry + (s_0 - s_c) / V + T_theta2 s / (tau V) + k_v (V_0 - V) + k_flare e + k_flare_i int e
+  At constant speed and angle of attack the path angle follows pitch one for one, gamma / theta = 1 / (1 + T_theta2
+  s) (T_theta2 = -1 / Z_alpha', the landing linearization's), so the pitch that flies the commanded path angle
+  gamma_c = -s_c / V is gamma_c + T_theta2 gamma_c' with gamma_c' = s / (tau V): the first two terms; k_v (V_0 - V)
+  is the angle of attack that holds the lift as the speed V (the smoothed true airspeed) falls below its entry
+  value V_0 (0 where ground effect cancels it, as in the 737 file); the PI on e takes up what they leave. The
+  throttle goes to idle below retard_height.
+* a runway alignment below align_height (the 737 MAX's alignment mode engages at 450 ft radio altitude, 737 MAX
+  FCOM): the rudder turns the heading onto the runway's and holds the sideslip that the crosswind then needs (the
+  737 FCTM's sideslip technique: "prior to the flare the airplane centerline is aligned on or parallel to the
+  runway centerline", upwind wing low; the localizer loop banks into the wind to hold the track):
+  r_c = -(crab - crab_res) / tau_align,  dr = k_r_align (r - r_c) + k_beta_align beta,
   crab = psi - runway heading. k_beta_align = -N_beta / N_dr holds the sideslip (yaw moment balance),
   k_r_align = (1/tau_r + N_r) / -N_dr puts the yaw-rate loop's pole at -1/tau_r, tau_r = tau_align / 3
-  (linearization derivatives; the aircraft file has them). The decrab is partial in a strong crosswind (as the
-  737's alignment mode: "Sideslip is limited to 5 degrees"): the bank that holds a sideslip beta is k_pb beta,
+  (linearization derivatives; the aircraft file has them). The decrab is partial in a strong crosswind (737 MAX
+  alignment mode: "Sideslip is limited to 5 degrees"): the bank that holds a sideslip beta is k_pb beta,
   k_pb = k_phi_align (V_c / V_design)^2 (the side-force balance -(Y_beta + Y_dr k_beta_align) / (g / V) of the
-  linearization, proportional to the dynamic pressure), so the sideslip is limited to b_max = bank_max / k_pb and
+  linearization, proportional to the dynamic pressure), so the sideslip is limited to
+  b_max = min(sideslip_max, bank_max / k_pb) (the bank allowance binds at high speed, the 5 deg below) and
   the rest of the wind correction eta = crab + beta (the air-relative track's angle to the runway, which the yaw
   manoeuvre only shares out between crab and sideslip) stays as crab: crab_res = eta - clip(eta, -b_max, b_max)
-  (0 when |eta| <= b_max: the full decrab); the bank command adds k_pb beta, the aileron k_da_align beta.
+  (0 when |eta| <= b_max: the full decrab); the bank command adds k_pb beta, the aileron k_da_align beta. While
+  aligning, the localizer loop steers the main gears' centre, l_g behind the guidance point, onto the centreline:
+  y_g = y - l_g sin(crab), y_g' = y' - l_g cos(crab) r (in the crab that is left the gear trails downwind of
+  the guidance point, 0.5 m at 3 deg).
 
 Sign conventions of the 737 FCS: + elevator = nose down, + aileron = roll right, + rudder = nose left.
 This class is the readable oracle; the flight loop runs its compiled twin (core/loop/flight_step.autopilot_step, equal
@@ -105,8 +119,13 @@ class Geometry:
 class Autopilot:
     """The approach autopilot of one run: holds its integrators and filter state (re-create per run)."""
 
-    def __init__(self, gains: AutopilotGains, trim: Trim, geometry: Geometry, dt_s: float) -> None:
+    def __init__(self, gains: AutopilotGains, trim: Trim, geometry: Geometry, dt_s: float, *,
+                 gear_arm_m: float = 0.0) -> None:
         self.g = gains
+        self.gear_arm_m = gear_arm_m
+        """Distance along the body x axis from the guidance point (the IMU) back to the main gears' centre, m
+        (JSBSim model geometry, flight/run.Approach.gear_arm_m): the alignment steers the main gear onto the
+        centreline, the flare regulates the main gear's sink rate."""
         self.trim = trim
         self.dt = dt_s
         self.heading_rad = geometry.heading_rad
@@ -137,6 +156,8 @@ class Autopilot:
         self._flare_tau = 0.0
         self._flare_h_off = 0.0
         self.aligning = False
+        self._flare_sink0 = 0.0  # the sink rate at flare entry (at least touchdown sink + 0.1), m/s
+        self._flare_v0 = 0.0  # the smoothed true airspeed at flare entry, m/s
 
     def deviations(self, x: float, y: float, z: float, vn: float, ve: float, vd: float) -> tuple[float, ...]:
         """Glidepath deviation d (m, + above the cone), its rate (m/s), cross-track y (m, + right) and its rate
@@ -164,12 +185,14 @@ class Autopilot:
         psi, r: true heading (rad) and yaw rate (rad/s) for the decrab (psi None: no decrab)."""
         g = self.g
         dt = self.dt
+        v_air = cas  # the smoothed true airspeed (the air-mass speed) when TAS is given
         if tas is not None and tas > 1.0:  # inertially smoothed speed (module docstring)
             gs = math.sqrt(vn * vn + ve * ve + vd * vd)
             if self._w != self._w:
                 self._w = tas - gs
             self._w += dt / g.tau_wind_s * (tas - gs - self._w)
-            cas = cas * (gs + self._w) / tas
+            v_air = gs + self._w
+            cas = cas * v_air / tas
         # deviations (as deviations(), inlined: this runs every step)
         ch, sh = self.ch, self.sh
         conv = (x * sh + y * ch) * self.conv_per_east_m
@@ -197,10 +220,20 @@ class Autopilot:
             else:
                 thr = 1.0 if thr >= 1.0 else 0.0
         if h_gear is not None and (self.flaring or h_gear <= g.flare_height_m):
-            theta_c, thr_flare = self._flare(h_gear, -vd)
+            sink = vd  # the guidance point's (module docstring: why not the main gear's)
+            theta_c, thr_flare = self._flare(h_gear, sink, v_air)
             thr = min(thr, thr_flare)
         self._theta_c = theta_c
         de = -g.k_theta * (theta_c - theta) + g.k_q * q
+        aligning = h_gear is not None and psi is not None and (self.aligning or h_gear <= g.align_height_m)
+        crab = 0.0
+        if aligning:
+            self.aligning = True
+            crab = _wrap(psi - (self.heading_rad + conv))
+            # the main gears' centre, gear_arm behind the guidance point, is what the alignment puts on the
+            # centreline: its cross-track and rate
+            y = y - self.gear_arm_m * math.sin(crab)
+            y_dot = y_dot - self.gear_arm_m * math.cos(crab) * r
         # localizer -> bank command
         phi_c = -(g.k_loc_p * y + g.k_loc_d * y_dot + g.k_loc_i * self.int_y)
         blim = g.bank_limit_rad
@@ -208,15 +241,14 @@ class Autopilot:
             self.int_y += y * dt
         else:
             phi_c = blim if phi_c > 0.0 else -blim
-        if h_gear is not None and psi is not None and (self.aligning or h_gear <= g.align_height_m):
-            self.aligning = True
-            crab = _wrap(psi - (self.heading_rad + conv))
+        if aligning:
             k_pb = g.k_phi_align  # bank per sideslip at the approach speed (dynamic pressure ratio)
             if g.align_cas_mps > 0.0:
                 sq = self.trim.cas_mps / g.align_cas_mps
                 k_pb = k_pb * (sq * sq)
-            # the sideslip the bank allowance admits; the rest of the wind correction (crab + beta) stays as crab
-            b_max = g.align_bank_max_rad / k_pb if k_pb > 0.0 else math.inf
+            # the sideslip limit (737 MAX: 5 deg) and the one the bank allowance admits, the smaller; the rest of
+            # the wind correction (crab + beta) stays as crab
+            b_max = min(g.align_sideslip_max_rad, g.align_bank_max_rad / k_pb if k_pb > 0.0 else math.inf)
             eta = crab + beta
             crab_res = eta - min(max(eta, -b_max), b_max)
             dr = g.k_r_align * (r + (crab - crab_res) / g.align_tau_s) + g.k_beta_align * beta
@@ -268,25 +300,33 @@ class Autopilot:
     def state(self) -> tuple[float, ...]:
         """The integrators and filters (int d, int y, e_f, wind along the path, int e_f, flaring, flare-entry pitch
         command, flare integral, last pitch command, TECS speed washout, int E_T, int E_B, flare tau, flare h_off,
-        aligning): the compiled autopilot's APS_* state vector."""
+        aligning, flare-entry sink rate and airspeed): the compiled autopilot's APS_* state vector."""
         return (self.int_d, self.int_y, self.e_f, self._w, self.int_e, float(self.flaring), self._theta_flare0,
                 self._int_flare, self._theta_c, self._v_lag, self.int_t, self.int_b, self._flare_tau,
-                self._flare_h_off, float(self.aligning))
+                self._flare_h_off, float(self.aligning), self._flare_sink0, self._flare_v0)
 
-    def _flare(self, h_gear: float, h_dot: float) -> tuple[float, float]:
-        """Exponential flare (module docstring): pitch command from the sink-rate error to
-        h'_c = -(h_gear - h_off) / tau, tau and h_off from the sink rate at entry; throttle limit (1 above the
-        retard height, then idle)."""
+    def _flare(self, h_gear: float, sink: float, v_air: float) -> tuple[float, float]:
+        """Exponential flare with its path feed-forward (module docstring): pitch command to fly the main gear's
+        sink rate `sink` (m/s, + down) onto h'_c = -(h_gear - h_off) / tau, tau and h_off from the sink rate at
+        entry, at airspeed v_air (m/s); throttle limit (1 above the retard height, then idle)."""
         g = self.g
         if not self.flaring:
             self.flaring = True
             self._theta_flare0 = self._theta_c
-            sink0 = max(-h_dot, g.touchdown_sink_mps + 0.1)  # an entry sink below the touchdown sink: 0.1 m/s above
+            sink0 = max(sink, g.touchdown_sink_mps + 0.1)  # an entry sink below the touchdown sink: 0.1 m/s above
             self._flare_tau = max(h_gear, 0.0) / (sink0 - g.touchdown_sink_mps) if h_gear > 0.0 else 1.0
             self._flare_h_off = -self._flare_tau * g.touchdown_sink_mps
-        e = -(max(h_gear, 0.0) - self._flare_h_off) / self._flare_tau - h_dot  # > 0: sinking too fast
+            self._flare_sink0 = sink0
+            self._flare_v0 = v_air
+        tau = self._flare_tau
+        sink_c = (max(h_gear, 0.0) - self._flare_h_off) / tau  # the commanded sink rate
+        e = sink - sink_c  # > 0: sinking too fast
         self._int_flare += e * self.dt
-        theta_c = self._theta_flare0 + g.k_flare * e + g.k_flare_i * self._int_flare
+        v0 = max(v_air, 1.0)
+        # feed-forward: the commanded path-angle change, led by the path's lag T_theta2 behind pitch
+        ff = ((self._flare_sink0 - sink_c) / v0 + g.flare_t_path_s * sink / (tau * v0)
+              + g.flare_k_v * (self._flare_v0 - v_air))
+        theta_c = self._theta_flare0 + ff + g.k_flare * e + g.k_flare_i * self._int_flare
         thr_limit = 1.0 if h_gear > g.retard_height_m else 0.0
         return theta_c, thr_limit
 

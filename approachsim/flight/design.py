@@ -151,6 +151,16 @@ class AutopilotGains:
     align_cas_mps: float = 0.0
     """Calibrated airspeed of the linearization k_phi_align comes from, m/s (the bank per sideslip scales with the
     dynamic pressure: k_phi_align (V_c / align_cas)^2 at the approach speed V_c; 0: not scheduled)."""
+    align_sideslip_max_rad: float = math.inf
+    """Decrab sideslip limit, rad (the 737 MAX alignment mode's 5 deg): the sideslip is limited to the smaller of
+    this and the bank allowance's align_bank_max / k_pb; the rest of the wind correction stays as crab."""
+    flare_t_path_s: float = 0.0
+    """Flare feed-forward: the flight-path lag behind pitch at constant speed, T_theta2 = -1 / Z_alpha' (the
+    landing linearization's alpha-row alpha coefficient), s; the pitch command leads the commanded path angle by
+    it (0: no lead term). The path-angle change itself is always fed forward."""
+    flare_k_v: float = 0.0
+    """Flare feed-forward: pitch per airspeed lost since flare entry at constant lift and path angle,
+    A_alpha,V / (A_alpha,alpha + A_alpha,theta) of the landing linearization, rad s/m (0: none)."""
 
 
 @dataclass(frozen=True)

@@ -55,7 +55,7 @@ from approachsim.core.loop import closed_step as ck
 from approachsim.core.loop import direct as dk
 from approachsim.core.loop import flight_step as fk
 from approachsim.core.loop import jsbsim_abi
-from approachsim.evaluate.touchdown import touchdown_scalars
+from approachsim.evaluate.touchdown import contact_offsets_m, touchdown_scalars
 from approachsim.flight import vectors as fv
 from approachsim.flight.aircraft import Aircraft, load_aircraft
 from approachsim.flight.autopilot import Autopilot, Geometry, Trim
@@ -186,6 +186,7 @@ class Approach:
         self._lin: Linearization | None = None
         self._start: InitialCondition | None = None
         self._gear: Array | None = None
+        self._contact: Array | None = None
 
     def start(self) -> InitialCondition:
         """The initial-condition command that JSBSim trims at the approach CAS on the glidepath in the profile's
@@ -230,6 +231,27 @@ class Approach:
                                    f"left and right main gear (y {arms[0, 1]:.2f}, {arms[1, 1]:.2f} m)")
             self._gear = arms
         return self._gear
+
+    @property
+    def ground_contact_m(self) -> Array | None:
+        """(k, 3) the right wing's ground-contact points' offsets from the right main gear's contact point, body
+        axes (x forward, y right, z down), m, with the strut at the aircraft file's compression
+        (evaluate.touchdown.contact_offsets_m; None: the aircraft file has no [ground_contact] table)."""
+        gc = self.aircraft.ground_contact
+        if gc is None:
+            return None
+        if self._contact is None:
+            fdm = FDM(self.aircraft.jsbsim_model, self.dt_s)
+            self._contact = contact_offsets_m(np.array(gc.points_struct_m), fdm.gear_location_struct_m(2),
+                                              gc.gear_compression_m)
+        return self._contact
+
+    @property
+    def gear_arm_m(self) -> float:
+        """Distance along the body x axis from the IMU (the guidance point) back to the main gears' centre, m: the
+        autopilot steers the main gear onto the centreline in the runway alignment and flares on its height and
+        sink rate (main_gear_lever_arms_m; 10.11 m for the 737)."""
+        return float(-np.mean(self.main_gear_lever_arms_m[:, 0]))
 
     @property
     def linearization(self) -> Linearization:
@@ -364,7 +386,7 @@ class Approach:
         fs = st[layouts.S_STEP:layouts.S_STEP + layouts.N_F_STATE]
         td = {}
         if code in (fk.TERM_TOUCHDOWN, fk.TERM_SHORT):  # scored at the main gear, not the IMU point
-            sc = touchdown_scalars(final, self.main_gear_lever_arms_m)
+            sc = touchdown_scalars(final, self.main_gear_lever_arms_m, self.ground_contact_m)
             td = {"touchdown_x_m": sc["td_x_m"], "touchdown_sink_mps": sc["td_sink_mps"],
                   "touchdown_y_m": sc["td_y_m"], "touchdown_drift_rad": sc["td_gear_slip_rad"],
                   "touchdown_crab_rad": sc["td_crab_rad"]}
@@ -424,7 +446,8 @@ class Approach:
         const = imu_point_constants(np.array(lever), ic.lat_rad, rw, dt)
         trim = Trim(theta_rad=fdm["attitude/theta-rad"], throttle=fdm["fcs/throttle-cmd-norm[0]"],
                     cas_mps=ac.approach_speed_mps)
-        ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m, rw.threshold_lat_rad), dt)
+        ap = Autopilot(ac.gains, trim, Geometry(rw.heading_rad, rw.glidepath_rad, rw.tch_m, rw.threshold_lat_rad), dt,
+                       gear_arm_m=self.gear_arm_m)
         monitor = StabilityMonitor(rw.glidepath_rad, rw.tch_m, ac.approach_speed_mps, dt,
                                    curvature=ap.cone.curvature)
         turb = None

@@ -138,7 +138,7 @@ def autopilot_arrays(ap: Any) -> tuple[Array, Array]:
     """(parameters, state) of the compiled autopilot (AP_*, APS_*) from its oracle (flight/autopilot.Autopilot)."""
     par = [getattr(ap.g, name) for name in layouts.AP_GAINS]
     par += [ap.trim.theta_rad, ap.trim.throttle, ap.trim.cas_mps, ap.ch, ap.sh, ap.heading_rad, ap.tan_gp,
-            ap.x_gpi_m, ap.cone_a, ap.cone_b, ap.cone_c, ap.conv_per_east_m, ap.dt]
+            ap.x_gpi_m, ap.cone_a, ap.cone_b, ap.cone_c, ap.conv_per_east_m, ap.gear_arm_m, ap.dt]
     return np.array(par, dtype=float), np.array(ap.state(), dtype=float)
 
 

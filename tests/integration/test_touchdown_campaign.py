@@ -110,8 +110,13 @@ def test_landing_campaign_end_to_end(tmp_path):
 
 @pytest.mark.slow
 def test_decision_heights_are_scored_as_in_an_approach_campaign():
-    """The same run flown as an approach and as a landing: identical to the decision heights above the flare
-    (CAT I and CAT II errors bit for bit), the landing adding only its touchdown columns."""
+    """The same run flown as an approach and as a landing: the landing adds its touchdown columns, and its
+    navigation errors at the decision heights are the approach run's within 1 % of the CAT III limits (lateral
+    6.8 ft, vertical 1.0 ft, design.md). Not bit for bit: the landing run aligns with the runway from 450 ft (the
+    737 MAX's alignment mode, aircraft file), above CAT I and II, and steers the main gear onto the centreline,
+    so from there its path, and with it the flight technical error, differs (observed: lateral 3.3 mm at CAT I;
+    FTE lateral 0.34 m, not compared)."""
+    from approachsim import units
     from approachsim.campaign.pipeline import closed_loop_group
     from approachsim.evaluate.touchdown import SCALARS
     from approachsim.profile import load_profile
@@ -121,8 +126,8 @@ def test_decision_heights_are_scored_as_in_an_approach_campaign():
     (b,) = closed_loop_group(profile, 5, [2], land=True)
     assert a.ok and b.ok, (a.error, b.error)
     assert set(b.scalars) - set(a.scalars) == set(SCALARS)
-    for key in ("cat1", "cat2"):
-        for comp in ("lateral_m", "vertical_m", "along_m", "t_s", "vpl_m", "tse_vert_m", "fte_lat_m"):
-            assert b.scalars[f"{key}_{comp}"] == a.scalars[f"{key}_{comp}"], (key, comp)
-    # CAT III (50 ft) may fall in the first instants of the flare (main gear at 50 ft): the error barely moves
-    assert b.scalars["cat3_vertical_m"] == pytest.approx(a.scalars["cat3_vertical_m"], abs=0.05)
+    lat_tol, vert_tol = 0.01 * 6.8 * units.FT, 0.01 * 1.0 * units.FT
+    for key in ("cat1", "cat2", "cat3"):
+        for comp, tol in (("lateral_m", lat_tol), ("along_m", lat_tol), ("vertical_m", vert_tol),
+                          ("vpl_m", vert_tol)):
+            assert b.scalars[f"{key}_{comp}"] == pytest.approx(a.scalars[f"{key}_{comp}"], abs=tol), (key, comp)

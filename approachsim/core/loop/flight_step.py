@@ -42,6 +42,7 @@ from approachsim import geo, units
 from approachsim.core import geodesy as gk
 from approachsim.core.layouts import (
     AP_ALIGN_BANK_MAX,
+    AP_ALIGN_BETA_MAX,
     AP_ALIGN_CAS,
     AP_ALIGN_H,
     AP_ALIGN_TAU,
@@ -55,6 +56,9 @@ from approachsim.core.layouts import (
     AP_CONV,
     AP_DT,
     AP_FLARE_H,
+    AP_FLARE_K_V,
+    AP_FLARE_T_PATH,
+    AP_GEAR_ARM,
     AP_HEADING,
     AP_K_BETA,
     AP_K_BETA_ALIGN,
@@ -101,7 +105,9 @@ from approachsim.core.layouts import (
     APS_ALIGNING,
     APS_E_F,
     APS_FLARE_H_OFF,
+    APS_FLARE_SINK0,
     APS_FLARE_TAU,
+    APS_FLARE_V0,
     APS_FLARING,
     APS_INT_B,
     APS_INT_D,
@@ -506,12 +512,14 @@ def autopilot_step(par: Array, st: Array, guide: tuple, air: tuple) -> tuple[flo
     x, y, z, vn, ve, vd = guide
     phi, theta, p, q, beta, cas, h_gear, tas, psi, r = air
     dt = par[AP_DT]
+    v_air = cas  # the smoothed true airspeed (the air-mass speed) when TAS is given
     if tas > 1.0:  # inertially smoothed speed
         gs = math.sqrt(vn * vn + ve * ve + vd * vd)
         if st[APS_WIND] != st[APS_WIND]:
             st[APS_WIND] = tas - gs
         st[APS_WIND] += dt / par[AP_TAU_WIND] * (tas - gs - st[APS_WIND])
-        cas = cas * (gs + st[APS_WIND]) / tas
+        v_air = gs + st[APS_WIND]
+        cas = cas * v_air / tas
     # glidepath (cone) and cross-track deviations, the runway axes turned by the meridian convergence
     ch, sh = par[AP_CH], par[AP_SH]
     conv = (x * sh + y * ch) * par[AP_CONV]
@@ -540,20 +548,38 @@ def autopilot_step(par: Array, st: Array, guide: tuple, air: tuple) -> tuple[flo
             thr = 1.0 if thr >= 1.0 else 0.0
     landing = h_gear == h_gear
     if landing and (st[APS_FLARING] != 0.0 or h_gear <= par[AP_FLARE_H]):
-        # exponential flare: h'_c = -(h_gear - h_off) / tau, tau and h_off from the entry sink (continuity)
+        # exponential flare on the main gear: h'_c = -(h_gear - h_off) / tau, tau and h_off from the entry sink
+        # (continuity); the commanded path angle fed forward, led by T_theta2
         td = par[AP_TD_SINK]
+        sink = vd
         if st[APS_FLARING] == 0.0:
             st[APS_FLARING] = 1.0
             st[APS_THETA_FLARE0] = st[APS_THETA_C]
-            sink0 = max(vd, td + 0.1)
+            sink0 = max(sink, td + 0.1)
             st[APS_FLARE_TAU] = max(h_gear, 0.0) / (sink0 - td) if h_gear > 0.0 else 1.0
             st[APS_FLARE_H_OFF] = -st[APS_FLARE_TAU] * td
-        e = -(max(h_gear, 0.0) - st[APS_FLARE_H_OFF]) / st[APS_FLARE_TAU] + vd
+            st[APS_FLARE_SINK0] = sink0
+            st[APS_FLARE_V0] = v_air
+        tau = st[APS_FLARE_TAU]
+        sink_c = (max(h_gear, 0.0) - st[APS_FLARE_H_OFF]) / tau
+        e = sink - sink_c
         st[APS_INT_FLARE] += e * dt
-        theta_c = st[APS_THETA_FLARE0] + par[AP_K_FLARE] * e + par[AP_K_FLARE_I] * st[APS_INT_FLARE]
+        v0 = max(v_air, 1.0)
+        ff = ((st[APS_FLARE_SINK0] - sink_c) / v0 + par[AP_FLARE_T_PATH] * sink / (tau * v0)
+              + par[AP_FLARE_K_V] * (st[APS_FLARE_V0] - v_air))
+        theta_c = st[APS_THETA_FLARE0] + ff + par[AP_K_FLARE] * e + par[AP_K_FLARE_I] * st[APS_INT_FLARE]
         thr = min(thr, 1.0 if h_gear > par[AP_RETARD_H] else 0.0)
     st[APS_THETA_C] = theta_c
     de = -par[AP_K_THETA] * (theta_c - theta) + par[AP_K_Q] * q
+    aligning = landing and psi == psi and (st[APS_ALIGNING] != 0.0 or h_gear <= par[AP_ALIGN_H])
+    crab = 0.0
+    if aligning:
+        st[APS_ALIGNING] = 1.0
+        crab = psi - (par[AP_HEADING] + conv) + math.pi
+        crab = crab - _TWO_PI * math.floor(crab / _TWO_PI) - math.pi
+        # the main gears' centre, gear_arm behind the guidance point, onto the centreline
+        y = y - par[AP_GEAR_ARM] * math.sin(crab)
+        y_dot = y_dot - par[AP_GEAR_ARM] * math.cos(crab) * r
     # localizer -> bank command
     phi_c = -(par[AP_K_LOC_P] * y + par[AP_K_LOC_D] * y_dot + par[AP_K_LOC_I] * st[APS_INT_Y])
     blim = par[AP_BANK_LIMIT]
@@ -561,17 +587,15 @@ def autopilot_step(par: Array, st: Array, guide: tuple, air: tuple) -> tuple[flo
         st[APS_INT_Y] += y * dt
     else:
         phi_c = blim if phi_c > 0.0 else -blim
-    if landing and psi == psi and (st[APS_ALIGNING] != 0.0 or h_gear <= par[AP_ALIGN_H]):
-        # decrab: yaw-rate command -crab / tau_align; the rudder, bank and aileron that hold the sideslip
-        st[APS_ALIGNING] = 1.0
-        crab = psi - (par[AP_HEADING] + conv) + math.pi
-        crab = crab - _TWO_PI * math.floor(crab / _TWO_PI) - math.pi
+    if aligning:
+        # runway alignment: yaw-rate command -crab / tau_align; the rudder, bank and aileron that hold the sideslip
         k_pb = par[AP_K_PHI_ALIGN]  # bank per sideslip at the approach speed (dynamic pressure ratio)
         if par[AP_ALIGN_CAS] > 0.0:
             sq = par[AP_CAS0] / par[AP_ALIGN_CAS]
             k_pb = k_pb * (sq * sq)
-        # the sideslip the bank allowance admits; the rest of the wind correction (crab + beta) stays as crab
-        b_max = par[AP_ALIGN_BANK_MAX] / k_pb if k_pb > 0.0 else math.inf
+        # the sideslip limit and the one the bank allowance admits, the smaller; the rest of the wind correction
+        # (crab + beta) stays as crab
+        b_max = min(par[AP_ALIGN_BETA_MAX], par[AP_ALIGN_BANK_MAX] / k_pb if k_pb > 0.0 else math.inf)
         eta = crab + beta
         crab_res = eta - min(max(eta, -b_max), b_max)
         dr = par[AP_K_R_ALIGN] * (r + (crab - crab_res) / par[AP_ALIGN_TAU]) + par[AP_K_BETA_ALIGN] * beta

@@ -24,6 +24,8 @@ from approachsim.evaluate.touchdown import (
     Criterion,
     c_nb_from_euler,
     clean_runs_needed,
+    contact_bank_rad,
+    contact_offsets_m,
     criterion_result,
     gear_state,
     nct_sf,
@@ -289,7 +291,36 @@ def test_overall_verdict():
 def test_no_shipped_limit_is_verified_so_no_verdict_is_claimed():
     """docs/touchdown.md: AC 120-28D's and CS-AWO's own numbers were not found; a limit marked V would need them."""
     assert all(c.mark in ("S", "U") for c in CRITERIA)
-    assert {c.key for c in CRITERIA if c.mark == "U"} == {"outboard_gear"}
+    assert {c.key for c in CRITERIA if c.mark == "U"} == {"outboard_gear", "ground_contact"}
+
+
+@pytest.mark.parametrize("theta_deg", [-2.0, 0.0, 3.0, 4.4, 8.0])
+def test_the_contact_bank_puts_the_point_on_the_ground(theta_deg):
+    """contact_bank_rad against an independent rotation (scipy, ZYX roll-pitch with the heading 0): at the bank
+    it returns, the point's down coordinate equals the gear contact's (the ground plane), to 1e-12 m; at a bank
+    0.1 deg short of it the point is above the ground."""
+    d = np.array([[2.74, 2.36, -0.46], [-3.45, 11.89, -3.93], [0.0, 5.0, -1.0]])
+    theta = math.radians(theta_deg)
+    phi = contact_bank_rad(theta, d)
+    for p, ph in zip(d, phi, strict=True):
+        down = Rotation.from_euler("ZYX", [0.0, theta, ph]).apply(p)[2]
+        assert down == pytest.approx(0.0, abs=1e-12)
+        short = Rotation.from_euler("ZYX", [0.0, theta, ph - math.radians(0.1)]).apply(p)[2]
+        assert short < 0.0  # z down: negative is above the ground
+    # level pitch: atan(height / outboard distance)
+    assert contact_bank_rad(0.0, d[2:])[0] == pytest.approx(math.atan(1.0 / 5.0), rel=1e-14)
+
+
+def test_contact_offsets_take_the_struct_frame_and_the_strut_compression():
+    """Structural (x aft, y right, z up) to body (x forward, y right, z down) offsets from the gear; a compressed
+    strut brings every point closer to the ground by the compression."""
+    gear = np.array([16.46, 2.54, -2.13])
+    pt = np.array([[13.72, 4.90, -1.54]])
+    d0 = contact_offsets_m(pt, gear, 0.0)[0]
+    np.testing.assert_allclose(d0, [2.74, 2.36, -0.59], atol=1e-12)
+    d1 = contact_offsets_m(pt, gear, 0.136)[0]
+    assert d1[2] - d0[2] == pytest.approx(0.136, abs=1e-15)
+    assert contact_bank_rad(0.0, d1[None, :])[0] < contact_bank_rad(0.0, d0[None, :])[0]
 
 
 # --- the details block and the contract --------------------------------------------------------------------------

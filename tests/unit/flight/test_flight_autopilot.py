@@ -103,9 +103,65 @@ def test_the_flare_command_starts_at_the_entry_sink_and_ends_at_the_touchdown_si
     assert -(0.0 - ap._flare_h_off) / tau == pytest.approx(-g.touchdown_sink_mps)
 
 
+def test_the_flare_feeds_the_commanded_path_angle_forward(ap):
+    """Pitch command of the flare (autopilot.py): at entry (zero sink-rate error) the theta_entry + T_theta2 s_0 /
+    (tau V) lead; one step later, with the sink held, the commanded path-angle change (s_0 - s_c) / V joins it and
+    the P and I terms act on e = s_0 - s_c. V: the smoothed true airspeed (here TAS = ground speed, no wind)."""
+    g = ap.g
+    assert g.flare_t_path_s == pytest.approx(2.26) and g.k_flare == pytest.approx(0.1)
+    h0, sink0, v = g.flare_height_m - 0.01, 3.8, 70.0
+    vg = math.hypot(v, sink0)
+    x = -300.0
+    ap.step(x, 0.0, _on_path(x), v, 0.0, sink0, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, h0, tas=vg)
+    tau = ap._flare_tau
+    lead = g.flare_t_path_s * sink0 / (tau * vg)
+    assert ap._theta_c - ap._theta_flare0 == pytest.approx(lead, rel=1e-12)
+    assert math.degrees(lead) == pytest.approx(1.4, abs=0.2)  # 2.26 s x 3.8 m/s / (4.8 s x 70 m/s)
+    h1 = h0 - 0.5
+    ap.step(x + 0.6, 0.0, _on_path(x), v, 0.0, sink0, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, h1, tas=vg)
+    sink_c = (h1 - ap._flare_h_off) / tau
+    e = sink0 - sink_c
+    want = (ap._theta_flare0 + (sink0 - sink_c) / vg + g.flare_t_path_s * sink0 / (tau * vg) + g.k_flare * e
+            + g.k_flare_i * e * ap.dt)
+    assert ap._theta_c == pytest.approx(want, rel=1e-12)
+
+
 def _full_decrab(ap):
-    g = dataclasses.replace(ap.g, align_bank_max_rad=math.inf)
+    g = dataclasses.replace(ap.g, align_bank_max_rad=math.inf, align_sideslip_max_rad=math.inf)
     return Autopilot(g, ap.trim, Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0), ap.dt)
+
+
+def test_the_alignment_engages_at_450_ft(ap):
+    """The 737 MAX alignment mode's height (aircraft file, 737 MAX FCOM): not aligning at 451 ft main-gear height,
+    aligning at 449 ft, and latched from then on."""
+    g = ap.g
+    assert g.align_height_m == pytest.approx(450.0 * units.FT)
+    x = -2600.0
+    ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, 451.0 * units.FT,
+            psi=math.radians(8.0), r=0.0)
+    assert not ap.aligning
+    ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, 449.0 * units.FT,
+            psi=math.radians(8.0), r=0.0)
+    assert ap.aligning
+
+
+def test_the_alignment_steers_the_main_gear_onto_the_centreline(ap):
+    """While aligning, the localizer loop flies the main gears' centre, gear_arm behind the guidance point:
+    crabbed 3 deg right with the guidance point on the centreline, the gear trails l sin(3 deg) left, and the
+    bank command (hence the aileron, k_phi per rad) moves right by k_loc_p l sin(3 deg); a yaw rate adds
+    k_loc_d l cos(crab) r."""
+    g = ap.g
+    geom = Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0)
+    at_imu = Autopilot(g, ap.trim, geom, ap.dt)
+    at_gear = Autopilot(g, ap.trim, geom, ap.dt, gear_arm_m=10.11)
+    crab, r = math.radians(3.0), 0.01
+    x = -200.0
+    args = (x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, 0.5 * g.align_height_m)
+    da0 = at_imu.step(*args, psi=crab, r=r)[1]
+    da1 = at_gear.step(*args, psi=crab, r=r)[1]
+    want = g.k_phi * (g.k_loc_p * 10.11 * math.sin(crab) + g.k_loc_d * 10.11 * math.cos(crab) * r)
+    assert da1 - da0 == pytest.approx(want, rel=1e-9)
+    assert da1 > da0  # towards the side the gear trails from
 
 
 def test_the_decrab_yaws_towards_the_runway_and_holds_the_sideslip(ap):
@@ -132,16 +188,19 @@ def _align_step(ap, crab_rad, beta_rad):
                    0.5 * ap.g.align_height_m, psi=crab_rad, r=0.0)
 
 
-def test_the_partial_decrab_limits_the_sideslip_to_the_bank_allowance(ap):
-    """The sideslip limit is the bank allowance over the bank per sideslip at the approach speed,
-    b_max = bank_max / (k_phi_align (V_c / V_design)^2). Crabbed 8 deg with no sideslip yet (wind correction
-    eta = crab + beta = 8 deg > b_max): the heading error the rudder works on is b_max, so the aircraft keeps
-    8 deg - b_max of crab; within the limit (eta = 4 deg) the law is the full decrab's, bit for bit."""
+def test_the_partial_decrab_limits_the_sideslip_to_5_deg(ap):
+    """The sideslip limit is the smaller of the 737 MAX's 5 deg and the bank allowance over the bank per sideslip at
+    the approach speed, bank_max / (k_phi_align (V_c / V_design)^2) = 5.7 deg at 140 KCAS: 5 deg binds. Crabbed
+    8 deg with no sideslip yet (wind correction eta = crab + beta = 8 deg > b_max): the heading error the rudder
+    works on is b_max, so the aircraft keeps 8 deg - b_max of crab; within the limit (eta = 4 deg) the law is the
+    full decrab's, bit for bit."""
     g = ap.g
     assert math.isfinite(g.align_bank_max_rad) and g.align_cas_mps > 0.0
+    assert math.degrees(g.align_sideslip_max_rad) == pytest.approx(5.0)
     sq = ap.trim.cas_mps / g.align_cas_mps
-    b_max = g.align_bank_max_rad / (g.k_phi_align * sq * sq)
-    assert math.degrees(b_max) == pytest.approx(5.7, abs=0.05)  # 4.9 deg / 0.862 at 72 m/s (140 KCAS: 72.02 m/s)
+    b_bank = g.align_bank_max_rad / (g.k_phi_align * sq * sq)
+    assert math.degrees(b_bank) == pytest.approx(5.7, abs=0.05)  # 4.9 deg / 0.862 at 72 m/s (140 KCAS: 72.02 m/s)
+    b_max = g.align_sideslip_max_rad
     full = _full_decrab(ap)
     _, _, dr, _ = _align_step(ap, math.radians(8.0), 0.0)
     assert dr == pytest.approx(g.k_r_align * b_max / g.align_tau_s, rel=1e-12)
@@ -152,23 +211,28 @@ def test_the_partial_decrab_limits_the_sideslip_to_the_bank_allowance(ap):
     full2 = _full_decrab(ap)
     assert _align_step(ap2, math.radians(3.0), math.radians(1.0)) == _align_step(full2, math.radians(3.0),
                                                                                    math.radians(1.0))
-    # at the held limit (beta = b_max, crab = eta - b_max) the heading error is zero and the bank fed forward is
-    # the allowance
+    # at the held limit (beta = b_max, crab = eta - b_max) the heading error is zero and the bank fed forward,
+    # k_pb 5 deg = 4.3 deg, is inside the allowance
     ap3 = Autopilot(g, ap.trim, Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0), ap.dt)
     _, _, dr3, _ = _align_step(ap3, math.radians(2.5), b_max)
     assert dr3 == pytest.approx(g.k_beta_align * b_max, rel=1e-9)
-    assert g.k_phi_align * sq * sq * b_max == pytest.approx(g.align_bank_max_rad, rel=1e-12)
+    assert g.k_phi_align * sq * sq * b_max < g.align_bank_max_rad
 
 
-def test_the_sideslip_limit_scales_with_the_dynamic_pressure(ap):
-    """At 133 kt the bank per sideslip is (133 / 140)^2 of the design speed's, so the limit is (140 / 133)^2 as
-    large: the same bank allowance holds more sideslip at a lower dynamic pressure (crabbed 12 deg, no sideslip)."""
+def test_the_sideslip_limit_is_scheduled_with_speed(ap):
+    """The bank per sideslip grows with the dynamic pressure, so above about 150 KCAS the bank allowance, not the
+    5 deg, limits the sideslip: at 160 kt the limit is bank_max / (k_phi_align (160 / 140)^2) = 4.4 deg; at 133 and
+    140 kt it is 5 deg (crabbed 12 deg, no sideslip)."""
     g = ap.g
-    slow = Autopilot(g, Trim(theta_rad=0.02, throttle=0.47, cas_mps=133.0 * units.KT),
-                     Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0), ap.dt)
-    fast = Autopilot(g, Trim(theta_rad=0.02, throttle=0.47, cas_mps=140.0 * units.KT),
-                     Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0), ap.dt)
-    dr_slow = _align_step(slow, math.radians(12.0), 0.0)[2]
-    dr_fast = _align_step(fast, math.radians(12.0), 0.0)[2]
-    assert dr_fast == pytest.approx(g.k_r_align * g.align_bank_max_rad / g.k_phi_align / g.align_tau_s, rel=1e-12)
-    assert dr_slow / dr_fast == pytest.approx((140.0 / 133.0) ** 2, rel=1e-12)
+
+    def dr_at(kt):
+        a = Autopilot(g, Trim(theta_rad=0.02, throttle=0.47, cas_mps=kt * units.KT),
+                      Geometry(heading_rad=0.0, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=0.0), ap.dt)
+        return _align_step(a, math.radians(12.0), 0.0)[2]
+
+    five = g.k_r_align * g.align_sideslip_max_rad / g.align_tau_s
+    assert dr_at(133.0) == pytest.approx(five, rel=1e-12)
+    assert dr_at(140.0) == pytest.approx(five, rel=1e-12)
+    b_fast = g.align_bank_max_rad / (g.k_phi_align * (160.0 * units.KT / g.align_cas_mps) ** 2)
+    assert math.degrees(b_fast) == pytest.approx(4.37, abs=0.02)
+    assert dr_at(160.0) == pytest.approx(g.k_r_align * b_fast / g.align_tau_s, rel=1e-12)

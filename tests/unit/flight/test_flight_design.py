@@ -175,3 +175,33 @@ def test_the_decrab_sideslip_limit_follows_the_dynamic_pressure(setup):
     print(f"bank per sideslip: linearization {k_phi:.3f}, scheduled {scheduled:.3f}; sideslip limit "
           f"{np.degrees(g.align_bank_max_rad / scheduled):.2f} deg for {np.degrees(g.align_bank_max_rad):.1f} deg")
     assert scheduled == pytest.approx(k_phi, rel=0.03)
+
+
+def test_flare_gains_are_the_linearizations(setup):
+    """The flare's path lag T_theta2 = -1 / A[alpha, alpha] (aircraft file flare_t_path_s, the default profile's
+    2.26 s; within 15 % of every shipped profile's), and the flare loop (sink-rate error -> pitch command -> the
+    pitch loop -> the guidance point's climb rate V (theta - alpha) + l q, l = 9.88 m from the CG forward to the IMU:
+    737.xml CG x 639 in, the aircraft file's IMU x 250 in) with k_flare and k_flare_i: phase margin >= 45 deg, and
+    its crossover below the closed pitch loop's natural frequency (loop separation)."""
+    import control
+
+    from approachsim import units
+
+    lin, ac, gp = setup
+    g = ac.gains
+    t2 = -1.0 / lin.A[1, 1]
+    print(f"T_theta2 {t2:.3f} s (file {g.flare_t_path_s})")
+    assert g.flare_t_path_s == pytest.approx(t2, rel=0.15)
+    idx = [0, 1, 2, 3]  # Vt, alpha, theta, q; elevator
+    scale = np.diag([units.FPS, 1.0, 1.0, 1.0])
+    a = scale @ lin.A[np.ix_(idx, idx)] @ np.linalg.inv(scale)
+    b = scale @ lin.B[idx, 2:3]
+    a_cl = a + b @ np.array([[0.0, 0.0, g.k_theta, g.k_q]])  # de = -k_theta (theta_c - theta) + k_q q
+    l_imu = (639.0 - 250.0) * units.IN
+    plant = control.ss(a_cl, -g.k_theta * b, np.array([[0.0, -lin.vt_mps, lin.vt_mps, l_imu]]), 0.0)
+    s = control.tf("s")
+    gm, pm, _, wc = control.margin((g.k_flare + g.k_flare_i / s) * plant)
+    wn = float(np.max(np.abs(np.linalg.eigvals(a_cl))))
+    print(f"flare loop: PM {pm:.1f} deg at {wc:.2f} rad/s, GM {gm}, pitch loop natural frequency {wn:.2f} rad/s")
+    assert pm >= PM_MIN_DEG
+    assert wc < wn

@@ -54,14 +54,15 @@ LAT = math.radians(39.8)
 
 def _autopilot(gains):
     return Autopilot(gains, Trim(theta_rad=0.03, throttle=0.45, cas_mps=72.0),
-                     Geometry(heading_rad=0.4, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=LAT), DT)
+                     Geometry(heading_rad=0.4, glidepath_rad=GP, tch_m=TCH, threshold_lat_rad=LAT), DT,
+                     gear_arm_m=10.11)
 
 
 def test_the_autopilot_gain_layout_is_the_gains_dataclass():
     import dataclasses
 
     assert layouts.AP_GAINS == tuple(f.name for f in dataclasses.fields(AutopilotGains))
-    assert layouts.N_AP_PAR == len(layouts.AP_GAINS) + 13
+    assert layouts.N_AP_PAR == len(layouts.AP_GAINS) + 14
 
 
 def _autopilot_inputs(rng, n, *, flare):
@@ -102,7 +103,8 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
     seen = {"pitch limited": 0, "bank limited": 0, "throttle 1": 0, "throttle 0": 0, "flaring": 0, "idle": 0,
             "aligning": 0, "sideslip limited": 0, "full decrab": 0}
     sq = ap.trim.cas_mps / gains.align_cas_mps
-    b_max = gains.align_bank_max_rad / (gains.k_phi_align * sq * sq)  # the partial decrab's sideslip limit
+    b_max = min(gains.align_sideslip_max_rad,  # the partial decrab's sideslip limit
+                gains.align_bank_max_rad / (gains.k_phi_align * sq * sq))
     for k in range(n):
         args = (x[k], y[k], z[k], *v[k], att[k, 0], att[k, 1], att[k, 2], att[k, 3], att[k, 4], cas[k])
         int_p = ap.int_b if gains.tecs else ap.int_d
