@@ -29,6 +29,10 @@ from approachsim.sensors import atmosphere
 from approachsim.sensors.config import SensorsConfig, parse_faults, parse_sensors
 
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
+QNH_REPORTS = ("exact", "whole_hpa")
+"""How the QNH set on the altimeter is reported (environment.qnh_report): exact (the day's QNH to the hundredth), or
+whole_hpa, rounded down to the whole hectopascal as a METAR / ATIS gives it (issue 39: a reporting error of 0 to
+-1 hPa, the altimeter reading up to 27 ft low at sea level)."""
 
 
 @dataclass(frozen=True)
@@ -88,7 +92,8 @@ class Environment:
     """The day's QNH at the field, Pa: the setting with which an altimeter reads the field elevation at the
     threshold (ISA inverse), whatever the temperature."""
     setting_pa: float = 101325.0
-    """What is set on the baro altimeter: QNH + the profile's qnh_setting_error_hPa, Pa."""
+    """What is set on the baro altimeter: the reported QNH (the day's QNH, or with qnh_report = "whole_hpa" rounded
+    down to the whole hPa) + the profile's qnh_setting_error_hPa, Pa."""
     sea_level_pa: float = 101325.0
     """The day's true sea-level pressure of the ISA+dT atmosphere that has the QNH's pressure at the field
     (sensors.atmosphere.sea_level_pressure_pa): what JSBSim's atmosphere is set to, Pa."""
@@ -209,7 +214,9 @@ def _environment(s: Section, runway: Runway) -> Environment:
             "elevation and isa_dev_C; for a mis-set altimeter give qnh_setting_error_hPa"
         )
     err = s.number("qnh_setting_error_hPa", 0.0, lo=-50.0, hi=50.0, unit="hPa")
+    report = s.string("qnh_report", "exact", choices=QNH_REPORTS)
     s.done()
+    reported = math.floor(qnh) if report == "whole_hpa" else qnh
     h_field = float(atmosphere.geopotential_m(runway.elevation_m))
     return Environment(
         wind_speed_mps=ws * units.KT,
@@ -217,7 +224,7 @@ def _environment(s: Section, runway: Runway) -> Environment:
         turbulence=turb,
         isa_dev_k=dt,
         qnh_pa=qnh * units.HPA,
-        setting_pa=(qnh + err) * units.HPA,
+        setting_pa=(reported + err) * units.HPA,
         sea_level_pa=atmosphere.sea_level_pressure_pa(qnh * units.HPA, h_field, dt),
     )
 

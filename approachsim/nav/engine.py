@@ -232,7 +232,8 @@ class EpochEngine:
         self.loop = em.kernel_loop(system.loop_gains() if lay.has("ac") else None)
         """The damping loop's constant gains (the engine runs constant or no loops only)."""
         self.rows = kg.Rows(self.lay, self.tx, self.th, self.rwy, float(self.ra_pct), float(self.ra_floor),
-                            self.channel_states, self.pl_states, self.cp_r, self.amb_prior)
+                            self.channel_states, self.pl_states, self.cp_r, self.amb_prior,
+                            float(system.baro_ref_m))
         """The rows' constants (core/nav/groups.Rows)."""
 
     def channel_sigmas(self, el: Array) -> tuple[Array, Array]:

@@ -9,7 +9,8 @@ States (a `StateLayout` says which are present and where):
     bg   (3)  gyro bias, body axes, rad/s         (random constant + random walk)
     ba   (3)  accelerometer bias, body, m/s^2    (random constant + random walk)
     bb   (1)  baro bias, m                        (first-order Gauss-Markov, seed 001 eq. 2, seed 003 eq. 1)
-    sb   (1)  baro scale factor                   (random constant, seed 003 eq. 1)
+    sb   (1)  baro scale factor on the height above the setting's reference H_ref (the field; random constant,
+              seed 003 eq. 1): the baro row and the loop see -(h - H_ref) sb
     clk  (2)  GPS receiver clock bias (m) and drift (m/s)   (seed 002 two-state clock, sec. 6)
     ac   (1)  baro damping-loop compensator, m/s^2 (only when the INS runs the 3rd-order loop, seed 003 eq. 3)
     gse  (k)  per-GPS-channel slow range error (SV clock/ephemeris + mapped iono + tropo), m, Gauss-Markov
@@ -17,6 +18,8 @@ States (a `StateLayout` says which are present and where):
     pmp  (p)  per-pseudolite multipath, m, Gauss-Markov
     ptr  (p)  per-pseudolite tropospheric residual, fraction of the range (random constant)
     pclk (2p) per-pseudolite transmitter clock bias and drift (unsynchronized pseudolites only)
+    psy  (p)  per-pseudolite time-sync error of a synchronized (GPS-disciplined) transmitter, m, Gauss-Markov
+              (sensors/pseudolite.py); after pclk, before rab
     rab  (1)  radar-altimeter bias + terrain-database bias, m (random constant: both enter the radalt row as -1)
     ram  (1)  radar-altimeter Markov error, m (Gauss-Markov, seed 000 eq. 5)
     tdb  (1)  terrain-database along-track error, unit Gauss-Markov u (the error is sigma(x) u, nav/terrain_db.py)
@@ -36,7 +39,7 @@ Dynamics (Titterton & Weston eq. 12.8, 12.12; Groves eq. 14.64-14.66 with the po
     psi' = -w_in x psi + dw_ie + dw_en - C_bn bg
     bg' = w_bg, ba' = w_ba ; bb' = -bb / tau_b + w_b ; sb' = 0 ; clk' = [[0, 1], [0, 0]] clk + w_clk
 
-With the baro loop (seed 003 eq. 3, linearized gains C1, C2, C3, loop error e = dh - bb - S h - v_b):
+With the baro loop (seed 003 eq. 3, linearized gains C1, C2, C3, loop error e = dh - bb - S (h - H_ref) - v_b):
     dh' += -C1 e ; dv_up' += -C2 e - ac ; ac' = C3 e    (dh = -dp_D, dv_up = -dv_D)
 and the baro white noise v_b enters the process noise through the gains.
 
@@ -77,6 +80,8 @@ class StateLayout:
     """Pseudolites with their own error states (0: none)."""
     pl_clock: bool = False
     """Pseudolites carry their own clock (unsynchronized)."""
+    pl_sync: bool = False
+    """Synchronized pseudolites carry a time-sync error state each (psy)."""
     radalt_bias: bool = False
     radalt_markov: bool = False
     terrain_db: bool = False
@@ -101,6 +106,8 @@ class StateLayout:
             sizes += [("pmp", self.n_pl), ("ptr", self.n_pl)]
             if self.pl_clock:
                 sizes.append(("pclk", 2 * self.n_pl))
+            if self.pl_sync:
+                sizes.append(("psy", self.n_pl))
         sizes += [(g, 1) for g, on in (("rab", self.radalt_bias), ("ram", self.radalt_markov),
                                        ("tdb", self.terrain_db)) if on]
         if self.carrier:  # last: every other group keeps its index (the compiled kernels' layout)
@@ -130,14 +137,14 @@ class StateLayout:
     @cached_property
     def packed(self) -> Array:
         """The layout as kernels.errormodel's int64 array: lay[L_N] = n, lay[L_<group>] its first index (-1
-        absent), lay[L_NSV], lay[L_NPL] the channel counts, lay[L_GIO], lay[L_AMB] the carrier groups (built once
-        per layout object: do not modify)."""
+        absent), lay[L_NSV], lay[L_NPL] the channel counts, lay[L_GIO], lay[L_AMB] the carrier groups, lay[L_PSY] the
+        pseudolites' sync group (built once per layout object: do not modify)."""
         lay = np.full(ek.LAY_SIZE, -1, dtype=np.int64)
         lay[ek.L_N], lay[ek.L_NSV], lay[ek.L_NPL] = self.n, self.n_sv, self.n_pl
         for k, g in enumerate(ek.LAY_GROUPS):
             if g in self.index:
                 lay[1 + k] = self.index[g].start
-        for g, at in (("gio", ek.L_GIO), ("amb", ek.L_AMB)):  # carrier phase (kernels/carrier.py)
+        for g, at in (("gio", ek.L_GIO), ("amb", ek.L_AMB), ("psy", ek.L_PSY)):  # carrier phase (kernels/carrier.py)
             if g in self.index:
                 lay[at] = self.index[g].start
         return lay
@@ -181,6 +188,13 @@ class ErrorNoise:
     gio_sigma_m: float | Array = 0.0
     """Per-channel ionospheric range-error 1-sigma (scalar or (n_sv,) by elevation), m (carrier phase only)."""
     gio_tau_s: float = 1800.0
+    baro_ref_m: float = 0.0
+    """The baro scale factor's reference H_ref, m: the altimeter-setting reference (the field); not a noise, the
+    constant of the sb terms -(h - H_ref) sb (seed 003 eq. 1 with the scale factor on the height above the setting's
+    reference: a QNH altimeter is exact at the field whatever its scale error)."""
+    psy_sigma_m: float = 0.0
+    psy_tau_s: float = 600.0
+    """Synchronized pseudolites' time-sync error: 1-sigma (m) and correlation time (s) of each psy state."""
 
     @cached_property
     def _kernel_arrays(self) -> dict[int, tuple[Array, Array, Array]]:
@@ -384,6 +398,8 @@ def dynamics_reference(
             F[ic, ic + 1] = 1.0
             Qc[ic, ic] = noise.pclk_sf
             Qc[ic + 1, ic + 1] = noise.pclk_sg
+    if layout.has("psy"):
+        _markov(F, Qc, ix["psy"], noise.psy_sigma_m, noise.psy_tau_s)
     if layout.has("ram"):
         _markov(F, Qc, ix["ram"], noise.ram_sigma_m, noise.ram_tau_s)
     if layout.has("tdb"):
@@ -395,12 +411,12 @@ def dynamics_reference(
         lin = loop.linearized()
         ia = layout.i("ac")
         i_h, i_v = P.start + 2, V.start + 2  # dp_D = -dh, dv_D = -dv_up
-        # loop error e = dh - bb - S h - v_b, written in dp_D: e = -dp_D - bb - h sb - v_b
+        # loop error e = dh - bb - S (h - H_ref) - v_b, written in dp_D: e = -dp_D - bb - (h - H_ref) sb - v_b
         e_row = np.zeros(n)
         e_row[i_h] = -1.0
         e_row[i_bb] = -1.0
         if layout.has("sb"):
-            e_row[layout.i("sb")] = -h_m
+            e_row[layout.i("sb")] = -(h_m - noise.baro_ref_m)
         F[i_v, ia] += 1.0
         if not loop_held:  # held (no baro): the compensator stays as it is and only ac acts (kernels.strapdown)
             F[i_h, :] += lin.c1 * e_row  # dp_D' = -dh' gets +C1 e

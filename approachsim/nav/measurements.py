@@ -8,10 +8,12 @@ row is an EKF linearization about the current estimate x_hat: with g(x) the exac
     z_lin = z - g(x_hat) + h' x_hat        so that the innovation z_lin - h' x_hat = z - g(x_hat).
 
 Rows (index names from errormodel.StateLayout):
-    baro      z = h_ins - h_baro        = -dp_D - bb - h sb + v                      (seed 002; seed 003 eq. 6)
+    baro      z = h_ins - h_baro        = -dp_D - bb - (h - H_ref) sb + v            (seed 002; seed 003 eq. 6 with
+              the scale factor on the height above the altimeter setting's reference H_ref, the field)
     radalt    z = (h_ins - T(ins)) - h_R = -dp_D - grad T . dp_h - rab - ram - sigma_db(x) tdb + v,
               R = (0.01 h)^2 + floor^2 (seed 002; rab, ram, tdb: errormodel, nav/terrain_db.py)
-    range     z = |r_ins - r_tx| - rho  = e . dp - clk - gse - gmp (+ pseudolite terms) + v   (seed 002 sec. 6)
+    range     z = |r_ins - r_tx| - rho  = e . dp - clk - gse - gmp (+ pseudolite terms: pmp, ptr, pclk or psy)
+              + v   (seed 002 sec. 6)
               (- gio too with carrier phase, whose states split the ionosphere off gse: nav/noise.py)
     carrier   z = |r_ins - r_sv| - phi  = e . dp - clk - gse + gio - amb + v                 (sensors/gnss/carrier.py:
               the code's geometry, clock and slow error, the ionosphere with the opposite sign, the arc's ambiguity)
@@ -65,13 +67,14 @@ def _row(layout: StateLayout) -> Array:
 
 
 def baro(layout: StateLayout, h_ins_m: float, h_baro_m: float, sigma_m: float, t_s: float,
-         name: str = "baro") -> ScalarMeasurement:
-    """Baro altitude difference: h = [-1 at dp_D, -1 at bb, -h at sb]; R = sigma^2 (white noise), m."""
+         name: str = "baro", h_ref_m: float = 0.0) -> ScalarMeasurement:
+    """Baro altitude difference: h = [-1 at dp_D, -1 at bb, -(h - H_ref) at sb]; R = sigma^2 (white noise), m;
+    h_ref_m = H_ref the altimeter setting's reference (the field), m."""
     h = _row(layout)
     h[layout.i("dp", 2)] = -1.0  # dh = -dp_D
     h[layout.i("bb")] = -1.0
     if layout.has("sb"):
-        h[layout.i("sb")] = -h_ins_m
+        h[layout.i("sb")] = -(h_ins_m - h_ref_m)
     return ScalarMeasurement(z=float(h_ins_m - h_baro_m), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
 
 
@@ -160,6 +163,8 @@ def pseudorange(
         h[layout.index["dp"]] = e_ned * (1.0 + x_hat[layout.i("ptr", pl)])  # range (1 + T): its gradient
         if layout.has("pclk"):
             h[layout.i("pclk", 2 * pl)] = -1.0
+        if layout.has("psy"):  # a synchronized transmitter's time-sync error
+            h[layout.i("psy", pl)] = -1.0
     z = rng_ins - rho_m
     lin = h.copy()
     lin[layout.index["dp"]] = 0.0

@@ -63,6 +63,8 @@ class NoiseModel:
     sensors: SensorsConfig
     nav: NavConfig
     layout: em.StateLayout
+    baro_ref_m: float = 0.0
+    """The baro scale factor's reference H_ref: the altimeter-setting reference (the field's height), m."""
     _cache: dict = field(default_factory=dict, init=False, compare=False, repr=False)
 
     def clock(self) -> ClockModel:
@@ -155,6 +157,8 @@ class NoiseModel:
             if not p.synchronized:
                 q = ClockModel.named(*PSEUDOLITE_CLOCK).q(1.0)
                 kw.update(pclk_sf=q[0, 0] - q[1, 1] / 3.0, pclk_sg=q[1, 1])
+            else:  # the time-sync error as the truth draws it (sensors/pseudolite.py)
+                kw.update(psy_sigma_m=p.sync_sigma_m, psy_tau_s=p.sync_tau_s)
         if self.sensors.radalt is not None:
             kw.update(ram_sigma_m=self.sensors.radalt.markov_sigma_m, ram_tau_s=self.sensors.radalt.markov_tau_s,
                       tdb_correlation_m=self.nav.terrain_database.correlation_m)
@@ -222,6 +226,8 @@ class NoiseModel:
             if lay.has("pclk"):
                 _, b0, d0 = PSEUDOLITE_CLOCK
                 d[lay.index["pclk"]] = np.tile([b0**2, d0**2], lay.n_pl)
+            if lay.has("psy"):
+                d[lay.index["psy"]] = nz.psy_sigma_m**2
         if lay.has("rab"):  # altimeter and database biases summed (both enter the radalt row as -1)
             d[lay.i("rab")] = self.sensors.radalt.bias_sigma_m**2 + self.nav.terrain_database.bias_sigma_m**2
         if lay.has("ram"):

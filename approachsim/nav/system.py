@@ -88,6 +88,7 @@ def layout_for(nav: NavConfig, sensors: SensorsConfig) -> em.StateLayout:
         n_sv=n_sv,
         n_pl=n_pl,
         pl_clock=n_pl > 0 and not sensors.pseudolite.synchronized,
+        pl_sync=n_pl > 0 and sensors.pseudolite.synchronized and sensors.pseudolite.sync_sigma_m > 0.0,
         carrier=carrier,
         **_radalt_states(sensors, nav),
     )
@@ -108,7 +109,7 @@ class NavSystem:
     rows: MeasurementRows = field(init=False, compare=False, repr=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "noise_model", NoiseModel(self.sensors, self.nav, self.layout))
+        object.__setattr__(self, "noise_model", NoiseModel(self.sensors, self.nav, self.layout, self.baro_ref_m))
         object.__setattr__(self, "rows", MeasurementRows(self.layout, self.sensors, self.nav, self.runway,
                                                          self.terrain_h))
 
@@ -127,6 +128,12 @@ class NavSystem:
         nav = getattr(profile, "nav", DEFAULT_NAV)
         return cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain)
 
+    @property
+    def baro_ref_m(self) -> float:
+        """The baro scale factor's reference H_ref (m): the altimeter-setting reference, the field (the runway
+        threshold's height; the truth's is the same elevation, geopotential: sensors/suite.py)."""
+        return float(self.runway.threshold_h_m)
+
     # --- models -------------------------------------------------------------------------------------------
 
     def noise(self, elevation_rad: Array | None = None) -> em.ErrorNoise:
@@ -144,7 +151,7 @@ class NavSystem:
     def loop_slopes(self, fs: FilterState, h_m: float, noise: em.ErrorNoise) -> vl.LoopGains | None:
         """The damping loop as the error model sees it: constant gains as they are; for the adaptive tanh /
         sinh forms the *statistical linearization* E[dk/de] of each branch over the loop error
-        e ~ N(e_hat, var), e_hat = -dp_D - bb - S h from the estimate, var = its variance + the baro noise
+        e ~ N(e_hat, var), e_hat = -dp_D - bb - S (h - H_ref) from the estimate, var = its variance + the baro noise
         (5-point Gauss-Hermite). The small-signal slope alone makes the filter claim a sigma it does not have
         once |b e| ~ 1 (tanh saturates, sinh grows)."""
         g = self.loop_gains()
@@ -155,7 +162,7 @@ class NavSystem:
         row[lay.i("dp", 2)] = -1.0
         row[lay.i("bb")] = -1.0
         if lay.has("sb"):
-            row[lay.i("sb")] = -h_m
+            row[lay.i("sb")] = -(h_m - self.baro_ref_m)
         P = self.filter.covariance(fs)
         e_hat = float(row @ fs.x)
         sd = float(np.sqrt(row @ P @ row + noise.baro_noise_sigma_m**2))

@@ -2,7 +2,9 @@
 
     h_ind = indicated_altitude(p_static, QNH setting)          (ISA inverse, sensors/atmosphere.py)
     h_c   = h_ind + (h_ind - H_f) (c - 1)                      (temperature correction, c = 1 without one)
-    h_B   = h_c (1 + S) + B_k + v_k                            (seed 003 eq. 1; seed 001 eq. 1-2 has S = 0)
+    h_B   = h_c + (h_c - H_f) S + B_k + v_k                    (seed 003 eq. 1 with the scale factor on the height
+                                                               above the setting's reference H_f, the field; seed
+                                                               001 eq. 1-2 has S = 0)
 
 The deterministic part is physics: with the profile's ISA deviation and true sea-level pressure in the
 truth's p_static and the profile's QNH setting here, a cold day or a wrong setting gives the real altimeter
@@ -12,7 +14,10 @@ temperature (sensors/atmosphere.py: the exact form of the ICAO Doc 8168 correcti
 with the METAR's rounding to a whole degree). S is a random-constant scale factor, B a first-order
 Gauss-Markov bias (sigma, tau; exact discretization of seed 001 eq. 2), v white noise. Defaults are seed 001
 Table 1 (sigma_B = 1 m, beta = 0.01 1/s so tau = 100 s) and seed 003 Table 1 (noise 1 m). No static-source
-(position) error.
+(position) error. The scale factor multiplies the height above the altimeter setting's reference (issue 39): a QNH
+altimeter reads the field elevation at the field whatever its gain error (the setting is made to make it so), so a
+scale error on the MSL height (seed 003's form) would put a 0.12 x 1656 m = 200 m error at a 5434 ft field's
+threshold.
 
 Optional first-order lag (lag_s > 0, the pneumatic / filter lag of the static system) on the indicated
 altitude, computed statelessly so that stepwise and batch application agree: each sample is a weighted
@@ -48,8 +53,8 @@ _NO_LAG = np.zeros(0)
 @dataclass(frozen=True)
 class Baro:
     """Barometric altimeter. setting_pa: the setting on the instrument, Pa (profile environment.setting_pa:
-    QNH + the setting error); field_m, temperature_ratio: the temperature correction's field geopotential elevation (m)
-    and c = T_f / (T0 - L H_f) (1: no correction)."""
+    QNH + the setting error); field_m: the field's geopotential elevation H_f (m), the setting's reference (the scale
+    factor's) and the temperature correction's; temperature_ratio: c = T_f / (T0 - L H_f) (1: no correction)."""
 
     setting_pa: float = atmosphere.P0_PA
     rate_hz: float = 10.0
@@ -142,7 +147,7 @@ class Baro:
         h_ind = h_ind + (h_ind - self.field_m) * (self.temperature_ratio - 1.0)
         sf = errors.constants["scale_factor"]
         sf = sf[:, None] if errors.batched else sf
-        h = h_ind * (1.0 + sf) + errors.series["bias"] + errors.series["noise"]
+        h = h_ind + (h_ind - self.field_m) * sf + errors.series["bias"] + errors.series["noise"]
         shape = h.shape
         return BaroSamples(
             t_s=errors.t_s, h_baro_m=h, sigma_m=np.full(errors.t_s.shape, self.noise_sigma_m),

@@ -17,7 +17,7 @@ from approachsim import units
 from approachsim.config import ProfileError, Section
 from approachsim.sensors.faults import FAULT_KINDS, FaultSpec
 from approachsim.sensors.gnss.carrier import L1_WAVELENGTH_M, CarrierModel
-from approachsim.sensors.gnss.clock import OSCILLATORS
+from approachsim.sensors.gnss.clock import C_LIGHT, OSCILLATORS
 from approachsim.sensors.gnss.constellation import SLOTS, parse_epoch
 from approachsim.sensors.gnss.gbas import AADS, GADS, GbasModel
 from approachsim.sensors.gnss.receiver import (
@@ -40,6 +40,7 @@ from approachsim.sensors.gnss.service import (
     ServiceModel,
 )
 from approachsim.sensors.presets import PRESETS
+from approachsim.sensors.pseudolite import SYNC_SIGMA_NS, SYNC_TAU_S
 from approachsim.sensors.radalt import RADALT_CORRELATED_1SIGMA_M
 
 SENSOR_NAMES = ("imu", "baro", "radalt", "gnss", "pseudolite")
@@ -156,6 +157,10 @@ class PseudoliteConfig:
     survey_sigma_m: float = 0.05
     tropo_ppm_sigma: float = 30.0
     max_range_m: float = 50e3
+    sync_sigma_m: float = SYNC_SIGMA_NS * 1e-9 * C_LIGHT
+    """A synchronized transmitter's time-sync error 1-sigma, m (c times the profile's sync_sigma_ns;
+    sensors/pseudolite.py)."""
+    sync_tau_s: float = SYNC_TAU_S
 
 
 @dataclass(frozen=True)
@@ -294,6 +299,8 @@ def parse_sensors(s: Section, site_rad: tuple[float, float] | None = None) -> Se
             survey_sigma_m=p.number("survey_sigma_m", 0.05, lo=0.0, unit="m"),
             tropo_ppm_sigma=p.number("tropo_ppm_sigma", 30.0, lo=0.0, unit="ppm"),
             max_range_m=p.number("max_range_nmi", 27.0, lo=0.1, hi=200.0, unit="nmi") * units.NMI,
+            sync_sigma_m=p.number("sync_sigma_ns", SYNC_SIGMA_NS, lo=0.0, hi=100.0, unit="ns") * 1e-9 * C_LIGHT,
+            sync_tau_s=p.number("sync_tau_s", SYNC_TAU_S, lo=1.0, hi=1e6, unit="s"),
         )
     p.done()
     s.done()

@@ -17,12 +17,13 @@ estimate exactly at `row`; None when the suite has no such sensor. Signs follow 
                       receiver's pool entry there: exactly the ambiguity of every channel valid at the record's first
                       sample, where every arc begins; gnss/carrier.py)
     clk  (N, 2)       receiver clock bias (m) and drift (m/s) (clock.py; shared by GPS and pseudolites)
-    bb   (N,)   m     baro Gauss-Markov bias; sb (N,) its scale factor (baro.py, h_B = h (1 + S) + B + v)
+    bb   (N,)   m     baro Gauss-Markov bias; sb (N,) its scale factor (baro.py, h_B = h + (h - H_f) S + B + v)
     bg   (N, 3) rad/s gyro bias in body axes as the INS sees it over the increment after `row`: turn-on +
                       Gauss-Markov + (S + M) w_ib (scale factor / misalignment at the true rate, imu.py)
     ba   (N, 3) m/s^2 the same for the accelerometers with (S + M) f_body (the filter's ba lumps them, P0)
     pmp  (N, p) m     pseudolite multipath; ptr (N, p) tropo residual as a fraction of the range
-    pclk (N, 2p)      pseudolite transmitter clock bias (m) and drift (m/s) pairs (zero when synchronized)
+    pclk (N, 2p)      pseudolite transmitter clock bias (m) and drift (m/s) pairs (unsynchronized)
+    psy  (N, p)  m    a synchronized pseudolite's time-sync error (pseudolite.py; the pl_clock series then)
     rab  (N,)   m     radar-altimeter bias (radalt.py); NavSystem.start adds the terrain database's bias
     ram  (N,)   m     radar-altimeter Gauss-Markov error
     tdb  (N,)         the terrain database's unit along-track Gauss-Markov at the start (NavSystem.start: the
@@ -62,6 +63,7 @@ class SensorStates:
     pmp: Array | None = None
     ptr: Array | None = None
     pclk: Array | None = None
+    psy: Array | None = None
     rab: Array | None = None
     ram: Array | None = None
     tdb: Array | None = None
@@ -231,6 +233,7 @@ _EXTRACT: dict[str, Callable[[_At], Array | None]] = {
     "pmp": lambda at: _series(at, "pseudolite", "multipath"),
     "ptr": _ptr,
     "pclk": _pclk,
+    "psy": lambda at: _series(at, "pseudolite", "pl_clock"),
     "rab": lambda at: None if at.sample("radalt") is None else np.asarray(
         at.sample("radalt")[0].constants["bias"], dtype=float).reshape(-1),
     "ram": lambda at: _series(at, "radalt", "markov"),

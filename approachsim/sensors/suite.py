@@ -62,9 +62,10 @@ def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterab
     out: dict[str, Any] = {"imu": Imu(grade)}
     if cfg.baro is not None:
         b = cfg.baro
-        field_m, ratio = 0.0, 1.0
+        # the field's geopotential elevation: the altimeter setting's reference (the scale factor's H_ref) and the
+        # temperature correction's H_f
+        field_m, ratio = float(atmosphere.geopotential_m(runway.threshold_h_m)), 1.0
         if b.temperature_correction == "aerodrome":
-            field_m = float(atmosphere.geopotential_m(runway.threshold_h_m))
             ratio = atmosphere.temperature_correction_ratio(
                 field_m, atmosphere.reported_aerodrome_temperature_k(field_m, isa_dev_k))
         out["baro"] = Baro(setting_pa=qnh_pa, rate_hz=b.rate_hz, bias_sigma_m=b.bias_sigma_m,
@@ -92,6 +93,7 @@ def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterab
             runway=runway, positions_rwy=p.positions_rwy, synchronized=p.synchronized, code_noise_m=p.code_noise_m,
             multipath_m=p.multipath_m, multipath_tau_s=p.multipath_tau_s, survey_sigma_m=p.survey_sigma_m,
             tropo_ppm_sigma=p.tropo_ppm_sigma, max_range_m=p.max_range_m, rate_hz=gnss_rate,
+            sync_sigma_m=p.sync_sigma_m, sync_tau_s=p.sync_tau_s,
         )
     faults = tuple(faults)
     for name in list(out):

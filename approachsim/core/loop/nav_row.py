@@ -76,7 +76,7 @@ def baro_sample(k: int, buf: np.ndarray, nw: np.ndarray, lag_w: np.ndarray, bias
     operations in order): h_ind = (T0 / L)(1 - (p / p_set)^(R L / g0)) of the static pressure at the IMU (buf column
     ROW_P_STATIC; with a lag, the weights lag_w over rows k, k - 1, ..., clipped at 0),
     h_c = h_ind + (h_ind - H_f)(c - 1),
-    h = h_c (1 + S) + bias + noise."""
+    h = h_c + (h_c - H_f) S + bias + noise."""
     t0l, p_set, ex = nw[W_BT0L], nw[W_BSET], nw[W_BEXP]
     if lag_w.shape[0] > 0:
         h = 0.0
@@ -85,7 +85,7 @@ def baro_sample(k: int, buf: np.ndarray, nw: np.ndarray, lag_w: np.ndarray, bias
     else:
         h = t0l * (1.0 - (buf[k, ROW_P_STATIC] / p_set) ** ex)
     h = h + (h - nw[W_BFLD]) * nw[W_BCM1]
-    return h * (1.0 + nw[W_BSF]) + bias + noise
+    return h + (h - nw[W_BFLD]) * nw[W_BSF] + bias + noise
 
 
 @njit(cache=True)

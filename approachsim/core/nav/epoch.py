@@ -127,11 +127,11 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, o
     baro_h = obs.baro_h
     if baro_h[0] == baro_h[0]:
         if own:
-            nu[0], _ = km.baro(lay, X[0], ins[0, 2], baro_h[0], 0.0, h)
+            nu[0], _ = km.baro(lay, X[0], ins[0, 2], baro_h[0], 0.0, h, rows.baro_ref)
         else:
-            km.baro(lay, x0, ref[2], baro_h[0], 0.0, h)
+            km.baro(lay, x0, ref[2], baro_h[0], 0.0, h, rows.baro_ref)
             for m in range(M):
-                nu[m] = km.baro_nu(lay, X[m], ins[m, 2], baro_h[m])
+                nu[m] = km.baro_nu(lay, X[m], ins[m, 2], baro_h[m], rows.baro_ref)
         k = _update(X, P, h, obs.baro_r, nu, CODE_BARO, k, out, b, kc)
     # radar altimeter
     radalt_h, db_x, db_u = obs.radalt_h, obs.db_x, obs.db_u

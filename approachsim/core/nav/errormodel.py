@@ -39,19 +39,21 @@ L_N, L_DP, L_DV, L_PSI, L_BG, L_BA, L_BB, L_SB, L_CLK, L_AC = range(10)
 L_GSE, L_GMP, L_PMP, L_PTR, L_PCLK, L_RAB, L_RAM, L_TDB, L_NSV, L_NPL = range(10, 20)
 L_GIO, L_AMB = 20, 21
 """The carrier-phase groups' first index (-1 absent): after every other group (kernels/carrier.py)."""
-LAY_SIZE = 22
+L_PSY = 22
+"""The synchronized pseudolites' time-sync error group psy (-1 absent)."""
+LAY_SIZE = 23
 LAY_GROUPS = ("dp", "dv", "psi", "bg", "ba", "bb", "sb", "clk", "ac", "gse", "gmp", "pmp", "ptr", "pclk", "rab",
               "ram", "tdb")
 """Group names in the order of lay[1:18]."""
 
 Q_ARW, Q_VRW, Q_BG_RW, Q_BA_RW, Q_BB_SIGMA, Q_BB_TAU, Q_BARO_SIGMA, Q_BARO_RATE = range(8)
 Q_CLK_SF, Q_CLK_SG, Q_GSE_TAU, Q_GMP_TAU, Q_PMP_SIGMA, Q_PMP_TAU, Q_PCLK_SF, Q_PCLK_SG = range(8, 16)
-Q_RAM_SIGMA, Q_RAM_TAU, Q_TDB_L = range(16, 19)
-Q_SIZE = 19
+Q_RAM_SIGMA, Q_RAM_TAU, Q_TDB_L, Q_BARO_REF, Q_PSY_SIGMA, Q_PSY_TAU = range(16, 22)
+Q_SIZE = 22
 Q_FIELDS = ("gyro_arw_rad_sqrts", "accel_vrw_mps_sqrts", "gyro_bias_rw", "accel_bias_rw", "baro_bias_sigma_m",
             "baro_bias_tau_s", "baro_noise_sigma_m", "baro_rate_hz", "clock_sf", "clock_sg", "gse_tau_s",
             "gmp_tau_s", "pmp_sigma_m", "pmp_tau_s", "pclk_sf", "pclk_sg", "ram_sigma_m", "ram_tau_s",
-            "tdb_correlation_m")
+            "tdb_correlation_m", "baro_ref_m", "psy_sigma_m", "psy_tau_s")
 """errormodel.ErrorNoise field of each q[Q_*], in index order."""
 
 LOOP_SIZE = 4
@@ -81,7 +83,8 @@ def dynamics(lay: np.ndarray, q: np.ndarray, gse_sigma: np.ndarray, gmp_sigma: n
     held: the damping loop held (no baro over the interval): only ac acts. Equations: errormodel's docstring,
         dp' = F_pp dp + dv ; dv' = [f x] psi + C ba - (2 w_ie + w_en) x dv + v x (2 dw_ie + dw_en) - (dg/dh) dp_D
         psi' = -w_in x psi + dw_in - C bg ; sensor states random constants / walks / Gauss-Markov ;
-        loop e = -dp_D - bb - h sb: dp_D' += C1 e, dv_D' += C2 e + ac, ac' = C3 e, Qc += g g' sigma_b^2 / rate.
+        loop e = -dp_D - bb - (h - H_ref) sb: dp_D' += C1 e, dv_D' += C2 e + ac, ac' = C3 e,
+        Qc += g g' sigma_b^2 / rate.
     """
     F[:, :] = 0.0
     Qc[:, :] = 0.0
@@ -182,6 +185,10 @@ def dynamics(lay: np.ndarray, q: np.ndarray, gse_sigma: np.ndarray, gmp_sigma: n
             F[i, i + 1] = 1.0
             Qc[i, i] = q[Q_PCLK_SF]
             Qc[i + 1, i + 1] = q[Q_PCLK_SG]
+    if lay[L_PSY] >= 0:
+        for j in range(lay[L_NPL]):
+            one[0] = q[Q_PSY_SIGMA]
+            _markov(F, Qc, lay[L_PSY] + j, 1, one, q[Q_PSY_TAU])
     if lay[L_RAM] >= 0:
         one[0] = q[Q_RAM_SIGMA]
         _markov(F, Qc, lay[L_RAM], 1, one, q[Q_RAM_TAU])
@@ -192,13 +199,13 @@ def dynamics(lay: np.ndarray, q: np.ndarray, gse_sigma: np.ndarray, gmp_sigma: n
     if iac >= 0:
         i_h, i_v = ip + 2, iv + 2  # dp_D = -dh, dv_D = -dv_up
         F[i_v, iac] += 1.0
-        if not held:  # loop error e = -dp_D - bb - h sb
+        if not held:  # loop error e = -dp_D - bb - (h - H_ref) sb
             isb = lay[L_SB]
             for row, g in ((i_h, loop[1]), (i_v, loop[2]), (iac, loop[3])):
                 F[row, i_h] += g * -1.0
                 F[row, ibb] += g * -1.0
                 if isb >= 0:
-                    F[row, isb] += g * -h
+                    F[row, isb] += g * -(h - q[Q_BARO_REF])
             gv = (-loop[1], -loop[2], -loop[3])
             idx = (i_h, i_v, iac)
             s2 = q[Q_BARO_SIGMA] ** 2

@@ -48,6 +48,9 @@ class Rows(NamedTuple):
     """The carrier-phase rows' noise variance, m^2 (0 without carrier phase)."""
     amb_prior: float
     """A float ambiguity's prior variance at a new carrier arc, m^2."""
+    baro_ref: float
+    """The baro scale factor's reference H_ref: the altimeter-setting reference (the field), m (the sb row's
+    -(h - H_ref))."""
 
 
 class Obs(NamedTuple):

@@ -83,25 +83,26 @@ def database_error(along: float, dbp: np.ndarray, db_x: np.ndarray, db_u: np.nda
 
 
 @njit(cache=True)
-def baro_nu(lay: np.ndarray, x_hat: np.ndarray, h_ins: float, h_baro: float) -> float:
-    """Innovation of the baro row: nu = (h_ins - h_baro) - (-dp_D - bb - h_ins sb), m."""
+def baro_nu(lay: np.ndarray, x_hat: np.ndarray, h_ins: float, h_baro: float, h_ref: float) -> float:
+    """Innovation of the baro row: nu = (h_ins - h_baro) - (-dp_D - bb - (h_ins - H_ref) sb), m; h_ref = H_ref the
+    altimeter-setting reference (the field), m."""
     pred = -x_hat[lay[ek.L_DP] + 2] - x_hat[lay[ek.L_BB]]
     if lay[ek.L_SB] >= 0:
-        pred = pred - h_ins * x_hat[lay[ek.L_SB]]
+        pred = pred - (h_ins - h_ref) * x_hat[lay[ek.L_SB]]
     return (h_ins - h_baro) - pred
 
 
 @njit(cache=True)
-def baro(lay: np.ndarray, x_hat: np.ndarray, h_ins: float, h_baro: float, sigma: float, h: np.ndarray
-         ) -> tuple[float, float]:
-    """Baro altitude difference z = h_ins - h_baro (m): h = -1 at dp_D, -1 at bb, -h_ins at sb (into h (n,));
-    returns (nu, r = sigma^2)."""
+def baro(lay: np.ndarray, x_hat: np.ndarray, h_ins: float, h_baro: float, sigma: float, h: np.ndarray,
+         h_ref: float) -> tuple[float, float]:
+    """Baro altitude difference z = h_ins - h_baro (m): h = -1 at dp_D, -1 at bb, -(h_ins - H_ref) at sb (into
+    h (n,)), H_ref = h_ref the altimeter-setting reference (m); returns (nu, r = sigma^2)."""
     h[:] = 0.0
     h[lay[ek.L_DP] + 2] = -1.0
     h[lay[ek.L_BB]] = -1.0
     if lay[ek.L_SB] >= 0:
-        h[lay[ek.L_SB]] = -h_ins
-    return baro_nu(lay, x_hat, h_ins, h_baro), sigma**2
+        h[lay[ek.L_SB]] = -(h_ins - h_ref)
+    return baro_nu(lay, x_hat, h_ins, h_baro, h_ref), sigma**2
 
 
 @njit(cache=True)
@@ -212,6 +213,11 @@ def _pseudorange(lay: np.ndarray, x_hat: np.ndarray, r_ins: np.ndarray, c_en: np
             lin -= x_hat[k + 2 * pl]
             if row:
                 h[k + 2 * pl] = -1.0
+        k = lay[ek.L_PSY]
+        if k >= 0:
+            lin -= x_hat[k + pl]
+            if row:
+                h[k + pl] = -1.0
     if row:  # e' (1 + T) at dp, e the unit vector transmitter -> corrected position, NED
         los_row(h, ip, c_en, a0, a1, a2, rng_hat, scale)
     z = rng_ins - rho
@@ -225,16 +231,17 @@ def pseudorange(lay: np.ndarray, x_hat: np.ndarray, r_ins: np.ndarray, c_en: np.
     """A code pseudorange rho (m) to a satellite (sv its channel, else -1) or pseudolite (pl its unit, else -1),
     tightly coupled: z = |r_ins - r_tx| - rho, g(x) = |r_ins - r_tx| - |r_ins - C' dp - r_tx| (1 + T) - clk
     - (channel errors). r_ins, r_tx (3,) ECEF m; c_en (3, 3) ECEF -> NED at the INS position. Row into h (n,):
-    e' (1 + T) at dp, -1 at clk and the channel's gse, gmp (pmp, pclk), -range at ptr. Returns (nu, sigma^2)."""
+    e' (1 + T) at dp, -1 at clk and the channel's gse, gmp (pmp, pclk, psy), -range at ptr. Returns (nu, sigma^2)."""
     nu = _pseudorange(lay, x_hat, r_ins, c_en, r_tx, rho, sv, pl, h, True)
     return nu, sigma**2
 
 
 @njit(cache=True)
-def baro_nu_many(lay: np.ndarray, X: np.ndarray, h_ins: np.ndarray, h_baro: np.ndarray, nu: np.ndarray) -> None:
-    """nu[m] of the baro row for runs m: X (M, n) estimates, h_ins, h_baro (M,) m."""
+def baro_nu_many(lay: np.ndarray, X: np.ndarray, h_ins: np.ndarray, h_baro: np.ndarray, h_ref: float,
+                 nu: np.ndarray) -> None:
+    """nu[m] of the baro row for runs m: X (M, n) estimates, h_ins, h_baro (M,) m, h_ref the setting's reference, m."""
     for m in range(X.shape[0]):
-        nu[m] = baro_nu(lay, X[m], h_ins[m], h_baro[m])
+        nu[m] = baro_nu(lay, X[m], h_ins[m], h_baro[m], h_ref)
 
 
 @njit(cache=True)

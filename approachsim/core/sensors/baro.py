@@ -17,11 +17,13 @@ def baro_apply(p_static: np.ndarray, setting_pa: float, t0_over_lapse_m: float, 
 
         h_ind = (T0 / L) (1 - (p / p_set)^(R L / g0))        (ISA inverse, sensors/atmosphere.py)
         h_c   = h_ind + (h_ind - H_f) (c - 1)                  (temperature correction; c - 1 = 0: none)
-        h     = h_c (1 + S_r) + B_ri + v_ri                    (sensors/baro.py)
+        h     = h_c + (h_c - H_f) S_r + B_ri + v_ri            (sensors/baro.py: the scale factor on the height above
+                                                               the altimeter-setting reference H_f, the field)
 
     p_static (m, n) the static pressure (Pa) of each sample's truth row (column 0) and, with a lag, of the n - 1 rows
     before it; weights (n,) the lag's impulse response (h_ind = sum_l w_l h_ind(p_il), in l order), empty without a
-    lag; t0_over_lapse_m = T0 / L (m), exponent = R L / g0; field_m = H_f (m), ratio_m1 = c - 1; scale factor sf
+    lag; t0_over_lapse_m = T0 / L (m), exponent = R L / g0; field_m = H_f (m) the field's geopotential elevation (the
+    setting's reference), ratio_m1 = c - 1; scale factor sf
     (R,), bias and noise (R, m) m."""
     m = p_static.shape[0]
     lagged = weights.shape[0] > 0
@@ -34,4 +36,4 @@ def baro_apply(p_static: np.ndarray, setting_pa: float, t0_over_lapse_m: float, 
             h = t0_over_lapse_m * (1.0 - (p_static[i, 0] / setting_pa) ** exponent)
         h = h + (h - field_m) * ratio_m1
         for r in range(sf.shape[0]):
-            out[r, i] = h * (1.0 + sf[r]) + bias[r, i] + noise[r, i]
+            out[r, i] = h + (h - field_m) * sf[r] + bias[r, i] + noise[r, i]

@@ -48,6 +48,8 @@ LAYOUTS = {
     "pseudolites": em.StateLayout(clock=True, n_sv=3, n_pl=2),
     "pseudolite-clocks-radalt": em.StateLayout(loop=True, n_sv=2, n_pl=3, pl_clock=True, radalt_bias=True,
                                                radalt_markov=True, terrain_db=True),
+    "pseudolite-sync-radalt": em.StateLayout(loop=True, n_sv=2, n_pl=2, pl_sync=True, radalt_bias=True,
+                                             terrain_db=True),
     "default": em.StateLayout(baro_scale=False, loop=True, n_sv=24, radalt_bias=True, radalt_markov=True,
                               terrain_db=True),
 }
@@ -60,7 +62,8 @@ def _noise(n_sv: int, rng: np.random.Generator) -> em.ErrorNoise:
         gyro_arw_rad_sqrts=4.8e-8 * rng.uniform(0.5, 2), accel_vrw_mps_sqrts=4.2e-7, gyro_bias_rw=1e-9,
         accel_bias_rw=2e-7, baro_bias_sigma_m=1.0, baro_bias_tau_s=100.0, clock_sf=0.009, clock_sg=0.035,
         gse_sigma_m=per, gmp_sigma_m=rng.uniform(0.1, 0.3, n_sv), gmp_tau_s=100.0, pmp_sigma_m=0.3,
-        pclk_sf=0.01, pclk_sg=0.02, ram_sigma_m=0.2155)
+        pclk_sf=0.01, pclk_sg=0.02, ram_sigma_m=0.2155, baro_ref_m=rng.uniform(0.0, 1700.0), psy_sigma_m=0.9,
+        psy_tau_s=600.0)
 
 
 def _point(rng: np.random.Generator) -> tuple:
@@ -358,6 +361,8 @@ def test_riccati_segment_equals_the_converged_covariance_reference():
 LAY_M = em.StateLayout(baro_scale=True, clock=True, loop=True, n_sv=6, n_pl=2, pl_clock=True, radalt_bias=True,
                        radalt_markov=True, terrain_db=True)
 LAY_PLAIN = em.StateLayout(baro_scale=False, clock=True, n_pl=1)
+LAY_SYNC = em.StateLayout(baro_scale=True, clock=True, loop=True, n_sv=3, n_pl=2, pl_sync=True, radalt_bias=True)
+"""Synchronized pseudolites: a time-sync state psy per transmitter (and no pclk)."""
 
 
 def _x_hat(lay: em.StateLayout, rng: np.random.Generator) -> np.ndarray:
@@ -382,13 +387,14 @@ def test_interp_kernel_is_numpys():
 
 @pytest.mark.parametrize("lay", [LAY_M, LAY_PLAIN], ids=["all-states", "plain"])
 def test_baro_row_kernel_equals_reference(lay):
+    """The scale factor's column -(h - H_ref) with H_ref from sea level to a 5434 ft field."""
     rng = np.random.default_rng(12)
     h = np.empty(lay.n)
     for _ in range(20):
-        x, h_ins = _x_hat(lay, rng), rng.uniform(0.0, 3000.0)
+        x, h_ins, h_ref = _x_hat(lay, rng), rng.uniform(0.0, 3000.0), rng.uniform(0.0, 1656.0)
         h_baro = h_ins + rng.normal(0.0, 5.0)
-        m = meas.baro(lay, h_ins, h_baro, 1.5, 0.0)
-        nu, r = mk.baro(lay.packed, x, h_ins, h_baro, 1.5, h)
+        m = meas.baro(lay, h_ins, h_baro, 1.5, 0.0, h_ref_m=h_ref)
+        nu, r = mk.baro(lay.packed, x, h_ins, h_baro, 1.5, h, h_ref)
         np.testing.assert_array_equal(h, m.h)  # constant entries (-1, the scale factor's h): no arithmetic
         assert r == m.r
         assert abs(nu - (m.z - m.h @ x)) <= 1e-9  # heights <= 3000 m: floor 8 eps 3000 = 5e-12 m, 200x below
@@ -447,13 +453,14 @@ def _geometry(rng: np.random.Generator):
     return r_ins, geo.c_ecef_to_ned(lat, lon)
 
 
-@pytest.mark.parametrize("tx", ["satellite", "satellite-no-channels", "pseudolite", "pseudolite-no-states"])
+@pytest.mark.parametrize("tx", ["satellite", "satellite-no-channels", "pseudolite", "pseudolite-no-states",
+                                "pseudolite-sync"])
 def test_pseudorange_row_kernel_equals_reference(tx):
-    """Satellites (gse / gmp channel states or none) and pseudolites (pmp, ptr, pclk or none): h and nu equal to
+    """Satellites (gse / gmp channel states or none) and pseudolites (pmp, ptr, pclk, psy or none): h and nu equal to
     their rounding floors from the operands (2e7 m satellite ranges, 6.4e6 m ECEF coordinates): 7e-8 m for a
     satellite's nu, however small nu is (one ulp of a 2.2e7 m range is 3.7e-9 m)."""
     rng = np.random.default_rng(14)
-    lay = LAY_M if tx in ("satellite", "pseudolite") else LAY_PLAIN
+    lay = {"satellite": LAY_M, "pseudolite": LAY_M, "pseudolite-sync": LAY_SYNC}.get(tx, LAY_PLAIN)
     sat = tx.startswith("satellite")
     h = np.empty(lay.n)
     worst = 0.0
@@ -504,9 +511,9 @@ def test_innovations_over_runs_equal_the_single_run_kernels():
     for m in range(M):
         assert nu[m] == mk.pseudorange(pk, X[m], r_ins[m], c_en[m], r_tx[m], rho[m], 1.0, 3, -1, h)[0]
     hb = hh + rng.normal(0.0, 3.0, M)
-    mk.baro_nu_many(pk, X, hh, hb, nu)
+    mk.baro_nu_many(pk, X, hh, hb, 12.5, nu)
     for m in range(M):
-        assert nu[m] == mk.baro(pk, X[m], hh[m], hb[m], 1.0, h)[0]
+        assert nu[m] == mk.baro(pk, X[m], hh[m], hb[m], 1.0, h, 12.5)[0]
     rwy = PROFILE.runway.frame
     tx, th, rv = meas.terrain_arrays(rwy, PROFILE.terrain)
     cfg = tdb.TerrainDbConfig()

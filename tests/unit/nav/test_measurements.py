@@ -67,6 +67,22 @@ def test_baro_row_and_value():
     assert m.r == 1.0
 
 
+def test_baro_scale_factor_is_on_the_height_above_the_field():
+    """A 5434 ft (1656 m) field, the aircraft 100 ft above it, a 12 % scale error (issue 39's uncorrected sigma):
+    the truth's error S (h - H_ref) is 3.7 m; on the MSL height it would be 202 m. The row's sb column is
+    -(h_ins - H_ref), so the filter's prediction matches the truth's error to S dh (the INS's 2 m error: 0.24 m)."""
+    h_ref = 5434.0 * 0.3048
+    h_ins = h_ref + 100.0 * 0.3048
+    x = np.zeros(LAY.n)
+    x[LAY.i("dp", 2)], x[LAY.i("sb")] = -2.0, 0.12  # INS 2 m high
+    h_true = h_ins - 2.0
+    h_baro = h_true + (h_true - h_ref) * 0.12  # sensors/baro.py with B = v = 0
+    m = meas.baro(LAY, h_ins, h_baro, 1.0, 0.0, h_ref_m=h_ref)
+    assert m.h[LAY.i("sb")] == pytest.approx(-100.0 * 0.3048, abs=1e-9)
+    assert m.h @ x == pytest.approx(m.z, abs=0.12 * 2.0 + 1e-9)
+    assert abs(h_baro - h_true) == pytest.approx(0.12 * 28.48, abs=0.01)
+
+
 def test_radalt_row_with_sloping_terrain():
     rwy = geo.RunwayFrame(LAT, LON, 0.0, np.radians(90.0))  # runway x = east
 

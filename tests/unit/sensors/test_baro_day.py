@@ -101,6 +101,25 @@ def test_qnh_setting_error_feet_per_hpa(elevation_ft, lo_ft, hi_ft):
     assert d == pytest.approx(float(slope * units.HPA / units.FT), rel=0.01)
 
 
+@pytest.mark.parametrize(("qnh_hpa", "reported_hpa"), [(1013.25, 1013.0), (1013.99, 1013.0), (1013.0, 1013.0),
+                                                      (1029.5, 1029.0)])
+def test_qnh_reported_in_whole_hpa_rounds_down_and_reads_low(qnh_hpa, reported_hpa):
+    """qnh_report = "whole_hpa": the setting is the QNH rounded down (issue 39), so at the field the altimeter reads
+    low by (QNH - reported) times the feet per hPa at the field, R T0 / (g0 p_set) (27.3 ft at 1013 hPa, 26.9 at
+    1029; within 0.5 %, the slope taken at the mid setting); "exact" (the default) is the QNH itself, bit for bit."""
+    exact = _profile(0.0, 0.0, qnh_hpa)
+    rounded = parse_profile({
+        "runway": {"threshold_lat_deg": 45.0, "threshold_lon_deg": 7.0, "elevation_ft": 0.0, "heading_true_deg": 90.0},
+        "environment": {"qnh_hPa": qnh_hpa, "qnh_report": "whole_hpa"},
+    })
+    assert exact.environment.setting_pa == qnh_hpa * units.HPA
+    assert rounded.environment.setting_pa == reported_hpa * units.HPA
+    assert rounded.environment.sea_level_pa == exact.environment.sea_level_pa  # the day is the same
+    d = _indicated_ft(rounded, 0.0) - _indicated_ft(exact, 0.0)
+    ft_per_hpa = atm.R_AIR * atm.T0_K / atm.G0 / (0.5 * (qnh_hpa + reported_hpa)) / units.FT
+    assert d == pytest.approx(-ft_per_hpa * (qnh_hpa - reported_hpa), rel=0.005, abs=1e-9)
+
+
 def test_true_qnh_key_is_refused_with_guidance():
     from approachsim.config import ProfileError
 

@@ -52,13 +52,14 @@ def test_mapped_states_reproduce_the_realized_measurement_errors():
     # 1e-9 and 1e-12 are ~100x those
     np.testing.assert_allclose(st.clk[:, 0], g.clock_bias_m[:, 0], atol=1e-9)
     np.testing.assert_allclose(st.clk[:, 1], g.clock_drift_mps[:, 0], atol=1e-12)
-    # baro: h_B - h_ind = B + S h_ind + v
+    # baro: h_B - h_ind = B + S (h_ind - H_f) + v, H_f the setting's reference (the field)
     b = errors.sensors["baro"]
     h_ind = exact["baro"].h_baro_m[:, 0]
+    h_f = suite.sensors["baro"].field_m
     # heights ~ 100 m from the ISA inverse (~8 roundings of T0 / L = 44.3 km: floor(8, 44330) = 7.9e-11 m); 1e-9 m
     # is 13x that
-    np.testing.assert_allclose(rec["baro"].h_baro_m[:, 0] - h_ind, st.bb + st.sb * h_ind + b.series["noise"][:, 0],
-                               atol=1e-9)
+    np.testing.assert_allclose(rec["baro"].h_baro_m[:, 0] - h_ind,
+                               st.bb + st.sb * (h_ind - h_f) + b.series["noise"][:, 0], atol=1e-9)
     assert np.all(np.abs(st.sb) > 0.0)
     # IMU, zero noise: the first increment's error is the body-axis bias the filter's bg / ba states mean
     dth_t, dv_t, dt = true_increments(truth, np.array([1]))
