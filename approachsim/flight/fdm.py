@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import io
 import math
 import os
 import sys
@@ -57,17 +58,21 @@ class TrimError(RuntimeError):
 
 @contextlib.contextmanager
 def _quiet_stdout():
-    """Send the process's C-level stdout (file descriptor 1) to /dev/null for the duration."""
+    """Send the process's C-level stdout (file descriptor 1) to /dev/null for the duration, and Python's sys.stdout
+    too: the JSBSim module writes its C++ output through sys.stdout when that is not the process's own (a doctest,
+    a notebook)."""
     try:
         sys.stdout.flush()
         saved = os.dup(1)
     except (OSError, ValueError, AttributeError):
-        yield
+        with contextlib.redirect_stdout(io.StringIO()):
+            yield
         return
     devnull = os.open(os.devnull, os.O_WRONLY)
     try:
         os.dup2(devnull, 1)
-        yield
+        with contextlib.redirect_stdout(io.StringIO()):
+            yield
     finally:
         os.dup2(saved, 1)
         os.close(saved)
