@@ -176,13 +176,13 @@ class Autopilot:
         self,
         x: float, y: float, z: float, vn: float, ve: float, vd: float,
         phi: float, theta: float, p: float, q: float, beta: float, cas: float, h_gear: float | None = None,
-        tas: float | None = None, psi: float | None = None, r: float = 0.0,
+        tas: float | None = None, yaw: tuple[float, float] | None = None,
     ) -> tuple[float, float, float, float]:
         """One control step: guidance position (runway frame, m) and NED velocity (m/s), attitude (rad),
         body rates (rad/s), sideslip (rad), calibrated airspeed (m/s) -> elevator, aileron, rudder, throttle.
         h_gear: main-gear height above the terrain (m) on landing runs (the radio altitude; None: no flare).
         tas: true airspeed (m/s) for the speed complement (None: the autothrottle holds the raw CAS).
-        psi, r: true heading (rad) and yaw rate (rad/s) for the decrab (psi None: no decrab)."""
+        yaw: (psi, r) true heading (rad) and yaw rate (rad/s) for the alignment (None: no alignment)."""
         g = self.g
         dt = self.dt
         v_air = cas  # the smoothed true airspeed (the air-mass speed) when TAS is given
@@ -225,7 +225,8 @@ class Autopilot:
             thr = min(thr, thr_flare)
         self._theta_c = theta_c
         de = -g.k_theta * (theta_c - theta) + g.k_q * q
-        aligning = h_gear is not None and psi is not None and (self.aligning or h_gear <= g.align_height_m)
+        psi, r = yaw if yaw is not None else (math.nan, 0.0)
+        aligning = h_gear is not None and yaw is not None and (self.aligning or h_gear <= g.align_height_m)
         crab = 0.0
         if aligning:
             self.aligning = True

@@ -138,10 +138,10 @@ def test_the_alignment_engages_at_450_ft(ap):
     assert g.align_height_m == pytest.approx(450.0 * units.FT)
     x = -2600.0
     ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, 451.0 * units.FT,
-            psi=math.radians(8.0), r=0.0)
+            yaw=(math.radians(8.0), 0.0))
     assert not ap.aligning
     ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, 449.0 * units.FT,
-            psi=math.radians(8.0), r=0.0)
+            yaw=(math.radians(8.0), 0.0))
     assert ap.aligning
 
 
@@ -157,8 +157,8 @@ def test_the_alignment_steers_the_main_gear_onto_the_centreline(ap):
     crab, r = math.radians(3.0), 0.01
     x = -200.0
     args = (x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, 0.5 * g.align_height_m)
-    da0 = at_imu.step(*args, psi=crab, r=r)[1]
-    da1 = at_gear.step(*args, psi=crab, r=r)[1]
+    da0 = at_imu.step(*args, yaw=(crab, r))[1]
+    da1 = at_gear.step(*args, yaw=(crab, r))[1]
     want = g.k_phi * (g.k_loc_p * 10.11 * math.sin(crab) + g.k_loc_d * 10.11 * math.cos(crab) * r)
     assert da1 - da0 == pytest.approx(want, rel=1e-9)
     assert da1 > da0  # towards the side the gear trails from
@@ -173,11 +173,11 @@ def test_the_decrab_yaws_towards_the_runway_and_holds_the_sideslip(ap):
     g = ap.g
     h = 0.5 * g.align_height_m
     de, da, dr, thr = ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, h,
-                              psi=math.radians(8.0), r=0.0)
+                              yaw=(math.radians(8.0), 0.0))
     assert ap.aligning
     assert dr == pytest.approx(g.k_r_align * math.radians(8.0) / g.align_tau_s)
     _, da_b, dr_b, _ = ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, 0.1, 72.0, h,
-                               psi=0.0, r=0.0)
+                               yaw=(0.0, 0.0))
     assert dr_b == pytest.approx(g.k_beta_align * 0.1, rel=1e-9)  # aligned: the rudder that holds beta = 0.1
     assert da_b > 0.0  # right wing down into the wind
 
@@ -185,7 +185,7 @@ def test_the_decrab_yaws_towards_the_runway_and_holds_the_sideslip(ap):
 def _align_step(ap, crab_rad, beta_rad):
     x = -200.0
     return ap.step(x, 0.0, _on_path(x), 70.0, 0.0, 3.6, 0.0, 0.02, 0.0, 0.0, beta_rad, 72.0,
-                   0.5 * ap.g.align_height_m, psi=crab_rad, r=0.0)
+                   0.5 * ap.g.align_height_m, yaw=(crab_rad, 0.0))
 
 
 def test_the_partial_decrab_limits_the_sideslip_to_5_deg(ap):

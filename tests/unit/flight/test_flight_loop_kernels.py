@@ -110,8 +110,8 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
         int_p = ap.int_b if gains.tecs else ap.int_d
         int_y = ap.int_y
         hg = None if math.isnan(h_gear[k]) else h_gear[k]
-        want = ap.step(*args, hg, None if math.isnan(tas[k]) else tas[k], psi=None if hg is None else psi[k],
-                       r=att[k, 5])
+        want = ap.step(*args, hg, None if math.isnan(tas[k]) else tas[k],
+                       yaw=None if hg is None else (psi[k], att[k, 5]))
         got = fk.autopilot_step(par, st, args[:6], (*args[6:], h_gear[k], tas[k],
                                                      psi[k] if hg is not None else math.nan, att[k, 5]))
         # exact: the kernel and its Python oracle do the same scalar IEEE operations in the same order (numba emits
