@@ -46,6 +46,18 @@ the step (a satellite fault counted twice: conservative); baro, radar altimeter 
 met) when its upper bound (the sum of the terms' upper bounds) is within the allocation, `exceeds` when its lower
 bound is beyond, `not shown` otherwise. CAT II / III allocations are per 15 s; the simulated window is the whole
 approach, so the per-approach probability compared with them is conservative.
+
+**Specific risk.** Certification bounds the worst fault, not the average over an assumed magnitude law (the ARAIM
+protection-level equation, the GBAS threat models' limit case, DO-253 / Annex 10 Attachment D): prior x max over
+the magnitude of P(HMI | magnitude). Each mode's samples are binned by magnitude decade (from the range's low end;
+the last bin ends at its high end: sat-ramp 0.01-0.1-1-5 m/s, sat-step 1-10-100 m) and by onset third of the
+window, and P(HMI | bin) is bounded per category (`specific_risk`): from the first step, a sample of the fault's
+own distribution (exact Clopper-Pearson, about samples / (3 x decades) per bin: 33 at 200 samples and two decades,
+so a bin without an HMI sample is bounded by 0.087), or from the last NAIS step where its effective sample size
+in the bin is larger (the likelihood-ratio-weighted conditional, Clopper-Pearson on Kish's effective counts:
+approximate). The verdict uses prior x the worst bin's upper bound; the average (the estimator's P(HMI | fault))
+is reported beside it as `..._average`. A bin is still an average over a decade and a third of the window: a
+narrower worst case inside it is not resolved.
 """
 
 from __future__ import annotations
@@ -117,6 +129,22 @@ class FaultMode:
             return float(self.high * abs(u))
         a, b = math.log(self.low), math.log(self.high)
         return float(math.exp(a + float(sps.norm.cdf(u)) * (b - a)))
+
+    def magnitude_edges(self) -> list[float]:
+        """The specific-risk magnitude bins' edges: decades from `low` (the last one ends at `high`, e.g. sat-ramp
+        0.01, 0.1, 1, 5 m/s); half-normal: 0, 1, 2, inf times `high` (|u| below 1, 1 to 2, beyond 2)."""
+        if self.law == "half-normal":
+            return [0.0, self.high, 2.0 * self.high, math.inf]
+        edges = [self.low]
+        while edges[-1] * 10.0 < self.high * (1.0 - 1e-9):
+            edges.append(edges[-1] * 10.0)
+        return [*edges, self.high]
+
+    def magnitude_fraction(self, lo: float, hi: float) -> float:
+        """The magnitude law's probability of [lo, hi) (the bin's share of the fault's prior)."""
+        if self.law == "half-normal":
+            return float(2.0 * (sps.norm.cdf(hi / self.high) - sps.norm.cdf(lo / self.high)))
+        return math.log(hi / lo) / math.log(self.high / self.low)
 
 
 _ISM = "ARAIM ISM P_sat (integrity-envelope.md 3a), per satellite in use"
@@ -345,6 +373,64 @@ def _columns(rows: Sequence[Mapping[str, Any]]) -> dict[str, Array]:
 # ---- one mode --------------------------------------------------------------------------------------------------
 
 
+ONSET_BINS = 3
+"""Onset bins of the specific risk: thirds of the onset window (early, middle, late in the approach)."""
+
+
+def sample_bins(mode: FaultMode, u: Array) -> tuple[Array, Array]:
+    """(magnitude bin, onset bin) of each standard-normal sample u (N, dim): `FaultMode.magnitude_edges` and
+    `ONSET_BINS` equal thirds of the onset window (Phi(u_0))."""
+    u = np.atleast_2d(np.asarray(u, float))
+    edges = mode.magnitude_edges()
+    mag = np.array([mode.magnitude(float(x)) for x in u[:, 1]]) if u.size else np.zeros(0)
+    mb = np.clip(np.searchsorted(edges, mag, side="right") - 1, 0, len(edges) - 2)
+    ob = np.clip((sps.norm.cdf(u[:, 0]) * ONSET_BINS).astype(int), 0, ONSET_BINS - 1) if u.size else mb
+    return mb.astype(int), ob.astype(int)
+
+
+def specific_risk(mode: FaultMode, first_u: Array, first_hit: Array, level: float, last_u: Array | None = None,
+                  last_hit: Array | None = None, last_w: Array | None = None) -> dict:
+    """P(HMI | magnitude bin, onset bin) of one mode and category, with one-sided Clopper-Pearson bounds at
+    `level`, from the samples the estimator drew (module docstring, "Specific risk").
+
+    The first step samples the fault's own distribution: per bin an unweighted count, exact Clopper-Pearson. The
+    last adaptive step (NAIS; None for mc or a one-step run) samples a proposal concentrated on the failure region:
+    per bin the likelihood-ratio-weighted conditional with Kish's effective sample size (rare.weighted_conditional,
+    approximate bounds). A bin's figure is the one of the two with the larger (effective) sample size: a choice by
+    size, not by outcome, so each bin keeps its level. The worst bin is the one with the largest upper bound; its
+    upper bound is an upper bound of max over bins of P(HMI | bin) at `level` (the true worst bin's own bound is
+    no larger). A bin with few samples has a wide bound (0 of n: 1 - (1 - level)^(1/n), 0.087 at n = 33)."""
+    edges = mode.magnitude_edges()
+    fb = sample_bins(mode, first_u)
+    first_hit = np.asarray(first_hit, bool)
+    lb = sample_bins(mode, last_u) if last_u is not None else None
+    bins = []
+    for i in range(len(edges) - 1):
+        for j in range(ONSET_BINS):
+            sel = (fb[0] == i) & (fb[1] == j)
+            k, n = int(np.sum(first_hit[sel])), int(np.sum(sel))
+            lo, hi = rare.clopper_pearson(k, n, level)
+            first = {"hits": k, "samples": n, "probability": k / n if n else None, "lower": lo, "upper": hi}
+            last = None
+            if lb is not None and last_hit is not None and last_w is not None:
+                s2 = (lb[0] == i) & (lb[1] == j)
+                last = rare.weighted_conditional(np.asarray(last_hit, bool)[s2], np.asarray(last_w, float)[s2],
+                                                 level)
+            use_last = last is not None and last["n_eff"] > n
+            used = last if use_last else first
+            bins.append({"magnitude": [edges[i], edges[i + 1]], "onset_third": j + 1,
+                         "onset_fraction": [j / ONSET_BINS, (j + 1) / ONSET_BINS],
+                         "bin_probability": mode.magnitude_fraction(edges[i], edges[i + 1]) / ONSET_BINS,
+                         "probability": used["probability"], "lower": used["lower"], "upper": used["upper"],
+                         "from": "last_step_weighted" if use_last else "first_step",
+                         "first_step": first, "last_step": last})
+    worst = max(range(len(bins)), key=lambda b: (bins[b]["upper"], bins[b]["probability"] or 0.0))
+    ns = [b["first_step"]["samples"] for b in bins]
+    return {"bins": bins, "worst_bin": worst, "worst_upper": bins[worst]["upper"],
+            "worst_lower": max(b["lower"] for b in bins),
+            "first_step_samples_per_bin": {"min": min(ns), "max": max(ns)}}
+
+
 MODE_OFFSET = 1_000_000
 """Run indices of mode k's samples start at (k + 1) * MODE_OFFSET (fault-free: at 0), so no two samples of a
 study share noise streams."""
@@ -396,6 +482,10 @@ def estimate_mode(sim: Simulator, mode: FaultMode, index: int, *, categories: Se
         else:
             r["bound"] = "importance sampling (normal interval)"
         r["mi_first_step"] = int(np.sum(fc.get(f"{key}_mi_g", np.zeros(1)) > 0.0))
+        one_sample = est.steps == 1 or last["u"] is last["first_u"] or not np.all(np.isfinite(last["w"]))
+        r["specific"] = specific_risk(
+            mode, np.asarray(last["first_u"]), fc.get(f"{key}_hmi_g", np.full(len(first_rows), -1.0)) > 0.0, level,
+            *((None, None, None) if one_sample else (np.asarray(last["u"]), ind, np.asarray(last["w"]))))
         per_cat[cat] = r
     allc = _columns(store)
     dp = None
@@ -483,7 +573,7 @@ def integrity_risk(profile: Any, *, modes: Sequence[str] | None = None, method: 
     workers = workers or os.cpu_count() or 1
     say = log or (lambda s: None)
     t0 = time.time()
-    out: dict = {"schema": "approachsim.integrity_risk/1", "profile": profile.name, "seed": seed,
+    out: dict = {"schema": "approachsim.integrity_risk/2", "profile": profile.name, "seed": seed,
                  "method": method, "samples_per_step": samples, "max_calls_per_mode": max_calls, "truths": truths,
                  "confidence": level, "bank_sensor_modes": bool(sensor_modes),
                  "bank_second_level": bool(second_level), "modes": {}}
@@ -512,11 +602,16 @@ def _fmt(x: Any) -> str:
 def totals(study: Mapping[str, Any], level: float) -> dict:
     """Per category: P(HMI) = fault-free + sum_k prior_k P(HMI | k), its bounds (sums of the terms' one-sided
     bounds: each term's bound at `level`, so the sum's coverage is at least 1 - sum of the misses: the union bound
-    is stated, not a joint level), the allocation and the verdict (module docstring)."""
+    is stated, not a joint level), the allocation and the verdict (module docstring). The upper sum and `verdict`
+    are the specific risk's (each mode's worst bin's upper bound x its prior, "Specific risk" in the module
+    docstring); `p_hmi_average_upper` and `verdict_average` the same with the average over the magnitude law.
+    `exceeds` comes from the average's lower bound in both (the average is at most the worst case, so it is a lower
+    bound on the specific risk too)."""
     out = {}
     for cat, req in REQUIREMENTS.items():
         ff = study["fault_free"]["categories"][cat]
         p, lo, hi, complete = ff["hmi_gaussian"], 0.0, ff["hmi_gaussian_worst_run"], True
+        hi_avg = hi
         terms = {"fault_free": {"probability": ff["hmi_gaussian"], "upper": ff["hmi_gaussian_worst_run"],
                                 "how": "Gaussian tail with the measured overbound; upper: the worst run's"}}
         for name, m in study["modes"].items():
@@ -526,15 +621,31 @@ def totals(study: Mapping[str, Any], level: float) -> dict:
             prior = m["prior"]
             up = c.get("upper")
             pr = c.get("probability") if c.get("shown") else None
+            sp = c.get("specific")
+            # specific risk: the worst (magnitude, onset) bin's upper bound (without bins: the average's, or 1); never
+            # below the average's upper bound (the worst case is at least the average)
+            a_up = up if up is not None else 1.0
+            w_up = max(sp["worst_upper"], a_up) if sp is not None else a_up
             terms[name] = {"prior": prior, "conditional": pr, "conditional_upper": up,
                            "probability": None if pr is None else prior * pr,
-                           "upper": None if up is None else prior * up, "shown": bool(c.get("shown"))}
-            hi = hi + (prior * up if up is not None else prior)
+                           "upper": None if up is None else prior * up, "shown": bool(c.get("shown")),
+                           "worst_bin_conditional_upper": w_up, "specific_upper": prior * w_up,
+                           "specific_shown": prior * w_up <= req.integrity_risk}
+            if sp is not None:
+                wb = sp["bins"][sp["worst_bin"]]
+                terms[name]["worst_bin"] = {k: wb[k] for k in ("magnitude", "onset_third", "probability", "lower",
+                                                               "upper", "from")}
+                terms[name]["worst_bin"]["samples"] = (wb["first_step"]["samples"] if wb["from"] == "first_step"
+                                                       else wb["last_step"]["n_eff"])
+                terms[name]["smallest_bin_probability"] = min(b["bin_probability"] for b in sp["bins"])
+            hi_avg = hi_avg + (prior * up if up is not None else prior)
+            hi = hi + prior * w_up
             lo = lo + (prior * c["lower"] if c.get("shown") else 0.0)
             p = p + (prior * pr if pr is not None else 0.0)
             complete = complete and c.get("shown", False)
         alloc = req.integrity_risk
         verdict = "shown" if hi <= alloc else ("exceeds" if lo > alloc else "not shown")
+        verdict_avg = "shown" if hi_avg <= alloc else ("exceeds" if lo > alloc else "not shown")
         # a term bounded only by its first step's Monte Carlo: the first-step size that would bound it, with no HMI
         # sample, by an equal share of the allocation (Clopper-Pearson at 0 hits: 1 - (1 - level)^(1 / n))
         share = alloc / max(1, len(terms))
@@ -544,14 +655,21 @@ def totals(study: Mapping[str, Any], level: float) -> dict:
             # the largest prior at which this term's upper bound stays within its equal share: what the fault
             # rate of a source without a sourced prior must be shown to be for this term not to decide the verdict
             up = tm["conditional_upper"]
-            tm["prior_allowed"] = share / up if up is not None and up > 0.0 else None
+            tm["prior_allowed_average"] = share / up if up is not None and up > 0.0 else None
+            w_up = tm["worst_bin_conditional_upper"]
+            tm["prior_allowed"] = share / w_up if w_up > 0.0 else None
             if not tm["shown"] and tm["prior"] > share:
                 tm["first_step_needed"] = math.ceil(math.log(1.0 - level) / math.log1p(-share / tm["prior"]))
+            if not tm["specific_shown"] and tm["prior"] > share and "smallest_bin_probability" in tm:
+                # specific risk: that many first-step runs in every bin, the smallest bin getting its share
+                n_bin = math.ceil(math.log(1.0 - level) / math.log1p(-share / tm["prior"]))
+                tm["first_step_needed_specific"] = math.ceil(n_bin / tm["smallest_bin_probability"])
         fa = study["fault_free"]["categories"][cat]["false_alert"]
         fa_up = max(fa["rate_per_15s_gaussian"], 0.0)
         out[cat] = {"p_hmi": p, "p_hmi_lower": lo, "p_hmi_upper": hi, "allocation": alloc,
                     "allocation_unit": "per approach" if req.exposure_s >= 150 else "per 15 s",
-                    "verdict": verdict, "every_term_estimated": complete, "terms": terms,
+                    "verdict": verdict, "p_hmi_average_upper": hi_avg, "verdict_average": verdict_avg,
+                    "every_term_estimated": complete, "terms": terms,
                     "p_false_alert_per_15s_gaussian": fa_up,
                     "p_false_alert_per_15s_upper_mc": fa["rate_per_15s_upper_mc"],
                     "false_alert_allocation_per_15s": fa["allocation_per_15s"],

@@ -247,6 +247,41 @@ def reweight(indicator: Array, w: Array, level: float = 0.95) -> dict:
             "shown": shown}
 
 
+def clopper_pearson_eff(k: float, n: float, level: float) -> tuple[float, float]:
+    """Clopper-Pearson (lower, upper), each one-sided at `level`, for a possibly non-integer count k of n (the
+    effective counts of a weighted sample, `weighted_conditional`); equal to `clopper_pearson` at integers. Both
+    bounds rise with k at fixed n and narrow as n grows at a fixed proportion (the beta quantiles are monotone)."""
+    if n <= 0:
+        return 0.0, 1.0
+    k = min(max(float(k), 0.0), float(n))
+    lo = 0.0 if k <= 0 else float(sps.beta.ppf(1.0 - level, k, n - k + 1))
+    hi = 1.0 if k >= n else float(sps.beta.ppf(level, k + 1, n - k))
+    return lo, hi
+
+
+def weighted_conditional(indicator: Array, w: Array, level: float = 0.95) -> dict:
+    """P(event | the samples' region) from an importance-weighted sample restricted to that region: the
+    self-normalized ratio p = sum(w 1) / sum(w), Kish's effective sample size n_eff = (sum w)^2 / sum(w^2), and
+    Clopper-Pearson bounds on the effective counts (p n_eff of n_eff, `clopper_pearson_eff`). With equal weights it is
+    the plain proportion and exact Clopper-Pearson; with unequal ones the bounds are approximate (the effective-size
+    argument, Kish 1965; as in the binomial approximation of weighted survey proportions), and a region the proposal
+    rarely visits has a small n_eff and so wide bounds. JSON-ready: probability (None without samples), hits (the
+    unweighted event count), samples, n_eff, k_eff, lower, upper."""
+    ind = np.asarray(indicator, bool)
+    w = np.asarray(w, float)
+    ok = np.isfinite(w) & (w > 0.0)
+    ind, w = ind[ok], w[ok]
+    sw = float(np.sum(w))
+    if ind.size == 0 or sw <= 0.0:
+        return {"probability": None, "hits": 0, "samples": 0, "n_eff": 0.0, "k_eff": 0.0, "lower": 0.0,
+                "upper": 1.0}
+    p = float(np.sum(w[ind]) / sw)
+    n_eff = sw * sw / float(np.sum(w * w))
+    lo, hi = clopper_pearson_eff(p * n_eff, n_eff, level)
+    return {"probability": p, "hits": int(ind.sum()), "samples": int(ind.size), "n_eff": n_eff,
+            "k_eff": p * n_eff, "lower": lo, "upper": hi}
+
+
 def rms_scale_upper(sum_sq: Array, count: Array, n_eff: int, level: float = 0.95) -> float:
     """One-sided upper bound at `level` of the RMS of normalized errors z = e / sigma from per-run sums of z^2
     (sum_sq) and counts (count): RMS = sqrt(sum sum_sq / sum count), bounded as a chi-square with n_eff degrees of

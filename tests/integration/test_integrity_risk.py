@@ -38,12 +38,17 @@ def test_small_study_writes_the_contract(tmp_path, capsys):
                    "--require", "CAT III"])
     assert status == 1  # 10 samples cannot show 1e-9
     r = json.loads((out / "integrity_risk.json").read_text())
-    assert r["schema"] == "approachsim.integrity_risk/1" and r["samples"] == 12
+    assert r["schema"] == "approachsim.integrity_risk/2" and r["samples"] == 12
     assert r["modes"]["baro-step"]["samples"] == 10 and r["fault_free"]["runs"] == 2
     for cat in ("CAT I", "CAT II", "CAT III"):
         c = r["categories"][cat]
         assert c["verdict"] in ("shown", "not shown", "exceeds")
         assert c["p_hmi_upper"] >= c["p_hmi"] >= c["p_hmi_lower"] >= 0.0
         assert c["allocation"] in (2e-7, 1e-9)
+        assert c["p_hmi_upper"] >= c["p_hmi_average_upper"]
+        assert c["verdict_average"] in ("shown", "not shown", "exceeds")
+        sp = r["modes"]["baro-step"]["categories"][cat]["specific"]
+        assert len(sp["bins"]) == 6 and sum(b["first_step"]["samples"] for b in sp["bins"]) == 10
+        assert c["terms"]["baro-step"]["specific_upper"] >= 1e-5 * sp["worst_upper"]
     assert r["categories"]["CAT III"]["verdict"] != "shown"
     assert "CAT III" in capsys.readouterr().out
