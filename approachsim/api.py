@@ -651,8 +651,9 @@ def integrity_risk(
 ) -> dict:
     """P(HMI) per category by importance sampling over the fault modes (what `approachsim integrity-risk` runs;
     docs/integrity.md): integrity_risk.json's content as plain data (categories.<CAT>.p_hmi, p_hmi_upper, verdict
-    "shown" | "not shown" | "exceeds", ...; docs/contract.md), also written to out/integrity_risk.json when out is
-    given. log: a function given each progress line (default: none)."""
+    "shown" | "not shown" | "exceeds": the specific risk, each mode's worst magnitude / onset bin; the average beside
+    it as p_hmi_average_upper, verdict_average; docs/contract.md), also written to out/integrity_risk.json when out
+    is given. log: a function given each progress line (default: none)."""
     import json
 
     from approachsim.campaign.integrity_risk import integrity_risk as run_risk
