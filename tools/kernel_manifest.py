@@ -2,7 +2,7 @@
 a cold cache, with the CPU seconds each took. Rerun after a change to a kernel's arguments or a call site's types
 (tests/unit/test_core_warm.py says when).
 
-    python tools/kernel_manifest.py [closed]      # closed: one closed-loop run of profiles/default.toml
+    python tools/kernel_manifest.py [closed|open]   # one closed- (open-) loop run of profiles/default.toml
 
 It runs in a fresh, empty numba cache directory (the compile times are a cold cache's) and takes about a minute.
 """
@@ -15,8 +15,9 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-WORKLOADS = {"closed": ["evaluate", str(ROOT / "profiles" / "default.toml"), "--runs", "1", "--workers", "1",
-                        "--seed", "1", "--no-report"]}
+_DEFAULT = ["evaluate", str(ROOT / "profiles" / "default.toml"), "--runs", "1", "--workers", "1", "--seed", "1",
+            "--no-report"]
+WORKLOADS = {"closed": _DEFAULT, "open": [*_DEFAULT, "--mode", "open"]}
 
 
 def main(kind: str = "closed") -> int:

@@ -388,3 +388,4 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool =
 
 
 closed_loop_group.kernels = "closed"  # type: ignore[attr-defined]  # its runs' kernels: core/manifests/closed.pkl
+open_loop_group.kernels = "open"  # type: ignore[attr-defined]  # its runs' kernels: core/manifests/open.pkl

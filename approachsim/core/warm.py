@@ -40,7 +40,8 @@ class Entry:
 
 
 def manifest_path(kind: str) -> Path:
-    """The shipped manifest of a kind of run (e.g. 'closed': a closed-loop evaluate with the integrity bank)."""
+    """The shipped manifest of a kind of run ('closed': a closed-loop evaluate with the integrity bank; 'open': the
+    open loop's)."""
     return MANIFEST_DIR / f"{kind}.pkl"
 
 

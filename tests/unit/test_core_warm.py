@@ -12,7 +12,7 @@ import numba
 import numpy as np
 import pytest
 
-from approachsim.campaign.pipeline import closed_loop_group
+from approachsim.campaign.pipeline import closed_loop_group, open_loop_group
 from approachsim.campaign.runner import kernels_of
 from approachsim.cli import main
 from approachsim.core import geodesy, warm
@@ -64,20 +64,22 @@ def test_pool_initializer_compiles_its_share_once(tmp_path: Path, monkeypatch: p
 
 def test_closed_loop_group_names_its_manifest() -> None:
     assert kernels_of(closed_loop_group) == "closed"
+    assert kernels_of(open_loop_group) == "open"
     assert kernels_of(functools.partial(closed_loop_group, land=True)) == "closed"
     assert kernels_of(np.mean) is None
 
 
-def test_shipped_closed_manifest_is_what_a_closed_loop_run_compiles(tmp_path: Path) -> None:
-    """Every entry of core/manifests/closed.pkl is a signature a closed-loop run of the default profile uses: an
+@pytest.mark.parametrize("kind", ["closed", "open"])
+def test_shipped_manifest_is_what_a_run_compiles(kind: str, tmp_path: Path) -> None:
+    """Every entry of core/manifests/<kind>.pkl is a signature a run of the default profile in that mode uses: an
     entry whose call site changed types would compile, on every cold cache, a variant no run uses. When this fails,
-    rerun tools/kernel_manifest.py."""
-    entries = warm.load("closed")
+    rerun tools/kernel_manifest.py <kind>."""
+    entries = warm.load(kind)
     assert len(entries) >= 10
     assert sum(e.cost_s for e in entries) > 10.0
     code = main(["evaluate", str(ROOT / "profiles" / "default.toml"), "--runs", "1", "--workers", "1", "--seed", "1",
-                 "--no-report", "--out", str(tmp_path / "e")])
+                 "--no-report", "--mode", kind, "--out", str(tmp_path / "e")])
     assert code in (0, 1)
     stale = [f"{e.module}.{e.name}{e.args}" for e in entries
              if e.args not in getattr(importlib.import_module(e.module), e.name).signatures]
-    assert not stale, f"stale manifest entries (rerun tools/kernel_manifest.py): {stale}"
+    assert not stale, f"stale manifest entries (rerun tools/kernel_manifest.py {kind}): {stale}"
