@@ -26,14 +26,13 @@ import math
 import operator
 import os
 import re
-import tomllib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from approachsim.config import ProfileError
-from approachsim.profile import Profile, parse_profile
+from approachsim.profile import Profile, parse_profile, read_profile_toml
 
 if TYPE_CHECKING:  # pragma: no cover - type names only
     import pandas
@@ -100,16 +99,7 @@ class ProfileSpec:
     @classmethod
     def from_file(cls, path: str | Path) -> ProfileSpec:
         """Read and validate a profile file (ProfileError for a missing file, bad TOML or a bad field)."""
-        p = Path(path)
-        if not p.is_file():
-            raise ProfileError(f"profile: no such file {str(p)!r}")
-        try:
-            data = tomllib.loads(p.read_text(encoding="utf-8"))
-        except UnicodeDecodeError:
-            raise ProfileError(f"profile: {str(p)!r} is not a UTF-8 text file") from None
-        except tomllib.TOMLDecodeError as e:
-            raise ProfileError(f"profile: {str(p)!r} is not valid TOML ({e})") from None
-        return cls.from_data(data, source=p.resolve())
+        return cls.from_data(read_profile_toml(path), source=Path(path).resolve())
 
     def with_settings(self, settings: Mapping[str, Any], *, name: str | None = None) -> ProfileSpec:
         """A variant: these profile keys set by their dotted TOML names ("sensors.imu.grade",

@@ -368,6 +368,11 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
 
 def load_profile(path: str | Path) -> Profile:
     """Read and validate a profile file. Missing file, bad TOML and bad fields all raise ProfileError."""
+    return parse_profile(read_profile_toml(path), source=Path(path).resolve())
+
+
+def read_profile_toml(path: str | Path) -> dict:
+    """A profile file's TOML as a dict, not yet validated (ProfileError for a missing file, not UTF-8, bad TOML)."""
     p = Path(path)
     if not p.is_file():
         raise ProfileError(f"profile: no such file {str(p)!r}")
@@ -377,4 +382,4 @@ def load_profile(path: str | Path) -> Profile:
         raise ProfileError(f"profile: {str(p)!r} is not a UTF-8 text file") from None
     except tomllib.TOMLDecodeError as e:
         raise ProfileError(f"profile: {str(p)!r} is not valid TOML ({e})") from None
-    return parse_profile(data, source=p.resolve())
+    return data
