@@ -11,9 +11,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from approachsim import geo
+from approachsim.core.jit import njit
 
 A = geo.A_WGS84
 B = geo.B_WGS84

@@ -28,9 +28,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from approachsim.core import layouts
+from approachsim.core.jit import njit
 from approachsim.core.nav import epoch as ke
 from approachsim.core.nav import groups as kg
 from approachsim.core.sensors import baro as bk
@@ -174,7 +174,10 @@ def direct_inputs(k: int, t: float, tol: float, jb: int, jr: int, jg: int, plan:
     if jg >= 0 and abs(g_ts[jg] - t) <= tol:
         for c in range(3):
             g_rx[0, c] = r_ecef[k, c]
-        g_sv[:, 0] = r_sv_all[:, jg]
+        for i in range(g_sv.shape[0]):
+            for s_ in range(g_sv.shape[2]):
+                for c in range(g_sv.shape[3]):
+                    g_sv[i, 0, s_, c] = r_sv_all[i, jg, s_, c]
         rng, u, el, az, vis, sel, pdop, f_iono, m_tropo, mp_scale, sigma = gk.sky(
             g_rx, g_sv, mask, mode, plan, shell, do253, mp_m, ce2, iono_z, tropo_z, cn2)
         pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, s_ce[:, jg:jg + 1], s_iono[:, jg:jg + 1],

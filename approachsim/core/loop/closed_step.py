@@ -12,8 +12,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from approachsim.core.jit import njit
 from approachsim.core.loop import flight_step as fk
 from approachsim.core.loop import nav_row as ik
 

@@ -19,10 +19,11 @@ from __future__ import annotations
 
 import numpy as np
 from llvmlite import ir
-from numba import njit, types
+from numba import types
 from numba.extending import intrinsic
 
 from approachsim.core import layouts
+from approachsim.core.jit import njit
 from approachsim.core.layouts import (
     D_EXEC,
     D_GET,

@@ -36,10 +36,10 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit
 
 from approachsim import geo, units
 from approachsim.core import geodesy as gk
+from approachsim.core.jit import njit
 from approachsim.core.layouts import (
     AP_ALIGN_BANK_MAX,
     AP_ALIGN_BETA_MAX,

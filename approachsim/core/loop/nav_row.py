@@ -24,8 +24,8 @@ tests/unit/nav/test_system_closed_loop.py flies both.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from approachsim.core.jit import njit
 from approachsim.core.layouts import (
     NX,
     ROW_F_BODY,

@@ -20,8 +20,8 @@ channels; gio, amb of channel c at index + c.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from approachsim.core.jit import njit
 from approachsim.core.nav import errormodel as ek
 from approachsim.core.nav import measurements as km
 

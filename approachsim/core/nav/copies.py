@@ -16,8 +16,8 @@ tests/unit/integrity/test_bankpass_carrier.py.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from approachsim.core.jit import njit
 from approachsim.core.nav import carrier as kcar
 from approachsim.core.nav import epoch as ke
 from approachsim.core.nav import errormodel as ek

@@ -39,9 +39,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from approachsim.core import geodesy as gk
+from approachsim.core.jit import njit
 from approachsim.core.nav import carrier as kcar
 from approachsim.core.nav import errormodel as ek
 from approachsim.core.nav import kalman as kk
@@ -256,7 +256,7 @@ def _with_resets(phi: np.ndarray, qd: np.ndarray, lay: np.ndarray, new: np.ndarr
     (core/nav/carrier.reset_ambiguities; qd, the caller's own copy, is reset in place)."""
     for c in range(new.shape[0]):
         if new[c] != 0:
-            phi_tmp[:, :] = phi
+            kk.copy_2d(phi_tmp, phi)
             kcar.reset_ambiguities(phi_tmp, qd, lay, new, prior)
             return phi_tmp
     return phi
@@ -281,7 +281,7 @@ def copies_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndar
     for i in range(N):
         hd = which[i]
         if last != hd:
-            qd_tmp[:, :] = qd_h[hd]
+            kk.copy_2d(qd_tmp, qd_h[hd])
         if ig >= 0:
             for c in range(chan.gse.shape[1]):
                 qd_tmp[ig + c, ig + c] = chan.gse[i, c] ** 2 * chan.f_gse

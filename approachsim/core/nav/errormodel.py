@@ -30,9 +30,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from approachsim.core import geodesy as gk
+from approachsim.core.jit import njit
 from approachsim.core.nav import kalman as kk
 
 L_N, L_DP, L_DV, L_PSI, L_BG, L_BA, L_BB, L_SB, L_CLK, L_AC = range(10)
@@ -315,7 +315,7 @@ def _square(phi: np.ndarray, qd: np.ndarray, W: np.ndarray, P2: np.ndarray, ptr:
     for i in range(m):  # Qd += Phi W'
         kk.row_sums(i, ptr, col, val, W, qd)
     _symmetrize(qd)
-    phi[:, :] = P2
+    kk.copy_2d(phi, P2)
 
 
 @njit(cache=True)

@@ -24,13 +24,24 @@ loops in a fixed order: they do not depend on any batch.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from approachsim.core.jit import njit
 
 
 def workspace(n: int) -> tuple[np.ndarray, ...]:
     """Scratch arrays for the kernels of an n-state filter (module docstring): allocate once per filter size."""
     return (np.empty((n, n)), np.empty(n), np.empty(n * n), np.empty(n + 1, dtype=np.int64),
             np.empty(n * n, dtype=np.int64))
+
+
+@njit(cache=True)
+def copy_2d(dst: np.ndarray, src: np.ndarray) -> None:
+    """dst[:, :] = src, element by element (same shape). A loop, not a slice assignment: numba compiles an
+    array-valued slice assignment with a shape-mismatch message built from unicode joins, about 3 s of compile
+    per process and per caller that links it, for a check the callers' equal shapes never need."""
+    for i in range(dst.shape[0]):
+        for j in range(dst.shape[1]):
+            dst[i, j] = src[i, j]
 
 
 @njit(cache=True)

@@ -25,9 +25,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from approachsim.core import geodesy as gk
+from approachsim.core.jit import njit
 from approachsim.core.nav import errormodel as ek
 
 

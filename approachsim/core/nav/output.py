@@ -17,9 +17,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from approachsim.core import geodesy as gk
+from approachsim.core.jit import njit
 from approachsim.core.nav.strapdown import _mm, rotation_exp
 
 _TWO_PI = 2.0 * math.pi

@@ -4,7 +4,8 @@ epoch span in one compiled call, with the same sums as the full filter's predict
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from approachsim.core.jit import njit
 
 Array = np.ndarray
 

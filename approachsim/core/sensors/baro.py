@@ -6,7 +6,8 @@ is the numpy oracle (tests/unit/sensors/test_sensor_kernels.py). They agree to 1
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from approachsim.core.jit import njit
 
 
 @njit(cache=True)

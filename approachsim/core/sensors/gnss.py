@@ -26,10 +26,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import literal_unroll, njit
+from numba import literal_unroll
 
 from approachsim import geo
 from approachsim.core import geodesy as gd
+from approachsim.core.jit import njit
 from approachsim.core.sensors import gnss_errors as ge
 
 OMEGA_E = geo.OMEGA_E

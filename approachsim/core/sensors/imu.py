@@ -6,7 +6,8 @@ increment at a time (increment, core/nav/strapdown.inloop_step)."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from approachsim.core.jit import njit
 
 
 @njit(cache=True)
