@@ -152,7 +152,8 @@ def _xwind_job(args: tuple) -> list[dict]:
         res = approach.fly(seed=1, run=r)
         row = {"run": r, "termination": res.termination, "ok": res.ok}
         if res.termination == "touchdown":
-            row.update(touchdown_scalars(res.truth, arms, approach.ground_contact_m))
+            row.update(touchdown_scalars(res.truth, arms, approach.ground_contact_m,
+                                         slope=approach.profile.runway.slope))
             row["flight_td_x_m"], row["flight_td_sink_mps"] = res.touchdown_x_m, res.touchdown_sink_mps
         out.append(row)
     return out

@@ -190,7 +190,8 @@ F_STATE = Layout(_scalars("de", "da", "dr", "thr", "lowest_m", "td_x_m", "td_sin
                           "mon_b", "phi", "theta", "p", "q", "beta", "cas_mps", "h_gear_m", "tas_mps", "psi", "r",
                           "wind_n_mps", "wind_e_mps"))
 (FS_DE, FS_DA, FS_DR, FS_THR, FS_LOWEST, FS_TD_X, FS_TD_SINK, FS_MON, FS_MON_Z, FS_MON_A, FS_MON_B,
- FS_PHI, FS_THETA, FS_P, FS_Q, FS_BETA, FS_CAS, FS_H_GEAR, FS_TAS, FS_PSI, FS_R, FS_WIND_N, FS_WIND_E) = F_STATE.starts()
+ FS_PHI, FS_THETA, FS_P, FS_Q, FS_BETA, FS_CAS, FS_H_GEAR, FS_TAS, FS_PSI, FS_R, FS_WIND_N,
+ FS_WIND_E) = F_STATE.starts()
 N_F_STATE = F_STATE.size
 
 # --- fly_step's vectors: the components' concatenated; the terrain profile (F_N_TERRAIN along-track distances, then

@@ -54,8 +54,8 @@ class Aircraft:
 class Mass:
     """Weight and balance of the JSBSim model and the aircraft's landing limits (aircraft file [mass]). The model
     has no payload stations: a chosen weight and CG is loaded as its tanks' contents (wing tanks first, each up to
-    its capacity, then the centre tank) with every tank moved to the one station x that puts the CG where asked
-    (JSBSim's propulsion/tank[i]/x-position); the tanks' y and z stay as modelled."""
+    its capacity, then the centre tank) with every tank's mass moved to the one station x that puts the CG where
+    asked (JSBSim's propulsion/tank[i]/x-position); the tanks' y and z stay as modelled."""
 
     empty_weight_lb: float
     empty_cg_x_in: float
@@ -65,6 +65,8 @@ class Mass:
     """The model's CG as loaded, in."""
     tank_capacity_lb: tuple[float, ...]
     """Capacity per tank, in JSBSim's tank order (wing tanks first, then the centre tank)."""
+    tank_x_in: tuple[float, ...]
+    """Each tank's modelled station (its drain location), in."""
     lemac_x_in: float
     mac_in: float
     min_landing_weight_lb: float
@@ -107,10 +109,12 @@ class Mass:
         out, left = [], load
         caps = self.tank_capacity_lb
         wings = min(load / 2.0, caps[0], caps[1])
-        for i, cap in enumerate(caps):
+        for i, (cap, d) in enumerate(zip(caps, self.tank_x_in, strict=True)):
             c = wings if i < 2 else min(left, cap)
             left -= c
-            out.append((c, x))
+            # JSBSim puts a tank's mass at drain + (contents / capacity) (location - drain) (FGTank::GetXYZ; the
+            # drain is the modelled location): the location that puts it at x
+            out.append((c, d + (x - d) * cap / c if c > 0.0 else d))
         return tuple(out)
 
 
@@ -238,6 +242,7 @@ def _mass(s: Section) -> Mass:
         loaded_weight_lb=s.number("loaded_weight_lb", lo=0.0, lo_open=True, unit=lb),
         loaded_cg_x_in=s.number("loaded_cg_x_in", unit="in"),
         tank_capacity_lb=s.numbers("tank_capacity_lb", min_len=3, unit=lb),
+        tank_x_in=s.numbers("tank_x_in", min_len=3, unit="in"),
         lemac_x_in=s.number("lemac_x_in", unit="in"),
         mac_in=s.number("mac_in", lo=0.0, lo_open=True, unit="in"),
         min_landing_weight_lb=s.number("min_landing_weight_lb", lo=0.0, lo_open=True, unit=lb),
@@ -249,6 +254,8 @@ def _mass(s: Section) -> Mass:
     s.done()
     if not m.min_landing_weight_lb <= m.max_landing_weight_lb:
         raise ProfileError(f"{s.path}.min_landing_weight_lb: must not exceed max_landing_weight_lb")
+    if len(m.tank_x_in) != len(m.tank_capacity_lb):
+        raise ProfileError(f"{s.path}.tank_x_in: needs one station per tank_capacity_lb value")
     if not m.cg_fwd_mac <= m.cg_aft_mac:
         raise ProfileError(f"{s.path}.cg_fwd_percent_mac: must not exceed cg_aft_percent_mac")
     return m

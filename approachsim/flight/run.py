@@ -70,8 +70,8 @@ from approachsim.flight.trim import (
     start_condition,
 )
 from approachsim.flight.turbulence import DrydenTurbulence
-from approachsim.flight.wind import varies as wind_varies
 from approachsim.flight.vectors import imu_point_constants
+from approachsim.flight.wind import varies as wind_varies
 from approachsim.profile import Profile
 from approachsim.records import NavigationSource, Truth
 from approachsim.seeding import stream, stream_int
@@ -388,7 +388,7 @@ class Approach:
         fs = st[layouts.S_STEP:layouts.S_STEP + layouts.N_F_STATE]
         td = {}
         if code in (fk.TERM_TOUCHDOWN, fk.TERM_SHORT):  # scored at the main gear, not the IMU point
-            sc = touchdown_scalars(final, self.main_gear_lever_arms_m, self.ground_contact_m)
+            sc = touchdown_scalars(final, self.main_gear_lever_arms_m, self.ground_contact_m, slope=rw.slope)
             td = {"touchdown_x_m": sc["td_x_m"], "touchdown_sink_mps": sc["td_sink_mps"],
                   "touchdown_y_m": sc["td_y_m"], "touchdown_drift_rad": sc["td_gear_slip_rad"],
                   "touchdown_crab_rad": sc["td_crab_rad"]}

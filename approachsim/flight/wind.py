@@ -52,14 +52,13 @@ def shear_fraction(h_m: float, top_m: float, bottom_m: float) -> float:
 def mean_wind_ned(env: object, h_m: float) -> tuple[float, float]:
     """The mean wind (north, east, m/s; where the air moves to) at height h_m above the terrain in the profile's
     environment (profile.Environment)."""
-    w = env.wind_speed_mps  # type: ignore[attr-defined]
-    to = env.wind_from_rad + math.pi  # type: ignore[attr-defined]
+    w, frm = env.wind_speed_mps, env.wind_from_rad  # type: ignore[attr-defined]
+    wn, we = -w * math.cos(frm), -w * math.sin(frm)  # the reference wind, as flight/run.py packs it
     f = 1.0
     if env.wind_profile == "log":  # type: ignore[attr-defined]
         f = log_factor(h_m, env.roughness_length_m, env.wind_reference_height_m)  # type: ignore[attr-defined]
     s = shear_fraction(h_m, env.shear_top_m, env.shear_bottom_m)  # type: ignore[attr-defined]
-    return (w * f * math.cos(to) + s * env.shear_n_mps,  # type: ignore[attr-defined]
-            w * f * math.sin(to) + s * env.shear_e_mps)  # type: ignore[attr-defined]
+    return wn * f + s * env.shear_n_mps, we * f + s * env.shear_e_mps  # type: ignore[attr-defined]
 
 
 def varies(env: object) -> bool:

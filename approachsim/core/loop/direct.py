@@ -108,8 +108,8 @@ def read_properties(d: Array, raw: Array, near: bool) -> None:
 @njit(cache=True)
 def write_and_run(d: Array, par: Array, de: float, da: float, dr: float, thr: float, gn: float, ge: float,
                   gd: float, terr_ft: float) -> None:
-    """A step's writes in the Python loop's order (the gusts when turbulent or the mean wind varies, the terrain when it has more than one
-    point), then JSBSim's step."""
+    """A step's writes in the Python loop's order (the gusts when turbulent or the mean wind varies, the terrain
+    when it has more than one point), then JSBSim's step."""
     s = d[D_SET]
     w = D_WRITE
     _set(s, d[w + WRITE_DE], de)

@@ -103,7 +103,6 @@ from approachsim.core.layouts import (
     AP_VERT_ACC,
     AP_X_GPI,
     APS_ALIGNING,
-    APS_SURFACE_SLOPE,
     APS_E_F,
     APS_FLARE_H_OFF,
     APS_FLARE_SINK0,
@@ -116,6 +115,7 @@ from approachsim.core.layouts import (
     APS_INT_FLARE,
     APS_INT_T,
     APS_INT_Y,
+    APS_SURFACE_SLOPE,
     APS_THETA_C,
     APS_THETA_FLARE0,
     APS_V_LAG,
@@ -136,18 +136,18 @@ from approachsim.core.layouts import (
     F_CA,
     F_CB,
     F_CC,
+    F_GEAR_X,
     F_LAND,
     F_MON_FLOOR,
     F_N_TERRAIN,
     F_PITCH_TRIM,
-    F_STOP_H,
-    F_TAN_GP,
-    F_TURBULENT,
-    F_GEAR_X,
     F_SHEAR_BOTTOM,
     F_SHEAR_E,
     F_SHEAR_N,
     F_SHEAR_TOP,
+    F_STOP_H,
+    F_TAN_GP,
+    F_TURBULENT,
     F_WIND0_E,
     F_WIND0_N,
     F_WIND_E,
@@ -176,10 +176,10 @@ from approachsim.core.layouts import (
     FS_TAS,
     FS_TD_SINK,
     FS_TD_X,
-    FS_WIND_E,
-    FS_WIND_N,
     FS_THETA,
     FS_THR,
+    FS_WIND_E,
+    FS_WIND_N,
     GEAR_AIRBORNE,
     MN_CA,
     MN_CB,
@@ -730,10 +730,11 @@ def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, i
     short of the threshold when x < 0; anything else on the ground or the IMU at the terrain; divergence (bank,
     distance from the glidepath or the centreline); below WATCH_HEIGHT_M (above the flare on landing runs) the
     stabilized-approach monitor, fed the speed through the mean air mass (CG ground velocity minus the mean
-    wind at the CG's height, fst[FS_WIND_N], fst[FS_WIND_E]) as CAS with JSBSim's CAS/TAS ratio. imu = (x, y, z, vn, ve, vd): the IMU's position (runway frame, m)
-    and NED velocity (m/s); h_agl its height above the terrain (m); phi the bank (rad); wow = (nose, left, right)
-    JSBSim's weight-on-wheels; v_cg the CG's NED velocity, CAS and TAS in m/s. fpar, fst: the step's F_* parameters
-    and FS_* state (touchdown and monitor figures are stored there)."""
+    wind at the CG's height, fst[FS_WIND_N], fst[FS_WIND_E]) as CAS with JSBSim's CAS/TAS ratio. imu = (x, y, z,
+    vn, ve, vd): the IMU's position (runway frame, m) and NED velocity (m/s); h_agl its height above the terrain
+    (m); phi the bank (rad); wow = (nose, left, right) JSBSim's weight-on-wheels; v_cg the CG's NED velocity, CAS
+    and TAS in m/s. fpar, fst: the step's F_* parameters and FS_* state (touchdown and monitor figures are stored
+    there)."""
     x, y, z, vn, ve, vd = imu
     wow_nose, wow_left, wow_right = wow
     vn_cg, ve_cg, vd_cg = v_cg
