@@ -303,7 +303,10 @@ def _summary(rows: list[dict], runs: int) -> dict:
             "drift_deg": _stats(td, "td_gear_slip_rad", deg), "pitch_deg": _stats(td, "td_pitch_rad", deg),
             "cas_kt": _stats(td, "td_cas_mps", 1.0 / units.KT),
             "contact_margin_deg": _stats(td, "td_contact_margin_rad", deg),
-            "criteria": _criteria(td, runs, runs - len(td))}
+            "criteria": _criteria(td, runs, runs - len(td)),
+            # the same over the landings that touched down: an unstabilized approach is a go-around, not a
+            # touchdown (the criteria above count every failed run as an exceedance of each)
+            "criteria_given_touchdown": _criteria(td, len(td), 0)}
 
 
 def dispersed(runs: int, workers: int, turb: str, seed: int = 40) -> dict:
@@ -389,7 +392,11 @@ TAIL_EVENTS = {"sink": ("td_sink_mps", 10.0 * units.FPS), "long": ("td_x_m", 915
 
 
 def _margins(row: dict) -> np.ndarray:
-    """Each tail event's relative margin (quantity - limit) / limit, a failed landing counting as every event."""
+    """Each tail event's relative margin (quantity - limit) / limit; an approach the stabilized-approach monitor
+    ended (a go-around, no touchdown) is no touchdown event (nan: rare.py counts it out), any other failed landing
+    (short, ground contact, divergence) counts as every event."""
+    if row["termination"].startswith("unstabilized"):
+        return np.full(len(TAIL_EVENTS), np.nan)
     if row["termination"] != "touchdown":
         return np.full(len(TAIL_EVENTS), 1.0)
     return np.array([(abs(row[q]) if q in ("td_y_m", "td_bank_rad") else row[q]) / lim - 1.0
@@ -416,20 +423,22 @@ def tails(samples: int, max_calls: int, workers: int, turb: str, seed: int = 40)
         state["run"] += n
         m = np.array([x for o in out for x in o])
         margins.append(m)
-        return m.max(axis=1)
+        return np.where(np.isnan(m[:, 0]), np.nan, np.nan_to_num(m, nan=-1.0).max(axis=1))
 
     est, fin = rare.estimate(g, N_DIM, method="nais", samples=samples, rho=0.1, seed=seed, max_calls=max_calls)
     last = margins[-1] if margins else np.zeros((0, len(TAIL_EVENTS)))
     per = {}
     for j, name in enumerate(TAIL_EVENTS):
         if last.shape[0] == fin["w"].shape[0] and np.all(np.isfinite(fin["w"])):
-            per[name] = rare.reweight(last[:, j] > 0.0, fin["w"])
-        first = margins[0][:, j] > 0.0
+            per[name] = rare.reweight(np.nan_to_num(last[:, j], nan=-1.0) > 0.0, fin["w"])
+        first = np.nan_to_num(margins[0][:, j], nan=-1.0) > 0.0
         per.setdefault(name, {})["first_step_mc"] = {"hits": int(first.sum()), "samples": int(first.size),
                                                      "cp95_upper": rare.clopper_pearson(int(first.sum()),
                                                                                         first.size, 0.95)[1]}
-        per[name]["largest_relative_margin"] = float(max(m[:, j].max() for m in margins))
+        per[name]["largest_relative_margin"] = float(np.nanmax(np.concatenate([m[:, j] for m in margins])))
+    go_around = int(sum(np.isnan(m[:, 0]).sum() for m in margins))
     return {"union": est.as_dict(), "per_event": per, "samples_per_step": samples, "max_calls": max_calls,
+            "go_arounds_counted_out": go_around,
             "landings": int(sum(m.shape[0] for m in margins)), "turbulence": turb}
 
 
