@@ -288,7 +288,10 @@ def _dispersed_job(args: tuple) -> list[dict]:
     return [_land(condition_of(dispersed_u(seed, r), mass), r, turb) for r in runs]
 
 
-def _stats(td: list[dict], key: str, f: float) -> dict:
+def _stats(td: list[dict], key: str, f: float) -> dict | None:
+    """mean, sd, min, max of a row quantity (None without at least two rows)."""
+    if len(td) < 2:
+        return None
     v = np.array([r[key] for r in td]) * f
     return {"mean": float(v.mean()), "sd": float(v.std(ddof=1)), "min": float(v.min()), "max": float(v.max())}
 
@@ -306,7 +309,7 @@ def _summary(rows: list[dict], runs: int) -> dict:
             "criteria": _criteria(td, runs, runs - len(td)),
             # the same over the landings that touched down: an unstabilized approach is a go-around, not a
             # touchdown (the criteria above count every failed run as an exceedance of each)
-            "criteria_given_touchdown": _criteria(td, len(td), 0)}
+            "criteria_given_touchdown": _criteria(td, len(td), 0) if len(td) > 2 else None}
 
 
 def dispersed(runs: int, workers: int, turb: str, seed: int = 40) -> dict:
@@ -372,10 +375,13 @@ def limits(runs: int, workers: int, turb: str, average: dict | None = None) -> d
     table = {}
     crits = next(iter(per.values()))["criteria"]
     for key in crits:
-        worst = max(per, key=lambda n: (per[n]["criteria"][key]["p_upper"] or 0.0))
+        # the worst condition: the most exceedances (failed runs count), then the largest normal-tail upper bound
+        worst = max(per, key=lambda n: (per[n]["criteria"][key]["exceedances"],
+                                        per[n]["criteria"][key]["p_upper"] or 0.0))
         entry = {"probability_required": crits[key]["probability_required"],
                  "limit_condition": worst, "limit": per[worst]["criteria"][key],
-                 "per_condition": {n: {k: per[n]["criteria"][key][k] for k in ("outcome", "p", "p_upper", "z")}
+                 "per_condition": {n: {k: per[n]["criteria"][key][k] for k in ("outcome", "p", "p_upper", "z",
+                                                                                 "exceedances")}
                                    for n in per}}
         if average is not None:
             entry["average"] = average["criteria"][key]
