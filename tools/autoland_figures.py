@@ -43,10 +43,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from approachsim import units  # noqa: E402
+from approachsim.config import ProfileError  # noqa: E402
 from approachsim.evaluate.touchdown import SCALARS, touchdown_details, touchdown_scalars  # noqa: E402
 from approachsim.flight.aircraft import load_aircraft  # noqa: E402
 from approachsim.flight.envelope_study import admissible, cases, measure, profile_dict  # noqa: E402
 from approachsim.flight.run import Approach  # noqa: E402
+from approachsim.flight.trim import StartError  # noqa: E402
 from approachsim.glidepath import GlidePath  # noqa: E402
 from approachsim.profile import parse_profile  # noqa: E402
 
@@ -269,8 +271,11 @@ def _condition_profile(c: dict, turb: str, wind_profile: str = "log", shear: dic
 
 def _land(c: dict, run: int, turb: str, seed: int = 1, **kw) -> dict:
     """One landing at condition c, turbulence of run `run` (seed 1): the condition and the touchdown scalars."""
-    approach = Approach(parse_profile(_condition_profile(c, turb, **kw), source=DEFAULT), land=True)
-    res = approach.fly(seed=seed, run=run)
+    try:
+        approach = Approach(parse_profile(_condition_profile(c, turb, **kw), source=DEFAULT), land=True)
+        res = approach.fly(seed=seed, run=run)
+    except (ProfileError, StartError) as e:  # JSBSim does not trim this 737 in the wind at the start
+        return {"run": run, **c, "termination": f"no start: {str(e)[:120]}", "ok": False}
     row = {"run": run, **c, "termination": res.termination, "ok": res.ok}
     if res.termination == "touchdown":
         row.update(touchdown_scalars(res.truth, approach.main_gear_lever_arms_m, approach.ground_contact_m,
@@ -399,9 +404,10 @@ TAIL_EVENTS = {"sink": ("td_sink_mps", 10.0 * units.FPS), "long": ("td_x_m", 915
 
 def _margins(row: dict) -> np.ndarray:
     """Each tail event's relative margin (quantity - limit) / limit; an approach the stabilized-approach monitor
-    ended (a go-around, no touchdown) is no touchdown event (nan: rare.py counts it out), any other failed landing
+    ended (a go-around) or that JSBSim could not trim at its start is no touchdown event (nan: rare.py counts it
+    out; tails reports how many), any other failed landing
     (short, ground contact, divergence) counts as every event."""
-    if row["termination"].startswith("unstabilized"):
+    if row["termination"].startswith(("unstabilized", "no start")):  # not flown to a touchdown: counted out
         return np.full(len(TAIL_EVENTS), np.nan)
     if row["termination"] != "touchdown":
         return np.full(len(TAIL_EVENTS), 1.0)
