@@ -30,6 +30,11 @@ from approachsim.sensors.config import SensorsConfig, parse_faults, parse_sensor
 
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
 QNH_REPORTS = ("exact", "whole_hpa")
+WIND_PROFILES = ("uniform", "log")
+"""How the mean wind changes with height (environment.wind_profile; flight/wind.py)."""
+RUNWAY_SLOPE_EXTENT_M = 3000.0
+"""How far past the threshold the runway slope is laid into the terrain (beyond: held), m: past the 915 m long
+touchdown limit with room for the rollout's first seconds."""
 """How the QNH set on the altimeter is reported (environment.qnh_report): exact (the day's QNH to the hundredth), or
 whole_hpa, rounded down to the whole hectopascal as a METAR / ATIS gives it (issue 39: a reporting error of 0 to
 -1 hPa, the altimeter reading up to 27 ft low at sea level)."""
@@ -49,6 +54,9 @@ class Runway:
     """Threshold crossing height of the glidepath."""
     start_distance_m: float
     """Distance from the threshold (along the extended centreline) where the run starts."""
+    slope: float = 0.0
+    """Longitudinal slope of the runway past the threshold, rise per metre (+: rising in the landing direction);
+    the terrain past the threshold (Terrain, RUNWAY_SLOPE_EXTENT_M) follows it."""
 
     @property
     def frame(self) -> RunwayFrame:
@@ -77,6 +85,10 @@ class AircraftChoice:
     gear_down: bool
     autopilot_law: str | None = None
     """Speed and path law flown ("classic" | "tecs"; None: the aircraft file's)."""
+    weight_n: float | None = None
+    """Gross weight at the start of the approach, N (None: the JSBSim model as loaded; aircraft file [mass])."""
+    cg_mac: float | None = None
+    """Centre-of-gravity position as a fraction of the mean aerodynamic chord (None: the model as loaded)."""
 
 
 @dataclass(frozen=True)
@@ -97,6 +109,21 @@ class Environment:
     sea_level_pa: float = 101325.0
     """The day's true sea-level pressure of the ISA+dT atmosphere that has the QNH's pressure at the field
     (sensors.atmosphere.sea_level_pressure_pa): what JSBSim's atmosphere is set to, Pa."""
+    wind_profile: str = "uniform"
+    """One of WIND_PROFILES: "uniform" (the wind at every height) or "log" (a logarithmic boundary layer whose
+    wind at wind_reference_height_m is the profile's; flight/wind.py)."""
+    wind_reference_height_m: float = 10.0
+    """Height above the terrain the profile's wind is given at (the log layer's reference), m."""
+    roughness_length_m: float = 0.15 * units.FT
+    """Roughness length z0 of the log layer, m (MIL-F-8785C Category C: 0.15 ft; flight/wind.py)."""
+    shear_top_m: float = 0.0
+    """Top of the shear layer above the terrain, m."""
+    shear_bottom_m: float = 0.0
+    """Bottom of the shear layer above the terrain, m (the change is complete below it)."""
+    shear_n_mps: float = 0.0
+    """The shear layer's wind change from its top to its bottom, north component (where the air moves to), m/s."""
+    shear_e_mps: float = 0.0
+    """The same, east component, m/s."""
 
     @property
     def true_qnh_pa(self) -> float:
@@ -172,6 +199,7 @@ def _runway(s: Section) -> Runway:
     gp = s.number("glidepath_deg", 3.0, lo=1.0, hi=10.0, unit="deg")
     tch = s.number("tch_ft", 50.0, lo=0.0, hi=200.0, unit="ft")
     start = s.number("start_distance_nmi", 10.0, lo=1.0, hi=30.0, unit="nmi")
+    slope = s.number("slope_percent", 0.0, lo=-2.0, hi=2.0, unit="% (rise in the landing direction)")
     s.done()
     return Runway(
         threshold_lat_rad=math.radians(lat),
@@ -181,6 +209,7 @@ def _runway(s: Section) -> Runway:
         glidepath_rad=math.radians(gp),
         tch_m=tch * units.FT,
         start_distance_m=start * units.NMI,
+        slope=slope / 100.0,
     )
 
 
@@ -198,8 +227,15 @@ def _aircraft(s: Section) -> AircraftChoice:
     law = s.raw("autopilot_law", None)
     if law is not None:
         law = s.string("autopilot_law", choices=("classic", "tecs"))
+    weight = s.raw("weight_lb", None)
+    if weight is not None:  # the aircraft file's [mass] range is checked where the aircraft is loaded
+        weight = s.number("weight_lb", lo=0.0, lo_open=True, unit="lb") * units.LBF
+    cg = s.raw("cg_percent_mac", None)
+    if cg is not None:
+        cg = s.number("cg_percent_mac", lo=-50.0, hi=100.0, unit="% MAC") / 100.0
     s.done()
-    return AircraftChoice(name=name, approach_speed_mps=speed, flaps_norm=flaps, gear_down=gear, autopilot_law=law)
+    return AircraftChoice(name=name, approach_speed_mps=speed, flaps_norm=flaps, gear_down=gear, autopilot_law=law,
+                          weight_n=weight, cg_mac=cg)
 
 
 def _environment(s: Section, runway: Runway) -> Environment:
@@ -215,7 +251,20 @@ def _environment(s: Section, runway: Runway) -> Environment:
         )
     err = s.number("qnh_setting_error_hPa", 0.0, lo=-50.0, hi=50.0, unit="hPa")
     report = s.string("qnh_report", "exact", choices=QNH_REPORTS)
+    shape = s.string("wind_profile", "uniform", choices=WIND_PROFILES)
+    ref = s.number("wind_reference_height_m", 10.0, lo=1.0, hi=100.0, unit="m")
+    z0 = s.number("roughness_length_m", 0.15 * units.FT, lo=0.0001, hi=0.5, unit="m")
+    top = s.number("shear_top_ft", 0.0, lo=0.0, hi=3000.0, unit="ft")
+    bottom = s.number("shear_bottom_ft", 0.0, lo=0.0, hi=3000.0, unit="ft")
+    loss = s.number("shear_headwind_loss_kt", 0.0, lo=-40.0, hi=40.0, unit="kt")
     s.done()
+    if loss != 0.0 and not top > bottom:
+        raise ProfileError(f"{s.path}.shear_top_ft: must be above shear_bottom_ft ({bottom:g} ft) for a shear, got "
+                           f"{top:g}")
+    if shape == "log" and not ref > z0:
+        raise ProfileError(f"{s.path}.wind_reference_height_m: must be above roughness_length_m ({z0:g} m)")
+    # the headwind lost from the top down: the air moving towards the landing direction by `loss`
+    dn, de = loss * units.KT * math.cos(runway.heading_rad), loss * units.KT * math.sin(runway.heading_rad)
     reported = math.floor(qnh) if report == "whole_hpa" else qnh
     h_field = float(atmosphere.geopotential_m(runway.elevation_m))
     return Environment(
@@ -226,13 +275,20 @@ def _environment(s: Section, runway: Runway) -> Environment:
         qnh_pa=qnh * units.HPA,
         setting_pa=(reported + err) * units.HPA,
         sea_level_pa=atmosphere.sea_level_pressure_pa(qnh * units.HPA, h_field, dt),
+        wind_profile=shape,
+        wind_reference_height_m=ref,
+        roughness_length_m=z0,
+        shear_top_m=top * units.FT,
+        shear_bottom_m=bottom * units.FT,
+        shear_n_mps=dn,
+        shear_e_mps=de,
     )
 
 
 def _terrain(s: Section, runway: Runway) -> Terrain:
     if not s.has("distance_nmi") and not s.has("height_ft"):
         s.done()
-        return Terrain(along_m=(0.0,), height_m=(runway.elevation_m,))
+        return _with_slope(Terrain(along_m=(0.0,), height_m=(runway.elevation_m,)), runway)
     dist = s.numbers("distance_nmi", min_len=2, unit="nmi before the threshold")
     hgt = s.numbers("height_ft", min_len=2, unit="ft")
     s.done()
@@ -247,7 +303,23 @@ def _terrain(s: Section, runway: Runway) -> Terrain:
     along = tuple(-d * units.NMI for d in dist)  # distance before the threshold is negative x
     terrain = Terrain(along_m=along, height_m=tuple(h * units.FT for h in hgt))
     check_terrain(terrain, runway, s.path)
-    return terrain
+    return _with_slope(terrain, runway)
+
+
+def _with_slope(terrain: Terrain, runway: Runway) -> Terrain:
+    """The terrain with the runway's slope laid past the threshold: points (0, elevation) (when the terrain ends
+    before it) and (RUNWAY_SLOPE_EXTENT_M, elevation + slope x extent); unchanged for a level runway."""
+    if runway.slope == 0.0:
+        return terrain
+    along, height = list(terrain.along_m), list(terrain.height_m)
+    if len(along) == 1:
+        along, height = [], []
+    if not along or along[-1] < 0.0:
+        along.append(0.0)
+        height.append(runway.elevation_m)
+    along.append(RUNWAY_SLOPE_EXTENT_M)
+    height.append(runway.elevation_m + runway.slope * RUNWAY_SLOPE_EXTENT_M)
+    return Terrain(along_m=tuple(along), height_m=tuple(height))
 
 
 TERRAIN_THRESHOLD_TOLERANCE_M = 1.0 * units.FT

@@ -373,7 +373,7 @@ def closed_loop_group(profile: Any, seed: int, runs: Sequence[int], land: bool =
             nav = source.result(truth).solution
             td = {}
             if land:
-                td = touchdown_scalars(truth, gear, approach.ground_contact_m)
+                td = touchdown_scalars(truth, gear, approach.ground_contact_m, slope=approach.profile.runway.slope)
                 truth, nav, flight = _head(truth, nav, flight, approach_stop_height_m(profile))
             clk = source.errors.clock
             clock_true = None if clk is None else np.interp(truth.t_s, clk.t_s, np.asarray(clk.series["bias"]))

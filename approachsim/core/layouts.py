@@ -150,10 +150,10 @@ AP_PAR = Layout(_scalars(*AP_GAINS, "theta0_rad", "throttle0", "cas0_mps", "cos_
 N_AP_PAR = AP_PAR.size
 AP_STATE = Layout(_scalars("int_d", "int_y", "e_f", "wind", "int_e", "flaring", "theta_flare0", "int_flare",
                            "theta_c", "v_lag", "int_t", "int_b", "flare_tau", "flare_h_off", "aligning",
-                           "flare_sink0", "flare_v0"))
+                           "flare_sink0", "flare_v0", "surface_slope"))
 (APS_INT_D, APS_INT_Y, APS_E_F, APS_WIND, APS_INT_E, APS_FLARING, APS_THETA_FLARE0, APS_INT_FLARE,
  APS_THETA_C, APS_V_LAG, APS_INT_T, APS_INT_B, APS_FLARE_TAU, APS_FLARE_H_OFF, APS_ALIGNING,
- APS_FLARE_SINK0, APS_FLARE_V0) = AP_STATE.starts()
+ APS_FLARE_SINK0, APS_FLARE_V0, APS_SURFACE_SLOPE) = AP_STATE.starts()
 N_AP_STATE = AP_STATE.size
 
 # --- Dryden turbulence: W20, dt, wind-axes rotation, the intensity table's altitudes and the level's row; state ---
@@ -179,14 +179,19 @@ N_MN_STATE = MN_STATE.size
 
 # --- the step's own parameters and state ----------------------------------------------------------------------------
 F_PAR = Layout(_scalars("pitch_trim", "stop_h_m", "land", "tan_gp", "tch_m", "mon_floor_m", "wind_n_mps",
-                        "wind_e_mps", "turbulent", "n_terrain", "x_gpi_m", "cone_a", "cone_b", "cone_c"))
+                        "wind_e_mps", "turbulent", "n_terrain", "x_gpi_m", "cone_a", "cone_b", "cone_c",
+                        "wind_varies", "wind_log", "wind_z0_m", "wind_ref_m", "wind0_n_mps", "wind0_e_mps",
+                        "shear_top_m", "shear_bottom_m", "shear_n_mps", "shear_e_mps", "gear_x_m"))
 (F_PITCH_TRIM, F_STOP_H, F_LAND, F_TAN_GP, F_TCH, F_MON_FLOOR, F_WIND_N, F_WIND_E, F_TURBULENT,
- F_N_TERRAIN, F_X_GPI, F_CA, F_CB, F_CC) = F_PAR.starts()
+ F_N_TERRAIN, F_X_GPI, F_CA, F_CB, F_CC, F_WIND_VARIES, F_WIND_LOG, F_WIND_Z0, F_WIND_REF, F_WIND0_N, F_WIND0_E,
+ F_SHEAR_TOP, F_SHEAR_BOTTOM, F_SHEAR_N, F_SHEAR_E, F_GEAR_X) = F_PAR.starts()
 N_F_PAR = F_PAR.size
 F_STATE = Layout(_scalars("de", "da", "dr", "thr", "lowest_m", "td_x_m", "td_sink_mps", "mon", "mon_z_m", "mon_a",
-                          "mon_b", "phi", "theta", "p", "q", "beta", "cas_mps", "h_gear_m", "tas_mps", "psi", "r"))
+                          "mon_b", "phi", "theta", "p", "q", "beta", "cas_mps", "h_gear_m", "tas_mps", "psi", "r",
+                          "wind_n_mps", "wind_e_mps"))
 (FS_DE, FS_DA, FS_DR, FS_THR, FS_LOWEST, FS_TD_X, FS_TD_SINK, FS_MON, FS_MON_Z, FS_MON_A, FS_MON_B,
- FS_PHI, FS_THETA, FS_P, FS_Q, FS_BETA, FS_CAS, FS_H_GEAR, FS_TAS, FS_PSI, FS_R) = F_STATE.starts()
+ FS_PHI, FS_THETA, FS_P, FS_Q, FS_BETA, FS_CAS, FS_H_GEAR, FS_TAS, FS_PSI, FS_R, FS_WIND_N,
+ FS_WIND_E) = F_STATE.starts()
 N_F_STATE = F_STATE.size
 
 # --- fly_step's vectors: the components' concatenated; the terrain profile (F_N_TERRAIN along-track distances, then

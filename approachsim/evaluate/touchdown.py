@@ -136,12 +136,16 @@ def contact_offsets_m(points_struct_m: Array, gear_struct_m: Array, compression_
     return np.column_stack((-(p[:, 0] - g[0]), p[:, 1] - g[1], -(p[:, 2] - g[2]) + compression_m))
 
 
-def touchdown_scalars(truth: Truth, main_gear_body_m: Array, contact_body_m: Array | None = None) -> dict[str, float]:
+def touchdown_scalars(truth: Truth, main_gear_body_m: Array, contact_body_m: Array | None = None, *,
+                      slope: float = 0.0) -> dict[str, float]:
     """The run's touchdown quantities (SCALARS, SI) from the last row of a landing run's truth (the touchdown row)
     and the left and right main-gear contact points relative to the IMU, (2, 3) body axes (x forward, y right,
     z down), m. contact_body_m: the right wing's ground-contact points' offsets from the right main gear
     (contact_offsets_m; the left wing's mirror them): the contact bank at the touchdown pitch on the low wing's
-    side and the margin to it (nan without them)."""
+    side and the margin to it (nan without them). slope: the runway's longitudinal slope past the threshold (rise per
+    metre, profile.Runway.slope): the sink rate is the gear's closing speed on the runway surface, -v_z + slope v_x,
+    and the gear height is above that surface (z - slope x); the ground contact stays the level-runway bank (a 2 %
+    slope tilts the runway by 1.1 deg in pitch, which contact_bank_rad's pitch would take up)."""
     k = len(truth) - 1
     heading = truth.runway.heading_rad
     pos, vel = gear_state(truth.r_rwy[k], truth.v_ned[k], truth.euler_rad[k], truth.w_ib_body[k], heading,
@@ -158,8 +162,8 @@ def touchdown_scalars(truth: Truth, main_gear_body_m: Array, contact_body_m: Arr
         "td_left_gear_y_m": float(pos[0, 1]),
         "td_right_gear_y_m": float(pos[1, 1]),
         "td_outboard_gear_y_m": float(pos[out_i, 1]),
-        "td_sink_mps": float(-vel[first, 2]),
-        "td_gear_height_m": float(pos[first, 2]),
+        "td_sink_mps": float(-vel[first, 2] + slope * vel[first, 0]) if slope else float(-vel[first, 2]),
+        "td_gear_height_m": float(pos[first, 2] - slope * pos[first, 0]) if slope else float(pos[first, 2]),
         "td_imu_x_m": float(truth.r_rwy[k, 0]),
         "td_imu_y_m": float(truth.r_rwy[k, 1]),
         "td_imu_sink_mps": float(truth.v_ned[k, 2]),

@@ -43,6 +43,79 @@ class Aircraft:
     """The approach limits of the aircraft file's [envelope] table (flight.envelope)."""
     ground_contact: GroundContact | None = None
     """The aircraft file's [ground_contact] table (None: no ground-contact criterion)."""
+    mass: Mass | None = None
+    """The aircraft file's [mass] table (None: the JSBSim model as loaded, no weight or CG choice)."""
+    tanks: tuple[tuple[float, float], ...] = ()
+    """The JSBSim tank loading that gives the profile's weight and CG: (contents lb, station x in) per tank
+    (Mass.tank_loading; empty: the model as loaded)."""
+
+
+@dataclass(frozen=True)
+class Mass:
+    """Weight and balance of the JSBSim model and the aircraft's landing limits (aircraft file [mass]). The model
+    has no payload stations: a chosen weight and CG is loaded as its tanks' contents (wing tanks first, each up to
+    its capacity, then the centre tank) with every tank's mass moved to the one station x that puts the CG where
+    asked (JSBSim's propulsion/tank[i]/x-position); the tanks' y and z stay as modelled."""
+
+    empty_weight_lb: float
+    empty_cg_x_in: float
+    loaded_weight_lb: float
+    """The model as loaded (empty + its tanks' contents): the weight approach_speed_kt is for."""
+    loaded_cg_x_in: float
+    """The model's CG as loaded, in."""
+    tank_capacity_lb: tuple[float, ...]
+    """Capacity per tank, in JSBSim's tank order (wing tanks first, then the centre tank)."""
+    tank_x_in: tuple[float, ...]
+    """Each tank's modelled station (its drain location), in."""
+    lemac_x_in: float
+    mac_in: float
+    min_landing_weight_lb: float
+    max_landing_weight_lb: float
+    cg_fwd_mac: float
+    cg_aft_mac: float
+    """The CG range dispersions draw from, fractions of the MAC."""
+    station_range_in: tuple[float, float]
+    """The stations a load may be placed at (the fuselage), in."""
+
+    @property
+    def loaded_cg_mac(self) -> float:
+        """The model's CG as loaded, fraction of the MAC."""
+        return (self.loaded_cg_x_in - self.lemac_x_in) / self.mac_in
+
+    def cg_x_in(self, cg_mac: float) -> float:
+        """Station of a CG given as a fraction of the MAC, in."""
+        return self.lemac_x_in + cg_mac * self.mac_in
+
+    def cg_range_mac(self, weight_lb: float) -> tuple[float, float]:
+        """The CG range (fractions of the MAC) loadable at a gross weight: [cg_fwd_mac, cg_aft_mac] within what the
+        load placed anywhere in station_range_in reaches."""
+        load = weight_lb - self.empty_weight_lb
+        ends = [((self.empty_weight_lb * self.empty_cg_x_in + load * x) / weight_lb - self.lemac_x_in) / self.mac_in
+                for x in self.station_range_in]
+        return max(self.cg_fwd_mac, min(ends)), min(self.cg_aft_mac, max(ends))
+
+    def tank_loading(self, weight_lb: float, cg_mac: float) -> tuple[tuple[float, float], ...]:
+        """(contents lb, station x in) per tank for the gross weight and CG; ValueError when the weight exceeds the
+        tanks or the CG needs a station outside station_range_in."""
+        load = weight_lb - self.empty_weight_lb
+        if not 0.0 < load <= sum(self.tank_capacity_lb):
+            raise ValueError(f"{weight_lb:.0f} lb is outside the model's {self.empty_weight_lb:.0f} lb empty weight "
+                             f"plus {sum(self.tank_capacity_lb):.0f} lb of tank capacity")
+        x = (weight_lb * self.cg_x_in(cg_mac) - self.empty_weight_lb * self.empty_cg_x_in) / load
+        lo, hi = self.station_range_in
+        if not lo <= x <= hi:
+            raise ValueError(f"a CG at {100.0 * cg_mac:.1f} % MAC needs the {load:.0f} lb load at station {x:.0f} in, "
+                             f"outside the fuselage ({lo:.0f}-{hi:.0f} in)")
+        out, left = [], load
+        caps = self.tank_capacity_lb
+        wings = min(load / 2.0, caps[0], caps[1])
+        for i, (cap, d) in enumerate(zip(caps, self.tank_x_in, strict=True)):
+            c = wings if i < 2 else min(left, cap)
+            left -= c
+            # JSBSim puts a tank's mass at drain + (contents / capacity) (location - drain) (FGTank::GetXYZ; the
+            # drain is the modelled location): the location that puts it at x
+            out.append((c, d + (x - d) * cap / c if c > 0.0 else d))
+        return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -161,6 +234,33 @@ def _limits(s: Section) -> ApproachLimits:
     return lim
 
 
+def _mass(s: Section) -> Mass:
+    lb = "lb"
+    m = Mass(
+        empty_weight_lb=s.number("empty_weight_lb", lo=0.0, lo_open=True, unit=lb),
+        empty_cg_x_in=s.number("empty_cg_x_in", unit="in"),
+        loaded_weight_lb=s.number("loaded_weight_lb", lo=0.0, lo_open=True, unit=lb),
+        loaded_cg_x_in=s.number("loaded_cg_x_in", unit="in"),
+        tank_capacity_lb=s.numbers("tank_capacity_lb", min_len=3, unit=lb),
+        tank_x_in=s.numbers("tank_x_in", min_len=3, unit="in"),
+        lemac_x_in=s.number("lemac_x_in", unit="in"),
+        mac_in=s.number("mac_in", lo=0.0, lo_open=True, unit="in"),
+        min_landing_weight_lb=s.number("min_landing_weight_lb", lo=0.0, lo_open=True, unit=lb),
+        max_landing_weight_lb=s.number("max_landing_weight_lb", lo=0.0, lo_open=True, unit=lb),
+        cg_fwd_mac=s.number("cg_fwd_percent_mac", lo=-50.0, hi=100.0, unit="% MAC") / 100.0,
+        cg_aft_mac=s.number("cg_aft_percent_mac", lo=-50.0, hi=100.0, unit="% MAC") / 100.0,
+        station_range_in=tuple(s.numbers("station_range_in", min_len=2, unit="in")[:2]),  # type: ignore[arg-type]
+    )
+    s.done()
+    if not m.min_landing_weight_lb <= m.max_landing_weight_lb:
+        raise ProfileError(f"{s.path}.min_landing_weight_lb: must not exceed max_landing_weight_lb")
+    if len(m.tank_x_in) != len(m.tank_capacity_lb):
+        raise ProfileError(f"{s.path}.tank_x_in: needs one station per tank_capacity_lb value")
+    if not m.cg_fwd_mac <= m.cg_aft_mac:
+        raise ProfileError(f"{s.path}.cg_fwd_percent_mac: must not exceed cg_aft_percent_mac")
+    return m
+
+
 def parse_aircraft(data: dict, source: Path) -> Aircraft:
     """Validate the dict of an aircraft file."""
     top = Section(data, "")
@@ -181,6 +281,7 @@ def parse_aircraft(data: dict, source: Path) -> Aircraft:
     gains = _gains(top.section("autopilot", default_empty=False))
     limits = _limits(top.section("envelope", default_empty=False))
     contact = _ground_contact(top.section("ground_contact")) if top.has("ground_contact") else None
+    mass = _mass(top.section("mass")) if top.has("mass") else None
     top.done()
     return Aircraft(
         name=name,
@@ -194,6 +295,7 @@ def parse_aircraft(data: dict, source: Path) -> Aircraft:
         source=source,
         limits=limits,
         ground_contact=contact,
+        mass=mass,
     )
 
 
@@ -209,10 +311,13 @@ def load_aircraft(profile: Profile) -> Aircraft:
     except ProfileError as e:
         raise ProfileError(f"aircraft file {path.name}: {e}") from None
     choice = profile.aircraft
+    speed, tanks = ac.approach_speed_mps, ()
+    if choice.weight_n is not None or choice.cg_mac is not None:
+        speed, tanks = _loading(ac, choice)
     return Aircraft(
         name=ac.name,
         jsbsim_model=ac.jsbsim_model,
-        approach_speed_mps=ac.approach_speed_mps if choice.approach_speed_mps is None else choice.approach_speed_mps,
+        approach_speed_mps=speed if choice.approach_speed_mps is None else choice.approach_speed_mps,
         flaps_norm=ac.flaps_norm if choice.flaps_norm is None else choice.flaps_norm,
         gear_down=choice.gear_down,
         engine_lag_s=ac.engine_lag_s,
@@ -222,4 +327,27 @@ def load_aircraft(profile: Profile) -> Aircraft:
         source=ac.source,
         limits=ac.limits,
         ground_contact=ac.ground_contact,
+        mass=ac.mass,
+        tanks=tanks,
     )
+
+
+def _loading(ac: Aircraft, choice: object) -> tuple[float, tuple[tuple[float, float], ...]]:
+    """The approach speed and tank loading for the profile's weight and CG (aircraft.weight_lb,
+    aircraft.cg_percent_mac; either one alone keeps the model's other): the file's approach speed scaled by
+    sqrt(W / W_loaded), the reference speed's constant lift coefficient (1.23 V_s1g at any weight)."""
+    m = ac.mass
+    if m is None:
+        raise ProfileError(f"aircraft.weight_lb: the aircraft file {ac.source.name} has no [mass] table")
+    w_lb = m.loaded_weight_lb if choice.weight_n is None else choice.weight_n / units.LBF  # type: ignore[attr-defined]
+    if not m.min_landing_weight_lb <= w_lb <= m.max_landing_weight_lb:
+        raise ProfileError(f"aircraft.weight_lb: must be in [{m.min_landing_weight_lb:g}, {m.max_landing_weight_lb:g}] "
+                           f"lb (aircraft file [mass] landing weights), got {w_lb:g}")
+    cg = choice.cg_mac  # type: ignore[attr-defined]
+    if cg is None:
+        cg = m.loaded_cg_mac
+    try:
+        tanks = m.tank_loading(w_lb, cg)
+    except ValueError as e:
+        raise ProfileError(f"aircraft.cg_percent_mac: {e}") from None
+    return ac.approach_speed_mps * math.sqrt(w_lb / m.loaded_weight_lb), tanks

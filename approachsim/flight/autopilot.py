@@ -158,6 +158,9 @@ class Autopilot:
         self.aligning = False
         self._flare_sink0 = 0.0  # the sink rate at flare entry (at least touchdown sink + 0.1), m/s
         self._flare_v0 = 0.0  # the smoothed true airspeed at flare entry, m/s
+        self.surface_slope = 0.0
+        """Slope of the terrain under the main gear, rise per metre along the runway (the flight loop sets it each
+        step on landing runs over a terrain profile): the flare's sink rate is the gear's closing speed on it."""
 
     def deviations(self, x: float, y: float, z: float, vn: float, ve: float, vd: float) -> tuple[float, ...]:
         """Glidepath deviation d (m, + above the cone), its rate (m/s), cross-track y (m, + right) and its rate
@@ -220,7 +223,9 @@ class Autopilot:
             else:
                 thr = 1.0 if thr >= 1.0 else 0.0
         if h_gear is not None and (self.flaring or h_gear <= g.flare_height_m):
-            sink = vd  # the guidance point's (module docstring: why not the main gear's)
+            # the guidance point's (module docstring: why not the main gear's), closing on a sloped surface as the
+            # radio altitude sees it: h' = -vd - slope x'
+            sink = vd + self.surface_slope * x0
             theta_c, thr_flare = self._flare(h_gear, sink, v_air)
             thr = min(thr, thr_flare)
         self._theta_c = theta_c
@@ -301,10 +306,10 @@ class Autopilot:
     def state(self) -> tuple[float, ...]:
         """The integrators and filters (int d, int y, e_f, wind along the path, int e_f, flaring, flare-entry pitch
         command, flare integral, last pitch command, TECS speed washout, int E_T, int E_B, flare tau, flare h_off,
-        aligning, flare-entry sink rate and airspeed): the compiled autopilot's APS_* state vector."""
+        aligning, flare-entry sink rate and airspeed, surface slope): the compiled autopilot's APS_* state vector."""
         return (self.int_d, self.int_y, self.e_f, self._w, self.int_e, float(self.flaring), self._theta_flare0,
                 self._int_flare, self._theta_c, self._v_lag, self.int_t, self.int_b, self._flare_tau,
-                self._flare_h_off, float(self.aligning), self._flare_sink0, self._flare_v0)
+                self._flare_h_off, float(self.aligning), self._flare_sink0, self._flare_v0, self.surface_slope)
 
     def _flare(self, h_gear: float, sink: float, v_air: float) -> tuple[float, float]:
         """Exponential flare with its path feed-forward (module docstring): pitch command to fly the main gear's

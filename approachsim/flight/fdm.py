@@ -99,6 +99,8 @@ class InitialCondition:
     isa_dev_k: float = 0.0
     sl_pressure_pa: float = 101325.0
     """The day's sea-level pressure (true QNH), Pa."""
+    tanks: tuple[tuple[float, float], ...] = ()
+    """Tank loading (contents lb, station x in) per JSBSim tank, set before the trim (empty: the model's)."""
 
 
 class FDM:
@@ -192,6 +194,9 @@ class FDM:
             f["ic/vw-dir-deg"] = math.degrees(ic.wind_from_rad + math.pi) % 360.0
             f["ic/vc-kts"] = ic.cas_mps / units.KT
             f["ic/gamma-rad"] = ic.gamma_rad
+        for i, (contents_lb, x_in) in enumerate(ic.tanks):  # the weight and CG (aircraft.Mass.tank_loading)
+            f[f"propulsion/tank[{i}]/contents-lbs"] = contents_lb
+            f[f"propulsion/tank[{i}]/x-position"] = x_in
         f["gear/gear-cmd-norm"] = 1.0 if ic.gear_down else 0.0
         f["fcs/flap-cmd-norm"] = ic.flaps_norm
         if not f.run_ic():

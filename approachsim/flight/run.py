@@ -71,6 +71,7 @@ from approachsim.flight.trim import (
 )
 from approachsim.flight.turbulence import DrydenTurbulence
 from approachsim.flight.vectors import imu_point_constants
+from approachsim.flight.wind import varies as wind_varies
 from approachsim.profile import Profile
 from approachsim.records import NavigationSource, Truth
 from approachsim.seeding import stream, stream_int
@@ -298,7 +299,8 @@ class Approach:
         n_max = int(math.ceil(max_time_s / dt)) + 1
         io = fdm.loop_io(layouts.RAW_FIELDS, layouts.GEAR_FIELDS, layouts.GEAR_AIRBORNE)
         par, st, nu = self._kernel_vectors(fdm, ic, seed, run, n_max)
-        turbulent = par[layouts.P_STEP + layouts.F_TURBULENT] != 0.0
+        turbulent = (par[layouts.P_STEP + layouts.F_TURBULENT] != 0.0  # gusts written: turbulence, varying wind
+                     or par[layouts.P_STEP + layouts.F_WIND_VARIES] != 0.0)
         if turbulent:
             io.gust_on()
         hilly = par[layouts.P_STEP + layouts.F_N_TERRAIN] > 1
@@ -386,7 +388,7 @@ class Approach:
         fs = st[layouts.S_STEP:layouts.S_STEP + layouts.N_F_STATE]
         td = {}
         if code in (fk.TERM_TOUCHDOWN, fk.TERM_SHORT):  # scored at the main gear, not the IMU point
-            sc = touchdown_scalars(final, self.main_gear_lever_arms_m, self.ground_contact_m)
+            sc = touchdown_scalars(final, self.main_gear_lever_arms_m, self.ground_contact_m, slope=rw.slope)
             td = {"touchdown_x_m": sc["td_x_m"], "touchdown_sink_mps": sc["td_sink_mps"],
                   "touchdown_y_m": sc["td_y_m"], "touchdown_drift_rad": sc["td_gear_slip_rad"],
                   "touchdown_crab_rad": sc["td_crab_rad"]}
@@ -466,6 +468,10 @@ class Approach:
             # the steady wind (blowing towards from + pi), m/s
             wind_ned_mps=(-env.wind_speed_mps * math.cos(env.wind_from_rad),
                           -env.wind_speed_mps * math.sin(env.wind_from_rad)),
+            wind=env if wind_varies(env) else None,
+            jsbsim_wind_ned_mps=(-ic.wind_speed_mps * math.cos(ic.wind_from_rad),
+                                 -ic.wind_speed_mps * math.sin(ic.wind_from_rad)),
+            gear_x_m=self.gear_arm_m if self.land else 0.0,
         )
         return par, st, nu
 

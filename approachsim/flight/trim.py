@@ -15,6 +15,8 @@ from dataclasses import replace
 from approachsim import geo, units
 from approachsim.flight.aircraft import Aircraft
 from approachsim.flight.fdm import FDM, InitialCondition, TrimError
+from approachsim.flight.wind import mean_wind_ned
+from approachsim.flight.wind import varies as wind_varies
 from approachsim.profile import Profile
 
 
@@ -29,6 +31,13 @@ def start_condition(profile: Profile, aircraft: Aircraft, *, still_air: bool = F
     lat, lon, _ = geo.ecef_to_geodetic(frame.to_ecef([along, 0.0, 0.0]))
     h = rw.elevation_m + float(rw.glidepath_height_m(along))
     env = profile.environment
+    wind = env.wind_speed_mps
+    if not still_air and wind_varies(env):  # JSBSim's steady wind is the mean wind at the start (flight/wind.py)
+        wn, we = mean_wind_ned(env, h - float(profile.terrain.height_at(along)))
+        wind = math.hypot(wn, we)
+        wind_from = math.atan2(-we, -wn) if wind > 0.0 else env.wind_from_rad
+    else:
+        wind_from = env.wind_from_rad
     return InitialCondition(
         lat_rad=float(lat),
         lon_rad=float(lon),
@@ -39,10 +48,11 @@ def start_condition(profile: Profile, aircraft: Aircraft, *, still_air: bool = F
         flaps_norm=aircraft.flaps_norm,
         gear_down=aircraft.gear_down,
         terrain_m=float(profile.terrain.height_at(along)),
-        wind_speed_mps=0.0 if still_air else env.wind_speed_mps,
-        wind_from_rad=env.wind_from_rad,
+        wind_speed_mps=0.0 if still_air else wind,
+        wind_from_rad=wind_from,
         isa_dev_k=env.isa_dev_k,
         sl_pressure_pa=env.sea_level_pa,
+        tanks=aircraft.tanks,
     )
 
 

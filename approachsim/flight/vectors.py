@@ -159,12 +159,17 @@ def monitor_arrays(mon: Any) -> tuple[Array, Array, Array]:
 
 def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, terrain_along_m: Array,
                    terrain_height_m: Array, *, pitch_trim: float, stop_height_m: float, land: bool,
-                   monitor_floor_m: float, wind_ned_mps: tuple[float, float]) -> tuple[Array, Array]:
+                   monitor_floor_m: float, wind_ned_mps: tuple[float, float], wind: Any | None = None,
+                   jsbsim_wind_ned_mps: tuple[float, float] = (0.0, 0.0), gear_x_m: float = 0.0
+                   ) -> tuple[Array, Array]:
     """fly_step's (par, st) for one flight: the IMU-point constants (imu_point_constants), the autopilot, monitor
     and turbulence (None: calm air) of the run (their oracles, fresh), the terrain profile (along-track distances
     and heights, m), the trimmed pitch trim (the elevator column of the Truth controls adds it), the stop height
     above the threshold (m; -inf: none), landing run (flare, touchdown), the height above the threshold the
-    monitor stops at (m) and the steady wind (north, east, m/s; the air moves with it)."""
+    monitor stops at (m) and the steady wind (north, east, m/s; the air moves with it). wind: the profile's
+    environment when its mean wind varies with height (flight/wind.py; None: it does not), then
+    jsbsim_wind_ned_mps is JSBSim's steady wind (the mean wind at the start) and wind_ned_mps the reference wind;
+    gear_x_m: the main gear's distance behind the IMU along the runway (landing runs: the terrain under it)."""
     ap_par, ap_st = autopilot_arrays(ap)
     mn_par, mn_st, ring = monitor_arrays(mon)
     if turb is not None:
@@ -179,11 +184,22 @@ def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, terrain_al
     fpar[layouts.F_MON_FLOOR] = monitor_floor_m
     fpar[layouts.F_WIND_N], fpar[layouts.F_WIND_E] = wind_ned_mps[0], wind_ned_mps[1]
     fpar[layouts.F_TURBULENT] = float(turb is not None)
+    fpar[layouts.F_GEAR_X] = gear_x_m
+    fpar[layouts.F_SHEAR_TOP], fpar[layouts.F_SHEAR_BOTTOM] = -math.inf, -math.inf  # no shear: never in force
+    if wind is not None:
+        fpar[layouts.F_WIND_VARIES] = 1.0
+        fpar[layouts.F_WIND_LOG] = float(wind.wind_profile == "log")
+        fpar[layouts.F_WIND_Z0], fpar[layouts.F_WIND_REF] = wind.roughness_length_m, wind.wind_reference_height_m
+        fpar[layouts.F_WIND0_N], fpar[layouts.F_WIND0_E] = jsbsim_wind_ned_mps
+        if wind.shear_n_mps != 0.0 or wind.shear_e_mps != 0.0:
+            fpar[layouts.F_SHEAR_TOP], fpar[layouts.F_SHEAR_BOTTOM] = wind.shear_top_m, wind.shear_bottom_m
+            fpar[layouts.F_SHEAR_N], fpar[layouts.F_SHEAR_E] = wind.shear_n_mps, wind.shear_e_mps
     fpar[layouts.F_N_TERRAIN] = len(terrain_along_m)
     fst = np.zeros(layouts.N_F_STATE)
     fst[layouts.FS_THR] = ap.trim.throttle  # the trimmed controls are in force at row 0
     fst[layouts.FS_LOWEST] = math.inf
     fst[layouts.FS_TD_X] = fst[layouts.FS_TD_SINK] = math.nan
+    fst[layouts.FS_WIND_N], fst[layouts.FS_WIND_E] = (jsbsim_wind_ned_mps if wind is not None else wind_ned_mps)
     par = np.concatenate([np.asarray(const, dtype=float), fpar, ap_par, tb_par, mn_par,
                           np.asarray(terrain_along_m, dtype=float), np.asarray(terrain_height_m, dtype=float)])
     st = np.concatenate([fst, ap_st, tb_st, mn_st, ring])

@@ -109,8 +109,8 @@ def read_properties(d: Array, raw: Array, near: bool) -> None:
 @njit(cache=True)
 def write_and_run(d: Array, par: Array, de: float, da: float, dr: float, thr: float, gn: float, ge: float,
                   gd: float, terr_ft: float) -> None:
-    """A step's writes in the Python loop's order (the gusts when turbulent, the terrain when it has more than one
-    point), then JSBSim's step."""
+    """A step's writes in the Python loop's order (the gusts when turbulent or the mean wind varies, the terrain
+    when it has more than one point), then JSBSim's step."""
     s = d[D_SET]
     w = D_WRITE
     _set(s, d[w + WRITE_DE], de)
@@ -118,7 +118,7 @@ def write_and_run(d: Array, par: Array, de: float, da: float, dr: float, thr: fl
     _set(s, d[w + WRITE_DR], dr)
     _set(s, d[w + WRITE_THR0], thr)
     _set(s, d[w + WRITE_THR1], thr)
-    if par[layouts.P_STEP + layouts.F_TURBULENT] != 0.0:
+    if par[layouts.P_STEP + layouts.F_TURBULENT] != 0.0 or par[layouts.P_STEP + layouts.F_WIND_VARIES] != 0.0:
         _set(s, d[w + WRITE_GN], gn)
         _set(s, d[w + WRITE_GE], ge)
         _set(s, d[w + WRITE_GD], gd)

@@ -115,6 +115,7 @@ from approachsim.core.layouts import (
     APS_INT_FLARE,
     APS_INT_T,
     APS_INT_Y,
+    APS_SURFACE_SLOPE,
     APS_THETA_C,
     APS_THETA_FLARE0,
     APS_V_LAG,
@@ -135,15 +136,26 @@ from approachsim.core.layouts import (
     F_CA,
     F_CB,
     F_CC,
+    F_GEAR_X,
     F_LAND,
     F_MON_FLOOR,
     F_N_TERRAIN,
     F_PITCH_TRIM,
+    F_SHEAR_BOTTOM,
+    F_SHEAR_E,
+    F_SHEAR_N,
+    F_SHEAR_TOP,
     F_STOP_H,
     F_TAN_GP,
     F_TURBULENT,
+    F_WIND0_E,
+    F_WIND0_N,
     F_WIND_E,
+    F_WIND_LOG,
     F_WIND_N,
+    F_WIND_REF,
+    F_WIND_VARIES,
+    F_WIND_Z0,
     F_X_GPI,
     FS_BETA,
     FS_CAS,
@@ -166,6 +178,8 @@ from approachsim.core.layouts import (
     FS_TD_X,
     FS_THETA,
     FS_THR,
+    FS_WIND_E,
+    FS_WIND_N,
     GEAR_AIRBORNE,
     MN_CA,
     MN_CB,
@@ -551,7 +565,7 @@ def autopilot_step(par: Array, st: Array, guide: tuple, air: tuple) -> tuple[flo
         # exponential flare on the main gear: h'_c = -(h_gear - h_off) / tau, tau and h_off from the entry sink
         # (continuity); the commanded path angle fed forward, led by T_theta2
         td = par[AP_TD_SINK]
-        sink = vd
+        sink = vd + st[APS_SURFACE_SLOPE] * x0  # the main gear's closing speed on a sloped surface (radio altitude)
         if st[APS_FLARING] == 0.0:
             st[APS_FLARING] = 1.0
             st[APS_THETA_FLARE0] = st[APS_THETA_C]
@@ -715,11 +729,12 @@ def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, i
     the IMU at the stop height; (landing runs) a main gear on the ground with the nose gear in the air: touchdown,
     short of the threshold when x < 0; anything else on the ground or the IMU at the terrain; divergence (bank,
     distance from the glidepath or the centreline); below WATCH_HEIGHT_M (above the flare on landing runs) the
-    stabilized-approach monitor, fed the speed through the mean air mass (CG ground velocity minus the steady
-    wind) as CAS with JSBSim's CAS/TAS ratio. imu = (x, y, z, vn, ve, vd): the IMU's position (runway frame, m)
-    and NED velocity (m/s); h_agl its height above the terrain (m); phi the bank (rad); wow = (nose, left, right)
-    JSBSim's weight-on-wheels; v_cg the CG's NED velocity, CAS and TAS in m/s. fpar, fst: the step's F_* parameters
-    and FS_* state (touchdown and monitor figures are stored there)."""
+    stabilized-approach monitor, fed the speed through the mean air mass (CG ground velocity minus the mean
+    wind at the CG's height, fst[FS_WIND_N], fst[FS_WIND_E]) as CAS with JSBSim's CAS/TAS ratio. imu = (x, y, z,
+    vn, ve, vd): the IMU's position (runway frame, m) and NED velocity (m/s); h_agl its height above the terrain
+    (m); phi the bank (rad); wow = (nose, left, right) JSBSim's weight-on-wheels; v_cg the CG's NED velocity, CAS
+    and TAS in m/s. fpar, fst: the step's F_* parameters and FS_* state (touchdown and monitor figures are stored
+    there)."""
     x, y, z, vn, ve, vd = imu
     wow_nose, wow_left, wow_right = wow
     vn_cg, ve_cg, vd_cg = v_cg
@@ -735,13 +750,43 @@ def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, i
             or abs(y) > DIVERGED_LATERAL_M):
         return TERM_DIVERGED
     if fpar[F_MON_FLOOR] < z < WATCH_HEIGHT_M:
-        an, ae = vn_cg - fpar[F_WIND_N], ve_cg - fpar[F_WIND_E]
+        an, ae = vn_cg - fst[FS_WIND_N], ve_cg - fst[FS_WIND_E]
         v_air = math.sqrt(an * an + ae * ae + vd_cg ** 2)
         result, a, b = monitor_step(mpar, mst, ring, x, y, z, v_air * cas / tas, vd, math.sqrt(vn * vn + ve * ve))
         if result != MON_OK:
             fst[FS_MON], fst[FS_MON_Z], fst[FS_MON_A], fst[FS_MON_B] = result, z, a, b
             return TERM_UNSTABLE
     return TERM_NONE
+
+
+LOG_H_MIN_M = 3.0 * _FT
+LOG_H_TOP_M = 1000.0 * _FT
+"""The log law's height range (MIL-F-8785C: 3 ft to 1000 ft; flight/wind.py, the oracle)."""
+
+
+@njit(cache=True)
+def mean_wind(fpar: Array, h_m: float) -> tuple[float, float]:
+    """The mean wind (north, east, m/s) at height h_m above the terrain (flight/wind.mean_wind_ned, the oracle):
+    the reference wind (F_WIND_N, F_WIND_E) times ln(h / z0) / ln(h_ref / z0) (h clipped to 3-1000 ft) when
+    F_WIND_LOG, plus the shear layer's change (F_SHEAR_N, F_SHEAR_E) times its fraction in force at h."""
+    f = 1.0
+    if fpar[F_WIND_LOG] != 0.0:
+        h = min(max(h_m, LOG_H_MIN_M), LOG_H_TOP_M)
+        f = math.log(h / fpar[F_WIND_Z0]) / math.log(fpar[F_WIND_REF] / fpar[F_WIND_Z0])
+    top, bottom = fpar[F_SHEAR_TOP], fpar[F_SHEAR_BOTTOM]
+    if h_m >= top:
+        s = 0.0
+    elif h_m <= bottom:
+        s = 1.0
+    else:
+        s = (top - h_m) / (top - bottom)
+    return fpar[F_WIND_N] * f + s * fpar[F_SHEAR_N], fpar[F_WIND_E] * f + s * fpar[F_SHEAR_E]
+
+
+@njit(cache=True)
+def _terrain_at(x: float, along: Array, height: Array) -> float:
+    """Terrain height (m) at runway-frame x (np.interp of the profile; its one height when flat)."""
+    return height[0] if height.shape[0] == 1 else np.interp(x, along, height)
 
 
 @njit(cache=True)
@@ -768,8 +813,9 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
     profile and the monitor's windows at their ends: flight_vectors builds them).
 
     Returns (TERM_* code, elevator, aileron, rudder, throttle (the commands to set for the next step; the ones in
-    force when not guided), gust north, east, down (ft/s, for JSBSim's atmosphere/gust-*-fps), terrain height
-    under the IMU (ft, for position/terrain-elevation-asl-ft), whether to read the gear at the next step).
+    force when not guided), gust north, east, down (ft/s, for JSBSim's atmosphere/gust-*-fps: the turbulence plus
+    the mean wind's change with height, flight/wind.py), terrain height under the IMU (under the main gear on
+    landing runs; ft, for position/terrain-elevation-asl-ft), whether to read the gear at the next step).
     """
     row = buf[k]
     fpar, fst = par[P_STEP:P_STEP + N_F_PAR], st[S_STEP:S_STEP + N_F_STATE]
@@ -792,6 +838,19 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
         tn, te, td = dryden_step(par[P_TB:P_TB + N_TB_PAR], st[S_TB:S_TB + N_TB_STATE], nu, k,
                                  raw[R_H_FT] * _FT - terr, tas)
         gn, ge, gd = tn / _FPS, te / _FPS, td / _FPS
+    if fpar[F_WIND_VARIES] != 0.0:  # the mean wind at the CG's height less JSBSim's steady wind, as a gust
+        wn, we = mean_wind(fpar, raw[R_H_FT] * _FT - terr)
+        fst[FS_WIND_N], fst[FS_WIND_E] = wn, we
+        gn += (wn - fpar[F_WIND0_N]) / _FPS
+        ge += (we - fpar[F_WIND0_E]) / _FPS
+    terr_w = terr  # the terrain JSBSim's ground plane takes: under the main gear on landing runs over a profile
+    if fpar[F_LAND] != 0.0 and nt > 1:
+        along, height = par[P_TERRAIN:P_TERRAIN + nt], par[P_TERRAIN + nt:P_TERRAIN + 2 * nt]
+        x_g = xr - fpar[F_GEAR_X]
+        terr_w = _terrain_at(x_g, along, height)
+        # the surface's slope under the main gear (central difference over 2 m), for the flare's closing speed
+        st[S_AP + APS_SURFACE_SLOPE] = 0.5 * (_terrain_at(x_g + 1.0, along, height)
+                                              - _terrain_at(x_g - 1.0, along, height))
     # the controls of the previous step act on this row until replaced
     row[CONTROLS_COL] = fst[FS_DE] + fpar[F_PITCH_TRIM]
     row[CONTROLS_COL + 1], row[CONTROLS_COL + 2], row[CONTROLS_COL + 3] = fst[FS_DA], fst[FS_DR], fst[FS_THR]
@@ -811,7 +870,7 @@ def fly_step(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Array,
                                    (phi, theta, p, q, beta, cas, h_gear, tas, psi, r))
     else:
         de, da, dr, thr = fst[FS_DE], fst[FS_DA], fst[FS_DR], fst[FS_THR]
-    return code, de, da, dr, thr, gn, ge, gd, terr / _FT, near
+    return code, de, da, dr, thr, gn, ge, gd, terr_w / _FT, near
 
 
 @njit(cache=True)

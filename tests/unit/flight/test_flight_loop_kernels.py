@@ -99,6 +99,7 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
     n = 600
     x, y, z, v, att, cas, h_gear, tas, psi = _autopilot_inputs(rng, n, flare=flare)
     ap = _autopilot(gains)
+    ap.surface_slope = 0.012 if flare else 0.0  # the flare's closing speed on a 1.2 % runway slope
     par, st = fv.autopilot_arrays(ap)
     seen = {"pitch limited": 0, "bank limited": 0, "throttle 1": 0, "throttle 0": 0, "flaring": 0, "idle": 0,
             "aligning": 0, "sideslip limited": 0, "full decrab": 0}
