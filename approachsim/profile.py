@@ -97,6 +97,14 @@ class Environment:
     sea_level_pa: float = 101325.0
     """The day's true sea-level pressure of the ISA+dT atmosphere that has the QNH's pressure at the field
     (sensors.atmosphere.sea_level_pressure_pa): what JSBSim's atmosphere is set to, Pa."""
+    inversion_k: float = 0.0
+    """A surface layer's departure from the constant-dT atmosphere (environment.inversion_K): the air at the field is
+    this much colder than the day's standard-lapse line, the departure falling linearly to 0 at inversion_depth_m
+    above the field (sensors/atmosphere.py inversion_log_ratio). It acts on the baro's static pressure and the
+    reported aerodrome temperature; JSBSim's flight keeps its constant-dT air (a 10 K layer changes the density by
+    3.5 %, which the autopilot flies through). K."""
+    inversion_depth_m: float = 1000.0 * 0.3048
+    """Depth of that layer above the field, m."""
 
     @property
     def true_qnh_pa(self) -> float:
@@ -215,6 +223,8 @@ def _environment(s: Section, runway: Runway) -> Environment:
         )
     err = s.number("qnh_setting_error_hPa", 0.0, lo=-50.0, hi=50.0, unit="hPa")
     report = s.string("qnh_report", "exact", choices=QNH_REPORTS)
+    inv_k = s.number("inversion_K", 0.0, lo=-20.0, hi=30.0, unit="K")
+    inv_depth_ft = s.number("inversion_depth_ft", 1000.0, lo=1.0, hi=10000.0, unit="ft")
     s.done()
     reported = math.floor(qnh) if report == "whole_hpa" else qnh
     h_field = float(atmosphere.geopotential_m(runway.elevation_m))
@@ -225,7 +235,9 @@ def _environment(s: Section, runway: Runway) -> Environment:
         isa_dev_k=dt,
         qnh_pa=qnh * units.HPA,
         setting_pa=(reported + err) * units.HPA,
-        sea_level_pa=atmosphere.sea_level_pressure_pa(qnh * units.HPA, h_field, dt),
+        sea_level_pa=atmosphere.sea_level_pressure_pa(qnh * units.HPA, h_field, dt, runway.elevation_m),
+        inversion_k=inv_k,
+        inversion_depth_m=inv_depth_ft * units.FT,
     )
 
 
