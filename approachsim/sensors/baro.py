@@ -17,7 +17,7 @@ Table 1 (sigma_B = 1 m, beta = 0.01 1/s so tau = 100 s) and seed 003 Table 1 (no
 (issue 39, docs/truth.md "Barometric altimeter"): the static-source (position) error left after the air data's
 correction, a second first-order Gauss-Markov process (static_source_sigma_m, static_source_tau_s), and the QNH
 reporting error, a per-run constant (qnh_sigma_m: the reported QNH's error times dh/dp at the field); each is drawn
-only when its sigma is not zero (the other errors keep their numbers). The scale factor multiplies the height above
+only when its sigma is not zero (a baro without them keeps its numbers). The scale factor multiplies the height above
 the altimeter setting's reference (issue 39): a QNH
 altimeter reads the field elevation at the field whatever its gain error (the setting is made to make it so), so a
 scale error on the MSL height (seed 003's form) would put a 0.12 x 1656 m = 200 m error at a 5434 ft field's
@@ -95,14 +95,15 @@ class Baro:
         noise (m,) m; constants: scale_factor ()."""
 
         def one(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
-            c = g.standard_normal(1)
-            z = g.standard_normal((m, 2))
+            # the constants first, then one row of normals per sample: a draw over a longer time base starts with
+            # the same numbers (the closed loop draws for its longest flight); the extra columns only when on
+            c = g.standard_normal(2 if self.qnh_sigma_m > 0.0 else 1)
+            z = g.standard_normal((m, 3 if self.static_source_sigma_m > 0.0 else 2))
             bias = base.gauss_markov(z[:, 0], self.bias_sigma_m, self.bias_tau_s, dt)
-            if self.static_source_sigma_m > 0.0:  # drawn after the others: they keep their numbers
-                bias = bias + base.gauss_markov(g.standard_normal(m), self.static_source_sigma_m,
-                                                self.static_source_tau_s, dt)
+            if self.static_source_sigma_m > 0.0:
+                bias = bias + base.gauss_markov(z[:, 2], self.static_source_sigma_m, self.static_source_tau_s, dt)
             if self.qnh_sigma_m > 0.0:
-                bias = bias + self.qnh_sigma_m * g.standard_normal(1)[0]
+                bias = bias + self.qnh_sigma_m * c[1]
             return {
                 "c_scale_factor": self.scale_factor_sigma * c[0],
                 "bias": bias,
