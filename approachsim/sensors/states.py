@@ -38,6 +38,7 @@ here and one entry in `_EXTRACT`.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
 from typing import Any
@@ -220,8 +221,11 @@ def _baro(at: _At) -> tuple[Array, Array] | None:
     sf = np.asarray(e.constants["scale_factor"], dtype=float).reshape(-1)
     k = int(e.rows[j])
     dt = None
-    if baro.lag_s > 0.0 and len(at.truth.t_s) < 2:  # the closed loop's start: the draw's grid gives the step
-        dt = float(e.t_s[1] - e.t_s[0]) / float(e.rows[1] - e.rows[0])
+    if baro.lag_s > 0.0:  # the truth's step; at the closed loop's start (row 1 not flown) the draw's grid gives it
+        t = at.truth.t_s
+        dt = float(t[1] - t[0]) if len(t) > 1 else math.nan
+        if not math.isfinite(dt):
+            dt = float(e.t_s[1] - e.t_s[0]) / float(e.rows[1] - e.rows[0])
     zero = np.zeros((sf.shape[0], 1))
     h_s = baro.record(at.truth, e.rows[j:j + 1], e.t_s[j:j + 1], sf, zero, zero, True, dt).h_baro_m[:, 0]
     h_ind = float(atmosphere.indicated_altitude_m(baro.sensed_pressure(np.asarray(baro.p_field_pa)),
