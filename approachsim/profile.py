@@ -124,6 +124,14 @@ class Environment:
     """The shear layer's wind change from its top to its bottom, north component (where the air moves to), m/s."""
     shear_e_mps: float = 0.0
     """The same, east component, m/s."""
+    inversion_k: float = 0.0
+    """A surface layer's departure from the constant-dT atmosphere (environment.inversion_K): the air at the field is
+    this much colder than the day's standard-lapse line, the departure falling linearly to 0 at inversion_depth_m
+    above the field (sensors/atmosphere.py inversion_log_ratio). It acts on the baro's static pressure and the
+    reported aerodrome temperature; JSBSim's flight keeps its constant-dT air (a 10 K layer changes the density by
+    3.5 %, which the autopilot flies through). K."""
+    inversion_depth_m: float = 1000.0 * 0.3048
+    """Depth of that layer above the field, m."""
 
     @property
     def true_qnh_pa(self) -> float:
@@ -257,6 +265,8 @@ def _environment(s: Section, runway: Runway) -> Environment:
     top = s.number("shear_top_ft", 0.0, lo=0.0, hi=3000.0, unit="ft")
     bottom = s.number("shear_bottom_ft", 0.0, lo=0.0, hi=3000.0, unit="ft")
     loss = s.number("shear_headwind_loss_kt", 0.0, lo=-40.0, hi=40.0, unit="kt")
+    inv_k = s.number("inversion_K", 0.0, lo=-20.0, hi=30.0, unit="K")
+    inv_depth_ft = s.number("inversion_depth_ft", 1000.0, lo=1.0, hi=10000.0, unit="ft")
     s.done()
     if loss != 0.0 and not top > bottom:
         raise ProfileError(f"{s.path}.shear_top_ft: must be above shear_bottom_ft ({bottom:g} ft) for a shear, got "
@@ -274,7 +284,7 @@ def _environment(s: Section, runway: Runway) -> Environment:
         isa_dev_k=dt,
         qnh_pa=qnh * units.HPA,
         setting_pa=(reported + err) * units.HPA,
-        sea_level_pa=atmosphere.sea_level_pressure_pa(qnh * units.HPA, h_field, dt),
+        sea_level_pa=atmosphere.sea_level_pressure_pa(qnh * units.HPA, h_field, dt, runway.elevation_m),
         wind_profile=shape,
         wind_reference_height_m=ref,
         roughness_length_m=z0,
@@ -282,6 +292,8 @@ def _environment(s: Section, runway: Runway) -> Environment:
         shear_bottom_m=bottom * units.FT,
         shear_n_mps=dn,
         shear_e_mps=de,
+        inversion_k=inv_k,
+        inversion_depth_m=inv_depth_ft * units.FT,
     )
 
 

@@ -142,6 +142,7 @@ def exercise() -> dict[str, list[Key]]:
     full["aircraft"].update(approach_speed_kt=140.0, flaps_norm=1.0)
     full["environment"]["qnh_setting_error_hPa"] = 0.0
     full["environment"]["qnh_report"] = "exact"
+    full["sensors"]["baro"]["temperature_scale_sigma"] = 0.12
     full["nav"]["filter_tuning"] = {}
     sizes = {"spike": {"k": 100.0, "every": 10}, "iam": {"magnitude": 10.0, "steps": [5]}, "cbm": {"magnitude": 1.0},
              "mni": {"factor": 4.0}, "step": {"magnitude": 1.0}, "ramp": {"rate": 0.1}, "outage": {}}

@@ -103,7 +103,8 @@ def run(args: argparse.Namespace) -> int:
     profile = spec.profile
     o = check_options(args, profile)
     if (b := profile.sensors.baro) is not None and (note := temperature_note(
-            profile.environment.isa_dev_k, profile.runway.elevation_m, b.bias_sigma_m, b.temperature_correction)):
+            profile.environment.isa_dev_k, profile.runway.elevation_m, b.bias_sigma_m, b.temperature_correction,
+            b.filter_scale_sigma)):
         sys.stderr.write(f"approachsim evaluate: note: {note}\n")
     require = parse_require(getattr(args, "require", None))
     try:

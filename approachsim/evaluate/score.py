@@ -24,6 +24,8 @@ glidepath), so scoring needs no profile.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from approachsim import units
@@ -96,6 +98,8 @@ def score_run(
             "along_m": at_crossing(err.along_m, cr),
             "lateral_m": at_crossing(err.lateral_m, cr),
             "vertical_m": at_crossing(err.vertical_m, cr),
+            # the filter's own vertical 1-sigma there (issue 39: e / sigma at each DH)
+            "vertical_sigma_m": at_crossing(np.sqrt(np.maximum(nav.P_pos_ned[:n, 2, 2], 0.0)), cr),
             "vpl_m": at_crossing(integ.vpl_m, cr),
             "hpl_m": at_crossing(integ.hpl_m, cr),
             "tse_lat_m": at_crossing(truth.loc_dev_m[:n], cr),
@@ -104,6 +108,8 @@ def score_run(
         if not (np.isfinite(vals["lateral_m"]) and np.isfinite(vals["vertical_m"])):
             raise RunScoreError(f"navigation solution is not finite at the {cat} decision height (diverged)")
         vals["gpdev_m"] = vals["vertical_m"] + vals["along_m"] * tan_gp
+        sig = vals["vertical_sigma_m"]
+        vals["vertical_e_sigma"] = vals["vertical_m"] / sig if sig > 0.0 else math.nan
         vals["fte_lat_m"] = (
             vals["tse_lat_m"] + vals["lateral_m"] if fte_lat_m is None else at_crossing(fte_lat_m[:n], cr)
         )

@@ -12,6 +12,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict
 
 import numpy as np
+from scipy import stats as sps
 
 from approachsim import units
 from approachsim.evaluate.config import EvaluationConfig
@@ -146,6 +147,17 @@ def _stats_ft(x_m: np.ndarray) -> dict:
     return {k: _num(v) for k, v in asdict(error_stats(x_m).scaled(1.0 / units.FT)).items()}
 
 
+def _e_sigma(r: np.ndarray) -> dict:
+    """RMS of the per-run vertical error / filter sigma at a DH (1 for a consistent filter; its 95 % chi-square band
+    for n runs beside it), the number of runs, the mean."""
+    r = r[np.isfinite(r)]
+    n = int(r.size)
+    if n == 0:
+        return {"runs": 0, "rms": None, "mean": None, "band_95": None}
+    return {"runs": n, "rms": _num(float(np.sqrt(np.mean(r**2)))), "mean": _num(float(np.mean(r))),
+            "band_95": [_num(float(np.sqrt(sps.chi2.ppf(q, n) / n))) for q in (0.025, 0.975)]}
+
+
 def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cfg: EvaluationConfig,
             counts: Mapping[str, np.ndarray] | None = None, integrity_fn: Callable[..., dict] | None = None) -> dict:
     """Everything beside the contract: bounds, ICAO limits, failures, integrity, FTE / TSE, time-averaged RMS.
@@ -178,6 +190,9 @@ def details(columns: Mapping[str, np.ndarray], results: list[CategoryResult], cf
         comps = ("along", "lateral", "vertical", "gpdev", "vpl", "hpl", "fte_lat", "fte_vert", "tse_lat", "tse_vert")
         for comp in comps:
             entry[f"{comp}_ft"] = _stats_ft(_col(columns, f"{key}_{comp}_m"))
+        if f"{key}_vertical_e_sigma" in columns:  # the filter's consistency at the DH (issue 39)
+            entry["vertical_sigma_ft"] = _stats_ft(_col(columns, f"{key}_vertical_sigma_m"))
+            entry["vertical_e_sigma"] = _e_sigma(_col(columns, f"{key}_vertical_e_sigma"))
         if f"{key}_int_epochs" in columns:  # the solution-separation bank's (integrity on)
             for c_name, name in (("vpl_dh_m", "vpl"), ("lpl_dh_m", "lpl")):
                 entry[f"{name}_ft"] = _stats_ft(_col(columns, f"{key}_int_{c_name}"))

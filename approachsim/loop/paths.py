@@ -14,7 +14,7 @@ from the configuration and the oracle switches, before the first row, and the ru
             "generic"   the Navigator's numpy epoch (online FDE, feedback, the robust or U-D filters, loose coupling,
                         an adaptive loop, carrier phase; or the oracle switch `fast_epochs = False`)
     baro    "compiled"  a plain altimeter's damping-loop samples made in the compiled row; "python": a faulted one's
-            by its model at the row; "none"
+            (or one sensing an inversion: sensors/baro.py) by its model at the row; "none"
     sigmas  "compiled"  the GPS channel sigmas of the compiled epoch compiled (core/loop/aiding.py channel_sigmas);
             "numpy": the numpy formulas (GBAS, or `compiled_sigmas = False`); "none": no compiled epoch or no GPS
 
@@ -79,6 +79,9 @@ def _direct_unavailable(source: Any) -> str | None:
         p = ps.get(name)
         if p is not None and type(p) is not kind:
             return f"the {name} is wrapped ({type(p).__name__}: a fault or another model): its records"
+    b = ps.get("baro")
+    if b is not None and b.baro.departs:
+        return "the baro senses a departure from the constant-dT air (an inversion): its records"
     g = ps.get("gnss")
     if g is not None:
         if g.rx.budget.gbas is not None:
@@ -113,11 +116,12 @@ def choose(source: Any) -> LoopPath:
     baro = source.suite.sensors.get("baro")
     if baro is None or source.errors.sensors.get("baro") is None:
         baro_path = "none"
-    elif type(baro) is Baro and row == "compiled":
+    elif type(baro) is Baro and row == "compiled" and not baro.departs:
         baro_path = "compiled"
     else:
         baro_path = "python"
-        reasons.append(("baro", "a wrapped altimeter (a fault) or the generic row: its model at the row"))
+        reasons.append(("baro", "a wrapped altimeter (a fault), an inversion or the generic row: its model at the "
+                                "row"))
     b = source.nav.noise_model.sensors.gnss
     g = None if b is None else b.budget()
     if epoch == "generic" or g is None or source.nav.layout.n_sv == 0:

@@ -282,6 +282,13 @@ def _dw_in(lat: float, h: float, v: Array, r_n: float, r_e: float) -> tuple[Arra
     return d_dp, d_dv, np.array([om * cl, 0.0, -om * sl])
 
 
+def linear_height(layout: StateLayout, h_ins_m: float, x_hat: Array) -> float:
+    """The height (m) the per-run error model is linearized at: the INS height, or with a baro scale-factor state the
+    navigation's, h_ins + dp_D_hat (the damping loop drags the INS toward a baro off by sb (h - H_ref), and the
+    loop's sb coefficient -(h - H_ref) must be the true height's; nav/measurements.baro says why)."""
+    return h_ins_m + float(x_hat[layout.i("dp", 2)]) if layout.has("sb") else h_ins_m
+
+
 def dynamics(
     layout: StateLayout,
     lat_rad: float,

@@ -67,14 +67,20 @@ def _row(layout: StateLayout) -> Array:
 
 
 def baro(layout: StateLayout, h_ins_m: float, h_baro_m: float, sigma_m: float, t_s: float,
-         name: str = "baro", h_ref_m: float = 0.0) -> ScalarMeasurement:
+         name: str = "baro", h_ref_m: float = 0.0, dp_d_hat_m: float = 0.0) -> ScalarMeasurement:
     """Baro altitude difference: h = [-1 at dp_D, -1 at bb, -(h - H_ref) at sb]; R = sigma^2 (white noise), m;
-    h_ref_m = H_ref the altimeter setting's reference (the field), m."""
+    h_ref_m = H_ref the altimeter setting's reference (the field), m.
+
+    h in the sb column is the navigation's height h_ins + dp_D_hat (dp_d_hat_m: the estimate's dp_D), not the INS
+    height: the damping loop drags the INS toward a baro that is off by sb (h - H_ref) (117 m at 985 m above a
+    5434 ft field at ISA -30), so h_ins is off by as much, and sb times that (14 m) would be a model error in the row;
+    with it the estimate ran away (issue 39: KDEN ISA -30, 98 m vertical error). h x_hat is then the exact
+    prediction -dp_D - bb - (h_ins + dp_D - H_ref) sb at the estimate (the EKF's, less its sb dp_D Jacobian term)."""
     h = _row(layout)
     h[layout.i("dp", 2)] = -1.0  # dh = -dp_D
     h[layout.i("bb")] = -1.0
     if layout.has("sb"):
-        h[layout.i("sb")] = -(h_ins_m - h_ref_m)
+        h[layout.i("sb")] = -(h_ins_m + dp_d_hat_m - h_ref_m)
     return ScalarMeasurement(z=float(h_ins_m - h_baro_m), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
 
 

@@ -321,9 +321,9 @@ class Navigator:
             if r_ins is None:
                 r_ins = ins.position_ecef(s)
             noise = system.noise(obs.elevations(i))
-            gains = system.loop_slopes(run.fs, float(s.h_m[i]), noise)
-            F, Qc = em.dynamics(lay, float(s.lat_rad[i]), float(s.h_m[i]), s.v_ned[i], f_ned_mean[i], s.c_bn[i],
-                                noise, gains, loop_held=held)
+            gains = system.loop_slopes(run.fs, em.linear_height(lay, float(s.h_m[i]), run.fs.x), noise)
+            F, Qc = em.dynamics(lay, float(s.lat_rad[i]), em.linear_height(lay, float(s.h_m[i]), run.fs.x), s.v_ned[i],
+                                f_ned_mean[i], s.c_bn[i], noise, gains, loop_held=held)
             phi, qd = em.discretize(F, Qc, dt_epoch)
             if new is not None:
                 phi, qd = reset_arcs(lay, phi, qd, new, self._amb_prior())

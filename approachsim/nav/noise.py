@@ -43,6 +43,7 @@ import numpy as np
 
 from approachsim.nav import errormodel as em
 from approachsim.nav.config import NavConfig
+from approachsim.sensors import atmosphere
 from approachsim.sensors.config import SensorsConfig
 from approachsim.sensors.gnss.clock import ClockModel
 from approachsim.sensors.presets import PRESETS
@@ -163,15 +164,19 @@ class NoiseModel:
             kw.update(ram_sigma_m=self.sensors.radalt.markov_sigma_m, ram_tau_s=self.sensors.radalt.markov_tau_s,
                       tdb_correlation_m=self.nav.terrain_database.correlation_m)
         q1 = self.clock().q(1.0)  # Q(1 s) = [[S_f + S_g / 3, S_g / 2], [., S_g]]
+        # one bb state for the truth's slow baro errors (BaroConfig.filter_bias: their variance and rate)
+        bb_sigma, bb_tau = (b.filter_bias(atmosphere.height_per_hpa_m(self.baro_ref_m)) if b is not None
+                            else (1.0, 100.0))
         return em.ErrorNoise(
             gyro_arw_rad_sqrts=g.gyro_arw_rad_sqrts,
             accel_vrw_mps_sqrts=g.accel_vrw_mps_sqrts,
             gyro_bias_rw=np.sqrt(2.0 * g.gyro_bi_radps**2 / g.gyro_bi_tau_s),
             accel_bias_rw=np.sqrt(2.0 * g.accel_bi_mps2**2 / g.accel_bi_tau_s),
-            baro_bias_sigma_m=b.bias_sigma_m if b is not None else 1.0,
-            baro_bias_tau_s=b.bias_tau_s if b is not None else 100.0,
+            baro_bias_sigma_m=bb_sigma,
+            baro_bias_tau_s=bb_tau,
             baro_noise_sigma_m=b.noise_sigma_m if b is not None else 1.0,
             baro_rate_hz=b.rate_hz if b is not None else 10.0,
+            baro_ref_m=self.baro_ref_m,  # the loop's sb column -(h - H_ref) (it was left at 0: the MSL height)
             clock_sf=float(q1[0, 0] - q1[1, 1] / 3.0),
             clock_sg=float(q1[1, 1]),
             **kw,
@@ -209,7 +214,7 @@ class NoiseModel:
                               + (9.8 * g.accel_misalign_rad) ** 2 + (9.8 * g.accel_sf) ** 2)
         d[lay.i("bb")] = nz.baro_bias_sigma_m**2
         if lay.has("sb"):
-            d[lay.i("sb")] = self.sensors.baro.scale_factor_sigma**2
+            d[lay.i("sb")] = self.sensors.baro.filter_scale_sigma**2
         if lay.has("clk"):
             c = self.clock()
             d[lay.index["clk"]] = [c.bias0_sigma_m**2, c.drift0_sigma_mps**2]

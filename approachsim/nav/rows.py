@@ -96,8 +96,9 @@ class MeasurementRows:
         out: list[Row] = []
         if obs.baro_h_m is not None and np.isfinite(obs.baro_h_m[i]):
             hb, sb = float(obs.baro_h_m[i]), float(obs.baro_sigma_m)
-            out.append(Row(Source(BARO), lambda x: meas.baro(lay, h, hb, sb, t,
-                                                                    h_ref_m=float(self.runway.threshold_h_m))))
+            h_ref = float(self.runway.threshold_h_m)
+            out.append(Row(Source(BARO), lambda x: meas.baro(lay, h, hb, sb, t, h_ref_m=h_ref,
+                                                                    dp_d_hat_m=float(x[lay.i("dp", 2)]))))
         if obs.radalt_h_m is not None and np.isfinite(obs.radalt_h_m[i]):
             hr = float(obs.radalt_h_m[i])
             sr = self.radalt_sigma_m(hr)

@@ -82,7 +82,7 @@ def layout_for(nav: NavConfig, sensors: SensorsConfig) -> em.StateLayout:
         raise ValueError("[sensors.gnss] carrier_phase needs tight GPS coupling with channel states ([nav] "
                          "gps_coupling = \"tight\", channel_states = true): the float ambiguities are channel states")
     return em.StateLayout(
-        baro_scale=sensors.baro is not None and sensors.baro.scale_factor_sigma > 0.0,
+        baro_scale=sensors.baro is not None and sensors.baro.filter_scale_sigma > 0.0,
         clock=(sensors.gnss is not None and nav.gps_coupling == "tight") or sensors.pseudolite is not None,
         loop=nav.baro_loop != "none",
         n_sv=n_sv,

@@ -136,6 +136,10 @@ PINNED: tuple[tuple[str, Any], ...] = (
     ("sensors.baro.bias_sigma_m", BARO_BIAS_SIGMA_FT * units.FT),
     ("sensors.baro.bias_tau_s", BARO_BIAS_TAU_S),
     ("sensors.baro.scale_factor_sigma", 0.0),
+    # the paper's baro has no temperature scale state, static-source or QNH error (issue 39's physical baro)
+    ("sensors.baro.temperature_scale_sigma", 0.0),
+    ("sensors.baro.static_source_sigma_m", 0.0),
+    ("sensors.baro.qnh_sigma_hPa", 0.0),
     ("sensors.baro.noise_sigma_m", 1.0),
     ("sensors.baro.lag_s", 0.0),
     # filter: feed-forward EKF, tight (pseudorange) coupling, 1 s, GPS as the 2-state clock + tuned R
@@ -377,7 +381,7 @@ def truth_states(profile: Any, *, n_sv: int = 4) -> dict[str, int]:
         imu += 6 if v > 0 else 0
     out = {"ins_navigation": 9, "imu": imu}
     if s.baro is not None:
-        out["baro"] = 1 + (1 if s.baro.scale_factor_sigma > 0 else 0)
+        out["baro"] = 1 + (1 if s.baro.filter_scale_sigma > 0 else 0)
     if s.gnss is not None:
         b = s.gnss.budget()
         per_sv = sum(1 for v in (b.clock_ephemeris_m, b.iono_zenith_m, b.tropo_zenith_m, b.multipath_m) if v > 0)

@@ -13,8 +13,12 @@ indication above the field (geopotential elevation H_f) by c = T_f / (T0 - L H_f
 temperature (sensors/atmosphere.py: the exact form of the ICAO Doc 8168 correction for the ISA+dT troposphere, left
 with the METAR's rounding to a whole degree). S is a random-constant scale factor, B a first-order
 Gauss-Markov bias (sigma, tau; exact discretization of seed 001 eq. 2), v white noise. Defaults are seed 001
-Table 1 (sigma_B = 1 m, beta = 0.01 1/s so tau = 100 s) and seed 003 Table 1 (noise 1 m). No static-source
-(position) error. The scale factor multiplies the height above the altimeter setting's reference (issue 39): a QNH
+Table 1 (sigma_B = 1 m, beta = 0.01 1/s so tau = 100 s) and seed 003 Table 1 (noise 1 m). B_k also carries
+(issue 39, docs/truth.md "Barometric altimeter"): the static-source (position) error left after the air data's
+correction, a second first-order Gauss-Markov process (static_source_sigma_m, static_source_tau_s), and the QNH
+reporting error, a per-run constant (qnh_sigma_m: the reported QNH's error times dh/dp at the field); each is drawn
+only when its sigma is not zero (a baro without them keeps its numbers). The scale factor multiplies the height above
+the altimeter setting's reference (issue 39): a QNH
 altimeter reads the field elevation at the field whatever its gain error (the setting is made to make it so), so a
 scale error on the MSL height (seed 003's form) would put a 0.12 x 1656 m = 200 m error at a 5434 ft field's
 threshold.
@@ -27,6 +31,12 @@ w_0 = b0, w_i = a^(i-1) (a b0 + b1); a = exp(-dt / tau), b0 = 1 - tau (1 - a) / 
 truncated at M = ceil(10 tau / dt) rows (the dropped tail weighs e^-10; weights renormalized to sum 1) with
 rows before the first repeated (the lag starts in steady state). On a steady descent at rate v it reads high
 by exactly v tau.
+
+Departure from the constant-dT atmosphere (inversion_k != 0): the static pressure the altimeter senses is JSBSim's
+times exp(atmosphere.inversion_log_ratio): a surface layer colder (or warmer) than the day's standard-lapse line, the
+field pressure kept. JSBSim's constant-dT air would make the aerodrome temperature correction exact; a real day's
+lapse rate departs from it, and the correction, made with the (colder) surface temperature, then over-corrects.
+This runs in numpy before the compiled indication, so such a baro takes the closed loop's python baro path.
 """
 
 from __future__ import annotations
@@ -53,8 +63,9 @@ _NO_LAG = np.zeros(0)
 @dataclass(frozen=True)
 class Baro:
     """Barometric altimeter. setting_pa: the setting on the instrument, Pa (profile environment.setting_pa:
-    QNH + the setting error); field_m: the field's geopotential elevation H_f (m), the setting's reference (the scale
-    factor's) and the temperature correction's; temperature_ratio: c = T_f / (T0 - L H_f) (1: no correction)."""
+    QNH + the setting error); field_m: the field elevation z_f (m) the altimeter reads at the field with QNH, the
+    setting's reference (the scale factor's) and the temperature correction's; temperature_ratio:
+    c = T_f / (T0 - L z_f) (1: no correction)."""
 
     setting_pa: float = atmosphere.P0_PA
     rate_hz: float = 10.0
@@ -65,19 +76,37 @@ class Baro:
     lag_s: float = 0.0
     field_m: float = 0.0
     temperature_ratio: float = 1.0
+    static_source_sigma_m: float = 0.0
+    static_source_tau_s: float = 300.0
+    qnh_sigma_m: float = 0.0
+    """The QNH reporting error's height at the field (m, per-run constant)."""
+    inversion_k: float = 0.0
+    """Surface-layer departure (K colder at the field) over inversion_depth_m (module docstring); 0: none."""
+    inversion_depth_m: float = 304.8
+    p_field_pa: float = atmosphere.P0_PA
+    """The field's static pressure (Pa) and its constant-dT temperature t_field_k (K): the departure's anchors."""
+    t_field_k: float = atmosphere.T0_K
     name: str = "baro"
 
     fault_targets: ClassVar[tuple[tuple[str, str, str], ...]] = (("h", "h_baro_m", "noise"),)
 
     def draw(self, t_s: Array, rng: base.RngLike) -> base.SensorErrors:
-        """series: bias (m,) m, noise (m,) m; constants: scale_factor ()."""
+        """series: bias (m,) m (the seed's Gauss-Markov bias + the static-source error + the QNH reporting error),
+        noise (m,) m; constants: scale_factor ()."""
 
         def one(g: np.random.Generator, m: int, dt: float) -> dict[str, Array]:
-            c = g.standard_normal(1)
-            z = g.standard_normal((m, 2))
+            # the constants first, then one row of normals per sample: a draw over a longer time base starts with
+            # the same numbers (the closed loop draws for its longest flight); the extra columns only when on
+            c = g.standard_normal(2 if self.qnh_sigma_m > 0.0 else 1)
+            z = g.standard_normal((m, 3 if self.static_source_sigma_m > 0.0 else 2))
+            bias = base.gauss_markov(z[:, 0], self.bias_sigma_m, self.bias_tau_s, dt)
+            if self.static_source_sigma_m > 0.0:
+                bias = bias + base.gauss_markov(z[:, 2], self.static_source_sigma_m, self.static_source_tau_s, dt)
+            if self.qnh_sigma_m > 0.0:
+                bias = bias + self.qnh_sigma_m * c[1]
             return {
                 "c_scale_factor": self.scale_factor_sigma * c[0],
-                "bias": base.gauss_markov(z[:, 0], self.bias_sigma_m, self.bias_tau_s, dt),
+                "bias": bias,
                 "noise": self.noise_sigma_m * z[:, 1],
             }
 
@@ -88,6 +117,19 @@ class Baro:
         compiled sample (core/sensors/baro.py; core/loop/nav_row.py makes a closed loop's samples with them)."""
         return (float(self.setting_pa), _T0_OVER_LAPSE_M, _EXPONENT_INV, float(self.field_m),
                 float(self.temperature_ratio) - 1.0)
+
+    @property
+    def departs(self) -> bool:
+        """Whether the sensed pressure departs from the truth's (an inversion: numpy before the kernel)."""
+        return self.inversion_k != 0.0
+
+    def sensed_pressure(self, p_pa: Array) -> Array:
+        """The static pressure (Pa) the altimeter senses for the truth's (JSBSim's) p_pa: p exp(inversion_log_ratio)
+        (module docstring); p itself without a departure."""
+        if not self.departs:
+            return p_pa
+        return p_pa * np.exp(atmosphere.inversion_log_ratio(p_pa, self.p_field_pa, self.t_field_k, self.inversion_k,
+                                                            self.inversion_depth_m))
 
     def lag_weights(self, dt_s: float) -> Array:
         """The lag's impulse-response weights (M + 1,) on a truth step dt_s (s), renormalized to sum 1 (module
@@ -121,6 +163,7 @@ class Baro:
         else:
             w = _NO_LAG
             p = truth.p_static_pa[rows[:, None]]
+        p = self.sensed_pressure(p)
         c = np.ascontiguousarray
         out = np.empty(np.shape(bias))
         bk.baro_apply(c(p, dtype=float), *self.kernel_constants(), w, c(sf, dtype=float), c(bias, dtype=float),
@@ -141,9 +184,11 @@ class Baro:
             w = self.lag_weights(float(truth.t_s[1] - truth.t_s[0]))
             idx = np.maximum(errors.rows[:, None] - np.arange(w.shape[0])[None, :], 0)
             # row-wise sum (not a matrix product: BLAS blocking would make one row differ from the batch)
-            h_ind = np.sum(atmosphere.indicated_altitude_m(truth.p_static_pa[idx], self.setting_pa) * w, axis=-1)
+            h_ind = np.sum(atmosphere.indicated_altitude_m(self.sensed_pressure(truth.p_static_pa[idx]),
+                                                           self.setting_pa) * w, axis=-1)
         else:
-            h_ind = atmosphere.indicated_altitude_m(truth.p_static_pa[errors.rows], self.setting_pa)
+            h_ind = atmosphere.indicated_altitude_m(self.sensed_pressure(truth.p_static_pa[errors.rows]),
+                                                    self.setting_pa)
         h_ind = h_ind + (h_ind - self.field_m) * (self.temperature_ratio - 1.0)
         sf = errors.constants["scale_factor"]
         sf = sf[:, None] if errors.batched else sf
@@ -160,14 +205,17 @@ class Baro:
         return self.apply(truth, e if noise else e.zeroed())
 
 
-def temperature_note(isa_dev_k: float, field_m: float, bias_sigma_m: float, correction: str) -> str | None:
+def temperature_note(isa_dev_k: float, field_m: float, bias_sigma_m: float, correction: str,
+                     scale_sigma: float = 0.0) -> str | None:
     """A warning for a profile whose uncorrected baro's temperature error, dT / (T0 + dT - L H_f) of the height above
     the field (field_m: its geometric elevation, m; sensors/atmosphere.py), exceeds 3 sigma of its declared bias at
-    1000 ft above the field: the filter then trusts a wrong height (docs/cat3.md); None when the budget covers it or
-    the indication is corrected."""
+    1000 ft above the field: the filter then trusts a wrong height (docs/cat3.md); None when the budget covers it, the
+    filter's scale-factor state does (3 scale_sigma, BaroConfig.filter_scale_sigma) or the indication is corrected."""
     if correction != "none":
         return None
     t_f = float(atmosphere.air_temperature_k(atmosphere.geopotential_m(field_m), isa_dev_k))
+    if abs(isa_dev_k) / t_f <= 3.0 * scale_sigma:
+        return None
     err_m = abs(isa_dev_k) / t_f * 1000.0 * units.FT
     if err_m <= 3.0 * bias_sigma_m:
         return None
@@ -228,6 +276,6 @@ class PreparedBaro:
         on the same values, without the record (the closed loop's compiled aiding epoch reads only this)."""
         lag, w, kc, out = self.one_constants(truth)
         k = int(self.errors.rows[j])
-        p = truth.p_static_pa[np.maximum(k - lag, 0)][None, :]
+        p = self.baro.sensed_pressure(truth.p_static_pa[np.maximum(k - lag, 0)][None, :])
         bk.baro_apply(p, *kc, w, self.sf, self.bias[:, j:j + 1], self.noise[:, j:j + 1], out)
         return float(out[0, 0])

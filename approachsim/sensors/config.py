@@ -56,6 +56,27 @@ class ImuConfig:
     accel_quant_mps: float = 0.0
 
 
+STATIC_SOURCE_SIGMA_M = 1.5
+"""Static-source (position) error left after the air data's correction, m 1-sigma [U]: standards.md 4.1 has no
+approach-configuration figure (RVSM's 25 m mean / 60 m mean + 3 sigma are cruise ASE); 0.5 % of the impact pressure
+at 140 kt (q_c ~ 3.2 kPa: 16 Pa, 1.3 m at the field) read as the residual of the SSEC (docs/truth.md)."""
+STATIC_SOURCE_TAU_S = 300.0
+"""Its correlation time, s [U]: it follows the airspeed, angle of attack and configuration, which change every few
+minutes on an approach (flaps, gear, the speed schedule)."""
+QNH_SIGMA_HPA = 0.3
+"""The reported QNH's error, hPa 1-sigma [U]: ICAO Annex 3's operationally desirable QNH accuracy, +-0.5 hPa (not
+retrieved into standards.md), read as 2 sigma, with the pressure tendency over a half-hour-old report
+(1 hPa in 3 h: 0.17 hPa) in quadrature: 0.3 hPa, 2.5 m at sea level. The whole-hPa rounding:
+environment.qnh_report."""
+TEMPERATURE_SCALE_SIGMA = {"none": 0.12, "aerodrome": 0.025}
+"""The filter's prior sigma of the day's temperature scale error on the height above the field, by
+temperature_correction [U: the issue's review]: none: dT / T_f, with ISA -30 (0.116 at sea level, 0.121 at
+5434 ft) inside 1 sigma; aerodrome: what a lapse rate departing from the standard leaves (a 10 K surface layer
+over 1000 ft: about 0.035 at the field, falling above)."""
+BIAS_TAU_CONSTANT_S = 36000.0
+"""The bb state's time constant when every slow baro error is a constant (only the QNH error), s."""
+
+
 @dataclass(frozen=True)
 class BaroConfig:
     """[sensors.baro]: seed 001 / 003 error model (m, s, dimensionless)."""
@@ -68,6 +89,34 @@ class BaroConfig:
     lag_s: float = 0.0
     temperature_correction: str = "none"
     """none | aerodrome: the indication corrected with the reported aerodrome temperature (sensors/atmosphere.py)."""
+    static_source_sigma_m: float = STATIC_SOURCE_SIGMA_M
+    static_source_tau_s: float = STATIC_SOURCE_TAU_S
+    qnh_sigma_hpa: float = QNH_SIGMA_HPA
+    """The reported QNH's error, hPa 1-sigma (a per-run constant; the truth converts it at the field's dh/dp)."""
+    temperature_scale_sigma: float | None = None
+    """The filter's prior on the day's temperature scale error of the height above the field (its sb state with
+    the instrument's scale_factor_sigma); None: TEMPERATURE_SCALE_SIGMA[temperature_correction]."""
+
+    @property
+    def filter_scale_sigma(self) -> float:
+        """The filter's sb prior sigma: the day's temperature scale error and the instrument's, in quadrature."""
+        t = TEMPERATURE_SCALE_SIGMA[self.temperature_correction] if self.temperature_scale_sigma is None else \
+            self.temperature_scale_sigma
+        return math.hypot(t, self.scale_factor_sigma)
+
+    def filter_bias(self, height_per_hpa_m: float) -> tuple[float, float]:
+        """(sigma m, tau s) of the filter's one baro-bias state bb for the truth's slow errors: the seed's Gauss-Markov
+        bias, the static-source error and the QNH error (dh/dp at the field height_per_hpa_m, m/hPa; a constant).
+        sigma^2 is the sum of their variances; tau = sigma^2 / sum(sigma_i^2 / tau_i) makes the filter's process noise
+        2 sigma^2 / tau the sum of theirs too: the state has the truth's variance and its rate of change (the
+        increment over the approach), the constant taking no part in the rate."""
+        parts = [(self.bias_sigma_m, self.bias_tau_s), (self.static_source_sigma_m, self.static_source_tau_s)]
+        q = self.qnh_sigma_hpa * height_per_hpa_m
+        var = sum(sg**2 for sg, _ in parts) + q**2
+        rate = sum(sg**2 / tau for sg, tau in parts)
+        if var == 0.0:
+            return 0.0, self.bias_tau_s
+        return math.sqrt(var), (var / rate if rate > 0.0 else BIAS_TAU_CONSTANT_S)
 
 
 @dataclass(frozen=True)
@@ -214,6 +263,13 @@ def parse_sensors(s: Section, site_rad: tuple[float, float] | None = None) -> Se
             noise_sigma_m=b.number("noise_sigma_m", 1.0, lo=0.0, unit="m"),
             lag_s=b.number("lag_s", 0.0, lo=0.0, hi=10.0, unit="s"),
             temperature_correction=b.string("temperature_correction", "none", choices=("none", "aerodrome")),
+            static_source_sigma_m=b.number("static_source_sigma_m", STATIC_SOURCE_SIGMA_M, lo=0.0, hi=100.0,
+                                           unit="m"),
+            static_source_tau_s=b.number("static_source_tau_s", STATIC_SOURCE_TAU_S, lo=0.0, lo_open=True, hi=1e6,
+                                         unit="s"),
+            qnh_sigma_hpa=b.number("qnh_sigma_hPa", QNH_SIGMA_HPA, lo=0.0, hi=10.0, unit="hPa"),
+            temperature_scale_sigma=(b.number("temperature_scale_sigma", lo=0.0, hi=0.5)
+                                     if b.has("temperature_scale_sigma") else None),
         )
     b.done()
 

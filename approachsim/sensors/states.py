@@ -17,7 +17,9 @@ estimate exactly at `row`; None when the suite has no such sensor. Signs follow 
                       receiver's pool entry there: exactly the ambiguity of every channel valid at the record's first
                       sample, where every arc begins; gnss/carrier.py)
     clk  (N, 2)       receiver clock bias (m) and drift (m/s) (clock.py; shared by GPS and pseudolites)
-    bb   (N,)   m     baro Gauss-Markov bias; sb (N,) its scale factor (baro.py, h_B = h + (h - H_f) S + B + v)
+    bb   (N,)   m     baro slow bias (the drawn Gauss-Markov + static-source + QNH errors) + the day's deterministic
+                      offset at the field; sb (N,) the scale factor on the height above the field: the drawn S and
+                      the day's temperature / inversion / geopotential error (`_baro`: the filter's split of them)
     bg   (N, 3) rad/s gyro bias in body axes as the INS sees it over the increment after `row`: turn-on +
                       Gauss-Markov + (S + M) w_ib (scale factor / misalignment at the true rate, imu.py)
     ba   (N, 3) m/s^2 the same for the accelerometers with (S + M) f_body (the filter's ba lumps them, P0)
@@ -36,13 +38,14 @@ here and one entry in `_EXTRACT`.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
 import numpy as np
 
-from approachsim.sensors import base
+from approachsim.sensors import atmosphere, base
 from approachsim.sensors.gnss.constellation import look_angles
 
 Array = np.ndarray
@@ -203,9 +206,35 @@ def _imu(at: _At, kind: str) -> Array | None:
             + np.einsum("nij,j->ni", m, inc))
 
 
-def _baro_sf(at: _At) -> Array | None:
+def _baro(at: _At) -> tuple[Array, Array] | None:
+    """(bb, sb) (N,) of the filter's baro row h_B = h + bb + sb (h - H_ref) + v at the sample's truth row: the
+    deterministic error of the day (temperature, an inversion, a QNH rounding or setting error, geopotential height;
+    sensors/baro.py) split as the filter sees it, b0 = the noise-free indication at the field less its elevation
+    into bb with the drawn slow errors, the rest of the noise-free error at the row (with the drawn scale factor S)
+    into sb. Exact at the row by construction; the split is the line through the field and the row."""
     s = at.sample("baro")
-    return None if s is None else np.asarray(s[0].constants["scale_factor"], dtype=float).reshape(-1)
+    if s is None:
+        return None
+    e, j = s
+    sensor = at.suite.sensors["baro"]
+    baro = getattr(sensor, "sensor", sensor)  # a Faulted baro's own model
+    sf = np.asarray(e.constants["scale_factor"], dtype=float).reshape(-1)
+    k = int(e.rows[j])
+    dt = None
+    if baro.lag_s > 0.0:  # the truth's step; at the closed loop's start (row 1 not flown) the draw's grid gives it
+        t = at.truth.t_s
+        dt = float(t[1] - t[0]) if len(t) > 1 else math.nan
+        if not math.isfinite(dt):
+            dt = float(e.t_s[1] - e.t_s[0]) / float(e.rows[1] - e.rows[0])
+    zero = np.zeros((sf.shape[0], 1))
+    h_s = baro.record(at.truth, e.rows[j:j + 1], e.t_s[j:j + 1], sf, zero, zero, True, dt).h_baro_m[:, 0]
+    h_ind = float(atmosphere.indicated_altitude_m(baro.sensed_pressure(np.asarray(baro.p_field_pa)),
+                                                  baro.setting_pa))
+    b0 = h_ind * baro.temperature_ratio - baro.field_m * (baro.temperature_ratio - 1.0) - baro.field_m
+    h = float(at.truth.h_m[k])
+    above = h - baro.field_m
+    sb = (h_s - h - b0) / above if abs(above) > 1.0 else sf
+    return np.asarray(e.series["bias"], dtype=float)[:, j] + b0, sb
 
 
 def _ptr(at: _At) -> Array | None:
@@ -226,8 +255,8 @@ _EXTRACT: dict[str, Callable[[_At], Array | None]] = {
     "gse": _gse,
     "gmp": _gmp,
     "clk": _clk,
-    "bb": lambda at: _series(at, "baro", "bias"),
-    "sb": _baro_sf,
+    "bb": lambda at: None if (b := _baro(at)) is None else b[0],
+    "sb": lambda at: None if (b := _baro(at)) is None else b[1],
     "bg": lambda at: _imu(at, "gyro"),
     "ba": lambda at: _imu(at, "accel"),
     "pmp": lambda at: _series(at, "pseudolite", "multipath"),

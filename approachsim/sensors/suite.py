@@ -54,23 +54,32 @@ RANGING = ("gnss", "pseudolite")
 
 
 def build_sensors(cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = (),
-                  isa_dev_k: float = 0.0) -> dict[str, Any]:
+                  isa_dev_k: float = 0.0, day: tuple[float, float, float] | None = None) -> dict[str, Any]:
     """Sensor objects by name from a SensorsConfig (runway frame for pseudolites and the field elevation, QNH setting
-    in Pa, the day's ISA deviation in K for the baro's reported aerodrome temperature)."""
+    in Pa, the day's ISA deviation in K for the baro's reported aerodrome temperature; day: (the day's QNH in Pa,
+    the surface layer's departure in K and its depth in m; profile environment), default (qnh_pa, 0, 0))."""
     grade = replace(PRESETS[cfg.imu.grade], gyro_quant_rad=cfg.imu.gyro_quant_rad,
                     accel_quant_mps=cfg.imu.accel_quant_mps)
     out: dict[str, Any] = {"imu": Imu(grade)}
     if cfg.baro is not None:
         b = cfg.baro
-        # the field's geopotential elevation: the altimeter setting's reference (the scale factor's H_ref) and the
-        # temperature correction's H_f
-        field_m, ratio = float(atmosphere.geopotential_m(runway.threshold_h_m)), 1.0
-        if b.temperature_correction == "aerodrome":
+        # the field elevation (geometric, what the altimeter reads there with QNH): the altimeter setting's reference
+        # (the scale factor's H_ref) and the temperature correction's; its geopotential height anchors the real air
+        qnh_day, inv_k, inv_m = (qnh_pa, 0.0, 0.0) if day is None else day
+        field_m = float(runway.threshold_h_m)
+        h_f = float(atmosphere.geopotential_m(field_m))
+        ratio = 1.0
+        if b.temperature_correction == "aerodrome":  # the surface temperature: the layer's departure included
             ratio = atmosphere.temperature_correction_ratio(
-                field_m, atmosphere.reported_aerodrome_temperature_k(field_m, isa_dev_k))
+                field_m, atmosphere.reported_aerodrome_temperature_k(h_f, isa_dev_k - inv_k))
         out["baro"] = Baro(setting_pa=qnh_pa, rate_hz=b.rate_hz, bias_sigma_m=b.bias_sigma_m,
                            bias_tau_s=b.bias_tau_s, scale_factor_sigma=b.scale_factor_sigma,
-                           noise_sigma_m=b.noise_sigma_m, lag_s=b.lag_s, field_m=field_m, temperature_ratio=ratio)
+                           noise_sigma_m=b.noise_sigma_m, lag_s=b.lag_s, field_m=field_m, temperature_ratio=ratio,
+                           static_source_sigma_m=b.static_source_sigma_m, static_source_tau_s=b.static_source_tau_s,
+                           qnh_sigma_m=b.qnh_sigma_hpa * atmosphere.height_per_hpa_m(field_m),
+                           inversion_k=inv_k, inversion_depth_m=inv_m,
+                           p_field_pa=atmosphere.field_pressure_pa(qnh_day, field_m),
+                           t_field_k=float(atmosphere.air_temperature_k(h_f, isa_dev_k)))
     if cfg.radalt is not None:
         r = cfg.radalt
         out["radalt"] = RadarAltimeter(rate_hz=r.rate_hz, max_range_m=r.max_range_m, percent_sigma=r.percent_sigma,
@@ -123,10 +132,11 @@ class SensorSuite:
 
     @classmethod
     def from_config(
-        cls, cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = (), isa_dev_k: float = 0.0
+        cls, cfg: SensorsConfig, runway: Any, qnh_pa: float, faults: Iterable[FaultSpec] = (), isa_dev_k: float = 0.0,
+        day: tuple[float, float, float] | None = None,
     ) -> SensorSuite:
         """Build from a SensorsConfig (build_sensors' arguments)."""
-        sensors = build_sensors(cfg, runway, qnh_pa, faults, isa_dev_k)
+        sensors = build_sensors(cfg, runway, qnh_pa, faults, isa_dev_k, day)
         clock = None
         rate = 1.0
         if cfg.gnss is not None:
@@ -141,7 +151,9 @@ class SensorSuite:
     def from_profile(cls, profile: Any) -> SensorSuite:
         """The suite of a Profile (its sensors, faults, runway, QNH setting and ISA deviation)."""
         env = profile.environment
-        return cls.from_config(profile.sensors, profile.runway.frame, env.setting_pa, profile.faults, env.isa_dev_k)
+        day = (env.qnh_pa, getattr(env, "inversion_k", 0.0), getattr(env, "inversion_depth_m", 0.0))
+        return cls.from_config(profile.sensors, profile.runway.frame, env.setting_pa, profile.faults, env.isa_dev_k,
+                               day)
 
     def without(self, *names: str) -> SensorSuite:
         """The same suite with sensors removed (the clock stays while a ranging sensor remains)."""

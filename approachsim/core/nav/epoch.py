@@ -217,7 +217,8 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, o
 def run_epoch(X: np.ndarray, P: np.ndarray, model: ErrorModel, y: np.ndarray, f_ned: np.ndarray, held: bool,
               dt: float, new: np.ndarray, rows: Rows, obs: Obs, out: Out, scr: Scratch) -> int:
     """The per-run EKF's whole epoch of one run: the error model (core/nav/errormodel.dynamics, core/nav/carrier.
-    dynamics: model's constants) linearized about its INS state y (16,) (packed, core/nav/strapdown.py) with the
+    dynamics: model's constants) linearized about its INS state y (16,) (packed, core/nav/strapdown.py; with a baro
+    scale-factor state at the navigation's height y[2] + X[0, dp_D]) with the
     interval's mean specific force f_ned (3,) NED m/s^2 and the damping loop held or not, discretized over dt (s)
     into scr.phi, scr.qd (scratch scr.F, scr.Qc), the ambiguities of the channels with new[c] != 0 reset to
     rows.amb_prior m^2 (core/nav/carrier.reset_ambiguities; new (k,), empty without carrier phase), then
@@ -225,7 +226,10 @@ def run_epoch(X: np.ndarray, P: np.ndarray, model: ErrorModel, y: np.ndarray, f_
     compiled discretization (X, P untouched: the caller takes the numpy path)."""
     F, Qc, phi, qd = scr.F, scr.Qc, scr.phi, scr.qd
     c_bn = y[6:15].reshape(3, 3)
-    ek.dynamics(model.lay, model.q, model.gse, model.gmp, y[0], y[2], y[3:6], f_ned, c_bn, model.loop, held, F, Qc)
+    h_lin = y[2]
+    if model.lay[ek.L_SB] >= 0:  # the loop's sb coefficient at the navigation's height (nav/errormodel.linear_height)
+        h_lin = y[2] + X[0, model.lay[ek.L_DP] + 2]
+    ek.dynamics(model.lay, model.q, model.gse, model.gmp, y[0], h_lin, y[3:6], f_ned, c_bn, model.loop, held, F, Qc)
     kcar.dynamics(model.lay, model.gio, model.gio_tau, F, Qc)
     if not ek.discretize(F, Qc, dt, phi, qd):
         return -1

@@ -84,24 +84,27 @@ def database_error(along: float, dbp: np.ndarray, db_x: np.ndarray, db_u: np.nda
 
 @njit(cache=True)
 def baro_nu(lay: np.ndarray, x_hat: np.ndarray, h_ins: float, h_baro: float, h_ref: float) -> float:
-    """Innovation of the baro row: nu = (h_ins - h_baro) - (-dp_D - bb - (h_ins - H_ref) sb), m; h_ref = H_ref the
+    """Innovation of the baro row: nu = (h_ins - h_baro) - (-dp_D - bb - (h_ins + dp_D - H_ref) sb), m, at the
+    estimate (h_ins + dp_D: the navigation's height; nav/measurements.baro says why); h_ref = H_ref the
     altimeter-setting reference (the field), m."""
-    pred = -x_hat[lay[ek.L_DP] + 2] - x_hat[lay[ek.L_BB]]
+    dpd = x_hat[lay[ek.L_DP] + 2]
+    pred = -dpd - x_hat[lay[ek.L_BB]]
     if lay[ek.L_SB] >= 0:
-        pred = pred - (h_ins - h_ref) * x_hat[lay[ek.L_SB]]
+        pred = pred - (h_ins + dpd - h_ref) * x_hat[lay[ek.L_SB]]
     return (h_ins - h_baro) - pred
 
 
 @njit(cache=True)
 def baro(lay: np.ndarray, x_hat: np.ndarray, h_ins: float, h_baro: float, sigma: float, h: np.ndarray,
          h_ref: float) -> tuple[float, float]:
-    """Baro altitude difference z = h_ins - h_baro (m): h = -1 at dp_D, -1 at bb, -(h_ins - H_ref) at sb (into
-    h (n,)), H_ref = h_ref the altimeter-setting reference (m); returns (nu, r = sigma^2)."""
+    """Baro altitude difference z = h_ins - h_baro (m): h = -1 at dp_D, -1 at bb, -(h_ins + dp_D_hat - H_ref) at sb
+    (into h (n,); the navigation's height, x_hat's dp_D), H_ref = h_ref the altimeter-setting reference (m);
+    returns (nu, r = sigma^2)."""
     h[:] = 0.0
     h[lay[ek.L_DP] + 2] = -1.0
     h[lay[ek.L_BB]] = -1.0
     if lay[ek.L_SB] >= 0:
-        h[lay[ek.L_SB]] = -(h_ins - h_ref)
+        h[lay[ek.L_SB]] = -(h_ins + x_hat[lay[ek.L_DP] + 2] - h_ref)
     return baro_nu(lay, x_hat, h_ins, h_baro, h_ref), sigma**2
 
 

@@ -27,6 +27,12 @@ pytestmark = pytest.mark.equality  # also run compiled for the generic CPU targe
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
 DEFAULT = load_profile(PROFILES / "default.toml")
+# without issue 39's baro scale-factor state: its column -(h_ins + dp_D_hat - H_ref) moves with the estimate, so
+# x's rounding floor enters S and P of the two paths (S: 2 dh sqrt(P_sb S), Cauchy-Schwarz; P's propagation through
+# the loop and the Joseph update not worked out: up to 245x these floors, gbas). The sb row's kernel against numpy
+# is test_epoch_kernels'; the closed loop's paths with it, test_closed_loop_epoch's.
+DEFAULT = replace(DEFAULT, sensors=replace(DEFAULT.sensors, baro=replace(DEFAULT.sensors.baro,
+                                                                          temperature_scale_sigma=0.0)))
 
 
 def _profile(kind: str):

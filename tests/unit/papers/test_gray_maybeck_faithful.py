@@ -20,11 +20,14 @@ from approachsim.papers import gray_maybeck_sensitivity as gs
 from approachsim.sensors.gnss.receiver import GnssErrorBudget
 from approachsim.sensors.presets import PRESETS
 
-CLOSED_SETTINGS_SHA256 = "46a085cf05939da1498c2f72ce5ef01b558bb00126775ccdbd41abcacb4f97f3"
+CLOSED_SETTINGS_SHA256 = "c2349a8239f77ced345a432c292a9626bc93004062a8b16c9505f797d09b3b96"
 """sha256 of json.dumps(case_settings(case), sort_keys=True, default=str) over the 16 cases, taken on main before
 the faithful variant was added: the closed-loop study (and the regress baselines' profiles) is unchanged. Retaken in
 issue 39 for one added pinned key, sensors.pseudolite.sync_sigma_ns = 0 on the pseudolite cases: the value the
-profiles had before the time-sync error existed (closed_loop_identity: gray-maybeck bit-identical)."""
+profiles had before the time-sync error existed (closed_loop_identity: gray-maybeck bit-identical). Retaken again
+in issue 39 (i39a) for three pinned baro keys, temperature_scale_sigma = static_source_sigma_m = qnh_sigma_hPa = 0:
+the paper's baro, as before the physical baro existed (regress: cases I and VII equal within the cross-machine
+floor)."""
 
 
 def test_closed_case_profiles_are_unchanged() -> None:

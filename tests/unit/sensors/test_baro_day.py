@@ -36,9 +36,11 @@ def _indicated_ft(prof, true_height_above_field_ft: float) -> float:
 @pytest.mark.parametrize("qnh_hpa", [990.0, 1013.25, 1030.0])
 def test_qnh_reads_field_elevation_at_the_field_on_any_day(elevation_ft, isa_dev_c, qnh_hpa):
     prof = _profile(elevation_ft, isa_dev_c, qnh_hpa)
-    field_geopot_ft = float(atm.geopotential_m(prof.runway.elevation_m)) / units.FT
+    # QNH makes the altimeter read the published, geometric elevation at the field (issue 39; before, the
+    # geopotential one: 3.1 ft lower at 8000 ft, so this test fails on the old model there)
+    field_ft = prof.runway.elevation_m / units.FT
     # the ISA pressure and its inverse: floor(16, T0 / L = 44330 m) = 1.6e-10 m = 5e-10 ft; 1e-6 ft is 2000x
-    assert _indicated_ft(prof, 0.0) == pytest.approx(field_geopot_ft, abs=1e-6)
+    assert _indicated_ft(prof, 0.0) == pytest.approx(field_ft, abs=1e-6)
 
 
 def test_the_old_error_at_the_field_is_gone():
@@ -80,7 +82,7 @@ def test_cold_temperature_error_matches_the_icao_correction(t0_c):
 def test_cold_error_grows_with_height_and_vanishes_at_the_field():
     prof = _profile(5000.0, -25.0)
     errs = [_indicated_ft(prof, h) - h for h in (0.0, 250.0, 1000.0)]
-    base = float(atm.geopotential_m(prof.runway.elevation_m)) / units.FT
+    base = prof.runway.elevation_m / units.FT  # QNH reads the geometric field elevation at the field
     assert errs[0] - base == pytest.approx(0.0, abs=1e-6)  # as above: 2000x floor(16, T0 / L)
     assert 0.0 < errs[1] - base < errs[2] - base
 
@@ -147,7 +149,9 @@ def _baro_error_ft(elevation_ft: float, isa_dev_c: float, correction: str) -> tu
     s = baro.measure(truth, np.random.default_rng(0), noise=False)
     h = atm.geopotential_m(truth.h_m[baro.draw(truth.t_s, np.random.default_rng(0)).rows])
     h_f = float(atm.geopotential_m(prof.runway.elevation_m))
-    return (s.h_baro_m - h) / units.FT, (h - h_f) / units.FT
+    # what an exact altimeter reads: the geometric field elevation (QNH) + the geopotential height above the field
+    exact = prof.runway.elevation_m + (h - h_f)
+    return (s.h_baro_m - exact) / units.FT, (h - h_f) / units.FT
 
 
 @pytest.mark.parametrize("elevation_ft", [0.0, 5434.0, 8000.0])
@@ -162,8 +166,10 @@ def test_aerodrome_temperature_correction_leaves_only_the_metar_rounding(elevati
     assert above.max() > 3000.0 and above.min() < 60.0
     # 1e-6 ft slack: 2000x the heights' floor(16, T0 / L) = 5e-10 ft
     assert np.all(np.abs(err) <= 0.5 / t_std * above + 1e-6)
-    # the uncorrected error: -dT / (T_std + dT) of the height above the field (exact in this troposphere)
-    np.testing.assert_allclose(raw, -isa_dev_c / (t_std + isa_dev_c) * above, rtol=1e-6, atol=1e-6)  # as above
+    # the uncorrected error: (T_std(z_f) / T_f - 1) of the height above the field, T_f = T_std(H_f) + dT (exact in
+    # this troposphere; the altimeter's ISA starts at the geometric elevation z_f, the air at its geopotential H_f)
+    t_ind = atm.T0_K - atm.LAPSE_K_PER_M * elevation_ft * units.FT
+    np.testing.assert_allclose(raw, (t_ind / (t_std + isa_dev_c) - 1.0) * above, rtol=1e-6, atol=1e-6)  # as above
     if isa_dev_c != 0.0:
         assert np.max(np.abs(raw)) > 30.0 * np.max(np.abs(err))
 

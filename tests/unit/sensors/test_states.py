@@ -52,14 +52,20 @@ def test_mapped_states_reproduce_the_realized_measurement_errors():
     # 1e-9 and 1e-12 are ~100x those
     np.testing.assert_allclose(st.clk[:, 0], g.clock_bias_m[:, 0], atol=1e-9)
     np.testing.assert_allclose(st.clk[:, 1], g.clock_drift_mps[:, 0], atol=1e-12)
-    # baro: h_B - h_ind = B + S (h_ind - H_f) + v, H_f the setting's reference (the field)
+    # baro: the filter's row h_B - h = bb + sb (h - H_ref) + v at the true height h of the sample's row, H_ref the
+    # field (sensors/states.py _baro: the day's deterministic error split into bb and sb)
     b = errors.sensors["baro"]
-    h_ind = exact["baro"].h_baro_m[:, 0]
+    h = truth.h_m[b.rows[0]]
     h_f = suite.sensors["baro"].field_m
     # heights ~ 100 m from the ISA inverse (~8 roundings of T0 / L = 44.3 km: floor(8, 44330) = 7.9e-11 m); 1e-9 m
     # is 13x that
-    np.testing.assert_allclose(rec["baro"].h_baro_m[:, 0] - h_ind,
-                               st.bb + st.sb * (h_ind - h_f) + b.series["noise"][:, 0], atol=1e-9)
+    np.testing.assert_allclose(rec["baro"].h_baro_m[:, 0] - h, st.bb + st.sb * (h - h_f) + b.series["noise"][:, 0],
+                               atol=1e-9)
+    # on this standard day the split holds the drawn errors: the noise-free error at the field is 0 (QNH reads the
+    # field elevation, 1e-9 m as above), so bb is the drawn slow bias, and sb the drawn S up to the geopotential
+    # scale 2 z / r0 (< 1e-4 here)
+    np.testing.assert_allclose(st.bb, b.series["bias"][:, 0], atol=1e-9)
+    np.testing.assert_allclose(st.sb, b.constants["scale_factor"], atol=1e-4)
     assert np.all(np.abs(st.sb) > 0.0)
     # IMU, zero noise: the first increment's error is the body-axis bias the filter's bg / ba states mean
     dth_t, dv_t, dt = true_increments(truth, np.array([1]))
