@@ -32,6 +32,21 @@ ambiguity and the position integrate), while over a few epochs it is conservativ
 carrier, 40 open-loop runs, 200 s): a 0.5 s multipath correlation time (inflation 1.3 instead of 10) leaves the
 filter's vertical sigma at the end at 0.2223 m against 0.2224 m, the true RMS 0.243 against 0.244 m: the carrier's
 fast error does not limit the position, so the simpler, conservative form is kept.
+
+The slow channel state's correlation time (`slow_tau_s`). The sensor draws the slow error as a sum of independent
+Gauss-Markov processes (stand-alone: clock/ephemeris 2 h, iono 30 min, tropo 1 h; GBAS: ground 300 s, iono, tropo;
+a service: its range, iono and tropo terms); the filter carries their sum as one state. Its variance is their summed
+variance; its time constant is the variance-weighted harmonic mean of theirs over a reference sky, so that its drift
+rate 2 sigma^2 / tau is theirs (over an approach of a few minutes, much shorter than every tau, that rate, not the
+shape of the autocorrelation, is what the range error does). The shortest of the three, used before, made the
+default profile's filter expect the clock/ephemeris error (2.4 m of its 2.5 m at 30 deg) to drift four times as fast
+as it does (1800 s for 5838 s): it over-claimed the horizontal velocity error (run-averaged e^2/P 0.82 / 0.63, N / E).
+Not one state per process: the three enter every pseudorange with the same unit coefficient, so the filter cannot
+separate them, and 2 x 24 more channel states would triple the channel block's cost for the one combination it
+sees. Not a time constant per channel: the compiled epochs share one Phi and one Qd factor per epoch across the
+channels; over the 5-90 deg sky the drift-matched tau of the default budget spans 4445-6840 s, and a truth with all
+three processes at the filter's one tau changed the default profile's horizontal velocity e^2/P by 0.05 at most.
+
 """
 
 from __future__ import annotations
@@ -45,6 +60,9 @@ from approachsim.nav import errormodel as em
 from approachsim.nav.config import NavConfig
 from approachsim.sensors.config import SensorsConfig
 from approachsim.sensors.gnss.clock import ClockModel
+from approachsim.sensors.gnss.elevation import iono_obliquity, tropo_mapping
+from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
+from approachsim.sensors.gnss.receiver import GnssErrorBudget
 from approachsim.sensors.presets import PRESETS
 
 Array = np.ndarray
@@ -52,8 +70,45 @@ Array = np.ndarray
 _CACHE_MAX = 512
 """Elevation vectors kept by `NoiseModel.noise` (one sky's epochs x runs at most)."""
 
+SKY_SIN_EL = np.linspace(np.sin(np.radians(5.0)), 1.0, 16)
+"""The reference sky of `slow_tau_s`: 16 elevations equally spaced in sin(el) from 5 deg to the zenith (equal solid
+angle above the default 5 deg mask)."""
+
 PSEUDOLITE_CLOCK = ("ocxo", 30.0, 0.03)
 """An unsynchronized pseudolite's transmitter clock: oscillator, bias and drift 1-sigma at the start (m, m/s)."""
+
+
+def slow_terms(bud: GnssErrorBudget, el_rad: Array, ionosphere: bool = True) -> list[tuple[Array, float]]:
+    """The slow range-error processes the sensor draws at elevations el_rad (k,), rad: [(1-sigma (k,) m, tau s)].
+    Stand-alone: clock/ephemeris, F(el) I_z, M(el) T_z; GBAS: ground, iono, tropo at gbas.REFERENCE_GEOMETRY; a
+    service: its broadcast range, iono and tropo terms (service.terms_m). ionosphere=False leaves the iono out
+    (carrier phase, where it has its own state)."""
+    if bud.gbas is not None:
+        s = bud.gbas.scales(el_rad, *REFERENCE_GEOMETRY)
+        out = [(s["ground"], bud.gbas.ground_tau_s), (s["iono"], bud.iono_tau_s), (s["tropo"], bud.tropo_tau_s)]
+    elif bud.service is not None:
+        t = bud.service.terms_m(el_rad)
+        out = [(t[..., 0], bud.service.range_tau_s), (t[..., 1], bud.iono_tau_s), (t[..., 2], bud.tropo_tau_s)]
+    else:
+        out = [(np.full(np.shape(el_rad), bud.clock_ephemeris_m), bud.clock_ephemeris_tau_s),
+               (bud.iono_zenith_m * iono_obliquity(el_rad), bud.iono_tau_s),
+               (bud.tropo_zenith_m * tropo_mapping(el_rad), bud.tropo_tau_s)]
+    return out if ionosphere else [out[0], out[2]]
+
+
+def slow_tau_s(bud: GnssErrorBudget, ionosphere: bool = True) -> float:
+    """The filter's one slow channel state's correlation time, s: the drift-matched (variance-weighted harmonic)
+    combination of the processes it lumps over the reference sky SKY_SIN_EL,
+
+        1 / tau = sum_i sum_k sigma_ik^2 / tau_i  /  sum_i sum_k sigma_ik^2   (i process, k elevation),
+
+    so that with the summed variance the state has both the sensor's stationary variance and its mean drift rate
+    E[(x(t + dt) - x(t))^2] = 2 dt sum sigma_i^2 / tau_i (dt << tau): the quantity that sets what a slow range
+    error does over an approach (module docstring: why one state, not one per process or a tau per channel)."""
+    terms = slow_terms(bud, np.arcsin(SKY_SIN_EL), ionosphere)
+    var = sum(float(np.sum(np.square(s))) for s, _ in terms)
+    rate = sum(float(np.sum(np.square(s))) / tau for s, tau in terms)
+    return var / rate if rate > 0.0 else max(tau for _, tau in terms)
 
 
 @dataclass(frozen=True)
@@ -148,9 +203,9 @@ class NoiseModel:
             el = np.maximum(el, np.radians(2.0))
             # per channel at its elevation (do253: the sensor's sigma_mp), one multipath value under nrc1995
             gse, gmp = bud.channel_sigmas_m(el)
-            kw.update(gse_sigma_m=gse, gse_tau_s=bud.slow_tau_s, gmp_sigma_m=gmp, gmp_tau_s=bud.multipath_tau_s)
+            kw.update(gse_sigma_m=gse, gse_tau_s=slow_tau_s(bud), gmp_sigma_m=gmp, gmp_tau_s=bud.multipath_tau_s)
             if self.carrier:
-                kw.update(self._carrier_kw(el), gse_tau_s=bud.slow_tau_no_iono_s, gio_tau_s=bud.iono_tau_s)
+                kw.update(self._carrier_kw(el), gse_tau_s=slow_tau_s(bud, ionosphere=False), gio_tau_s=bud.iono_tau_s)
         if self.sensors.pseudolite is not None:
             p = self.sensors.pseudolite
             kw.update(pmp_sigma_m=p.multipath_m, pmp_tau_s=p.multipath_tau_s)
