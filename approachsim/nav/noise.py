@@ -47,6 +47,17 @@ sees. Not a time constant per channel: the compiled epochs share one Phi and one
 channels; over the 5-90 deg sky the drift-matched tau of the default budget spans 4445-6840 s, and a truth with all
 three processes at the filter's one tau changed the default profile's horizontal velocity e^2/P by 0.05 at most.
 
+Gyro scale-factor and misalignment errors (`gyro_axis_q`): the IMU's (S + M) w_ib (random constants per run, the
+grade's sigmas) is process noise, not 9 filter states. In light turbulence it is what turns the drift-matched
+filter's along-track velocity over-confident (default profile: east velocity e^2/P 1.27 with them in the truth,
+0.99 without; 0.99 in calm air with them): the slow pitch and yaw excursions (periods 20-100 s) rotate the body
+through a few degrees and back, and 100 ppm of that is a few microradians of tilt the aiding removes only slowly. A
+white rate noise with the body rates' spectrum in that band (BODY_RATE_PSD, measured on the flown airframe) gives
+q_k = sf^2 S_k + mis^2 (S_i + S_j) per body axis; states would need the body rate in the compiled error dynamics
+(every epoch kernel's inputs), 9 more states in every covariance, and would estimate quantities that, at 100 ppm
+and 0.02 mrad, the approach's few degrees of rotation cannot observe. The accelerometer's scale factor and
+misalignment are in the ba prior (under 1 g they look like a bias); with both the gyro's and the accelerometer's
+removed from the truth the default profile's east velocity e^2/P is 0.99, as with the gyro's alone.
 """
 
 from __future__ import annotations
@@ -73,6 +84,16 @@ _CACHE_MAX = 512
 SKY_SIN_EL = np.linspace(np.sin(np.radians(5.0)), 1.0, 16)
 """The reference sky of `slow_tau_s`: 16 elevations equally spaced in sin(el) from 5 deg to the zenith (equal solid
 angle above the default 5 deg mask)."""
+
+BODY_RATE_PSD: dict[str, tuple[float, float, float]] = {
+    "none": (0.0, 0.0, 0.0),
+    "light": (2.37e-6, 1.43e-4, 8.07e-5),
+    "moderate": (5.83e-6, 3.14e-4, 1.76e-4),
+    "severe": (1.31e-5, 7.07e-4, 3.96e-4),
+}
+"""Two-sided PSD of the airframe's body rates (roll, pitch, yaw), rad^2/s^2/Hz, over 0.01-0.05 Hz, by turbulence
+level: tools/body_rate_psd.py on the default profile's 737 (seeds 1-3); severe, beyond the 737's approach limit, is
+moderate x (75 / 50)^2, the Dryden gust variance ratio (engineering choice)."""
 
 PSEUDOLITE_CLOCK = ("ocxo", 30.0, 0.03)
 """An unsynchronized pseudolite's transmitter clock: oscillator, bias and drift 1-sigma at the start (m, m/s)."""
@@ -120,6 +141,8 @@ class NoiseModel:
     layout: em.StateLayout
     baro_ref_m: float = 0.0
     """The baro scale factor's reference H_ref: the altimeter-setting reference (the field's height), m."""
+    turbulence: str = "none"
+    """The environment's turbulence level (BODY_RATE_PSD): the body rates the gyro axis errors act on."""
     _cache: dict = field(default_factory=dict, init=False, compare=False, repr=False)
 
     def clock(self) -> ClockModel:
@@ -217,6 +240,7 @@ class NoiseModel:
         if self.sensors.radalt is not None:
             kw.update(ram_sigma_m=self.sensors.radalt.markov_sigma_m, ram_tau_s=self.sensors.radalt.markov_tau_s,
                       tdb_correlation_m=self.nav.terrain_database.correlation_m)
+        qx, qy, qz = self.gyro_axis_q()
         q1 = self.clock().q(1.0)  # Q(1 s) = [[S_f + S_g / 3, S_g / 2], [., S_g]]
         return em.ErrorNoise(
             gyro_arw_rad_sqrts=g.gyro_arw_rad_sqrts,
@@ -229,8 +253,19 @@ class NoiseModel:
             baro_rate_hz=b.rate_hz if b is not None else 10.0,
             clock_sf=float(q1[0, 0] - q1[1, 1] / 3.0),
             clock_sg=float(q1[1, 1]),
+            gyro_axis_q_x=qx, gyro_axis_q_y=qy, gyro_axis_q_z=qz,
             **kw,
         )
+
+    def gyro_axis_q(self) -> tuple[float, float, float]:
+        """White rate noise (rad^2/s) on body axes x, y, z for the gyro scale-factor and misalignment errors the
+        filter has no states for: the error rate (S + M) w_ib, S and M random constants of 1-sigma gyro_sf and
+        gyro_misalign_rad (the grade), at the body-rate spectrum S_k of the turbulence level (BODY_RATE_PSD, the
+        0.01-0.05 Hz band), q_k = sf^2 S_k + mis^2 (S_i + S_j). Why process noise, not 9 states: module docstring."""
+        g = PRESETS[self.sensors.imu.grade]
+        s = np.asarray(BODY_RATE_PSD[self.turbulence])
+        q = g.gyro_sf**2 * s + g.gyro_misalign_rad**2 * (s.sum() - s)
+        return float(q[0]), float(q[1]), float(q[2])
 
     def channel_qd(self, qd: Array, el_rad: Array, dt_s: float) -> Array:
         """Qd with the GPS channel states' (gse, gmp: decoupled first-order Markov) entries at elevations el_rad
