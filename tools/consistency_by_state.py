@@ -1,23 +1,32 @@
-"""Filter consistency state by state on a flown approach: which of the 9 navigation errors the filter over- or
-under-claims (the diagnosis behind tests/integration/test_nav_consistency_jsbsim.py's NEES finding).
+"""Filter consistency state by state on a flown approach: which navigation errors the filter over- or under-claims,
+and the consistency suite of issue 39 (item 5).
 
     python tools/consistency_by_state.py PROFILE [--runs 60] [--seed 1] [--set KEY=VALUE ...]
-        [--slow-tau-s TAU]
+        [--slow-tau-s TAU] [--ideal-imu-axes gyro|accel|gyro,accel] [--filter-turbulence LEVEL]
+    python tools/consistency_by_state.py --suite [--runs 60] [--seeds 1 2] [--workers 1] [--out docs/consistency.md]
 
 The profile is flown once on truth; RUNS seeded sensor realizations and open-loop navigation runs (the shared
 covariance, as campaigns run) follow on that truth. Printed per state (dp N E D m, dv N E D m/s, psi N E D rad; clk
 the receiver clock bias, m): the run-averaged e^2 / P over the approach after its first quarter (1 for a consistent
-filter; below 1 the filter over-claims), the fraction of epochs whose run average is inside the two-sided 95 %
-chi2(RUNS)/RUNS bounds, and the filter's mean sigma. --set changes a profile key for this run (dotted path, a TOML
-value: --set sensors.gnss.multipath_model='"nrc1995"'). --slow-tau-s sets the truth's clock/ephemeris, iono and tropo
-time constants to TAU (the filter keeps its own: it models the three as one Gauss-Markov state at the shortest,
-nav/noise.py): with TAU = 1800 the truth drifts as fast as the filter assumes.
+filter; below 1 the filter over-claims), the fractions of epochs whose run average is inside / below / above the
+two-sided 95 % chi2(RUNS)/RUNS bounds, the filter's mean sigma, and the run-mean error over the sigma (RMS over the
+epochs: about 1 / sqrt(RUNS) when nothing is common to the runs). --set changes a profile key for this run (dotted
+path, a TOML value: --set sensors.gnss.multipath_model='"nrc1995"'). Diagnostics on the truth: --slow-tau-s sets
+its clock/ephemeris, iono and tropo time constants to TAU; --ideal-imu-axes removes its gyro and/or accelerometer
+scale-factor and misalignment errors. --filter-turbulence builds the filter's gyro scale-factor / misalignment
+process noise at another turbulence level (none: the time-constant-only filter, the control of the suite).
+
+--suite runs the cases of SUITE (the default profile, the CAT III candidate, ISA -30 and +30 uncorrected and a
+5434 ft field, the last three with the baro scale-factor state) at each seed, the profile's filter and the control
+on the same records, and writes the table with the acceptance of issue 39: every state's e^2/P in [0.8, 1.25],
+inside its band at >= 90 % of the epochs and above it at <= 5 %.
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 import os
 import tomllib
 from pathlib import Path
@@ -41,63 +50,200 @@ def _set(data: dict, item: str) -> None:
     node[last] = tomllib.loads(f"v = {value}")["v"]
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("profile", type=Path)
-    ap.add_argument("--runs", type=int, default=60)
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    ap.add_argument("--slow-tau-s", type=float, default=None)
-    a = ap.parse_args()
-
+def flown(profile: Path, runs: int, seed: int, sets: tuple[str, ...] = (), slow_tau_s: float | None = None,
+          ideal_imu_axes: str = "") -> tuple:
+    """(profile, truth, records, start states, runs): the profile (with `sets`) flown once (seed, run 0) and RUNS sensor
+    realizations on its truth (the truth options: module docstring)."""
     from approachsim.flight.run import Approach
-    from approachsim.nav.system import NavSystem
     from approachsim.profile import parse_profile
-    from approachsim.seeding import stream
     from approachsim.sensors.gnss import receiver
     from approachsim.sensors.states import measure_with_states
     from approachsim.sensors.suite import SensorSuite
 
-    data = tomllib.loads(a.profile.read_text(encoding="utf-8"))
-    for item in a.set:
+    data = tomllib.loads(profile.read_text(encoding="utf-8"))
+    for item in sets:
         _set(data, item)
-    prof = parse_profile(data, source=a.profile.resolve())
-    truth = Approach(prof).fly(seed=a.seed, run=0).truth
+    prof = parse_profile(data, source=profile.resolve())
+    truth = Approach(prof).fly(seed=seed, run=0).truth
     suite = SensorSuite.from_profile(prof)
-    if a.slow_tau_s is not None:  # the truth's slow range errors only; the filter is built from the profile below
+    if slow_tau_s is not None:  # the truth's slow range errors only; the filter is built from the profile
         gnss = suite.sensors["gnss"]
         if not isinstance(gnss, receiver.GnssReceiver):
             raise SystemExit("--slow-tau-s needs a plain GNSS receiver (no fault on it)")
-        budget = dataclasses.replace(gnss.budget, clock_ephemeris_tau_s=a.slow_tau_s, iono_tau_s=a.slow_tau_s,
-                                     tropo_tau_s=a.slow_tau_s)
-        sensors = dict(suite.sensors) | {"gnss": dataclasses.replace(gnss, budget=budget)}
-        suite = dataclasses.replace(suite, sensors=MappingProxyType(sensors))
-    recs, st = measure_with_states(suite, truth, seed=a.seed, runs=list(range(a.runs)))
+        budget = dataclasses.replace(gnss.budget, clock_ephemeris_tau_s=slow_tau_s, iono_tau_s=slow_tau_s,
+                                     tropo_tau_s=slow_tau_s)
+        suite = dataclasses.replace(suite, sensors=MappingProxyType(dict(suite.sensors) | {
+            "gnss": dataclasses.replace(gnss, budget=budget)}))
+    if ideal_imu_axes:  # the truth's IMU only; the filter is built from the profile's grade
+        imu = suite.sensors["imu"]
+        zero = {"gyro": ("gyro_sf", "gyro_misalign_rad"), "accel": ("accel_sf", "accel_misalign_rad")}
+        grade = dataclasses.replace(imu.grade, **{k: 0.0 for s in ideal_imu_axes.split(",") for k in zero[s]})
+        suite = dataclasses.replace(suite, sensors=MappingProxyType(dict(suite.sensors) | {
+            "imu": dataclasses.replace(imu, grade=grade)}))
+    recs, st = measure_with_states(suite, truth, seed=seed, runs=list(range(runs)))
+    return prof, truth, recs, st, runs
+
+
+def navigate(fl: tuple, seed: int, filter_turbulence: str | None = None
+             ) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
+    """Open-loop navigation runs (shared covariance) on flown(...)'s records: (e (runs, epochs, s) the true errors,
+    P (runs, epochs, s) the filter's variances, the state names) of the 9 navigation errors and, with GNSS, the
+    receiver clock bias (m). filter_turbulence: the filter's gyro axis noise at that level (None: the profile's)."""
+    from approachsim.nav.system import NavSystem
+    from approachsim.seeding import stream
+
+    prof, truth, recs, st, runs = fl
     nav = NavSystem.from_profile(prof)
-    rs = nav.run(truth, recs, [stream(a.seed, r, "nav") for r in range(a.runs)], shared_covariance=True, states=st)
+    if filter_turbulence is not None:
+        nav = dataclasses.replace(nav, turbulence=filter_turbulence)
+    rs = nav.run(truth, recs, [stream(seed, r, "nav") for r in range(runs)], shared_covariance=True, states=st)
     e = np.stack([r.true_error_nav for r in rs])
     d = np.diagonal(np.stack([r.P_nav for r in rs]), axis1=2, axis2=3)
     lay = rs[0].layout
     if lay.has("clk") and "gnss" in recs:  # the receiver clock bias: the filter's clk state against the truth's
         g = recs["gnss"]
-        t_g, cb = np.asarray(g.t_s), np.asarray(g.clock_bias_m).reshape(a.runs, -1)
+        t_g, cb = np.asarray(g.t_s), np.asarray(g.clock_bias_m).reshape(runs, -1)
         ic = lay.i("clk")
         idx = [np.clip(np.searchsorted(t_g, r.t_epoch_s + 1e-9, side="right") - 1, 0, t_g.size - 1) for r in rs]
         ec = np.stack([r.x[:, ic] - cb[i, j] for i, (r, j) in enumerate(zip(rs, idx, strict=True))])
-        e = np.concatenate([e, ec[..., None]], axis=-1)
-        d = np.concatenate([d, np.stack([r.P_diag[:, ic] for r in rs])[..., None]], axis=-1)
+        return (np.concatenate([e, ec[..., None]], axis=-1),
+                np.concatenate([d, np.stack([r.P_diag[:, ic] for r in rs])[..., None]], axis=-1), STATES + ("clk",))
+    return e, d, STATES
+
+
+def summary(e: np.ndarray, d: np.ndarray) -> dict[str, np.ndarray]:
+    """Per state over the approach after its first quarter: the run-averaged e^2 / P (mean over epochs), the
+    fractions of epochs whose run average is inside / below / above the two-sided 95 % chi2(R)/R bounds (R runs),
+    the filter's mean sigma and the run-mean error over the sigma's RMS (a deterministic error common to the runs
+    on their one truth)."""
+    runs = e.shape[0]
     z = (e**2 / d).mean(axis=0)
     later = slice(z.shape[0] // 4, z.shape[0])
-    lo, hi = chi2.ppf([0.025, 0.975], a.runs) / a.runs
-    print(f"{a.profile}: {a.runs} runs, {z.shape[0]} epochs (from epoch {later.start}); 95 % bounds [{lo:.2f}, "
-          f"{hi:.2f}]" + "".join(f"; {s}" for s in a.set)
-          + (f"; truth slow taus {a.slow_tau_s:g} s" if a.slow_tau_s is not None else ""))
-    print(f"  {'state':6s} {'e^2/P':>6s} {'inside':>7s} {'below':>6s} {'above':>6s} {'sigma':>10s}")
-    for c, name in enumerate(STATES + ("clk",) if z.shape[1] > len(STATES) else STATES):
-        zc = z[later, c]
-        print(f"  {name:6s} {zc.mean():6.2f} {np.mean((zc >= lo) & (zc <= hi)):7.2f} {np.mean(zc < lo):6.2f} "
-              f"{np.mean(zc > hi):6.2f} {np.sqrt(d[:, later, c]).mean():10.3g}")
+    lo, hi = chi2.ppf([0.025, 0.975], runs) / runs
+    zc = z[later]
+    sig = np.sqrt(d[:, later])
+    return {"ratio": zc.mean(axis=0), "inside": np.mean((zc >= lo) & (zc <= hi), axis=0),
+            "below": np.mean(zc < lo, axis=0), "above": np.mean(zc > hi, axis=0), "sigma": sig.mean(axis=(0, 1)),
+            "common": np.sqrt(np.mean((e[:, later].mean(axis=0) / sig.mean(axis=0)) ** 2, axis=0)),
+            "bounds": np.array([lo, hi]), "epochs": np.array([z.shape[0], later.start])}
 
+
+ROOT = Path(__file__).resolve().parents[1]
+BARO_SF = "sensors.baro.scale_factor_sigma=0.12"
+"""The baro scale-factor state (opt-in today), sigma 0.12: issue 39's uncorrected figure."""
+SUITE: dict[str, tuple[str, tuple[str, ...]]] = {
+    "default": ("profiles/default.toml", ()),
+    "CAT III candidate": ("profiles/gbas-cat3-candidate.toml", ()),
+    "ISA -30, uncorrected": ("profiles/default.toml", ("environment.isa_dev_C=-30.0", BARO_SF)),
+    "ISA +30, uncorrected": ("profiles/default.toml", ("environment.isa_dev_C=30.0", BARO_SF)),
+    "5434 ft field": ("profiles/default.toml", ("runway.elevation_ft=5434.0", BARO_SF)),
+}
+"""The suite's cases: (profile, --set items)."""
+CONTROL = "none"
+"""The control filter: the drift-matched slow range-error tau alone, no gyro scale-factor / misalignment noise."""
+RATIO_BAND = (0.8, 1.25)
+INSIDE_MIN = 0.9
+ABOVE_MAX = 0.05
+
+
+def suite_case(case: str, seed: int, runs: int) -> dict[str, dict[str, list[float]]]:
+    """One case at one seed: {"filter": summary, "control": summary} (arrays as lists), the two filters on the same
+    flight and sensor records."""
+    path, sets = SUITE[case]
+    fl = flown(ROOT / path, runs, seed, sets)
+    out = {}
+    for name, turb in (("filter", None), ("control", CONTROL)):
+        e, d, names = navigate(fl, seed, turb)
+        out[name] = {k: np.asarray(v).tolist() for k, v in summary(e, d).items()} | {"names": list(names)}
+    return out
+
+
+def passes(sm: dict, c: int) -> bool:
+    """Issue 39's acceptance for state c of a summary."""
+    return (RATIO_BAND[0] <= sm["ratio"][c] <= RATIO_BAND[1] and sm["inside"][c] >= INSIDE_MIN
+            and sm["above"][c] <= ABOVE_MAX)
+
+
+def suite_table(results: dict[tuple[str, int], dict], runs: int, seeds: list[int]) -> str:
+    """The markdown table of the suite (one block per case: per state, per seed, filter and control)."""
+    lines = []
+    for case, (path, sets) in SUITE.items():
+        res = [results[(case, s)] for s in seeds]
+        names = res[0]["filter"]["names"]
+        lo, hi = res[0]["filter"]["bounds"]
+        lines += [f"### {case}", "", f"`{path}`" + "".join(f" `--set {x}`" for x in sets)
+                  + f"; {runs} runs per seed, 95 % band of the run average [{lo:.2f}, {hi:.2f}]; e^2/P, inside, "
+                  "above per seed (s1 / s2 ...); pass: e^2/P in [0.8, 1.25], inside >= 0.90, above <= 0.05 at every "
+                  "seed.", "",
+                  "| state | filter e^2/P | inside | above | pass | control e^2/P | inside | above | pass |",
+                  "|---|---|---|---|---|---|---|---|---|"]
+        for c, n in enumerate(names):
+            row = [n]
+            for f in ("filter", "control"):
+                row += [" / ".join(f"{r[f][k][c]:.2f}" for r in res) for k in ("ratio", "inside", "above")]
+                row.append("yes" if all(passes(r[f], c) for r in res) else "**no**")
+            lines.append("| " + " | ".join(row) + " |")
+        ok = {f: all(passes(r[f], c) for r in res for c in range(len(names))) for f in ("filter", "control")}
+        lines += ["", f"Every state passes: filter {'yes' if ok['filter'] else '**no**'}, control "
+                  f"{'yes' if ok['control'] else 'no'}.", ""]
+    return "\n".join(lines)
+
+
+def run_suite(runs: int, seeds: list[int], workers: int, out: Path | None) -> None:
+    """Every case of SUITE at every seed (in `workers` processes); the table printed and written to `out`."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    jobs = [(c, s) for c in SUITE for s in seeds]
+    with ProcessPoolExecutor(max_workers=workers) as ex:
+        futs = {j: ex.submit(suite_case, j[0], j[1], runs) for j in jobs}
+        results = {j: f.result() for j, f in futs.items()}
+    table = suite_table(results, runs, seeds)
+    print(table)
+    if out is not None:
+        text = out.read_text(encoding="utf-8") if out.exists() else ""
+        head = text.split(TABLE_MARK)[0] if TABLE_MARK in text else text
+        out.write_text(head + TABLE_MARK + "\n\n" + table, encoding="utf-8")
+        (out.with_suffix(".json")).write_text(json.dumps({f"{c} / seed {s}": r for (c, s), r in results.items()},
+                                                         indent=1), encoding="utf-8")
+
+
+TABLE_MARK = "<!-- consistency suite table: tools/consistency_by_state.py --suite writes below -->"
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("profile", type=Path, nargs="?")
+    ap.add_argument("--suite", action="store_true")
+    ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--out", type=Path, default=None)
+    ap.add_argument("--runs", type=int, default=60)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    ap.add_argument("--slow-tau-s", type=float, default=None)
+    ap.add_argument("--ideal-imu-axes", default="", choices=("", "gyro", "accel", "gyro,accel"),
+                    help="the truth's IMU without scale-factor and misalignment errors (gyro, accel or both)")
+    ap.add_argument("--filter-turbulence", default=None, choices=("none", "light", "moderate", "severe"),
+                    help="the filter's gyro axis process noise at this turbulence level (default: the profile's)")
+    a = ap.parse_args()
+    if a.suite:
+        run_suite(a.runs, a.seeds, a.workers, a.out)
+        return
+    if a.profile is None:
+        ap.error("PROFILE is required without --suite")
+    fl = flown(a.profile, a.runs, a.seed, tuple(a.set), a.slow_tau_s, a.ideal_imu_axes)
+    e, d, names = navigate(fl, a.seed, a.filter_turbulence)
+    s = summary(e, d)
+    lo, hi = s["bounds"]
+    print(f"{a.profile}: {a.runs} runs, {s['epochs'][0]} epochs (from epoch {s['epochs'][1]}); 95 % bounds "
+          f"[{lo:.2f}, {hi:.2f}]" + "".join(f"; {x}" for x in a.set)
+          + (f"; truth slow taus {a.slow_tau_s:g} s" if a.slow_tau_s is not None else "")
+          + (f"; truth {a.ideal_imu_axes} without scale factor / misalignment" if a.ideal_imu_axes else "")
+          + (f"; filter turbulence {a.filter_turbulence}" if a.filter_turbulence else ""))
+    print(f"  {'state':6s} {'e^2/P':>6s} {'inside':>7s} {'below':>6s} {'above':>6s} {'sigma':>10s} {'common':>7s}")
+    for c, name in enumerate(names):
+        print(f"  {name:6s} {s['ratio'][c]:6.2f} {s['inside'][c]:7.2f} {s['below'][c]:6.2f} {s['above'][c]:6.2f} "
+              f"{s['sigma'][c]:10.3g} {s['common'][c]:7.2f}")
 
 if __name__ == "__main__":
     main()

@@ -195,6 +195,12 @@ class ErrorNoise:
     psy_sigma_m: float = 0.0
     psy_tau_s: float = 600.0
     """Synchronized pseudolites' time-sync error: 1-sigma (m) and correlation time (s) of each psy state."""
+    gyro_axis_q_x: float = 0.0
+    gyro_axis_q_y: float = 0.0
+    gyro_axis_q_z: float = 0.0
+    """White rate noise of the gyro scale-factor / misalignment errors on body axes x, y, z, rad^2/s: (S + M) w_ib
+    at the airframe's body-rate spectrum in the aided band (nav/noise.py gyro_axis_q); rotated to NED, added to
+    the attitude's ARW."""
 
     @cached_property
     def _kernel_arrays(self) -> dict[int, tuple[Array, Array, Array]]:
@@ -386,7 +392,8 @@ def dynamics_reference(
     F[i_bb, i_bb] = -1.0 / noise.baro_bias_tau_s
     Qc[i_bb, i_bb] = 2.0 * noise.baro_bias_sigma_m**2 / noise.baro_bias_tau_s
     Qc[V, V] = noise.accel_vrw_mps_sqrts**2 * np.eye(3)
-    Qc[A, A] = noise.gyro_arw_rad_sqrts**2 * np.eye(3)
+    Qc[A, A] = noise.gyro_arw_rad_sqrts**2 * np.eye(3) + c_bn @ np.diag(
+        [noise.gyro_axis_q_x, noise.gyro_axis_q_y, noise.gyro_axis_q_z]) @ c_bn.T
     Qc[ix["bg"], ix["bg"]] = noise.gyro_bias_rw**2 * np.eye(3)
     Qc[ix["ba"], ix["ba"]] = noise.accel_bias_rw**2 * np.eye(3)
     if layout.has("clk"):

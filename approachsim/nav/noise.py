@@ -32,6 +32,32 @@ ambiguity and the position integrate), while over a few epochs it is conservativ
 carrier, 40 open-loop runs, 200 s): a 0.5 s multipath correlation time (inflation 1.3 instead of 10) leaves the
 filter's vertical sigma at the end at 0.2223 m against 0.2224 m, the true RMS 0.243 against 0.244 m: the carrier's
 fast error does not limit the position, so the simpler, conservative form is kept.
+
+The slow channel state's correlation time (`slow_tau_s`). The sensor draws the slow error as a sum of independent
+Gauss-Markov processes (stand-alone: clock/ephemeris 2 h, iono 30 min, tropo 1 h; GBAS: ground 300 s, iono, tropo;
+a service: its range, iono and tropo terms); the filter carries their sum as one state. Its variance is their summed
+variance; its time constant is the variance-weighted harmonic mean of theirs over a reference sky, so that its drift
+rate 2 sigma^2 / tau is theirs (over an approach of a few minutes, much shorter than every tau, that rate, not the
+shape of the autocorrelation, is what the range error does). The shortest of the three, used before, made the
+default profile's filter expect the clock/ephemeris error (2.4 m of its 2.5 m at 30 deg) to drift four times as fast
+as it does (1800 s for 5838 s): it over-claimed the horizontal velocity error (run-averaged e^2/P 0.82 / 0.63, N / E).
+Not one state per process: the three enter every pseudorange with the same unit coefficient, so the filter cannot
+separate them, and 2 x 24 more channel states would triple the channel block's cost for the one combination it
+sees. Not a time constant per channel: the compiled epochs share one Phi and one Qd factor per epoch across the
+channels; over the 5-90 deg sky the drift-matched tau of the default budget spans 4445-6840 s, and a truth with all
+three processes at the filter's one tau changed the default profile's horizontal velocity e^2/P by 0.05 at most.
+
+Gyro scale-factor and misalignment errors (`gyro_axis_q`): the IMU's (S + M) w_ib (random constants per run, the
+grade's sigmas) is process noise, not 9 filter states. In light turbulence it is what turns the drift-matched
+filter's along-track velocity over-confident (default profile: east velocity e^2/P 1.27 with them in the truth,
+0.99 without; 0.99 in calm air with them): the slow pitch and yaw excursions (periods 20-100 s) rotate the body
+through a few degrees and back, and 100 ppm of that is a few microradians of tilt the aiding removes only slowly. A
+white rate noise with the body rates' spectrum in that band (BODY_RATE_PSD, measured on the flown airframe) gives
+q_k = sf^2 S_k + mis^2 (S_i + S_j) per body axis; states would need the body rate in the compiled error dynamics
+(every epoch kernel's inputs), 9 more states in every covariance, and would estimate quantities that, at 100 ppm
+and 0.02 mrad, the approach's few degrees of rotation cannot observe. The accelerometer's scale factor and
+misalignment are in the ba prior (under 1 g they look like a bias); with both the gyro's and the accelerometer's
+removed from the truth the default profile's east velocity e^2/P is 0.99, as with the gyro's alone.
 """
 
 from __future__ import annotations
@@ -46,6 +72,9 @@ from approachsim.nav.config import NavConfig
 from approachsim.sensors import atmosphere
 from approachsim.sensors.config import SensorsConfig
 from approachsim.sensors.gnss.clock import ClockModel
+from approachsim.sensors.gnss.elevation import iono_obliquity, tropo_mapping
+from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
+from approachsim.sensors.gnss.receiver import GnssErrorBudget
 from approachsim.sensors.presets import PRESETS
 
 Array = np.ndarray
@@ -53,8 +82,55 @@ Array = np.ndarray
 _CACHE_MAX = 512
 """Elevation vectors kept by `NoiseModel.noise` (one sky's epochs x runs at most)."""
 
+SKY_SIN_EL = np.linspace(np.sin(np.radians(5.0)), 1.0, 16)
+"""The reference sky of `slow_tau_s`: 16 elevations equally spaced in sin(el) from 5 deg to the zenith (equal solid
+angle above the default 5 deg mask)."""
+
+BODY_RATE_PSD: dict[str, tuple[float, float, float]] = {
+    "none": (0.0, 0.0, 0.0),
+    "light": (2.37e-6, 1.43e-4, 8.07e-5),
+    "moderate": (5.83e-6, 3.14e-4, 1.76e-4),
+    "severe": (1.31e-5, 7.07e-4, 3.96e-4),
+}
+"""Two-sided PSD of the airframe's body rates (roll, pitch, yaw), rad^2/s^2/Hz, over 0.01-0.05 Hz, by turbulence
+level: tools/body_rate_psd.py on the default profile's 737 (seeds 1-3); severe, beyond the 737's approach limit, is
+moderate x (75 / 50)^2, the Dryden gust variance ratio (engineering choice)."""
+
 PSEUDOLITE_CLOCK = ("ocxo", 30.0, 0.03)
 """An unsynchronized pseudolite's transmitter clock: oscillator, bias and drift 1-sigma at the start (m, m/s)."""
+
+
+def slow_terms(bud: GnssErrorBudget, el_rad: Array, ionosphere: bool = True) -> list[tuple[Array, float]]:
+    """The slow range-error processes the sensor draws at elevations el_rad (k,), rad: [(1-sigma (k,) m, tau s)].
+    Stand-alone: clock/ephemeris, F(el) I_z, M(el) T_z; GBAS: ground, iono, tropo at gbas.REFERENCE_GEOMETRY; a
+    service: its broadcast range, iono and tropo terms (service.terms_m). ionosphere=False leaves the iono out
+    (carrier phase, where it has its own state)."""
+    if bud.gbas is not None:
+        s = bud.gbas.scales(el_rad, *REFERENCE_GEOMETRY)
+        out = [(s["ground"], bud.gbas.ground_tau_s), (s["iono"], bud.iono_tau_s), (s["tropo"], bud.tropo_tau_s)]
+    elif bud.service is not None:
+        t = bud.service.terms_m(el_rad)
+        out = [(t[..., 0], bud.service.range_tau_s), (t[..., 1], bud.iono_tau_s), (t[..., 2], bud.tropo_tau_s)]
+    else:
+        out = [(np.full(np.shape(el_rad), bud.clock_ephemeris_m), bud.clock_ephemeris_tau_s),
+               (bud.iono_zenith_m * iono_obliquity(el_rad), bud.iono_tau_s),
+               (bud.tropo_zenith_m * tropo_mapping(el_rad), bud.tropo_tau_s)]
+    return out if ionosphere else [out[0], out[2]]
+
+
+def slow_tau_s(bud: GnssErrorBudget, ionosphere: bool = True) -> float:
+    """The filter's one slow channel state's correlation time, s: the drift-matched (variance-weighted harmonic)
+    combination of the processes it lumps over the reference sky SKY_SIN_EL,
+
+        1 / tau = sum_i sum_k sigma_ik^2 / tau_i  /  sum_i sum_k sigma_ik^2   (i process, k elevation),
+
+    so that with the summed variance the state has both the sensor's stationary variance and its mean drift rate
+    E[(x(t + dt) - x(t))^2] = 2 dt sum sigma_i^2 / tau_i (dt << tau): the quantity that sets what a slow range
+    error does over an approach (module docstring: why one state, not one per process or a tau per channel)."""
+    terms = slow_terms(bud, np.arcsin(SKY_SIN_EL), ionosphere)
+    var = sum(float(np.sum(np.square(s))) for s, _ in terms)
+    rate = sum(float(np.sum(np.square(s))) / tau for s, tau in terms)
+    return var / rate if rate > 0.0 else max(tau for _, tau in terms)
 
 
 @dataclass(frozen=True)
@@ -66,6 +142,8 @@ class NoiseModel:
     layout: em.StateLayout
     baro_ref_m: float = 0.0
     """The baro scale factor's reference H_ref: the altimeter-setting reference (the field's height), m."""
+    turbulence: str = "none"
+    """The environment's turbulence level (BODY_RATE_PSD): the body rates the gyro axis errors act on."""
     _cache: dict = field(default_factory=dict, init=False, compare=False, repr=False)
 
     def clock(self) -> ClockModel:
@@ -149,9 +227,9 @@ class NoiseModel:
             el = np.maximum(el, np.radians(2.0))
             # per channel at its elevation (do253: the sensor's sigma_mp), one multipath value under nrc1995
             gse, gmp = bud.channel_sigmas_m(el)
-            kw.update(gse_sigma_m=gse, gse_tau_s=bud.slow_tau_s, gmp_sigma_m=gmp, gmp_tau_s=bud.multipath_tau_s)
+            kw.update(gse_sigma_m=gse, gse_tau_s=slow_tau_s(bud), gmp_sigma_m=gmp, gmp_tau_s=bud.multipath_tau_s)
             if self.carrier:
-                kw.update(self._carrier_kw(el), gse_tau_s=bud.slow_tau_no_iono_s, gio_tau_s=bud.iono_tau_s)
+                kw.update(self._carrier_kw(el), gse_tau_s=slow_tau_s(bud, ionosphere=False), gio_tau_s=bud.iono_tau_s)
         if self.sensors.pseudolite is not None:
             p = self.sensors.pseudolite
             kw.update(pmp_sigma_m=p.multipath_m, pmp_tau_s=p.multipath_tau_s)
@@ -163,6 +241,7 @@ class NoiseModel:
         if self.sensors.radalt is not None:
             kw.update(ram_sigma_m=self.sensors.radalt.markov_sigma_m, ram_tau_s=self.sensors.radalt.markov_tau_s,
                       tdb_correlation_m=self.nav.terrain_database.correlation_m)
+        qx, qy, qz = self.gyro_axis_q()
         q1 = self.clock().q(1.0)  # Q(1 s) = [[S_f + S_g / 3, S_g / 2], [., S_g]]
         # one bb state for the truth's slow baro errors (BaroConfig.filter_bias: their variance and rate)
         bb_sigma, bb_tau = (b.filter_bias(atmosphere.height_per_hpa_m(self.baro_ref_m)) if b is not None
@@ -179,8 +258,19 @@ class NoiseModel:
             baro_ref_m=self.baro_ref_m,  # the loop's sb column -(h - H_ref) (it was left at 0: the MSL height)
             clock_sf=float(q1[0, 0] - q1[1, 1] / 3.0),
             clock_sg=float(q1[1, 1]),
+            gyro_axis_q_x=qx, gyro_axis_q_y=qy, gyro_axis_q_z=qz,
             **kw,
         )
+
+    def gyro_axis_q(self) -> tuple[float, float, float]:
+        """White rate noise (rad^2/s) on body axes x, y, z for the gyro scale-factor and misalignment errors the
+        filter has no states for: the error rate (S + M) w_ib, S and M random constants of 1-sigma gyro_sf and
+        gyro_misalign_rad (the grade), at the body-rate spectrum S_k of the turbulence level (BODY_RATE_PSD, the
+        0.01-0.05 Hz band), q_k = sf^2 S_k + mis^2 (S_i + S_j). Why process noise, not 9 states: module docstring."""
+        g = PRESETS[self.sensors.imu.grade]
+        s = np.asarray(BODY_RATE_PSD[self.turbulence])
+        q = g.gyro_sf**2 * s + g.gyro_misalign_rad**2 * (s.sum() - s)
+        return float(q[0]), float(q[1]), float(q[2])
 
     def channel_qd(self, qd: Array, el_rad: Array, dt_s: float) -> Array:
         """Qd with the GPS channel states' (gse, gmp: decoupled first-order Markov) entries at elevations el_rad

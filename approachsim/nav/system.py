@@ -105,28 +105,34 @@ class NavSystem:
     """Terrain ellipsoid height (m) at ECEF points (..., 3): the filter's terrain database."""
     filter: NavFilter = field(compare=False)
     layout: em.StateLayout = field(compare=False)
+    turbulence: str = "none"
+    """The environment's turbulence level: the gyro axis errors' process noise (nav/noise.py gyro_axis_q)."""
     noise_model: NoiseModel = field(init=False, compare=False, repr=False)
     rows: MeasurementRows = field(init=False, compare=False, repr=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "noise_model", NoiseModel(self.sensors, self.nav, self.layout, self.baro_ref_m))
+        object.__setattr__(self, "noise_model", NoiseModel(self.sensors, self.nav, self.layout, self.baro_ref_m,
+                                                                 self.turbulence))
         object.__setattr__(self, "rows", MeasurementRows(self.layout, self.sensors, self.nav, self.runway,
                                                          self.terrain_h))
 
     @classmethod
     def build(cls, nav: NavConfig = DEFAULT_NAV, sensors: SensorsConfig = DEFAULT_SENSORS,
-              runway: geo.RunwayFrame | None = None, terrain: Any = None) -> NavSystem:
-        """From configs; runway defaults to a frame at SFO 28R, terrain to flat at the threshold height."""
+              runway: geo.RunwayFrame | None = None, terrain: Any = None, turbulence: str = "none") -> NavSystem:
+        """From configs; runway defaults to a frame at SFO 28R, terrain to flat at the threshold height; turbulence
+        the environment's level (nav/noise.py BODY_RATE_PSD)."""
         rwy = runway or geo.RunwayFrame(np.radians(37.6117), np.radians(-122.3581), 4.0, np.radians(298.0))
         return cls(nav=nav, sensors=sensors, runway=rwy, terrain_h=TerrainDatabase(rwy, terrain),
-                   filter=nav.make_filter(), layout=layout_for(nav, sensors))
+                   filter=nav.make_filter(), layout=layout_for(nav, sensors), turbulence=turbulence)
 
     @classmethod
     def from_profile(cls, profile: Any) -> NavSystem:
         """The navigation system of a Profile (its [nav], [sensors], runway and terrain). A value: systems of equal
         profiles are equal (and hash alike), so what a truth's memo keeps for one serves the other (`_prepared`)."""
         nav = getattr(profile, "nav", DEFAULT_NAV)
-        return cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain)
+        env = getattr(profile, "environment", None)
+        return cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain,
+                         turbulence=getattr(env, "turbulence", "none"))
 
     @property
     def baro_ref_m(self) -> float:

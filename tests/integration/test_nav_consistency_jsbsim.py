@@ -17,6 +17,7 @@ full GPS geometry history are in.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -92,15 +93,12 @@ def normalized_errors(runs) -> np.ndarray:
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="finding: the filter over-claims the horizontal velocity error (run-averaged "
-                   "e^2/P of v_N 0.79, v_E 0.70 over the approach; 52 % and 72 % of epochs below their 95 % bounds), "
-                   "so the 9-state NEES (8.4 of 9) is below its bounds at 22-26 % of epochs. Until the baro loop's "
-                   "held-sample fix (docs/baro-loop-hold-bias.md) the vertical velocity's optimism (1.19, 33 % of "
-                   "epochs above) offset it and this passed. Cause (measured, 60 runs): the filter lumps the slow "
-                   "range errors (clock/ephemeris tau 7200 s, iono 1800 s, tropo 3600 s) into one Gauss-Markov state "
-                   "at the shortest tau (nav/noise.py), so it expects them to drift faster than they do; with the "
-                   "truth's three at 1800 s, v_N / v_E give 1.41 / 1.07 (0.82 / 0.63 as they are)")
 def test_average_nees_inside_95_percent_bounds(runs):
+    """The 9-state NEES inside its 95 % bounds at >= 90 % of the epochs. A strict xfail until issue 39: the filter's
+    slow range-error state drifted at the shortest of the three processes' time constants and over-claimed the
+    horizontal velocity (e^2/P 0.79 / 0.70, N / E); with the drift-matched tau and the gyro scale-factor /
+    misalignment process noise (nav/noise.py) it passes: NEES mean 9.02 (per-run EKF) / 9.00 (shared covariance),
+    inside at 100 % of the epochs (the control without the gyro noise: 9.50, 93 %)."""
     nees = average_nees(runs)
     assert len(nees) >= 250  # 1 s epochs over the ~260 s approach
     inside = nees_inside(nees)
@@ -110,7 +108,7 @@ def test_average_nees_inside_95_percent_bounds(runs):
 @pytest.mark.slow
 def test_average_nees_is_not_optimistic(runs):
     """The safety side of consistency: the run-averaged NEES above its upper 95 % bound at no more than 5 % of the
-    epochs (measured: none; those outside are all below, the horizontal velocity's conservatism)."""
+    epochs (measured: none; every epoch inside since issue 39's filter changes)."""
     nees = average_nees(runs)
     hi = chi2.ppf(0.975, 9 * RUNS) / RUNS
     assert np.mean(nees > hi) <= 0.05, (nees.mean(), np.mean(nees > hi))
@@ -174,6 +172,66 @@ def nis_inside(by_epoch: dict[float, list[float]]) -> np.ndarray:
     return np.array(out)
 
 
+STATES = ("p_N", "p_E", "p_D", "v_N", "v_E", "v_D", "psi_N", "psi_E", "psi_D")
+RATIO_BAND = (0.8, 1.25)
+"""Issue 39's acceptance, state by state: the run-averaged e^2 / P over the approach (after its first quarter, as
+tools/consistency_by_state.py) in [0.8, 1.25], inside its 95 % chi2(RUNS)/RUNS band at >= 90 % of the epochs and
+above it at <= 5 %. How finely one seed resolves it: the epoch mean of e^2/P is not a 100-run x 200-epoch average
+but of a few independent stretches per approach (the slow range errors and the aided velocity are correlated over
+tens of seconds to minutes), and one seed is one flown truth and one set of skies. The full suite's two seeds
+(docs/consistency.md, 60 runs each) differ by up to 0.2 on the velocities and 0.4 on the clock; so this reduced
+check separates the filter from the control (along-track velocity 1.5, above its band at ~60 % of the epochs) with
+margin, while a 10-20 % error in a state's claimed variance is inside what one seed can tell."""
+INSIDE_MIN, ABOVE_MAX = 0.9, 0.05
+
+
+def per_state(runs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(e^2/P mean, fraction inside, fraction above) of each of the 9 navigation errors over the approach after its
+    first quarter."""
+    z = normalized_errors(runs)
+    z = z[len(z) // 4:]
+    lo, hi = chi2.ppf([0.025, 0.975], RUNS) / RUNS
+    return z.mean(axis=0), np.mean((z >= lo) & (z <= hi), axis=0), np.mean(z > hi, axis=0)
+
+
+def state_passes(ratio: float, inside: float, above: float) -> bool:
+    return RATIO_BAND[0] <= ratio <= RATIO_BAND[1] and inside >= INSIDE_MIN and above <= ABOVE_MAX
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("state", range(9), ids=STATES)
+def test_every_state_is_consistent(runs, state):
+    """The reduced consistency suite (issue 39 item 5; the full one: tools/consistency_by_state.py --suite): the
+    default profile, 100 runs, seed 1, both filter forms, each state on its own. Measured (per-run EKF and shared
+    covariance alike to 0.03): e^2/P p 1.22 / 1.00 / 1.06-1.09, v 1.10 / 0.88 / 0.95, psi 0.86 / 1.03 / 1.02
+    (N / E / D); all inside at >= 95 % of the epochs; v_N above its band at 5 % of them, on the limit. The full
+    suite's misses on this profile (60 runs, docs/consistency.md) are at its seed 2 or within the seed scatter."""
+    ratio, inside, above = (v[state] for v in per_state(runs))
+    assert state_passes(ratio, inside, above), (STATES[state], ratio, inside, above)
+
+
+@pytest.fixture(scope="module")
+def control(flown):
+    """The time-constant-only filter (issue 39's control): the drift-matched slow range-error tau without the gyro
+    scale-factor / misalignment process noise (nav/noise.py gyro_axis_q), shared covariance, same records."""
+    prof, truth, recs = flown
+    nav = replace(NavSystem.from_profile(prof), turbulence="none")
+    assert nav.noise_model.gyro_axis_q() == (0.0, 0.0, 0.0)
+    rec, st = recs
+    return nav.run(truth, rec, [stream(SEED, r, "nav") for r in range(RUNS)], shared_covariance=True, states=st)
+
+
+@pytest.mark.slow
+def test_time_constant_only_control_fails(control):
+    """The control must fail the suite: without the gyro axis noise the turbulence's slow pitch and yaw excursions
+    times the 100 ppm scale factor make the horizontal velocity over-confident. Measured (100 runs, seed 1): v_N
+    1.33 above its band at 64 % of the epochs, v_E 1.22 above at 21 % (the filter: 1.10 / 0.88, 5 % / 0 %)."""
+    ratio, inside, above = per_state(control)
+    failing = [STATES[c] for c in range(9) if not state_passes(ratio[c], inside[c], above[c])]
+    assert {"v_N", "v_E"} & set(failing), (ratio[3:5], inside[3:5], above[3:5])
+    assert max(ratio[3], ratio[4]) > RATIO_BAND[1]
+
+
 if __name__ == "__main__":  # the measured figures: python tests/integration/test_nav_consistency_jsbsim.py
     flown_ = fly_and_sense()
     for shared in (False, True):
@@ -185,3 +243,5 @@ if __name__ == "__main__":  # the measured figures: python tests/integration/tes
             by = nis_by_epoch(rs, g)
             print(f"  NIS {g}: mean {np.mean([np.mean(v) for v in by.values()]):.3f} (1 expected), "
                   f"inside {nis_inside(by).mean():.3f} of {len(by)} epochs")
+        for name, r, i, a in zip(STATES, *per_state(rs), strict=True):
+            print(f"  {name:6s} e^2/P {r:.2f} inside {i:.2f} above {a:.2f}")

@@ -66,13 +66,15 @@ def test_degraded_radar_altimeter_is_caught_and_a_reshuffle_is_not(tmp_path):
     # alpha = 1e-3 to assert. A finding about the test's power at CAT I, not a tolerance
     assert vertical - {"CAT I.vertical_1sigma_ft"} <= _flagged(_rerun(_variant(tmp_path, "radalt-1.1", 1.1), doc,
                                                                       tmp_path))
-    # 2x: flagged at CAT III (+33.0 %, p = 0.00075); the lateral figures (GPS) are untouched. At CAT I and II the
-    # filter re-weights the doubled altimetry against GPS and baro run by run, so the change is not uniform: CAT I
-    # +32.9 %, p = 0.004 and CAT II +36.8 %, p = 0.0016, both missed at alpha = 1e-3 (baseline of the baro loop's
-    # held-sample fix; with earlier baselines CAT II was flagged once and CAT I missed at +21..27 %): findings about
-    # the paired test's power, approachsim/campaign/regress.py
+    # 2x: caught, and the lateral figures (GPS) are untouched. Which figure catches it depends on the baseline's
+    # realization: the filter re-weights the doubled altimetry against GPS and baro run by run, so the change is not
+    # uniform. With the baseline of issue 39's filter changes the vertical 1-sigma moves +31.0 / +34.9 / +31.8 %
+    # (CAT I / II / III) at p = 0.0041 / 0.0012 / 0.0013, all just missed at alpha = 1e-3, and CAT II's verdict
+    # (fails -> indeterminate) flags it; with the baro loop's held-sample fix CAT III was flagged (+33.0 %,
+    # p = 0.00075) and CAT I / II missed (p = 0.004 / 0.0016): findings about the paired test's power at 20 runs,
+    # approachsim/campaign/regress.py
     d2 = _rerun(_variant(tmp_path, "radalt-2", 2.0), doc, tmp_path)
-    assert "CAT III.vertical_1sigma_ft" in _flagged(d2) and not any("lateral" in f for f in _flagged(d2))
+    assert _flagged(d2) and not any("lateral" in f for f in _flagged(d2))
     # the same model on other random numbers: its 1-sigma figures move by tens of per cent, nothing is flagged
     reshuffled = _rerun(ROOT / "profiles" / "default.toml", doc, tmp_path, seed=doc["seed"] + 1)
     moved = [d for d in reshuffled if "paired" in d.field and d.old != d.new]

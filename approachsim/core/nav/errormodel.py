@@ -49,11 +49,14 @@ LAY_GROUPS = ("dp", "dv", "psi", "bg", "ba", "bb", "sb", "clk", "ac", "gse", "gm
 Q_ARW, Q_VRW, Q_BG_RW, Q_BA_RW, Q_BB_SIGMA, Q_BB_TAU, Q_BARO_SIGMA, Q_BARO_RATE = range(8)
 Q_CLK_SF, Q_CLK_SG, Q_GSE_TAU, Q_GMP_TAU, Q_PMP_SIGMA, Q_PMP_TAU, Q_PCLK_SF, Q_PCLK_SG = range(8, 16)
 Q_RAM_SIGMA, Q_RAM_TAU, Q_TDB_L, Q_BARO_REF, Q_PSY_SIGMA, Q_PSY_TAU = range(16, 22)
-Q_SIZE = 22
+Q_GAX = 22
+"""q[Q_GAX + k]: the gyro scale-factor / misalignment white rate noise of body axis k, rad^2/s (nav/noise.py)."""
+Q_SIZE = 25
 Q_FIELDS = ("gyro_arw_rad_sqrts", "accel_vrw_mps_sqrts", "gyro_bias_rw", "accel_bias_rw", "baro_bias_sigma_m",
             "baro_bias_tau_s", "baro_noise_sigma_m", "baro_rate_hz", "clock_sf", "clock_sg", "gse_tau_s",
             "gmp_tau_s", "pmp_sigma_m", "pmp_tau_s", "pclk_sf", "pclk_sg", "ram_sigma_m", "ram_tau_s",
-            "tdb_correlation_m", "baro_ref_m", "psy_sigma_m", "psy_tau_s")
+            "tdb_correlation_m", "baro_ref_m", "psy_sigma_m", "psy_tau_s", "gyro_axis_q_x", "gyro_axis_q_y",
+            "gyro_axis_q_z")
 """errormodel.ErrorNoise field of each q[Q_*], in index order."""
 
 LOOP_SIZE = 4
@@ -84,7 +87,7 @@ def dynamics(lay: np.ndarray, q: np.ndarray, gse_sigma: np.ndarray, gmp_sigma: n
         dp' = F_pp dp + dv ; dv' = [f x] psi + C ba - (2 w_ie + w_en) x dv + v x (2 dw_ie + dw_en) - (dg/dh) dp_D
         psi' = -w_in x psi + dw_in - C bg ; sensor states random constants / walks / Gauss-Markov ;
         loop e = -dp_D - bb - (h - H_ref) sb: dp_D' += C1 e, dv_D' += C2 e + ac, ac' = C3 e,
-        Qc += g g' sigma_b^2 / rate.
+        Qc += g g' sigma_b^2 / rate; Qc[psi, psi] += C diag(q[Q_GAX:Q_GAX + 3]) C' (gyro axis errors, body axes).
     """
     F[:, :] = 0.0
     Qc[:, :] = 0.0
@@ -164,6 +167,11 @@ def dynamics(lay: np.ndarray, q: np.ndarray, gse_sigma: np.ndarray, gmp_sigma: n
     for k in range(3):
         Qc[iv + k, iv + k] = q[Q_VRW] ** 2
         Qc[ia + k, ia + k] = q[Q_ARW] ** 2
+    for r in range(3):
+        for c in range(3):
+            Qc[ia + r, ia + c] += (c_bn[r, 0] * c_bn[c, 0] * q[Q_GAX] + c_bn[r, 1] * c_bn[c, 1] * q[Q_GAX + 1]
+                                   + c_bn[r, 2] * c_bn[c, 2] * q[Q_GAX + 2])
+    for k in range(3):
         Qc[ibg + k, ibg + k] = q[Q_BG_RW] ** 2
         Qc[iba + k, iba + k] = q[Q_BA_RW] ** 2
     ic = lay[L_CLK]

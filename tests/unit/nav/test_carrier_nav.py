@@ -16,7 +16,7 @@ from scipy.stats import chi2
 
 from approachsim import geo, synthetic
 from approachsim.nav import errormodel as em
-from approachsim.nav import ins
+from approachsim.nav import ins, noise
 from approachsim.nav import measurements as meas
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.config import FdeConfig, InitialError
@@ -61,7 +61,9 @@ def test_layout_prior_and_the_split_of_the_slow_state():
     assert np.all(d_on[lo.index["gio"]] > 1e-4)  # the GBAS iono residual at the reference geometry: several cm
     nz = on.noise(el)
     bud = CARRIER.sensors.gnss.budget()
-    assert nz.gio_tau_s == bud.iono_tau_s and nz.gse_tau_s == min(bud.gbas.ground_tau_s, bud.tropo_tau_s)
+    # gse without the ionosphere: the drift-matched tau of ground (300 s) and tropo (3600 s) alone
+    assert nz.gio_tau_s == bud.iono_tau_s and nz.gse_tau_s == noise.slow_tau_s(bud, ionosphere=False)
+    assert bud.gbas.ground_tau_s < nz.gse_tau_s < bud.tropo_tau_s
     F, Qc = em.dynamics(lo, 0.6, 100.0, np.array([70.0, 0.0, 3.0]), np.array([0.0, 0.0, -9.8]), np.eye(3), nz)
     i, a = lo.index["gio"], lo.index["amb"]
     np.testing.assert_allclose(np.diag(F)[i], -1.0 / bud.iono_tau_s)

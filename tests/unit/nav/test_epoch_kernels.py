@@ -63,7 +63,8 @@ def _noise(n_sv: int, rng: np.random.Generator) -> em.ErrorNoise:
         accel_bias_rw=2e-7, baro_bias_sigma_m=1.0, baro_bias_tau_s=100.0, clock_sf=0.009, clock_sg=0.035,
         gse_sigma_m=per, gmp_sigma_m=rng.uniform(0.1, 0.3, n_sv), gmp_tau_s=100.0, pmp_sigma_m=0.3,
         pclk_sf=0.01, pclk_sg=0.02, ram_sigma_m=0.2155, baro_ref_m=rng.uniform(0.0, 1700.0), psy_sigma_m=0.9,
-        psy_tau_s=600.0)
+        psy_tau_s=600.0, **dict(zip(("gyro_axis_q_x", "gyro_axis_q_y", "gyro_axis_q_z"),
+                                     rng.uniform(0.0, 3e-12, 3).tolist(), strict=True)))
 
 
 def _point(rng: np.random.Generator) -> tuple:

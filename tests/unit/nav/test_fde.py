@@ -177,18 +177,24 @@ def test_gnss_ramp_excluded_before_the_error_leaves_the_pl(truths, rate_mps):
          "target": "pseudorange"}
     c = _case(truths, [f], nmi=10.0)
     t_x = _check_excluded(c, f"gps{_gps_channel(_profile()):02d}")
-    if rate_mps == 0.5:  # the slow ramp needs the gradual test (a 2 m/s one may trip the snapshot test first)
-        assert c.run.solution.exclusions[0].test == "sum"
+    if rate_mps == 0.5:  # the snapshot test: with the slow range-error state drifting at the drift-matched tau
+        # (nav/noise.py slow_tau_s, 5838 s) it no longer absorbs the ramp's first metres, so the chi2 test trips
+        # before the gradual one (at the shortest process's 1800 s, issue 39's before, the sum test caught it)
+        assert c.run.solution.exclusions[0].test == "chi2"
     if rate_mps == 2.0:  # unprotected, this one becomes misleading before the threshold
         assert np.isfinite(c.t_exceed) and t_x < c.t_exceed
 
 
-def test_gnss_ramp_0p1_is_absorbed_never_misleading(truths):
-    """0.1 m/s: 26 m by the threshold, absorbed by the channel's range-error state; not detected over the
-    approach, and the unprotected error stays inside the protection level."""
+def test_gnss_ramp_0p1_is_excluded_never_misleading(truths):
+    """0.1 m/s: 26 m by the threshold. The channel's slow range-error state, drifting at the sensor's own rate
+    (the drift-matched tau, nav/noise.py slow_tau_s), cannot absorb it: the gradual (sum) test excludes the channel
+    (measured: at 58 s, 28 s and 2.8 m after the onset, statistic 6.31 against 5.56). Before issue 39, with the state
+    at the shortest process's 1800 s, it was absorbed and never detected. Either way the unprotected error stays
+    inside the protection level."""
     f = {"sensor": "gnss", "kind": "ramp", "channel": PRN, "start_s": ONSET_S, "rate": 0.1, "target": "pseudorange"}
     c = _case(truths, [f], nmi=10.0)
-    assert c.run.solution.exclusions == ()
+    t_x = _check_excluded(c, f"gps{_gps_channel(_profile()):02d}")
+    assert c.run.solution.exclusions[0].test == "sum" and t_x - ONSET_S <= 60.0
     assert not np.isfinite(c.t_exceed)
 
 

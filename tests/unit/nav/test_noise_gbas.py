@@ -1,6 +1,7 @@
 """nav/noise.py under GBAS corrections: the GPS channel states' noise follows the receiver's corrected budget.
 
-The slow state carries the ground + iono + tropo residuals (correlation time the ground's 300 s), the fast state the
+The slow state carries the ground + iono + tropo residuals (correlation time their drift-matched combination,
+noise.slow_tau_s), the fast state the
 airborne multipath + smoothed receiver noise (100 s); the elevation-only noise takes the distance-dependent terms at
 gbas.REFERENCE_GEOMETRY; the white code noise is the 2 mm carrier-phase noise. Stand-alone ranging keeps its
 formulas bit for bit."""
@@ -35,14 +36,21 @@ def navs():
     return _nav(), _nav(corrections="gbas", selection="all")
 
 
-def _written_out(el):
-    """The default GBAS model's channel sigmas at REFERENCE_GEOMETRY, from the standards' tables and forms."""
+def _terms(el):
+    """The default GBAS model's ground, iono, tropo sigmas at REFERENCE_GEOMETRY, from the standards' forms."""
     x, dh, v = gb.REFERENCE_GEOMETRY
     th = np.degrees(el)
     a = np.where(th > 35.0, 0.15 + 0.84 * np.exp(-th / 15.5), 0.24)
     gnd = np.sqrt(a * a / 4 + 0.04**2)
     iono = iono_obliquity(el) * 4e-6 * (x + 2 * 100.0 * v)
     tropo = 30.0 * 7350e-6 / np.sqrt(0.002 + np.sin(el) ** 2) * (1.0 - math.exp(-dh / 7350.0))
+    return gnd, iono, tropo
+
+
+def _written_out(el):
+    """The default GBAS model's channel sigmas at REFERENCE_GEOMETRY, from the standards' tables and forms."""
+    gnd, iono, tropo = _terms(el)
+    th = np.degrees(el)
     mp = 0.13 + 0.53 * np.exp(-th / 10.0)
     noise = 0.11 + 0.13 * np.exp(-th / 4.0)
     return np.sqrt(gnd**2 + iono**2 + tropo**2), np.sqrt(mp**2 + noise**2)
@@ -55,7 +63,12 @@ def test_channel_noise_is_the_corrected_budget(navs):
     gse, gmp = _written_out(el)
     np.testing.assert_allclose(nz.gse_sigma_m, gse, rtol=1e-12)
     np.testing.assert_allclose(nz.gmp_sigma_m, gmp, rtol=1e-12)
-    assert nz.gse_tau_s == 300.0 and nz.gmp_tau_s == 100.0
+    assert nz.gmp_tau_s == 100.0
+    # the slow state's tau: sum sigma^2 / sum sigma^2 / tau over the equal-solid-angle sky above 5 deg (16 points)
+    sky = np.arcsin(np.linspace(math.sin(math.radians(5.0)), 1.0, 16))
+    v = [t**2 for t in _terms(sky)]
+    tau = sum(x.sum() for x in v) / sum(x.sum() / t for x, t in zip(v, (300.0, 1800.0, 3600.0), strict=True))
+    assert nz.gse_tau_s == pytest.approx(tau, rel=1e-12) and 300.0 < tau < 1800.0
     assert nav.sensors.gnss.budget().code_noise_m == 0.002  # the white pseudorange noise of the channel-state rows
     # the arrays the compiled epoch takes and P0's channel entries are the same sigmas
     _, k_gse, k_gmp = nav.noise_model.kernel_arrays(el)
@@ -78,7 +91,8 @@ def test_channel_qd_follows_the_corrected_budget_at_each_sky(navs):
     qd2 = em.discretize(*em.dynamics(*args, nav.noise(el2), nav.loop_gains()), 1.0)[1]
     np.testing.assert_allclose(nav.noise_model.channel_qd(qd1, el2, 1.0), qd2, rtol=1e-12, atol=0.0)
     k = np.arange(lay.index["gse"].start, lay.index["gse"].stop)
-    np.testing.assert_allclose(qd2[k, k], _written_out(el2)[0] ** 2 * -np.expm1(-2.0 / 300.0), rtol=1e-12)
+    tau = nav.noise(None).gse_tau_s  # the drift-matched tau (test_channel_noise_is_the_corrected_budget)
+    np.testing.assert_allclose(qd2[k, k], _written_out(el2)[0] ** 2 * -np.expm1(-2.0 / tau), rtol=1e-12)
 
 
 def test_corrected_channel_noise_is_lower_and_falls_with_elevation(navs):
@@ -133,8 +147,9 @@ def test_compiled_channel_sigmas_equal_the_budget(navs):
 
 
 def test_stand_alone_channel_noise_keeps_its_formula():
-    """corrections = "none": sqrt(ce^2 + (I_z F)^2 + (T_z M)^2) and the DO-253 curve, bit for bit; tau the shortest of
-    clock/ephemeris, iono, tropo."""
+    """corrections = "none": sqrt(ce^2 + (I_z F)^2 + (T_z M)^2) and the DO-253 curve, bit for bit; tau the
+    drift-matched sum sigma^2 / sum (sigma^2 / tau) of clock/ephemeris, iono, tropo over the 5-90 deg sky: between
+    the shortest and the longest, near the clock/ephemeris's 7200 s that dominates the P(Y) budget."""
     nav = NavSystem.from_profile(load_profile(DEFAULT))
     bud = nav.sensors.gnss.budget()
     el = np.radians(np.linspace(3.0, 89.0, 24))
@@ -143,5 +158,10 @@ def test_stand_alone_channel_noise_keeps_its_formula():
                   + (bud.tropo_zenith_m * tropo_mapping(el)) ** 2)
     np.testing.assert_array_equal(nz.gse_sigma_m, gse)
     np.testing.assert_array_equal(nz.gmp_sigma_m, 0.13 + 0.53 * np.exp(-np.degrees(el) / 10.0))
-    assert nz.gse_tau_s == min(bud.clock_ephemeris_tau_s, bud.iono_tau_s, bud.tropo_tau_s) == 1800.0
+    sky = np.arcsin(np.linspace(math.sin(math.radians(5.0)), 1.0, 16))
+    v = (np.full(16, bud.clock_ephemeris_m) ** 2, (bud.iono_zenith_m * iono_obliquity(sky)) ** 2,
+         (bud.tropo_zenith_m * tropo_mapping(sky)) ** 2)
+    taus = (bud.clock_ephemeris_tau_s, bud.iono_tau_s, bud.tropo_tau_s)
+    tau = sum(x.sum() for x in v) / sum(x.sum() / t for x, t in zip(v, taus, strict=True))
+    assert nz.gse_tau_s == pytest.approx(tau, rel=1e-12) and 5000.0 < tau < 7200.0
     assert bud.code_noise_m == 0.6
