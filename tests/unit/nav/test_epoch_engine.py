@@ -26,7 +26,9 @@ from approachsim.sensors.suite import SensorSuite
 pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
-DEFAULT = load_profile(PROFILES / "default.toml")
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
+DEFAULT = load_profile(PY_DEFAULT)
 
 
 def _profile(kind: str):
