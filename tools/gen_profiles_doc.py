@@ -98,6 +98,11 @@ def _wrap(kind: str) -> None:
     setattr(Section, kind, rec)
 
 
+SERVICE_KEYS = ("service", "udre_index", "give_index", "delta_udre", "eps_fc_m", "eps_rrc_m", "eps_ltc_m", "eps_er_m",
+                "rss_udre", "dfrei", "aad", "ura_m", "truth", "filter_model")
+"""[sensors.gnss] keys of a GNSS service (sensors/config.py _parse_service): out of the code-preset pass."""
+
+
 def install_recorder() -> None:
     """Record every key read through a Section getter (nested getters count once, as the outer one)."""
     for kind in ("raw", "number", "integer", "boolean", "string", "numbers"):
@@ -133,6 +138,11 @@ def exercise() -> dict[str, list[Key]]:
 
     base = tomllib.loads((PROFILES_DIR / "default.toml").read_text(encoding="utf-8"))
     full = copy.deepcopy(base)
+    # the code presets' keys (GBAS and carrier phase are code-preset options): the default's service keys out
+    gnss = full["sensors"]["gnss"]
+    for k in [k for k in gnss if k in SERVICE_KEYS]:
+        gnss.pop(k)
+    gnss.update(code="P(Y)", multipath_model="do253", multipath_tau_s=100.0, clock_ephemeris="current")
     full["sensors"]["pseudolite"] = {"enabled": True, "units": [{"along_ft": 0.0, "cross_ft": -500.0}]}
     full["sensors"]["gnss"]["doppler"] = True
     full["sensors"]["gnss"]["corrections"] = "gbas"
@@ -160,6 +170,8 @@ def exercise() -> dict[str, list[Key]]:
     svc = copy.deepcopy(base)
     for k in ("code", "multipath_model", "multipath_tau_s", "clock_ephemeris"):
         svc["sensors"]["gnss"].pop(k, None)
+    for k in [k for k in svc["sensors"]["gnss"] if k in SERVICE_KEYS]:
+        svc["sensors"]["gnss"].pop(k)
     svc["sensors"]["gnss"]["service"] = "sbas-l1"
     parse_profile(svc, source=PROFILES_DIR / "default.toml")
     seen = {(k.key, k.table) for k in profile_keys}

@@ -248,8 +248,8 @@ def verdict_table(summary: dict, det: dict) -> str:
             f"limit {lp['limit_horizontal_95_m']:g}), VPL/HPL median {_f(lp['vpl_median_m'], '.1f').strip()}/"
             f"{_f(lp['hpl_median_m'], '.1f').strip()} m (VAL/HAL {lp['val_m']:g}/{lp['hal_m']:g}), available at DH "
             f"{_f(lp['availability_dh'], '.3f').strip()} (lower {_f(lp['availability_dh_lower'], '.3f').strip()}), "
-            f"integrity basis {lp['integrity_basis'] or 'none (stand-alone: fault-free WLS levels only)'}: "
-            f"{lp['verdict']}"
+            f"integrity basis {lp['integrity_basis'] or 'none (stand-alone: fault-free WLS levels only)'}, "
+            f"HMI approaches {lp.get('hmi_runs')} (MI {lp.get('mi_runs')}): {lp['verdict']}"
         )
     best = summary["best_category"] or "none"
     lines.append(

@@ -182,11 +182,13 @@ def _geometry_at_dh(gnss: Any, scalars: dict) -> dict:
 def _lpv200_at_dh(gnss: Any, scalars: dict, sbas: bool, truth: Any) -> dict:
     """One run's LPV-200 columns (evaluate/lpv.py) from a GNSS service's record: the WLS protection levels with
     the broadcast sigmas (integrity/sbas.py) at the CAT I crossing's latest GNSS sample, LPV-200 available there,
-    the fraction of GNSS epochs available up to it, whether the service is SBAS (an integrity basis), and the
+    the fraction of GNSS epochs available up to it, whether the service is SBAS (an integrity basis), the epochs
+    available, misleading and hazardously misleading down to it (evaluate/lpv.py count_misleading), and the
     snapshot WLS fix's vertical and horizontal error there (a stand-alone receiver's position error, the figure
     published SBAS accuracies describe; the navigation error blends it with the INS, baro and radar altimeter)."""
     import numpy as np
 
+    from approachsim.evaluate.lpv import count_misleading  # stage (module docstring)
     from approachsim.integrity.sbas import (  # stage (module docstring)
         lpv200_available,
         protection_levels,
@@ -203,11 +205,19 @@ def _lpv200_at_dh(gnss: Any, scalars: dict, sbas: bool, truth: Any) -> dict:
     k = int(np.clip(np.searchsorted(truth.t_s, gnss.t_s[j], side="left"), 0, len(truth.t_s) - 1))
     r_sv = np.asarray(gnss.r_sv_ecef)[j]
     err = np.asarray(gnss.pseudorange_m)[j] - np.linalg.norm(r_sv - truth.r_ecef[k], axis=-1)
-    d = snapshot_error_enu(np.asarray(gnss.elevation_rad)[j], np.asarray(gnss.azimuth_rad)[j],
-                           np.asarray(gnss.valid)[j], np.asarray(gnss.sigma_m)[j], err)
+    # the snapshot fix's error at every GNSS epoch down to the DH (its latest sample j): MI / HMI against the PLs
+    ks = np.clip(np.searchsorted(truth.t_s, gnss.t_s[: j + 1], side="left"), 0, len(truth.t_s) - 1)
+    r_sv = np.asarray(gnss.r_sv_ecef)[: j + 1]
+    err = np.asarray(gnss.pseudorange_m)[: j + 1] - np.linalg.norm(r_sv - truth.r_ecef[ks][:, None, :], axis=-1)
+    d = snapshot_error_enu(np.asarray(gnss.elevation_rad)[: j + 1], np.asarray(gnss.azimuth_rad)[: j + 1],
+                           np.asarray(gnss.valid)[: j + 1], np.asarray(gnss.sigma_m)[: j + 1], err)
+    hor = np.hypot(d[:, 0], d[:, 1])
+    n_av, n_mi, n_hmi = count_misleading(d[:, 2], hor, vpl[: j + 1], hpl[: j + 1])
     return {"lpv200_vpl_m": float(vpl[j]), "lpv200_hpl_m": float(hpl[j]), "lpv200_avail_dh": float(ok[j]),
             "lpv200_avail_fraction": float(np.mean(ok[: j + 1])), "lpv200_sbas": float(sbas),
-            "lpv200_snapshot_vertical_m": float(d[2]), "lpv200_snapshot_horizontal_m": float(np.hypot(d[0], d[1]))}
+            "lpv200_snapshot_vertical_m": float(d[-1, 2]), "lpv200_snapshot_horizontal_m": float(hor[-1]),
+            "lpv200_available_epochs": float(n_av), "lpv200_mi_epochs": float(n_mi),
+            "lpv200_hmi_epochs": float(n_hmi)}
 
 
 def _gnss_closed_loop(source: Any, truth: Any) -> Any:

@@ -15,6 +15,14 @@ Over the runs, on one-sided confidence bounds as the CAT verdicts (evaluate/verd
   Annex 10's range, as the CAT integrity criterion); only an SBAS service has an integrity basis (the ground
   system's monitoring behind the broadcast UDRE / GIVE / DFRE); a stand-alone receiver's WLS levels are the
   fault-free part only, so its LPV-200 integrity fails ("integrity_basis": null);
+* misleading information against the SBAS protection levels, per run over the approach down to the DH
+  (count_misleading): an epoch is available when VPL <= VAL and HPL <= HAL; misleading (MI) when the GNSS-only
+  WLS fix's error exceeds its protection level there (|vertical| > VPL or horizontal > HPL), hazardously misleading
+  (HMI) when it exceeds the alert limit (|vertical| > VAL or horizontal > HAL) while available (the Stanford
+  integrity diagram's regions). The PLs bound that snapshot fix, not the blended navigation solution. A run with an
+  HMI epoch is an HMI approach; one observed at a simulated run count contradicts the 2e-7 per approach flatly, so
+  it fails the integrity verdict; none cannot show 2e-7 (about 1.5e7 runs would), which rests on the SBAS ground
+  monitoring (the integrity basis), so it does not make the verdict indeterminate;
 * failed runs count against it as against every category (evaluation.max_failure_fraction).
 
 The verdict combines them as the categories' do: fails if any fails, meets if all meet, else indeterminate.
@@ -30,6 +38,7 @@ import numpy as np
 from approachsim.evaluate.config import EvaluationConfig
 from approachsim.evaluate.stats import quantile_lower_rank, quantile_upper_rank
 from approachsim.evaluate.verdict import ICAO_MIN_RUNS, _runs_for_availability, clopper_pearson, failure_verdict
+from approachsim.integrity.requirements import ROWS
 from approachsim.integrity.sbas import (
     LPV200_DH_FT,
     LPV200_HAL_M,
@@ -40,6 +49,22 @@ from approachsim.integrity.sbas import (
 
 REQUIRED_AVAILABILITY = 0.99
 """Availability at the DH the integrity criterion asks for (integrity.requirements' CAT I value)."""
+INTEGRITY_RISK = ROWS["LPV-200"].integrity_risk
+"""LPV-200's integrity risk per approach (2e-7; the requirements table's row)."""
+
+
+def count_misleading(vertical_m: np.ndarray, horizontal_m: np.ndarray, vpl_m: np.ndarray,
+                     hpl_m: np.ndarray) -> tuple[int, int, int]:
+    """(available, MI, HMI) epoch counts of one run (module docstring): the GNSS-only WLS fix's vertical and
+    horizontal radial errors (m) against its VPL / HPL (m) per epoch; an epoch with no fix (nan error) counts as
+    available only."""
+    v, h = np.abs(np.asarray(vertical_m, dtype=float)), np.asarray(horizontal_m, dtype=float)
+    vpl, hpl = np.asarray(vpl_m, dtype=float), np.asarray(hpl_m, dtype=float)
+    avail = (vpl <= LPV200_VAL_M) & (hpl <= LPV200_HAL_M)
+    with np.errstate(invalid="ignore"):
+        mi = avail & ((v > vpl) | (h > hpl))
+        hmi = avail & ((v > LPV200_VAL_M) | (h > LPV200_HAL_M))
+    return int(avail.sum()), int(mi.sum()), int(hmi.sum())
 
 
 def _num(x: float) -> float | None:
@@ -75,6 +100,25 @@ def _runs_needed(verdict: str, acc: list[str], integ: str, k: int, n: int, level
     return None if not needs or any(x is None for x in needs) else max(needs)
 
 
+def _total(columns: Mapping[str, np.ndarray], key: str) -> int | None:
+    """Sum of a per-run count column over the runs that have it (None: no run has it)."""
+    x = np.asarray(columns.get(key, np.full(1, np.nan)), dtype=float)
+    x = x[np.isfinite(x)]
+    return int(x.sum()) if x.size else None
+
+
+def _misleading(columns: Mapping[str, np.ndarray], level: float) -> tuple[int | None, int | None, float]:
+    """(runs with MI, runs with HMI, one-sided Clopper-Pearson upper bound of the per-approach HMI probability) over
+    the runs with the counts (None, None, nan without them)."""
+    mi = np.asarray(columns.get("lpv200_mi_epochs", np.full(1, np.nan)), dtype=float)
+    hmi = np.asarray(columns.get("lpv200_hmi_epochs", np.full(1, np.nan)), dtype=float)
+    ok = np.isfinite(hmi)
+    if not ok.any():
+        return None, None, math.nan
+    k = int((hmi[ok] > 0).sum())
+    return int((mi[ok] > 0).sum()), k, clopper_pearson(k, int(ok.sum()), level)[1]
+
+
 def lpv200_summary(columns: Mapping[str, np.ndarray], cfg: EvaluationConfig, *, runs: int,
                    failed_runs: int) -> dict | None:
     """summary.json "lpv200" from the per-run columns (module docstring); None when the runs carry no LPV-200
@@ -93,7 +137,8 @@ def lpv200_summary(columns: Mapping[str, np.ndarray], cfg: EvaluationConfig, *, 
     k, n = int(avail.sum()), int(avail.size)
     a_lo, a_hi = clopper_pearson(k, n, level)
     sbas = bool(np.nanmax(columns.get("lpv200_sbas", np.zeros(1)))) if n else False
-    if not sbas:
+    mi_runs, hmi_runs, hmi_p_hi = _misleading(columns, level)
+    if not sbas or hmi_runs:
         integ = "fails"
     else:
         integ = "meets" if n and a_lo >= REQUIRED_AVAILABILITY else (
@@ -120,6 +165,10 @@ def lpv200_summary(columns: Mapping[str, np.ndarray], cfg: EvaluationConfig, *, 
         "availability_dh": _num(k / n) if n else None, "availability_dh_lower": _num(a_lo),
         "availability_approach_mean": _num(float(np.nanmean(frac))) if np.isfinite(frac).any() else None,
         "required_availability": REQUIRED_AVAILABILITY,
+        "available_epochs": _total(columns, "lpv200_available_epochs"),
+        "mi_epochs": _total(columns, "lpv200_mi_epochs"), "hmi_epochs": _total(columns, "lpv200_hmi_epochs"),
+        "mi_runs": mi_runs, "hmi_runs": hmi_runs, "hmi_probability_upper": _num(hmi_p_hi),
+        "integrity_risk": INTEGRITY_RISK,
         "snapshot_vertical_95_m": sv95, "snapshot_horizontal_95_m": sh95,
         "accuracy_verdict": "fails" if "fails" in acc else ("meets" if acc == ["meets", "meets"] else "indeterminate"),
         "integrity_verdict": integ,

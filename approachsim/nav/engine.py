@@ -220,8 +220,8 @@ class EpochEngine:
                                 bud.multipath_model == "do253", float(bud.multipath_m))
             if bud.gbas is not None:
                 self._gbas = bud.gbas.channel_kernel_args()
-            if bud.service is not None:  # a civil service's broadcast sigmas (sensors/gnss/service.py)
-                self._service = bud.service.params()
+            if bud.service is not None:  # a civil service's filter model (sensors/gnss/service.py)
+                self._service = bud.service.filter_params()
         self.carrier = lay.has("amb")
         """Carrier phase: the rows, states and arc resets of kernels/carrier.py."""
         self.cp_r = float(system.rows.carrier_sigma_m) ** 2 if self.carrier else 0.0

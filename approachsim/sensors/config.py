@@ -32,6 +32,7 @@ from approachsim.sensors.gnss.receiver import (
 from approachsim.sensors.gnss.service import AADS as SERVICE_AADS
 from approachsim.sensors.gnss.service import (
     DFRE_SIGMA_M,
+    FILTER_MODELS,
     GIVE_M,
     SERVICES,
     TRUTHS,
@@ -387,7 +388,7 @@ def _parse_service(g: Section, site_rad: tuple[float, float] | None) -> ServiceM
     """[sensors.gnss] service and its keys (sensors/gnss/service.py); a key of a model the service does not have is
     an error naming it (an SBAS correction key without an SBAS service, a code-preset key with a service)."""
     if not g.has("service"):
-        for k in (*SBAS_L1_KEYS, "dfrei", "aad", "ura_m", "truth"):
+        for k in (*SBAS_L1_KEYS, "dfrei", "aad", "ura_m", "truth", "filter_model"):
             if g.has(k):
                 raise ProfileError(f"{g.path}.{k}: only used with a GNSS service (service = "
                                    f"{' | '.join(repr(x) for x in SERVICES)}); none is set")
@@ -426,7 +427,8 @@ def _parse_service(g: Section, site_rad: tuple[float, float] | None) -> ServiceM
         dfrei=g.integer("dfrei", 4, lo=1, hi=len(DFRE_SIGMA_M)),
         aad=aad,
         ura_m=g.number("ura_m", URA_M, lo=0.0, lo_open=True, hi=100.0, unit="m"),
-        truth=g.string("truth", "nominal", choices=TRUTHS),
+        truth=(truth := g.string("truth", "nominal", choices=TRUTHS)),
+        filter_model=g.string("filter_model", truth, choices=FILTER_MODELS),
     )
     return model if site_rad is None else model.at_site(*site_rad)
 

@@ -3,10 +3,10 @@
     python docs/examples/trade_study.py              # 20 open-loop runs per variant (about 2 min on 2 cores)
     python docs/examples/trade_study.py --runs 2     # what the tests run (docs/api.md)
 
-Which of Gray & Maybeck's best and worst INS grades (0.4 and 4 nmi/h CEP), with stand-alone GPS or with GBAS
-corrections, reaches which category? The base is the shipped default profile with the accuracy verdict alone
-(integrity off: the solution-separation bank would triple the time). Prints the comparison table and the verdicts,
-and saves the study figure.
+Which of Gray & Maybeck's best and worst INS grades (0.4 and 4 nmi/h CEP), with stand-alone GPS L1 C/A (the
+broadcast Klobuchar ionosphere) or with SBAS L1 corrections (the default's receiver), reaches which category? The
+base is the shipped default profile with the accuracy verdict alone (integrity off: the solution-separation bank
+would triple the time). Prints the comparison table and the verdicts, and saves the study figure.
 """
 
 from __future__ import annotations
@@ -19,11 +19,11 @@ import approachsim as asim
 GRADES = ["nav-0.4", "nav-4.0"]
 """Gray & Maybeck's 0.4 and 4 nmi/h CEP navigation grades (docs/profiles.md, [sensors.imu] grade)."""
 SERVICES = {
-    "stand-alone": {"sensors.gnss.corrections": "none"},
-    "gbas": {"sensors.gnss.corrections": "gbas", "sensors.gnss.multipath_model": "do253"},
+    "stand-alone": {"sensors.gnss.service": "l1ca"},
+    "sbas": {"sensors.gnss.service": "sbas-l1"},
 }
-"""The GNSS service: stand-alone ranging, or pseudoranges corrected by a GBAS ground station (which needs the DO-253
-airframe multipath model)."""
+"""The GNSS service ([sensors.gnss] service, docs/gnss-services.md): stand-alone L1 C/A ranging, or SBAS L1
+corrections (RTCA DO-229)."""
 
 
 def main(runs: int = 20, seed: int = 1, out: Path | None = None, workers: int | None = None) -> asim.StudyResult:

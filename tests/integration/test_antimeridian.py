@@ -28,7 +28,7 @@ from approachsim.loop.errors import approach_errors
 from approachsim.profile import parse_profile
 
 ROOT = Path(__file__).resolve().parents[2]
-DEFAULT = ROOT / "profiles" / "default.toml"
+DEFAULT = ROOT / "tests" / "data" / "default-py.toml"
 
 pytestmark = pytest.mark.slow
 

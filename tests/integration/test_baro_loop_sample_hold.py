@@ -26,7 +26,7 @@ from approachsim.campaign.pipeline import open_loop_group
 from approachsim.profile import parse_profile
 
 ROOT = Path(__file__).resolve().parents[2]
-DEFAULT = ROOT / "profiles" / "default.toml"
+DEFAULT = ROOT / "tests" / "data" / "default-py.toml"
 
 pytestmark = pytest.mark.slow
 

@@ -12,7 +12,7 @@ import pytest
 from approachsim.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
-GOOD = (ROOT / "profiles" / "default.toml").read_text()
+GOOD = (ROOT / "tests" / "data" / "default-py.toml").read_text()
 
 
 def _edit(old: str, new: str) -> str:
@@ -78,7 +78,7 @@ def test_missing_file_exits_2(tmp_path, capsys):
 
 
 def test_bad_seed_option_exits_2(tmp_path, capsys):
-    assert main(["fly", str(ROOT / "profiles" / "default.toml"), "--out", str(tmp_path), "--seed", "-3"]) == 2
+    assert main(["fly", str(ROOT / "tests" / "data" / "default-py.toml"), "--out", str(tmp_path), "--seed", "-3"]) == 2
     _check(capsys.readouterr().err, "--seed")
 
 

@@ -13,7 +13,7 @@ import pytest
 from approachsim.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
-DEFAULT = str(ROOT / "profiles" / "default.toml")
+DEFAULT = str(ROOT / "tests" / "data" / "default-py.toml")
 
 
 @pytest.mark.parametrize(

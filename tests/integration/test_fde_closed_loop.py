@@ -20,7 +20,7 @@ from approachsim.profile import parse_profile
 
 pytestmark = pytest.mark.slow
 
-DEFAULT = Path(__file__).resolve().parents[2] / "profiles" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[2] / "tests" / "data" / "default-py.toml"
 PRN = 16
 ONSET_S = 20.0
 

@@ -27,11 +27,13 @@ from approachsim.nav.registry import FILTERS
 from approachsim.profile import parse_profile
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 
 @pytest.fixture(scope="module")
 def approach_2nmi():
-    path = PROFILES / "default.toml"
+    path = PY_DEFAULT
     data = tomllib.loads(path.read_text(encoding="utf-8"))
     data["runway"]["start_distance_nmi"] = 2.0
     return data, path

@@ -34,7 +34,7 @@ from approachsim.sensors import atmosphere as atm
 pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[2]
-DEFAULT = ROOT / "profiles" / "default.toml"
+DEFAULT = ROOT / "tests" / "data" / "default-py.toml"
 BASE = tomllib.loads(DEFAULT.read_text(encoding="utf-8"))
 LIMITS = {"light": (5.0, 10.0), "moderate": (10.0, 20.0)}
 

@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def _short_profile(tmp_path: Path) -> Path:
     """The default profile (light turbulence) started 2 nmi out; aircraft found in the repository's aircraft/."""
-    text = (ROOT / "profiles" / "default.toml").read_text()
+    text = (ROOT / "tests" / "data" / "default-py.toml").read_text()
     assert "start_distance_nmi = 10.0" in text
     path = tmp_path / "short.toml"
     path.write_text(text.replace("start_distance_nmi = 10.0", "start_distance_nmi = 2.0"))

@@ -25,7 +25,7 @@ from approachsim.profile import load_profile
 
 pytestmark = pytest.mark.slow
 
-DEFAULT = Path(__file__).resolve().parents[2] / "profiles" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[2] / "tests" / "data" / "default-py.toml"
 RATE_BOUND = 2.0e-10 * geo.OMEGA_JSBSIM + 1e-16
 """JSBSim's |q|^2 - 1 stays within 2e-10 (renormalized at |1 - |q|| >= 1e-10), rad/s."""
 

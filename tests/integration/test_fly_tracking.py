@@ -91,14 +91,14 @@ def _segment_rms_ft(r_ecef: np.ndarray, runway) -> tuple[float, float, float]:
 
 
 def _calm_default():
-    src = ROOT / "profiles" / "default.toml"
+    src = ROOT / "tests" / "data" / "default-py.toml"
     data = tomllib.loads(src.read_text())
     data["environment"].update(turbulence="none", wind_speed_kt=0.0)
     return parse_profile(data, source=src)
 
 
 def test_default_light_turbulence_ten_seeds():
-    profile = load_profile(ROOT / "profiles" / "default.toml")
+    profile = load_profile(ROOT / "tests" / "data" / "default-py.toml")
     approach = Approach(profile)
     seed = profile.run.seed
     rows = []
@@ -195,7 +195,7 @@ def test_crosswind_landing_is_decrabbed_at_touchdown():
     limit, 8.1 - 5.0 = 3.1 deg at 140 kt; 4.0 +- 0.55 deg over 200 landings, [2.7, 5.6]) within 2 deg, the bank below
     the 12 deg wing-tip criterion, and the main gear on the runway's touchdown zone, within 10 ft of the centreline
     (the alignment from 450 ft steers the main gear onto it: -1.95 +- 1.22 ft over 200 landings, [-5.4, 2.0])."""
-    src = ROOT / "profiles" / "default.toml"
+    src = ROOT / "tests" / "data" / "default-py.toml"
     data = tomllib.loads(src.read_text())
     data["environment"].update(wind_speed_kt=20.0, wind_from_deg=(data["runway"]["heading_true_deg"] + 90.0) % 360)
     approach = Approach(parse_profile(data, source=src), land=True)

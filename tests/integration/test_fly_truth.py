@@ -16,7 +16,7 @@ from approachsim.profile import load_profile, parse_profile
 pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[2]
-DEFAULT = ROOT / "profiles" / "default.toml"
+DEFAULT = ROOT / "tests" / "data" / "default-py.toml"
 
 
 def test_runs_are_reproducible_within_one_process():

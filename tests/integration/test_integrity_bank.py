@@ -19,7 +19,7 @@ from approachsim.profile import parse_profile
 
 pytestmark = pytest.mark.slow
 
-DEFAULT = Path(__file__).resolve().parents[2] / "profiles" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[2] / "tests" / "data" / "default-py.toml"
 DH = {"CAT I": 200 * units.FT, "CAT II": 100 * units.FT, "CAT III": 50 * units.FT}
 PRN = 14
 

@@ -12,7 +12,7 @@ import pytest
 from approachsim.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
-DEFAULT = str(ROOT / "profiles" / "default.toml")
+DEFAULT = str(ROOT / "tests" / "data" / "default-py.toml")
 
 
 @pytest.mark.parametrize("argv, needle", [

@@ -20,7 +20,7 @@ pytestmark = pytest.mark.slow
 
 
 def test_baro_step_detected_and_excluded_with_sensor_modes() -> None:
-    prof = load_profile(ROOT / "profiles" / "default.toml")
+    prof = load_profile(ROOT / "tests" / "data" / "default-py.toml")
     truth, _, _ = flight_truth(prof, 1, 0)
     t0 = float(truth.t_s[0])
     ep, _ = run_bank(prof, truth, 1, 5, sensor_modes_on=True)

@@ -74,7 +74,7 @@ from approachsim.sensors.faults import FaultSpec
 from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
-PROFILE = Path(__file__).resolve().parents[2] / "profiles" / "default.toml"
+PROFILE = Path(__file__).resolve().parents[2] / "tests" / "data" / "default-py.toml"
 RUNS = 20
 SEEDS = (101, 102, 103)
 ALPHA = 0.05

@@ -9,14 +9,16 @@ import pytest
 from approachsim.cli import main
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 
 @pytest.mark.parametrize(
     ("argv", "needle"),
     [
         (["navigate", "profiles/none.toml", "--out", "OUT"], "no such file"),
-        (["navigate", str(PROFILES / "default.toml"), "--out", "OUT", "--seed", "-1"], "--seed"),
-        (["navigate", str(PROFILES / "default.toml"), "--out", "OUT", "--run", "-2"], "--run"),
+        (["navigate", str(PY_DEFAULT), "--out", "OUT", "--seed", "-1"], "--seed"),
+        (["navigate", str(PY_DEFAULT), "--out", "OUT", "--run", "-2"], "--run"),
         (["navigate", "BAD", "--out", "OUT"], "nav.filter"),
         (["navigate", "TUNE", "--out", "OUT"], "nav.filter_tuning.gate"),
         (["navigate", "RATE", "--out", "OUT"], "nav.aiding_rate_hz"),
@@ -41,5 +43,5 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, needle):
 
 def test_bad_mode_is_an_argparse_error(capsys):
     with pytest.raises(SystemExit) as e:
-        main(["navigate", str(PROFILES / "default.toml"), "--out", "x", "--mode", "sideways"])
+        main(["navigate", str(PY_DEFAULT), "--out", "x", "--mode", "sideways"])
     assert e.value.code == 2

@@ -26,6 +26,8 @@ from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 RUNS = 100
 SEED = 1
@@ -33,7 +35,7 @@ SEED = 1
 
 @pytest.fixture(scope="module")
 def runs():
-    prof = load_profile(PROFILES / "default.toml")
+    prof = load_profile(PY_DEFAULT)
     ra, db = prof.sensors.radalt, prof.nav.terrain_database
     assert ra.bias_sigma_m > 0 and ra.markov_sigma_m > 0 and db.bias_sigma_m > 0 and db.correlated  # not white
     truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 90.0,

@@ -32,6 +32,8 @@ from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 RUNS = 100
 SEED = 1
@@ -39,7 +41,7 @@ SEED = 1
 
 def fly_and_sense():
     """The default profile flown once (seed SEED, run 0) and RUNS seeded sensor realizations on its truth."""
-    prof = load_profile(PROFILES / "default.toml")
+    prof = load_profile(PY_DEFAULT)
     assert prof.environment.turbulence == "light"
     flight = Approach(prof).fly(seed=SEED, run=0)
     assert flight.termination == "reached stop height"

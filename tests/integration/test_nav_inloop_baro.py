@@ -16,13 +16,15 @@ from approachsim.loop.closed_loop import NavInTheLoop
 from approachsim.profile import parse_profile
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 pytestmark = pytest.mark.slow
 
 
 @pytest.mark.parametrize("correction", ["aerodrome", "none"])
 def test_inloop_baro_samples_equal_the_sensor_models(correction):
-    path = PROFILES / "default.toml"
+    path = PY_DEFAULT
     data = tomllib.loads(path.read_text(encoding="utf-8"))
     data["runway"]["start_distance_nmi"] = 3.0
     data["runway"]["elevation_ft"] = 5434.0

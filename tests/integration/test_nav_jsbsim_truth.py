@@ -32,10 +32,12 @@ from approachsim.sensors.imu import true_increments
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 pytestmark = pytest.mark.slow
 
-PROFILE = load_profile(PROFILES / "default.toml")
+PROFILE = load_profile(PY_DEFAULT)
 
 
 @pytest.fixture(scope="module")

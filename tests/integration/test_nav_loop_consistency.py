@@ -20,6 +20,8 @@ from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 RUNS = 20
 
@@ -40,7 +42,7 @@ RUNS = 20
     ],
 )
 def test_filter_with_damping_loop_is_consistent(form, start):
-    prof = load_profile(PROFILES / "default.toml")
+    prof = load_profile(PY_DEFAULT)
     truth = synthetic.glidepath_descent(prof.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 90.0,
                                         ground_speed_mps=70.0)
     recs, st = measure_with_states(SensorSuite.from_profile(prof), truth, seed=1, runs=list(range(RUNS)))

@@ -16,7 +16,7 @@ pytestmark = pytest.mark.slow
 
 def _profile(tmp_path: Path) -> Path:
     """The shipped default, open loop, accuracy verdict alone, flight groups of 2 (a group falls in two shards)."""
-    text = (ROOT / "profiles" / "default.toml").read_text().replace('name = "default"', 'name = "sharded"', 1)
+    text = (ROOT / "tests" / "data" / "default-py.toml").read_text().replace('name = "default"', 'name = "sharded"', 1)
     p = tmp_path / "sharded.toml"
     p.write_text(text + "\n[evaluation]\nintegrity = false\nflight_group = 2\nseries_runs = 2\n")
     return p

@@ -14,7 +14,7 @@ import pytest
 from approachsim.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
-DEFAULT = str(ROOT / "profiles" / "default.toml")
+DEFAULT = str(ROOT / "tests" / "data" / "default-py.toml")
 
 
 def test_land_with_open_loop_exits_2_with_one_line(tmp_path, capsys):

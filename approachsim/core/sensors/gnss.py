@@ -13,7 +13,7 @@ same sample of a batch bit for bit.
     pseudorange_sum    range + scaled error terms + receiver clock for every run, nan where not selected
     pseudoranges       pseudorange_sum with the stand-alone receiver's terms (clock/ephemeris, iono, tropo, mp, noise)
     channel_sigmas     the navigation filter's GPS channel-state sigmas of a stand-alone budget, element by element
-    service_channel_sigmas  the filter's channel-state sigmas of a civil service (broadcast), element by element
+    service_channel_sigmas  a civil service's channel sigmas (broadcast, or the filter's own), element by element
     service_channel_terms   a civil service's broadcast range / iono / tropo / air sigmas, pierce distance
     gbas_scales        the GBAS-corrected residual's scales and nominal sigma per channel (gnss/gbas.py)
     gbas_channel_sigmas the navigation filter's GPS channel-state sigmas under GBAS, element by element
@@ -355,8 +355,9 @@ def channel_sigmas(el: np.ndarray, shell_m: float, ce_m: float, iono_m: float, t
 @njit(cache=True)
 def service_channel_sigmas(el: np.ndarray, p: np.ndarray, guard: bool, gse: np.ndarray, gmp: np.ndarray,
                            total: np.ndarray) -> None:
-    """A civil service's broadcast channel sigmas (m) at elevations el (N, k) rad, into gse, gmp, total (N, k),
-    element by element: gnss_errors.service_sigmas (slow, fast) and their RSS, DO-229's sigma_i; with guard, el <-
+    """A civil service's channel sigmas (m) at elevations el (N, k) rad, into gse, gmp, total (N, k), element by
+    element: gnss_errors.service_sigmas (slow, fast) and their RSS (DO-229's sigma_i with the broadcast parameters;
+    the navigation filter's own model with ServiceModel.filter_params' scales); with guard, el <-
     guard_elevation(el) (nav/noise.py's: nan 0.5 rad, at least 2 deg), else nan stays nan."""
     for i in range(el.shape[0]):
         for c in range(el.shape[1]):

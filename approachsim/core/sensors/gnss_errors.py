@@ -144,8 +144,10 @@ IONO_FREE = 1
 """iono_model: iono-free combination, the higher-order residual 40 / (261 + el_deg^2) + 0.018 m."""
 
 SERVICE_FIELDS = ("iono_model", "sigma_range_m", "sigma_vertical_iono_m", "tropo_zenith_m", "air_model", "gamma",
-                  "shell_m")
-"""The layout of a service's parameter vector (service_sigmas' `p`), by name (sensors/gnss/service.py packs it)."""
+                  "shell_m", "range_scale", "iono_scale", "tropo_scale", "air_scale")
+"""The layout of a service's parameter vector (service_sigmas' `p`), by name (sensors/gnss/service.py packs it).
+The four scales multiply the range, iono, tropo and air terms: ones for the broadcast sigmas, the nominal fractions
+for the navigation filter's own error model (service.py ServiceModel.filter_params)."""
 
 
 @njit(cache=True)
@@ -220,8 +222,8 @@ def pierce_distance_m(el_rad: float, shell_m: float) -> float:
 
 @njit(cache=True)
 def service_terms(el_rad: float, p: np.ndarray) -> tuple[float, float, float, float]:
-    """The broadcast 1-sigmas (m) of one satellite at elevation el_rad of the service with parameters p
-    (SERVICE_FIELDS): (range, ionosphere, troposphere, airborne):
+    """The 1-sigmas (m) of one satellite at elevation el_rad of the service with parameters p (SERVICE_FIELDS):
+    (range, ionosphere, troposphere, airborne), each times its scale p[7:11] (ones: the broadcast sigmas):
 
         range  sigma_flt (SBAS L1), sigma_DFRE (DFMC SBAS) or sigma_URA (stand-alone)
         iono   F_pp sigma_vertical (IONO_L1: sigma_UIVE, or the Klobuchar tau_vert), F_pp at h_I = shell_m
@@ -236,13 +238,13 @@ def service_terms(el_rad: float, p: np.ndarray) -> tuple[float, float, float, fl
     air = sigma_air_m(el_rad, air_model)
     if air_model != AIR_ED259A:
         air *= p[5]
-    return p[1], iono, p[3] * tropo_mapping(math.sin(el_rad)), air
+    return p[7] * p[1], p[8] * iono, p[9] * p[3] * tropo_mapping(math.sin(el_rad)), p[10] * air
 
 
 @njit(cache=True)
 def service_sigmas(el_rad: float, p: np.ndarray) -> tuple[float, float]:
-    """(slow, fast) broadcast 1-sigmas (m) of one satellite (service_terms): the navigation filter's channel states
-    (nav/noise.py), slow = sqrt(range^2 + iono^2 + tropo^2), fast = air. Their RSS is DO-229's
-    sigma_i^2 = sigma_flt^2 + sigma_UIRE^2 + sigma_air^2 + sigma_tropo^2 (App. J J.1)."""
+    """(slow, fast) 1-sigmas (m) of one satellite (service_terms): slow = sqrt(range^2 + iono^2 + tropo^2), fast =
+    air. With unit scales their RSS is DO-229's sigma_i^2 = sigma_flt^2 + sigma_UIRE^2 + sigma_air^2 + sigma_tropo^2
+    (App. J J.1); with the nominal fractions, the navigation filter's channel states (nav/noise.py)."""
     r, i, t, a = service_terms(el_rad, p)
     return math.sqrt(r * r + i * i + t * t), a

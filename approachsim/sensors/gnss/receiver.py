@@ -210,9 +210,8 @@ class GnssErrorBudget:
         (None: gbas.REFERENCE_GEOMETRY)."""
         if self.gbas is not None:
             return self.gbas.channel_sigmas_m(el_rad, x_air_m, dh_m, v_air_mps)
-        if self.service is not None:  # the broadcast sigmas (service.py), nav/noise.py's guard already applied
-            slow, fast, _ = self.service.channel_sigmas_m(el_rad, guard=False)
-            return slow, fast
+        if self.service is not None:  # the filter's own model (service.py), nav/noise.py's guard already applied
+            return self.service.filter_channel_sigmas_m(el_rad)
         gse = np.sqrt(self.clock_ephemeris_m**2 + (self.iono_zenith_m * iono_obliquity(el_rad)) ** 2
                       + (self.tropo_zenith_m * tropo_mapping(el_rad)) ** 2)
         gmp = self.multipath_sigma_m(el_rad) if self.multipath_model == "do253" else self.multipath_m

@@ -45,7 +45,7 @@ Broadcast terms:
 Truth (sensors/gnss/receiver.py draws it): the broadcast sigmas are overbounds (they must bound the tails of every
 satellite's error at 1e-7), so the errors a receiver sees are smaller. The truth is drawn from correlated
 processes at a fraction of each broadcast term ([sensors.gnss] truth = "nominal"; "broadcast" draws every term at
-its full broadcast sigma and independent per channel: the filter's own model, for consistency checks):
+its full broadcast sigma and independent per channel, a worst case):
 
   range    per satellite, Gauss-Markov; SBAS correction residual (fast + long-term) 0.3 sigma_flt / sigma_DFRE,
            tau 600 s; stand-alone broadcast clock and ephemeris 0.3 sigma_URA (0.72 m: the measured GPS signal-in-
@@ -70,6 +70,12 @@ J. Hughes Technical Center's WAAS Performance Analysis Report #10 (Nov 2004) giv
 1.0-1.8 m against 95 % VPLs of 25-43 m at its sites; with VPL = 5.33 sigma_V that is a true vertical sigma about
 0.11-0.18 of the broadcast one. A range-domain 0.3 with the correlated iono field gives a position ratio within a
 factor two of that on the conservative side (docs/profiles.md gives the measured figures).
+
+Filter ([sensors.gnss] filter_model, default the truth's): the protection levels weight with the broadcast sigmas
+(DO-229 requires it of the PLs); the hybrid INS/GNSS navigation filter carries its own model of the nominal error
+processes: per channel a slow state at sqrt((f_r range)^2 + (f_i iono)^2 + (f_t tropo)^2) and a fast one at
+f_a air, the f the truth's fractions (filter_params). A filter weighting with the overbounds cannot be consistent
+against what they overbound (docs/gnss-services.md gives the argument and the measured e^2/P).
 """
 
 from __future__ import annotations
@@ -126,6 +132,9 @@ AADS = ("A", "B", "ED-259A")
 """Airborne models: AAD-A, AAD-B (single frequency; x gamma on dual), the ED-259A dual-frequency model."""
 TRUTHS = ("nominal", "broadcast")
 """Truth draws: at the argued fractions of the broadcast sigmas, or at the broadcast sigmas."""
+FILTER_MODELS = ("nominal", "broadcast")
+"""The navigation filter's own channel error model: the nominal error processes (the truth's fractions of the
+broadcast sigmas) or the broadcast sigmas; the protection levels use the broadcast sigmas either way."""
 
 TRUTH_FRACTIONS: Mapping[str, tuple[float, float, float, float]] = MappingProxyType({
     "sbas-l1": (0.3, 0.3, 0.5, 0.7),
@@ -184,6 +193,8 @@ class ServiceModel:
     """"A" | "B" | "ED-259A"; None: "ED-259A" for the DFMC services, "B" for the others."""
     ura_m: float = URA_M
     truth: str = "nominal"
+    filter_model: str | None = None
+    """"nominal" | "broadcast": the navigation filter's channel error model; None: the truth's (module docstring)."""
     site_lat_rad: float = math.radians(45.0)
     """The approach's location (the runway threshold; profile.py sets it): the Klobuchar bound's geomagnetic
     latitude."""
@@ -204,6 +215,10 @@ class ServiceModel:
             raise ValueError(f"aad must be one of {', '.join(AADS)}; got {self.aad!r}")
         if self.truth not in TRUTHS:
             raise ValueError(f"truth must be one of {', '.join(TRUTHS)}; got {self.truth!r}")
+        if self.filter_model is None:
+            object.__setattr__(self, "filter_model", self.truth)
+        if self.filter_model not in FILTER_MODELS:
+            raise ValueError(f"filter_model must be one of {', '.join(FILTER_MODELS)}; got {self.filter_model!r}")
 
     @property
     def sbas(self) -> bool:
@@ -257,13 +272,24 @@ class ServiceModel:
         """gnss_errors' airborne model code of `aad`."""
         return {"A": ge.AIR_AAD_A, "B": ge.AIR_AAD_B, "ED-259A": ge.AIR_ED259A}[str(self.aad)]
 
-    def params(self) -> Array:
-        """The packed parameter vector of gnss_errors.service_terms (SERVICE_FIELDS order)."""
+    def params(self, scales: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)) -> Array:
+        """The packed parameter vector of gnss_errors.service_terms (SERVICE_FIELDS order): the broadcast sigmas, or
+        with `scales` on the (range, iono, tropo, air) terms."""
         vals = {"iono_model": ge.IONO_FREE if self.dual_frequency else ge.IONO_L1,
                 "sigma_range_m": self.sigma_range_m(), "sigma_vertical_iono_m": self.sigma_vertical_iono_m(),
                 "tropo_zenith_m": ge.MOPS_TROPO_ZENITH_M, "air_model": self.air_model(), "gamma": self.gamma(),
-                "shell_m": IONO_SHELL_M}
+                "shell_m": IONO_SHELL_M, "range_scale": scales[0], "iono_scale": scales[1],
+                "tropo_scale": scales[2], "air_scale": scales[3]}
         return np.array([float(vals[k]) for k in ge.SERVICE_FIELDS])
+
+    def filter_fractions(self) -> tuple[float, float, float, float]:
+        """The navigation filter's channel sigmas / broadcast sigmas of (range, iono, tropo, air): the nominal
+        truth's fractions (filter_model = "nominal") or ones ("broadcast")."""
+        return (1.0, 1.0, 1.0, 1.0) if self.filter_model == "broadcast" else TRUTH_FRACTIONS[self.service]
+
+    def filter_params(self) -> Array:
+        """The packed parameters of the navigation filter's channel error model (params at filter_fractions)."""
+        return self.params(self.filter_fractions())
 
     def at_site(self, lat_rad: float, lon_rad: float) -> ServiceModel:
         """This service at the approach's location (the Klobuchar bound's geomagnetic latitude)."""
@@ -293,6 +319,15 @@ class ServiceModel:
         out = tuple(np.empty(e2.shape) for _ in range(3))
         gk.service_channel_sigmas(e2, self.params(), guard, *out)
         return tuple(o.reshape(el.shape) for o in out)  # type: ignore[return-value]
+
+    def filter_channel_sigmas_m(self, el_rad: Array) -> tuple[Array, Array]:
+        """(slow, fast) 1-sigmas (m) of the navigation filter's channel states at elevations el_rad (already guarded
+        by nav/noise.py), rad: its own error model (filter_params), not the broadcast one."""
+        el = np.asarray(el_rad, dtype=float)
+        e2 = np.ascontiguousarray(el.reshape(-1, el.shape[-1]) if el.ndim else el.reshape(1, 1))
+        out = tuple(np.empty(e2.shape) for _ in range(3))
+        gk.service_channel_sigmas(e2, self.filter_params(), False, *out)
+        return out[0].reshape(el.shape), out[1].reshape(el.shape)
 
     def sigma_m(self, el_rad: Array) -> Array:
         """DO-229's sigma_i (m) at elevations el_rad, rad (no guard: nan stays nan)."""

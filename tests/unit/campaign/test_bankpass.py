@@ -30,7 +30,9 @@ from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
-DEFAULT = load_profile(PROFILES / "default.toml")
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
+DEFAULT = load_profile(PY_DEFAULT)
 SEED = 4
 
 

@@ -130,7 +130,7 @@ def test_a_real_profile_travels_to_worker_processes():
 
     from approachsim.profile import load_profile
 
-    prof = load_profile(ROOT / "profiles" / "default.toml")
+    prof = load_profile(ROOT / "tests" / "data" / "default-py.toml")
     res = run_campaign(prof, seed=1, runs=4, run_fn=profile_run, workers=2, per_task=1, progress=False)
     # exact: the profile's decision height passed through (a parsed 200.0)
     assert not res.failed and all(r.scalars["dh_cat1_ft"] == 200.0 for r in res.results)

@@ -18,7 +18,7 @@ from approachsim.profile import load_profile
 from approachsim.seeding import stream
 
 ROOT = Path(__file__).resolve().parents[3]
-BASE = ROOT / "profiles" / "default.toml"
+BASE = ROOT / "tests" / "data" / "default-py.toml"
 
 
 def _write(tmp_path: Path, body: str) -> Path:
@@ -146,6 +146,6 @@ def test_every_shipped_study_file_is_valid():
         assert load_study(p).variants, p
     s = load_study(ROOT / "studies" / "realism-defaults.toml")
     assert [v.name[0] for v in s.variants] == list("ABCDEFGH")
-    base = load_profile(ROOT / "profiles" / "default.toml")
+    base = load_profile(ROOT / "tests" / "data" / "default-py.toml")
     assert s.variants[-1].profile.sensors == base.sensors and s.variants[-1].profile.nav == base.nav
     assert s.variants[0].profile.nav.baro_loop == "none" and s.variants[0].profile.sensors.gnss.epoch == "fixed"

@@ -13,21 +13,24 @@ from approachsim.loop.closed_loop import NavInTheLoop
 from approachsim.profile import load_profile, parse_profile
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 
 def _profile(name: str, **sections):
-    d = tomllib.loads((PROFILES / name).read_text(encoding="utf-8"))
+    path = PY_DEFAULT if name == "default.toml" else PROFILES / name
+    d = tomllib.loads(path.read_text(encoding="utf-8"))
     for sec, kv in sections.items():
         top, _, sub = sec.partition("__")
         tgt = d.setdefault(top, {})
         if sub:
             tgt = tgt.setdefault(sub, {})
         tgt.update(kv)
-    return parse_profile(d, source=(PROFILES / name).resolve())
+    return parse_profile(d, source=path.resolve())
 
 
 def test_default_profile_takes_every_fast_form():
-    src = NavInTheLoop(load_profile(PROFILES / "default.toml"), seed=1, run=0, max_time_s=30.0)
+    src = NavInTheLoop(load_profile(PY_DEFAULT), seed=1, run=0, max_time_s=30.0)
     p = src.path
     assert (p.row, p.epoch, p.baro, p.sigmas) == ("compiled", "fused", "compiled", "compiled")
     assert p.reasons == () and p.name == "row=compiled epoch=fused baro=compiled sigmas=compiled"
@@ -48,7 +51,7 @@ def test_a_slower_part_says_why(sections, part, name, why):
 
 
 def test_oracle_switches_choose_the_numpy_paths():
-    prof = load_profile(PROFILES / "default.toml")
+    prof = load_profile(PY_DEFAULT)
     src = NavInTheLoop(prof, seed=1, run=0, max_time_s=30.0)
     src.direct_inputs = False
     assert src.path.epoch == "records" and "oracle" in src.path.reason("epoch")
@@ -67,7 +70,7 @@ def test_gbas_takes_the_records_and_the_numpy_sigmas():
 def test_open_loop_path_follows_the_shared_covariance():
     from approachsim.nav.system import NavSystem
 
-    assert paths.open_loop_path(NavSystem.from_profile(load_profile(PROFILES / "default.toml"))) == "epoch=shared"
+    assert paths.open_loop_path(NavSystem.from_profile(load_profile(PY_DEFAULT))) == "epoch=shared"
     rob = NavSystem.from_profile(_profile("default.toml", nav={"filter": "rkf-gate"}))
     assert paths.open_loop_path(rob) == "epoch=generic"
 
@@ -78,7 +81,7 @@ def test_a_closed_loop_run_records_its_path():
     from approachsim.campaign.pipeline import closed_loop_group
     from approachsim.campaign.result import RunResult
 
-    (r,) = closed_loop_group(load_profile(PROFILES / "default.toml"), 1, [0])
+    (r,) = closed_loop_group(load_profile(PY_DEFAULT), 1, [0])
     assert r.ok, r.error
     loop, rest = r.path.split(" ", 1)
     assert loop in ("flight=direct", "flight=python")

@@ -22,10 +22,12 @@ from approachsim.profile import parse_profile
 pytestmark = pytest.mark.equality
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 
 def _profile(name: str, baro: dict | None = None, **nav):
-    path = PROFILES / name
+    path = PY_DEFAULT if name == "default.toml" else PROFILES / name
     d = tomllib.loads(path.read_text(encoding="utf-8"))
     d.setdefault("nav", {}).update(nav)
     if baro:
@@ -139,7 +141,7 @@ def test_direct_epoch_inputs_equal_the_records(name, nav, baro):
 def test_configurations_without_direct_inputs_take_the_records(name, faults):
     """GBAS ranging and a faulted sensor have no direct form: the compiled epoch takes its inputs from the
     records (FastEpoch.direct False) and flies."""
-    path = PROFILES / name
+    path = PY_DEFAULT if name == "default.toml" else PROFILES / name
     d = tomllib.loads(path.read_text(encoding="utf-8"))
     if faults is not None:
         d["faults"] = faults
@@ -154,9 +156,9 @@ def test_compiled_channel_sigmas_equal_the_budget_numpy(multipath_model):
     """The compiled epoch's GPS channel sigmas (numpy's cos, sin, exp, the rest compiled in numpy's order:
     NavInTheLoop._noise_arrays) are the receiver budget's numpy formulas' (`_noise_arrays_numpy`) bit for bit, at
     elevations over the whole sky, below the noise model's 2 deg floor and nan (no elevation: 0.5 rad)."""
-    d = tomllib.loads((PROFILES / "default.toml").read_text(encoding="utf-8"))
+    d = tomllib.loads(PY_DEFAULT.read_text(encoding="utf-8"))
     d["sensors"]["gnss"]["multipath_model"] = multipath_model
-    prof = parse_profile(d, source=(PROFILES / "default.toml").resolve())
+    prof = parse_profile(d, source=PY_DEFAULT.resolve())
     src, _, _ = _fly_inputs(prof, True, seconds=1.5)
     assert src._fast.sig is not None
     rng = np.random.default_rng(26)

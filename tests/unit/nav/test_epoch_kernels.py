@@ -30,7 +30,7 @@ from approachsim.profile import load_profile
 
 pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
 
-PROFILE = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+PROFILE = load_profile(Path(__file__).resolve().parents[3] / "tests" / "data" / "default-py.toml")
 RTOL = 1e-12
 """Kernel vs numpy oracle on the same inputs, relative: 4500 eps. An error-model entry is a sum of at most three
 products (k ~ 6, 1.3e-15), a Joseph update's entry a few n-term sums (n <= 70, k ~ 3n ~ 200 eps = 5e-14): 1e-12 holds

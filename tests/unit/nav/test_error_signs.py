@@ -14,7 +14,7 @@ from approachsim import synthetic
 from approachsim.loop.errors import approach_errors
 from approachsim.profile import load_profile
 
-PROFILE = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+PROFILE = load_profile(Path(__file__).resolve().parents[3] / "tests" / "data" / "default-py.toml")
 
 
 def test_nse_is_minus_the_navigation_error_in_path_terms():

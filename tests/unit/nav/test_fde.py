@@ -27,7 +27,7 @@ from approachsim.profile import parse_profile
 from approachsim.seeding import stream
 from approachsim.sensors.suite import SensorSuite
 
-DEFAULT = Path(__file__).resolve().parents[3] / "profiles" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[3] / "tests" / "data" / "default-py.toml"
 PRN = 16  # in view for the whole approach at the default epoch (elevation about 50 deg)
 ONSET_S = 30.0
 TTA_S = REQUIREMENTS["CAT II"].time_to_alert_s

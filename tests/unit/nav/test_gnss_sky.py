@@ -12,13 +12,15 @@ from approachsim.profile import load_profile
 from approachsim.sensors.gnss.receiver import do253_multipath_sigma_m
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 
 def test_per_class_channel_qd_equals_the_discretized_model_at_that_sky():
     """The shared-covariance path builds Phi, Qd once and resets the GPS channel states' Qd entries to a class's
     own elevations; that must equal discretizing the error model with that sky's noise (the gse / gmp states
     are decoupled first-order Markov states), and the gmp entries follow the DO-253 sigma at each elevation."""
-    nav = NavSystem.from_profile(load_profile(PROFILES / "default.toml"))
+    nav = NavSystem.from_profile(load_profile(PY_DEFAULT))
     lay = nav.layout
     assert lay.has("gse")
     rng = np.random.default_rng(3)

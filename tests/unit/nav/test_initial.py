@@ -20,7 +20,7 @@ from approachsim.seeding import stream
 from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
-PROFILE = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+PROFILE = load_profile(Path(__file__).resolve().parents[3] / "tests" / "data" / "default-py.toml")
 
 
 def _linear_case(seed: int = 3):

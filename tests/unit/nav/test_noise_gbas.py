@@ -22,7 +22,9 @@ from approachsim.sensors.gnss import gbas as gb
 from approachsim.sensors.gnss.receiver import iono_obliquity, tropo_mapping
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
-DEFAULT = PROFILES / "default.toml"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
+DEFAULT = PY_DEFAULT
 
 
 def _nav(**gnss) -> NavSystem:

@@ -24,7 +24,7 @@ from approachsim.sensors.faults import FaultSpec
 from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite
 
-DEFAULT = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+DEFAULT = load_profile(Path(__file__).resolve().parents[3] / "tests" / "data" / "default-py.toml")
 SEED = 3
 RUNS = [0, 1, 2]
 

@@ -22,8 +22,10 @@ from approachsim.sensors.states import measure_with_states
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
-PROFILE = load_profile(PROFILES / "default.toml")
+PROFILE = load_profile(PY_DEFAULT)
 
 
 def _truth(duration_s=60.0):

@@ -23,8 +23,10 @@ from approachsim.sensors.suite import SensorSuite
 pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
-PROFILE = load_profile(PROFILES / "default.toml")
+PROFILE = load_profile(PY_DEFAULT)
 
 
 def _truth(duration_s: float):
@@ -74,7 +76,7 @@ def test_shared_runs_bit_identical_in_any_batch_also_with_a_departing_schedule(e
         assert not np.array_equal(batch[0].P_diag, batch[2].P_diag)
 
 
-@pytest.mark.parametrize("path", [PROFILES / "default.toml", PROFILES / "gray-maybeck.toml"])  # GPS; + pseudolite
+@pytest.mark.parametrize("path", [PY_DEFAULT, PROFILES / "gray-maybeck.toml"])  # GPS; + pseudolite
 def test_shared_matches_per_run_filters_to_a_small_fraction_of_sigma(path):
     prof = load_profile(path)  # default: per-run skies (one class per run); Gray & Maybeck: one fixed sky
     truth = _truth(20.0)

@@ -16,7 +16,7 @@ from approachsim.nav.system import NavSystem
 from approachsim.profile import load_profile
 from approachsim.seeding import stream, substream
 
-_DEFAULT = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+_DEFAULT = load_profile(Path(__file__).resolve().parents[3] / "tests" / "data" / "default-py.toml")
 PROFILE = replace(_DEFAULT, nav=replace(_DEFAULT.nav, initial_error=replace(_DEFAULT.nav.initial_error, start="prior")))
 """The default profile with the prior start: these tests call NavSystem.start alone (no sensor states)."""
 N = 2000  # realizations: the relative sd of a sigma estimate is 1 / sqrt(2 N) = 1.6 %; bounds below are 5 sd

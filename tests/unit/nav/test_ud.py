@@ -25,6 +25,8 @@ from approachsim.nav.ud import (
 )
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 
 def _spd(rng: np.random.Generator, n: int) -> np.ndarray:
@@ -257,7 +259,7 @@ def test_ud_variants_run_inside_the_navigation_system_named_in_the_profile() -> 
     from approachsim.sensors.states import measure_with_states
     from approachsim.sensors.suite import SensorSuite
 
-    profile = load_profile(PROFILES / "default.toml")
+    profile = load_profile(PY_DEFAULT)
     truth = synthetic.glidepath_descent(profile.runway.frame, rate_hz=20.0, start_distance_m=70.0 * 20,
                                         ground_speed_mps=70.0)
     recs, st = measure_with_states(SensorSuite.from_profile(profile), truth, seed=3, runs=0)

@@ -30,7 +30,9 @@ from approachsim.sensors.gnss.receiver import draw_receiver_clock
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
-DEFAULT = PROFILES / "default.toml"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
+DEFAULT = PY_DEFAULT
 
 
 def _profile(**gnss):

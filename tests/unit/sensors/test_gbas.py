@@ -35,7 +35,9 @@ from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite, SuiteErrors
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
-DEFAULT = PROFILES / "default.toml"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
+DEFAULT = PY_DEFAULT
 SCALED = ("ground", "iono", "tropo", "multipath", "noise")
 """The unit Gauss-Markov series the kernel scales."""
 TERMS = (*SCALED, "white")

@@ -33,12 +33,14 @@ from approachsim.sensors.suite import SensorSuite
 pytestmark = pytest.mark.equality  # also run compiled for the generic CPU target (scripts/test.sh)
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 
 @pytest.fixture(scope="module")
 def approach():
     """The default profile's synthetic approach (its runway, 10 nmi, 1 Hz GNSS rows) and receiver."""
-    p = load_profile(PROFILES / "default.toml")
+    p = load_profile(PY_DEFAULT)
     truth = synthetic.profile_descent(p, rate_hz=10.0)
     return truth, SensorSuite.from_profile(p).sensors["gnss"]
 

@@ -143,6 +143,30 @@ def test_truth_is_overbounded() -> None:
                 assert not np.any(sc["iono_common"]) and not np.any(sc["tropo"])
 
 
+def test_filter_model_is_the_nominal_processes_and_pls_keep_the_broadcast() -> None:
+    """The navigation filter's channel sigmas (filter_model = "nominal", the truth's default) are the nominal truth's
+    fractions of each broadcast term, slow = RSS of range, iono, tropo and fast = air, computed here from terms_m;
+    the broadcast sigma_i (what the protection levels use) does not depend on filter_model; filter_model =
+    "broadcast" gives the broadcast terms back; and the receiver budget hands nav/noise.py the filter's model."""
+    from approachsim.sensors.gnss.receiver import make_budget
+    from approachsim.sensors.gnss.service import TRUTH_FRACTIONS
+
+    el = np.radians(np.array([[5.0, 12.0, 30.0, 60.0, 90.0]]))
+    for name in ("sbas-l1", "dfmc-sbas", "dfmc", "l1ca", "py-pps"):
+        nom, bc = ServiceModel(name), ServiceModel(name, filter_model="broadcast")
+        assert nom.filter_model == "nominal" and ServiceModel(name, truth="broadcast").filter_model == "broadcast"
+        t = nom.terms_m(el)
+        fr = np.array(TRUTH_FRACTIONS[name])
+        slow, fast = nom.filter_channel_sigmas_m(el)
+        np.testing.assert_allclose(slow, np.sqrt(((fr[:3] * t[..., :3]) ** 2).sum(-1)), rtol=1e-14)
+        np.testing.assert_allclose(fast, fr[3] * t[..., 3], rtol=1e-14)
+        np.testing.assert_allclose(nom.sigma_m(el), bc.sigma_m(el), rtol=0, atol=0)
+        np.testing.assert_allclose(np.hypot(*bc.filter_channel_sigmas_m(el)), bc.sigma_m(el), rtol=1e-14)
+        assert np.all(np.hypot(slow, fast) < 0.75 * nom.sigma_m(el))
+        bud = make_budget("C/A", service=nom)
+        np.testing.assert_array_equal(bud.channel_sigmas_m(el)[0], slow)
+
+
 # --- the profile keys: one line naming the field, exit 2 at the command line (docs/contract.md) --------------------
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
@@ -169,6 +193,9 @@ def _profile(drop: tuple[str, ...] = (), **gnss: object):
     ((), {"code": "C/A"}, "sensors.gnss.code"),
     ((), {"aad": "ED-259A"}, "sensors.gnss.aad"),
     ((), {"truth": "optimistic"}, "sensors.gnss.truth"),
+    ((), {"filter_model": "overbound"}, "sensors.gnss.filter_model"),
+    (("service", "udre_index", "give_index", "aad", "truth"), {"filter_model": "nominal"},
+     "sensors.gnss.filter_model"),  # a service key with no service
     (("service",), {}, "sensors.gnss.udre_index"),  # SBAS keys with no service at all
 ])
 def test_bad_service_keys_name_the_field(drop, gnss, field) -> None:

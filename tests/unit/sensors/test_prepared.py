@@ -17,7 +17,7 @@ from approachsim.sensors.config import PseudoliteConfig
 from approachsim.sensors.faults import FaultSpec
 from approachsim.sensors.suite import SensorSuite
 
-PROFILE = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+PROFILE = load_profile(Path(__file__).resolve().parents[3] / "tests" / "data" / "default-py.toml")
 
 FAULTS = (
     FaultSpec("gnss", "outage", start_s=40.0, end_s=60.0),

@@ -16,10 +16,12 @@ from approachsim.sensors.config import PseudoliteConfig
 from approachsim.sensors.suite import SensorSuite
 
 PROFILES = Path(__file__).resolve().parents[3] / "profiles"
+PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
+"""The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 
 def _full_suite():
-    p = load_profile(PROFILES / "default.toml")
+    p = load_profile(PY_DEFAULT)
     cfg = p.sensors
     from dataclasses import replace
 
@@ -46,7 +48,7 @@ def setup():
 
 
 def test_default_profile_suite_is_seed_002(setup):
-    p = load_profile(PROFILES / "default.toml")
+    p = load_profile(PY_DEFAULT)
     s = SensorSuite.from_profile(p)
     assert set(s.sensors) == {"imu", "baro", "radalt", "gnss"}
     assert s.sensors["imu"].grade.name == "nav-2.0"
@@ -96,7 +98,7 @@ def test_stepwise_apply_equals_batch_for_every_sensor(setup):
 
 
 def test_profile_without_sensors_loads_with_defaults_and_errors_name_fields():
-    data = tomllib.loads((PROFILES / "default.toml").read_text())
+    data = tomllib.loads((PY_DEFAULT).read_text())
     data.pop("sensors", None)
     p = parse_profile(data)
     assert p.sensors.imu.grade == "nav-2.0" and p.faults == ()

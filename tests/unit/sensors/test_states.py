@@ -16,7 +16,7 @@ from approachsim.sensors.imu import true_increments
 from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite, SuiteErrors
 
-PROFILE = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+PROFILE = load_profile(Path(__file__).resolve().parents[3] / "tests" / "data" / "default-py.toml")
 
 
 def _setup(row: int = 0):
