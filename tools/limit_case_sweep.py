@@ -26,7 +26,8 @@ def table(paths: list[str]) -> str:
         for name, m in s["modes"].items():
             for cat, c in m["categories"].items():
                 w = c["worst_fault"]
-                ch = "" if w["channel"] in (None, -1) else f", channel {w['channel']:.0f}"
+                who = "PRN" if name.startswith("sat-") else "unit"
+                ch = "" if w["channel"] in (None, -1) else f", {who} {w['channel']:.0f}"
                 fault = (f"{w['magnitude']:.3g} {w['unit']} {m['kind']}, onset {w['onset']}{ch}"
                          f"{' (detected later)' if w['detected_later'] else ' (never detected)'}")
                 lines.append(f"| {s['profile']} | {name} | {m['points']} | {cat} | {c['max_ratio']:.2f} "
