@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from approachsim.campaign.bank_modes import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
+from approachsim.campaign.bank_modes import mode_name
 from approachsim.nav import initial, ins
 
 Array = np.ndarray
@@ -60,13 +60,8 @@ class PreFault:
 
 def row_name(code: int) -> str:
     """The measurement row name of a bank mode code (campaign/bank_modes.py; nav/observations.Source.name)."""
-    if code >= 0:
-        return f"gps{code:02d}"
-    if code == BARO_MODE:
-        return "baro"
-    if code == RADALT_MODE:
-        return "radalt"
-    return f"pl{PSEUDOLITE_MODE - code}"
+    kind, _, k = mode_name(code).partition(" ")
+    return {"gnss": f"gps{int(k or 0):02d}", "pseudolite": f"pl{k}"}.get(kind, kind)
 
 
 def estimate_offsets(nav: Any, truth: Any, obs: Any, P_conv: Array, modes: Array, fault: PreFault

@@ -154,6 +154,10 @@ def test_onset_before_the_window_and_the_prior_per_approach() -> None:
     assert pre_fault(MODES["baro-step"], {"age_at_start_s": 60.0, "channel_index": -1, "magnitude": 5.0}
                      ) == PreFault("baro", "step", 5.0, 60.0)
     assert pre_fault(MODES["baro-step"], {"age_at_start_s": 0.0, "channel_index": -1, "magnitude": 5.0}) is None
+    # the faulted source's measurement row (nav/observations.Source.name): GNSS channel 7, pseudolite unit 1
+    assert pre_fault(MODES["sat-ramp"], {"age_at_start_s": 5.0, "channel_index": 7, "magnitude": 0.1}).row == "gps07"
+    assert pre_fault(MODES["pseudolite-step"], {"age_at_start_s": 5.0, "channel_index": 1, "magnitude": 3.0}
+                     ).row == "pl1"
 
 
 def test_pseudolite_unit_from_the_profile() -> None:
