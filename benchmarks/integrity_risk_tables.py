@@ -68,25 +68,30 @@ def main() -> None:
                                     "before the lowest DH")
             print(f"| {name} | {g(m['prior'])} [{m['prior_mark']}] | {m['samples']} | {m['estimator']['steps']} | "
                   + " | ".join(cells) + f" | {w} |")
-        print("\n| category | P(HMI) | lower | upper (worst bin) | allocation | verdict (specific risk) | "
-              "average upper | average verdict | P(FA)/15 s (Gaussian, overbound) | P(FA)/15 s MC upper | FA verdict |")
-        print("|---|---|---|---|---|---|---|---|---|---|---|")
+        print("\n| category | P(HMI) | lower | upper (worst bin) | sourced upper | allocation | verdict (sourced "
+              "priors, specific risk) | with assumed priors | average upper | average verdict | P(FA)/15 s (Gaussian, "
+              "overbound) | P(FA)/15 s MC upper | FA verdict |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         for cat, c in cats.items():
-            print(f"| {cat} | {g(c['p_hmi'])} | {g(c['p_hmi_lower'])} | {g(c['p_hmi_upper'])} | {g(c['allocation'])} "
-                  f"{c['allocation_unit']} | {c['verdict']} | {g(c['p_hmi_average_upper'])} | {c['verdict_average']} | "
+            print(f"| {cat} | {g(c['p_hmi'])} | {g(c['p_hmi_lower'])} | {g(c['p_hmi_upper'])} | "
+                  f"{g(c['p_hmi_upper_sourced'])} | {g(c['allocation'])} {c['allocation_unit']} | {c['verdict']}"
+                  f"{' ([U]: ' + ', '.join(c['unsourced_terms']) + ')' if c['unsourced_terms'] else ''} | "
+                  f"{c['verdict_assumed']} | {g(c['p_hmi_average_upper'])} | {c['verdict_average']} | "
                   f"{g(c['p_false_alert_per_15s_gaussian'])} | "
                   f"{g(c['p_false_alert_per_15s_upper_mc'])} | {c['false_alert_verdict']} |")
         wb = [(cat, k, t) for cat, c in cats.items() for k, t in c["terms"].items() if "worst_bin" in t]
         if wb:
-            print("\n| mode | category | worst bin | onset third | P(HMI given bin) [lower, upper] | samples (n_eff) | "
+            print("\n| mode | category | worst bin | onset | P(HMI given bin) [lower, upper] | samples (n_eff) | "
                   "x prior | shown | average upper x prior |")
             print("|---|---|---|---|---|---|---|---|---|")
             for cat, k, t in wb:
                 b = t["worst_bin"]
                 print(f"| {k} | {cat} | {b['magnitude'][0]:g}-{b['magnitude'][1]:g} {r['modes'][k]['unit']} | "
-                      f"{b['onset_third']}/3 | {g(b['probability'])} [{g(b['lower'])}, {g(b['upper'])}] | "
+                      f"{b.get('onset') or str(b['onset_third']) + '/3'} | "
+                      f"{g(b['probability'])} [{g(b['lower'])}, {g(b['upper'])}] | "
                       f"{b['samples']:.0f} ({b['from']}) | {g(t['specific_upper'])} | "
-                      f"{'yes' if t['specific_shown'] else 'no'} | {g(t['upper'])} |")
+                      f"{'no [U]' if t.get('prior_mark') == 'U' else ('yes' if t['specific_shown'] else 'no')} | "
+                      f"{g(t['upper'])} |")
         print("\n| mode | prior used | largest prior within its share (worst bin): CAT I | CAT II | CAT III |")
         print("|---|---|---|---|---|")
         for name, m in r["modes"].items():
@@ -94,6 +99,10 @@ def main() -> None:
             print(f"| {name} | {g(m['prior'])} [{m['prior_mark']}] | " + " | ".join(g(a) for a in allowed) + " |")
         need = {f"{cat} {k}": t["first_step_needed"] for cat, c in cats.items() for k, t in c["terms"].items()
                 if "first_step_needed" in t}
+        need_sp = {f"{cat} {k}": t["first_step_needed_specific"] for cat, c in cats.items()
+                   for k, t in c["terms"].items() if "first_step_needed_specific" in t}
+        if need_sp:
+            print("\nfirst-step runs that would bound every bin of a term by its share (0 HMI):", need_sp)
         if need:
             print("\nfirst-step runs that would bound a term not estimated (0 HMI):", need)
 

@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from approachsim import geo
+from approachsim.campaign import preapproach
 from approachsim.campaign.bank_modes import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
 from approachsim.core.nav import copies as kcp
 from approachsim.core.nav import groups as kg
@@ -110,12 +111,14 @@ def applicable(nav: Any, records: dict[str, Any]) -> bool:
 
 
 def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: np.random.Generator,
-              states: Any, memo: TruthMemo | None = None) -> BankPass | None:
+              states: Any, memo: TruthMemo | None = None, pre: Any = None) -> BankPass | None:
     """The main filter and one sub-filter per mode of `modes` (campaign/bank_modes.py codes) over one run's records
     (`applicable`; run axis of length one), started from the run's realized sensor states `states`
     (sensors.states.start_states) with its "nav" stream `rng` (module docstring). None when an epoch's model is
     too large for the compiled discretization (the caller takes NavSystem.run, which falls back to numpy's). memo:
-    the truth's TruthMemo (its converged start, reference and epoch models kept for the other runs on it)."""
+    the truth's TruthMemo (its converged start, reference and epoch models kept for the other runs on it). pre: a
+    fault present at the start (campaign.preapproach.PreFault): each copy's start carries what the pre-approach
+    segment's aiding made of it (campaign/preapproach.py)."""
     records = tuned_records(records, nav.nav.gps_sigma_scale)
     imu = records["imu"]
     dth, dvb = np.asarray(imu.dtheta_body)[:1], np.asarray(imu.dv_body)[:1]
@@ -129,6 +132,11 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     el0 = np.asarray(gnss.elevation_rad)[:, 0]
     s, runs = nav.start(truth, [rng], elevation_rad=el0[0], obs=obs0, states=states, elevation_per_run=el0,
                         memo=memo)
+    x_off = None
+    if pre is not None:
+        x_f, delta = preapproach.estimate_offsets(nav, truth, obs0, np.asarray(runs[0].fs.P, dtype=float), modes,
+                                                  pre)
+        s, x_off = preapproach.apply(nav.layout, s, x_f, delta)
     # the INS once (Navigator.propagate: feed-forward, no bias feedback), with the damping loop's baro
     held = _baro_held(nav, records, truth, m)
     hb_full, age = (None, None) if held is None else held
@@ -142,7 +150,7 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     used = np.flatnonzero(np.any(np.asarray(gnss.valid, dtype=bool)[0], axis=0))
     return _core(nav, truth, modes, m, epoch_rows, runs[0].fs.x, np.asarray(runs[0].fs.P, dtype=float),
                  runs[0].db_error, rows[0, epoch_rows::epoch_rows], None if hb_full is None else hb_full[0], o, used,
-                 runs[0].arcs, memo=memo)
+                 runs[0].arcs, memo=memo, x_off=x_off)
 
 
 def _baro_held(nav: Any, records: dict[str, Any], truth: Any, m: int) -> tuple[Array, Array] | None:
@@ -208,7 +216,8 @@ def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Arr
 
 def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Array, P_conv: Array,
           db_error: Any, ins_ep: Array, hb1: Array | None, o: dict[str, Any], used: Array,
-          arcs0: Array | None = None, main: Any = None, memo: TruthMemo | None = None) -> BankPass | None:
+          arcs0: Array | None = None, main: Any = None, memo: TruthMemo | None = None,
+          x_off: Array | None = None) -> BankPass | None:
     """The pass from the run's start (x_hat, P_conv, its terrain-database error), its INS states at the epochs
     ins_ep (E, 16), its baro held for the damping loop hb1 (m,) or None, its stacked observations o (one run) and
     the GNSS channels it measures; carrier phase: arcs0 (k,) the start's carrier arc ids (None: none yet), from
@@ -296,6 +305,8 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Ar
     dbp, db_x, db_u = EpochEngine.stack([db] * C)
     n = red.n
     X = np.repeat(x_hat[idx][None], C, axis=0)
+    if x_off is not None:  # a fault present at the start: each copy's own pre-approach response (preapproach.py)
+        X = X + x_off[:, idx]
     P3 = np.repeat(P_conv[np.ix_(idx, idx)][None], C, axis=0)
     R = 2 + (2 if carrier else 1) * kr + pl_rho.shape[2]
     codes, nu, S = np.zeros((C, E, R), dtype=np.int64), np.zeros((C, E, R)), np.zeros((C, E, R))

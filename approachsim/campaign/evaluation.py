@@ -7,6 +7,7 @@ merge of all n shards scores the whole campaign (shards.merge_shards).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +33,15 @@ class Evaluation:
     wall_s: float
     warnings: tuple[str, ...] = ()
     """Lines about the executor (a Dask worker found failing every task), beside the runs."""
+
+
+def grouped(profile: Any, runs: int, mode: str) -> Any:
+    """The profile with its open-loop flight groups sized for a campaign of `runs` (EvaluationConfig.group_size:
+    at least five groups); closed loop and a size already small enough: the profile itself."""
+    size = profile.evaluation.group_size(runs)
+    if mode != "open" or size == profile.evaluation.flight_group:
+        return profile
+    return dataclasses.replace(profile, evaluation=dataclasses.replace(profile.evaluation, flight_group=size))
 
 
 def campaign_meta(profile: Any, *, seed: int, mode: str, land: bool, shard: tuple[int, int] | None = None) -> dict:
@@ -67,7 +77,10 @@ def evaluate_profile(
     """Run and score a campaign; writes the run store, summary.json and details.json into out_dir (out_dir None:
     nothing is written, the results stay in memory). shard (k, n): only the k-th of n slices of the runs
     (shards.shard_runs), stored in out_dir with shard.json; nothing scored."""
+    profile = grouped(profile, runs, mode)
     spec = spec if spec is not None else spec_for(profile, mode)
+    if not spec.closed_loop and spec.group_size != profile.evaluation.flight_group:  # a spec made before grouped
+        spec = dataclasses.replace(spec, group_size=profile.evaluation.flight_group)
     meta = campaign_meta(profile, seed=seed, mode=mode, land=spec.land, shard=shard)
     only = None if shard is None else shard_runs(runs, *shard)
     res = run_campaign(
@@ -101,6 +114,8 @@ def score_campaign(profile: Any, results: list[RunResult], *, seed: int, closed_
 def merge_shards(profile: Any, dirs: Sequence[Path], out_dir: Path) -> Evaluation:
     """Merge the n shard directories of one campaign of `profile` into out_dir: the single campaign's run store,
     summary.json and details.json (shards.read_shards checks them; its wall_s is the shards' sum)."""
+    m0, all_runs, _ = read_shards(dirs)  # the campaign's size and mode decide its flight groups (grouped)
+    profile = grouped(profile, len(all_runs), str(m0["mode"]))
     meta, results, wall = read_shards(dirs, profile)
     merge_store(dirs, out_dir, meta, results)
     land = bool(meta.get("land"))

@@ -328,8 +328,8 @@ def score_run(ep: BankEpochs, epoch_hz: float, start_height_m: float, dh_m: dict
 
 
 def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: bool = False, *,
-             compiled: bool = True, group: tuple[Any, int] | None = None, memo: TruthMemo | None = None
-             ) -> tuple[BankEpochs, Any]:
+             compiled: bool = True, group: tuple[Any, int] | None = None, memo: TruthMemo | None = None,
+             pre: Any = None) -> tuple[BankEpochs, Any]:
     """Measure run `run` of the campaign seeded `seed` on `truth`, navigate it with the main filter and the
     sub-filter bank (one batched pass) and project on the approach axes; returns (epochs, main NavRun).
     sensor_modes_on: the baro, radar altimeter and pseudolite units are fault modes too (module docstring).
@@ -344,7 +344,8 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     for this run, its run k (campaign/pipeline.py): nothing is drawn, started or integrated again (the same numbers,
     bankpass.bank_pass_group). memo: the truth's TruthMemo (approachsim/memo.py) from the caller that shares the
     truth among runs (an open-loop group, a study's flown truth): the converged start, the reference and the epoch
-    models are then made once."""
+    models are then made once. pre: a fault present at the start (campaign.preapproach.PreFault; the compiled
+    pass only: ValueError elsewhere)."""
     from dataclasses import fields, replace
 
     if compiled and group is not None and not sensor_modes_on:
@@ -372,10 +373,12 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     own_ins = bool(sensor_modes_on and "baro" in one and nav.loop_gains() is not None)
     share = not nav.nav.feedback and "imu" in one and not own_ins
     if compiled and share and bankpass.applicable(nav, one):  # the compiled reduced pass (campaign/bankpass.py)
-        bp = bankpass.bank_pass(nav, truth, one, channels, stream(seed, run, "nav"), states, memo)
+        bp = bankpass.bank_pass(nav, truth, one, channels, stream(seed, run, "nav"), states, memo, pre=pre)
         if bp is not None:
             ep = bank_epochs_arrays(bp.t_s, bp.true_error_nav, bp.P_nav, channels, truth, profile.runway.heading_rad)
             return ep, bp.main_run()
+    if pre is not None:
+        raise ValueError("a fault present before the approach needs the compiled bank pass (campaign/bankpass.py)")
     rest = suite.without("imu") if share else suite  # feed-forward: one IMU record for every copy
     recs = rest.apply(truth, rest.draw(truth.t_s, seed, [run] * copies))
     if share:

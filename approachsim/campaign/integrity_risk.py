@@ -75,6 +75,8 @@ from typing import Any
 import numpy as np
 from scipy import stats as sps
 
+from approachsim.campaign import preapproach
+from approachsim.campaign.bank_modes import BARO_MODE, PSEUDOLITE_MODE, RADALT_MODE
 from approachsim.campaign.integrity_bank import run_bank, score_category
 from approachsim.campaign.integrity_campaign import bank_profile
 from approachsim.campaign.pipeline import approach_stop_height_m
@@ -90,7 +92,11 @@ Array = np.ndarray
 
 CATEGORY_KEYS = {"CAT I": "cat1", "CAT II": "cat2", "CAT III": "cat3"}
 P_SAT = 1e-5
-"""Prior probability of a fault of one satellite per approach (ARAIM ISM default, [S])."""
+"""State probability of a fault of one satellite (ARAIM ISD: 1e-5 / h x 1 h mean fault duration, [S])."""
+ONSET_BINS = 3
+"""Onset bins of the specific risk inside the window: thirds of the onset window (early, middle, late)."""
+PRE_BINS = 3
+"""Onset bins before the window (a mode with an MFD): thirds of the MFD."""
 
 
 @dataclass(frozen=True)
@@ -112,6 +118,50 @@ class FaultMode:
     law: str = "log-uniform"
     """Magnitude law: log-uniform over [low, high], or half-normal (|N(0, high^2)|, low unused: the estimator
     validation's mode, whose tail is the fault's own)."""
+    mfd_s: float = 0.0
+    """Mean fault duration, s: `prior` is then the state probability (rate x MFD) and onsets are sampled over the
+    MFD before the window as well as inside it ("Faults present before the approach"); 0: inside the window only,
+    `prior` per approach."""
+    mfd_mark: str = ""
+    pre_fraction: float = 0.0
+    """Share of the onset's uniform Phi(u_0) mapped before the window: MFD / (MFD + window length), set per study
+    from its first truth (`with_window`); 0: every onset inside the window."""
+
+    def with_window(self, window_s: float) -> FaultMode:
+        """This mode for an onset window of `window_s` seconds: the pre-approach share MFD / (MFD + window)."""
+        if self.mfd_s <= 0.0:
+            return self
+        return dataclasses.replace(self, pre_fraction=self.mfd_s / (self.mfd_s + float(window_s)))
+
+    def prior_per_approach(self, window_s: float) -> float:
+        """The probability that a fault of this mode (one satellite or unit) is present during the onset window:
+        rate x (MFD + window) = state probability x (1 + window / MFD) (every fault lasting its MFD); without an
+        MFD, `prior` itself."""
+        return self.prior * (1.0 + float(window_s) / self.mfd_s) if self.mfd_s > 0.0 else self.prior
+
+    def onset(self, f: float, window: tuple[float, float]) -> float:
+        """The onset time (s) of the onset window's uniform f in [0, 1]: below `pre_fraction` an age uniform over
+        the MFD before the window's start (the oldest at f = 0), above it uniform over the window."""
+        lo, hi = window
+        if f < self.pre_fraction:
+            return lo - (1.0 - f / self.pre_fraction) * self.mfd_s
+        g = (f - self.pre_fraction) / (1.0 - self.pre_fraction) if self.pre_fraction > 0.0 else f
+        return lo + g * (hi - lo)
+
+    def onset_edges(self) -> list[tuple[float, float, str]]:
+        """The specific risk's onset bins as ranges of Phi(u_0) with labels: thirds of the MFD before the window
+        (ages counted back from the window's start) when the mode has one, then thirds of the window."""
+        out = []
+        if self.pre_fraction > 0.0:
+            a = self.pre_fraction
+            for j in range(PRE_BINS):
+                age = (self.mfd_s * (1 - (j + 1) / PRE_BINS), self.mfd_s * (1 - j / PRE_BINS))
+                out.append((a * j / PRE_BINS, a * (j + 1) / PRE_BINS,
+                            f"present {age[0]:.0f}-{age[1]:.0f} s before"))
+        b = self.pre_fraction
+        for j in range(ONSET_BINS):
+            out.append((b + (1 - b) * j / ONSET_BINS, b + (1 - b) * (j + 1) / ONSET_BINS, f"window {j + 1}/3"))
+        return out
 
     @property
     def has_channel(self) -> bool:
@@ -147,14 +197,20 @@ class FaultMode:
         return math.log(hi / lo) / math.log(self.high / self.low)
 
 
-_ISM = "ARAIM ISM P_sat (integrity-envelope.md 3a), per satellite in use"
+_ISM = ("ARAIM ISD: R_sat 1e-5 / h x mean fault duration 1 h = state probability 1e-5 per satellite (draft ICAO "
+        "Annex 10 default ISD, standards.md 1.5; ARAIM-4DS, integrity-envelope.md 3a), not reduced for GBAS or SBAS "
+        "ground monitoring")
+_NONE = "none found: assumed; the term is not shown (prior_allowed: the prior it could carry)"
+MFD_SAT_S = 3600.0
+"""GPS satellite mean fault duration, s (ARAIM ISD, standards.md 1.5 [S])."""
 MODES: Mapping[str, FaultMode] = {
-    "sat-ramp": FaultMode("sat-ramp", "gnss", "ramp", 0.01, 5.0, P_SAT, "S", _ISM),
-    "sat-step": FaultMode("sat-step", "gnss", "step", 1.0, 100.0, P_SAT, "S", _ISM),
-    "baro-step": FaultMode("baro-step", "baro", "step", 1.0, 100.0, 1e-5, "U", "none found: assumed"),
-    "radalt-bias": FaultMode("radalt-bias", "radalt", "step", 0.3, 30.0, 1e-5, "U", "none found: assumed"),
-    "pseudolite-step": FaultMode("pseudolite-step", "pseudolite", "step", 1.0, 100.0, 1e-5, "U",
-                                 "none found: assumed, per unit"),
+    "sat-ramp": FaultMode("sat-ramp", "gnss", "ramp", 0.01, 5.0, P_SAT, "S", _ISM, mfd_s=MFD_SAT_S, mfd_mark="S"),
+    "sat-step": FaultMode("sat-step", "gnss", "step", 1.0, 100.0, P_SAT, "S", _ISM, mfd_s=MFD_SAT_S, mfd_mark="S"),
+    "baro-step": FaultMode("baro-step", "baro", "step", 1.0, 100.0, 1e-5, "U", _NONE, mfd_s=3600.0, mfd_mark="U"),
+    "radalt-bias": FaultMode("radalt-bias", "radalt", "step", 0.3, 30.0, 1e-5, "U", _NONE, mfd_s=3600.0,
+                             mfd_mark="U"),
+    "pseudolite-step": FaultMode("pseudolite-step", "pseudolite", "step", 1.0, 100.0, 1e-5, "U", _NONE + ", per unit",
+                                 mfd_s=3600.0, mfd_mark="U"),
 }
 """Fault modes by name (module docstring)."""
 
@@ -225,27 +281,42 @@ def flight_truth(profile: Any, seed: int, index: int) -> tuple[Any, float, float
 
 def fault_spec(mode: FaultMode, u: Array, profile: Any, truth: Any, seed: int, run: int,
                window: tuple[float, float]) -> tuple[Any, dict]:
-    """The FaultSpec u maps to (module docstring) and its physical parameters."""
+    """The FaultSpec u maps to (module docstring) and its physical parameters: the onset by FaultMode.onset (before
+    the window's start when the mode has an MFD and Phi(u_0) < its pre_fraction: `age_at_start_s` > 0 when that is
+    before the run's first sample, which the pre-approach segment then carries: run_sample)."""
     u = np.asarray(u, float)
-    onset = window[0] + float(sps.norm.cdf(u[0])) * (window[1] - window[0])
+    onset = mode.onset(float(sps.norm.cdf(u[0])), window)
     mag = mode.magnitude(float(u[1]))
-    channel, n_used = None, 1
+    channel, n_used, index = None, 1, -1
     if mode.sensor == "gnss":
         suite = SensorSuite.from_profile(profile)
         g = suite.without(*[s for s in suite.sensors if s != "gnss"]).measure(truth, seed=seed, runs=[run])["gnss"]
-        j = int(np.clip(np.searchsorted(g.t_s, onset), 0, len(g.t_s) - 1))
+        j = int(np.clip(np.searchsorted(g.t_s, max(onset, float(g.t_s[0]))), 0, len(g.t_s) - 1))
         used = np.flatnonzero(np.asarray(g.valid)[0, j])
         n_used = int(used.size)
-        ch = int(used[min(int(sps.norm.cdf(u[2]) * n_used), n_used - 1)])
-        channel = int(np.asarray(g.prn)[ch])
+        index = int(used[min(int(sps.norm.cdf(u[2]) * n_used), n_used - 1)])
+        channel = int(np.asarray(g.prn)[index])
     elif mode.sensor == "pseudolite":
         n_used = len(profile.sensors.pseudolite.positions_rwy)
-        channel = min(int(sps.norm.cdf(u[2]) * n_used), n_used - 1)
+        channel = index = min(int(sps.norm.cdf(u[2]) * n_used), n_used - 1)
     target = {"gnss": "pseudorange", "pseudolite": "pseudorange", "baro": "h", "radalt": "h"}[mode.sensor]
     spec = FaultSpec(sensor=mode.sensor, kind=mode.kind, start_s=onset, target=target, channel=channel,
                      magnitude=mag if mode.kind == "step" else 0.0, rate=mag if mode.kind == "ramp" else 0.0)
+    t0 = float(truth.t_s[0]) if truth is not None else window[0]
     return spec, {"onset_s": onset, "magnitude": mag, "channel": -1 if channel is None else channel,
-                  "n_channels": n_used}
+                  "n_channels": n_used, "channel_index": index, "age_at_start_s": max(0.0, t0 - onset),
+                  "onset_before_window_s": max(0.0, window[0] - onset)}
+
+
+def pre_fault(mode: FaultMode, params: Mapping[str, float]) -> Any:
+    """The pre-approach segment's fault (campaign.preapproach.PreFault) of a sample whose onset is before the run
+    start (fault_spec's params), else None."""
+    if params["age_at_start_s"] <= 0.0:
+        return None
+    code = {"gnss": int(params["channel_index"]), "baro": BARO_MODE, "radalt": RADALT_MODE,
+            "pseudolite": PSEUDOLITE_MODE - int(params["channel_index"])}[mode.sensor]
+    return preapproach.PreFault(preapproach.row_name(code), mode.kind, float(params["magnitude"]),
+                                float(params["age_at_start_s"]))
 
 
 def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float, confirm: bool = False) -> dict[str, float]:
@@ -289,9 +360,10 @@ def limit_states(ep: Any, cfg: Any, epoch_hz: float, t0_s: float, confirm: bool 
     return out
 
 
-def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | None, u: Sequence[float],
+def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: FaultMode | str | None, u: Sequence[float],
                sensor_modes: bool = False, confirm: bool = False) -> dict[str, float]:
-    """One sample: the flown truth run % truths, the fault of `mode_name` at u (None: fault-free), the bank (with
+    """One sample: the flown truth run % truths, the fault of `mode_name` (a FaultMode or its name) at u (None:
+    fault-free; present before the run start: with its pre-approach segment, campaign/preapproach.py), the bank (with
     the baro, radar altimeter and pseudolites as fault modes too when `sensor_modes`), the limit states (and the
     fault's parameters); confirm: the second-level identification (bank.second_level). A sample that raises is
     returned with `failed` = 1 and every category's hmi_g = +1e3 (a failed navigation counts as the event:
@@ -301,10 +373,14 @@ def run_sample(profile: Any, seed: int, run: int, truths: int, mode_name: str | 
         truth, t_lo, t_hi = flown.truth, flown.t_lo_s, flown.t_hi_s
         prof = profile
         params: dict = {}
+        pre = None
         if mode_name is not None:
-            spec, params = fault_spec(fault_mode(mode_name), np.asarray(u), profile, truth, seed, run, (t_lo, t_hi))
+            mode = mode_name if isinstance(mode_name, FaultMode) else fault_mode(mode_name)
+            spec, params = fault_spec(mode, np.asarray(u), profile, truth, seed, run, (t_lo, t_hi))
             prof = dataclasses.replace(profile, faults=(*tuple(profile.faults or ()), spec))
-        ep, _ = run_bank(bank_profile(prof), truth, seed, run, sensor_modes_on=sensor_modes, memo=flown.memo)
+            pre = pre_fault(mode, params)
+        ep, _ = run_bank(bank_profile(prof), truth, seed, run, sensor_modes_on=sensor_modes, memo=flown.memo,
+                         pre=pre)
         out = limit_states(ep, profile.evaluation, profile.nav.aiding_rate_hz, float(truth.t_s[0]), confirm)
         return {**out, **{f"fault_{k}": float(v) for k, v in params.items()}, "failed": 0.0}
     except Exception as e:  # noqa: BLE001 - a failed sample is data (counted as the event), never dropped
@@ -347,7 +423,7 @@ class Simulator:
             self._pool.shutdown(cancel_futures=True)
             self._pool = None
 
-    def run(self, mode_name: str | None, runs: Sequence[int], u: Array) -> list[dict]:
+    def run(self, mode_name: FaultMode | str | None, runs: Sequence[int], u: Array) -> list[dict]:
         """The samples (runs[i], u[i]) of one mode, in order."""
         t = time.time()
         items = list(zip([int(r) for r in runs], np.asarray(u, float).tolist(), strict=True))
@@ -373,19 +449,19 @@ def _columns(rows: Sequence[Mapping[str, Any]]) -> dict[str, Array]:
 # ---- one mode --------------------------------------------------------------------------------------------------
 
 
-ONSET_BINS = 3
-"""Onset bins of the specific risk: thirds of the onset window (early, middle, late in the approach)."""
-
 
 def sample_bins(mode: FaultMode, u: Array) -> tuple[Array, Array]:
     """(magnitude bin, onset bin) of each standard-normal sample u (N, dim): `FaultMode.magnitude_edges` and
-    `ONSET_BINS` equal thirds of the onset window (Phi(u_0))."""
+    `FaultMode.onset_edges` over Phi(u_0) (thirds of the MFD before the window, when the mode has one, then
+    `ONSET_BINS` thirds of the window)."""
     u = np.atleast_2d(np.asarray(u, float))
     edges = mode.magnitude_edges()
     mag = np.array([mode.magnitude(float(x)) for x in u[:, 1]]) if u.size else np.zeros(0)
     mb = np.clip(np.searchsorted(edges, mag, side="right") - 1, 0, len(edges) - 2)
-    ob = np.clip((sps.norm.cdf(u[:, 0]) * ONSET_BINS).astype(int), 0, ONSET_BINS - 1) if u.size else mb
-    return mb.astype(int), ob.astype(int)
+    on = mode.onset_edges()
+    cuts = np.array([e[1] for e in on[:-1]])
+    ob = np.searchsorted(cuts, sps.norm.cdf(u[:, 0]), side="right") if u.size else mb
+    return mb.astype(int), np.asarray(ob).astype(int)
 
 
 def specific_risk(mode: FaultMode, first_u: Array, first_hit: Array, level: float, last_u: Array | None = None,
@@ -401,12 +477,13 @@ def specific_risk(mode: FaultMode, first_u: Array, first_hit: Array, level: floa
     upper bound is an upper bound of max over bins of P(HMI | bin) at `level` (the true worst bin's own bound is
     no larger). A bin with few samples has a wide bound (0 of n: 1 - (1 - level)^(1/n), 0.087 at n = 33)."""
     edges = mode.magnitude_edges()
+    onsets = mode.onset_edges()
     fb = sample_bins(mode, first_u)
     first_hit = np.asarray(first_hit, bool)
     lb = sample_bins(mode, last_u) if last_u is not None else None
     bins = []
     for i in range(len(edges) - 1):
-        for j in range(ONSET_BINS):
+        for j, (f_lo, f_hi, label) in enumerate(onsets):
             sel = (fb[0] == i) & (fb[1] == j)
             k, n = int(np.sum(first_hit[sel])), int(np.sum(sel))
             lo, hi = rare.clopper_pearson(k, n, level)
@@ -418,9 +495,11 @@ def specific_risk(mode: FaultMode, first_u: Array, first_hit: Array, level: floa
                                                  level)
             use_last = last is not None and last["n_eff"] > n
             used = last if use_last else first
-            bins.append({"magnitude": [edges[i], edges[i + 1]], "onset_third": j + 1,
-                         "onset_fraction": [j / ONSET_BINS, (j + 1) / ONSET_BINS],
-                         "bin_probability": mode.magnitude_fraction(edges[i], edges[i + 1]) / ONSET_BINS,
+            third = j - (len(onsets) - ONSET_BINS) + 1
+            bins.append({"magnitude": [edges[i], edges[i + 1]], "onset": label,
+                         "onset_third": third if third >= 1 else None,
+                         "onset_fraction": [f_lo, f_hi],
+                         "bin_probability": mode.magnitude_fraction(edges[i], edges[i + 1]) * (f_hi - f_lo),
                          "probability": used["probability"], "lower": used["lower"], "upper": used["upper"],
                          "from": "last_step_weighted" if use_last else "first_step",
                          "first_step": first, "last_step": last})
@@ -448,7 +527,7 @@ def estimate_mode(sim: Simulator, mode: FaultMode, index: int, *, categories: Se
     def g(u: Array) -> Array:
         runs = (index + 1) * MODE_OFFSET + counter[0] + np.arange(u.shape[0])
         counter[0] += u.shape[0]
-        rows = sim.run(mode.name, runs, u)
+        rows = sim.run(mode, runs, u)
         for x, r in zip(u, rows, strict=True):
             rows_of[np.asarray(x, float).tobytes()] = r
         store.extend(rows)
@@ -488,18 +567,24 @@ def estimate_mode(sim: Simulator, mode: FaultMode, index: int, *, categories: Se
             *((None, None, None) if one_sample else (np.asarray(last["u"]), ind, np.asarray(last["w"]))))
         per_cat[cat] = r
     allc = _columns(store)
+    _, t_lo, t_hi = flight_truth(sim.profile, sim.seed, 0)
     dp = None
     if est.design_point_u is not None:
-        truth, t_lo, t_hi = flight_truth(sim.profile, sim.seed, 0)
         u = np.asarray(est.design_point_u)
         dp = {"u": [float(x) for x in u], "onset_fraction": float(sps.norm.cdf(u[0])),
-              "onset_s_before_lowest_dh": float((1.0 - sps.norm.cdf(u[0])) * (t_hi - t_lo)),
+              "onset_s_before_lowest_dh": float(t_hi - mode.onset(float(sps.norm.cdf(u[0])), (t_lo, t_hi))),
               "magnitude": mode.magnitude(float(u[1])), "unit": "m/s" if mode.kind == "ramp" else "m"}
     n_ch = allc.get("fault_n_channels", np.array([1.0]))
-    prior = mode.prior * (float(np.nanmax(n_ch)) if mode.has_channel else 1.0)  # per satellite / unit
+    per_unit = mode.prior_per_approach(t_hi - t_lo)
+    prior = per_unit * (float(np.nanmax(n_ch)) if mode.has_channel else 1.0)  # per satellite / unit
+    age = allc.get("fault_age_at_start_s", np.zeros(1))
     return {"mode": mode.name, "sensor": mode.sensor, "kind": mode.kind,
             "range": [mode.low, mode.high], "unit": "m/s" if mode.kind == "ramp" else "m",
             "prior": prior, "prior_mark": mode.prior_mark, "prior_source": mode.prior_source,
+            "prior_state": mode.prior, "mean_fault_duration_s": mode.mfd_s, "mfd_mark": mode.mfd_mark,
+            "onset_window_s": t_hi - t_lo, "pre_fraction": mode.pre_fraction,
+            "prior_per_unit_per_approach": per_unit,
+            "present_at_start_fraction": float(np.mean(age > 0.0)) if age.size else 0.0,
             "estimator": est.as_dict(), "categories": per_cat, "worst_profile": dp,
             "samples": len(store), "failed_samples": int(np.nansum(allc.get("failed", np.zeros(1)))),
             "first_error": next((r["error"] for r in store if r.get("error")), None),
@@ -580,6 +665,8 @@ def integrity_risk(profile: Any, *, modes: Sequence[str] | None = None, method: 
     with Simulator(profile, seed, truths, workers, sensor_modes, second_level) as sim:
         say(f"fault-free: {fault_free_runs} runs")
         out["fault_free"] = fault_free(sim, fault_free_runs, level)
+        _, t_lo, t_hi = flight_truth(profile, seed, 0)
+        ms = [m.with_window(t_hi - t_lo) for m in ms]  # the pre-approach share of the onsets (FaultMode.onset)
         for m in ms:
             i = list(MODES).index(m.name)  # run indices and estimator seed by the mode, not its place in the list
             say(f"{m.name}: {method}, {samples} samples per step")
@@ -612,6 +699,7 @@ def totals(study: Mapping[str, Any], level: float) -> dict:
         ff = study["fault_free"]["categories"][cat]
         p, lo, hi, complete = ff["hmi_gaussian"], 0.0, ff["hmi_gaussian_worst_run"], True
         hi_avg = hi
+        hi_src, lo_src, unsourced = hi, 0.0, []
         terms = {"fault_free": {"probability": ff["hmi_gaussian"], "upper": ff["hmi_gaussian_worst_run"],
                                 "how": "Gaussian tail with the measured overbound; upper: the worst run's"}}
         for name, m in study["modes"].items():
@@ -633,19 +721,33 @@ def totals(study: Mapping[str, Any], level: float) -> dict:
                            "specific_shown": prior * w_up <= req.integrity_risk}
             if sp is not None:
                 wb = sp["bins"][sp["worst_bin"]]
-                terms[name]["worst_bin"] = {k: wb[k] for k in ("magnitude", "onset_third", "probability", "lower",
-                                                               "upper", "from")}
+                terms[name]["worst_bin"] = {k: wb[k] for k in ("magnitude", "onset", "onset_third", "probability",
+                                                               "lower", "upper", "from")}
                 terms[name]["worst_bin"]["samples"] = (wb["first_step"]["samples"] if wb["from"] == "first_step"
                                                        else wb["last_step"]["n_eff"])
                 terms[name]["smallest_bin_probability"] = min(b["bin_probability"] for b in sp["bins"])
             hi_avg = hi_avg + (prior * up if up is not None else prior)
             hi = hi + prior * w_up
             lo = lo + (prior * c["lower"] if c.get("shown") else 0.0)
+            terms[name]["prior_mark"] = m.get("prior_mark", "U")
+            if terms[name]["prior_mark"] == "U":  # an assumed prior: the term is "not shown", whatever its bound
+                unsourced.append(name)
+                terms[name]["term_verdict"] = "not shown (prior assumed [U]: see prior_allowed)"
+            else:
+                hi_src += prior * w_up
+                lo_src += prior * c["lower"] if c.get("shown") else 0.0
+                terms[name]["term_verdict"] = "shown" if terms[name]["specific_shown"] else "not shown"
             p = p + (prior * pr if pr is not None else 0.0)
             complete = complete and c.get("shown", False)
         alloc = req.integrity_risk
-        verdict = "shown" if hi <= alloc else ("exceeds" if lo > alloc else "not shown")
-        verdict_avg = "shown" if hi_avg <= alloc else ("exceeds" if lo > alloc else "not shown")
+        # a windowed category (CAT II / III: 15 s / 30 s before the DH) is simulated over the whole approach: its
+        # lower bound is no lower bound on the windowed event, so it never `exceeds` (issue 41 item 1)
+        can_exceed = req.hmi_window_s() is None
+        verdict_assumed = "shown" if hi <= alloc else ("exceeds" if can_exceed and lo > alloc else "not shown")
+        verdict_avg = "shown" if hi_avg <= alloc else ("exceeds" if can_exceed and lo > alloc else "not shown")
+        # the verdict: on the sourced priors; a term whose prior is assumed [U] keeps the category at most "not shown"
+        verdict_src = "shown" if hi_src <= alloc else ("exceeds" if can_exceed and lo_src > alloc else "not shown")
+        verdict = "not shown" if verdict_src == "shown" and unsourced else verdict_src
         # a term bounded only by its first step's Monte Carlo: the first-step size that would bound it, with no HMI
         # sample, by an equal share of the allocation (Clopper-Pearson at 0 hits: 1 - (1 - level)^(1 / n))
         share = alloc / max(1, len(terms))
@@ -668,7 +770,9 @@ def totals(study: Mapping[str, Any], level: float) -> dict:
         fa_up = max(fa["rate_per_15s_gaussian"], 0.0)
         out[cat] = {"p_hmi": p, "p_hmi_lower": lo, "p_hmi_upper": hi, "allocation": alloc,
                     "allocation_unit": "per approach" if req.exposure_s >= 150 else "per 15 s",
-                    "verdict": verdict, "p_hmi_average_upper": hi_avg, "verdict_average": verdict_avg,
+                    "verdict": verdict, "verdict_sourced": verdict_src, "p_hmi_upper_sourced": hi_src,
+                    "p_hmi_lower_sourced": lo_src, "unsourced_terms": unsourced,
+                    "verdict_assumed": verdict_assumed, "p_hmi_average_upper": hi_avg, "verdict_average": verdict_avg,
                     "every_term_estimated": complete, "terms": terms,
                     "p_false_alert_per_15s_gaussian": fa_up,
                     "p_false_alert_per_15s_upper_mc": fa["rate_per_15s_upper_mc"],

@@ -207,6 +207,16 @@ def verdict_table(summary: dict, det: dict) -> str:
             + (f", allowed failure fraction {allowed:g} (upper bound {_f(f.get('fraction_upper'), '.3f').strip()})"
                if allowed else " (no failure allowed: every category fails)")
         )
+    else:
+        c0 = next(iter(det["categories"].values()))
+        f = c0.get("failures", {})
+        met = [c for c, e in summary["decision_heights"].items() if e["verdict"] == "meets"]
+        if met and f.get("fraction_upper") is not None:  # a 0-failure meets: what the runs bound the failures by
+            lines.append(
+                f"no failed run in {summary['runs']}: {', '.join(met)} meets with a failure probability per approach "
+                f"<= {_f(f['fraction_upper'], '.3g').strip()} (one-sided Clopper-Pearson, "
+                f"{c0.get('confidence', 0.95):.0%}), not zero"
+            )
     if not summary["closed_loop"]:
         lines.append(
             "open loop: runs of one group share one flown truth (evaluation.flight_group); "

@@ -92,17 +92,19 @@ def run(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise ProfileError(f"--out: {str(out)!r} exists and is not a directory")
     res = api.integrity_risk(spec, out=out, log=lambda s: print(s, file=sys.stderr, flush=True), **kw)
-    print("specific risk: each mode's worst (magnitude decade, onset third) bin's upper bound x prior; "
-          "average: over the magnitude law (docs/integrity.md)")
-    print(f"{'category':9} {'P(HMI)':>9} {'upper':>9} {'allocation':>12}  verdict     {'avg upper':>9}  avg verdict  "
-          "P(FA)/15s upper  (allocation)")
+    print("specific risk: each mode's worst (magnitude decade, onset) bin's upper bound x prior; verdict on the "
+          "sourced priors ([U] terms: not shown, see prior_allowed); average: over the magnitude law "
+          "(docs/integrity.md)")
+    print(f"{'category':9} {'P(HMI)':>9} {'upper':>9} {'sourced':>9} {'allocation':>12}  verdict     "
+          f"{'assumed':>9}  {'avg upper':>9}  P(FA)/15s upper  (allocation)")
     for cat, c in res["categories"].items():
-        print(f"{cat:9} {_fmt(c['p_hmi']):>9} {_fmt(c['p_hmi_upper']):>9} {_fmt(c['allocation']):>7} "
-              f"{c['allocation_unit'][4:]:>4}  {c['verdict']:10}  {_fmt(c['p_hmi_average_upper']):>9}  "
-              f"{c['verdict_average']:11}  {_fmt(c['p_false_alert_per_15s_gaussian']):>9}"
+        print(f"{cat:9} {_fmt(c['p_hmi']):>9} {_fmt(c['p_hmi_upper']):>9} {_fmt(c['p_hmi_upper_sourced']):>9} "
+              f"{_fmt(c['allocation']):>7} {c['allocation_unit'][4:]:>4}  {c['verdict']:10}  "
+              f"{c['verdict_assumed']:>9}  {_fmt(c['p_hmi_average_upper']):>9}  "
+              f"{_fmt(c['p_false_alert_per_15s_gaussian']):>9}"
               f"        ({_fmt(c['false_alert_allocation_per_15s'])}) {c['false_alert_verdict']}")
-    print(f"{'mode':16} {'category':9} {'worst bin':>18} {'onset':>5} {'P(HMI|bin)':>10} {'upper':>7} {'n':>6} "
-          f"{'x prior':>8} {'shown':>5}  {'average up':>10} {'x prior':>8}")
+    print(f"{'mode':16} {'category':9} {'worst bin':>18} {'onset':>26} {'P(HMI|bin)':>10} {'upper':>7} {'n':>6} "
+          f"{'x prior':>8} {'prior':>6} {'shown':>5}  {'average up':>10} {'x prior':>8}")
     for cat, c in res["categories"].items():
         for name, t in c["terms"].items():
             wb = t.get("worst_bin")
@@ -110,9 +112,11 @@ def run(args: argparse.Namespace) -> int:
                 continue
             m = res["modes"][name]
             band = f"{wb['magnitude'][0]:g}-{wb['magnitude'][1]:g} {m['unit']}"
-            print(f"{name:16} {cat:9} {band:>18} {wb['onset_third']:>3}/3 {_fmt(wb['probability']):>10} "
+            onset = wb.get("onset") or f"window {wb['onset_third']}/3"
+            shown = "no [U]" if t.get("prior_mark") == "U" else ("yes" if t["specific_shown"] else "no")
+            print(f"{name:16} {cat:9} {band:>18} {onset:>26} {_fmt(wb['probability']):>10} "
                   f"{_fmt(wb['upper']):>7} {wb['samples']:>6.0f} {_fmt(t['specific_upper']):>8} "
-                  f"{'yes' if t['specific_shown'] else 'no':>5}  {_fmt(t['conditional_upper']):>10} "
+                  f"{'[' + t.get('prior_mark', 'U') + ']':>6} {shown:>5}  {_fmt(t['conditional_upper']):>10} "
                   f"{_fmt(t['upper']):>8}")
     print(f"{res['samples']} navigation runs, {res['wall_s']:.0f} s; wrote {out / 'integrity_risk.json'}")
     for name, m in res["modes"].items():

@@ -48,7 +48,9 @@ def test_small_study_writes_the_contract(tmp_path, capsys):
         assert c["p_hmi_upper"] >= c["p_hmi_average_upper"]
         assert c["verdict_average"] in ("shown", "not shown", "exceeds")
         sp = r["modes"]["baro-step"]["categories"][cat]["specific"]
-        assert len(sp["bins"]) == 6 and sum(b["first_step"]["samples"] for b in sp["bins"]) == 10
+        # two magnitude decades x (three thirds of the hour before the window + three of the window)
+        assert len(sp["bins"]) == 12 and sum(b["first_step"]["samples"] for b in sp["bins"]) == 10
+        assert c["unsourced_terms"] == ["baro-step"] and c["verdict"] != "shown"  # an assumed prior: not shown
         assert c["terms"]["baro-step"]["specific_upper"] >= 1e-5 * sp["worst_upper"]
     assert r["categories"]["CAT III"]["verdict"] != "shown"
     assert "CAT III" in capsys.readouterr().out

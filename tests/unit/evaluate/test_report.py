@@ -19,7 +19,7 @@ from approachsim.report.evaluate import report_problems, write_report
 
 
 def test_outputs_and_report(tmp_path):
-    cfg = EvaluationConfig()
+    cfg = EvaluationConfig(verdict="faa")  # 12-13 runs: the FAA table alone (ICAO 95 % needs >= 59 runs)
     truth = make_truth(hz=4.0)
     rng = np.random.default_rng(5)
     results = []
@@ -56,6 +56,10 @@ def test_outputs_and_report(tmp_path):
     ok, det_ok = evaluate_results(results[:12], cfg, profile="synthetic", seed=1, closed_loop=False)
     assert ok["decision_heights"]["CAT I"]["verdict"] == "meets" and ok["best_category"] == "CAT I"
     assert "CAT I        200 |" in verdict_table(ok, det_ok).splitlines()[2]
+    # a 0-failure meets carries the failure probability's upper bound, 1 - 0.05^(1/12) = 0.221, in its text
+    assert ("no failed run in 12: CAT I meets with a failure probability per approach <= 0.221 (one-sided "
+            "Clopper-Pearson, 95%), not zero") in verdict_table(ok, det_ok)
+    assert abs(ok_fraction_upper(det_ok) - (1.0 - 0.05 ** (1.0 / 12.0))) < 1e-12
     closed, det_c = evaluate_results(results, cfg, profile="synthetic", seed=1, closed_loop=True)
     assert "CAT II       100 | RMS ft: FTE lat" in verdict_table(closed, det_c)
     page = write_report(tmp_path, results, summary, det).read_text()
@@ -105,7 +109,7 @@ def test_report_leads_with_the_verdict_contract(tmp_path):
     """report.html's first table is the verdict contract: per category and axis summary.json's 1-sigma, upper bound
     and limit (the exact values in data-value, shown as the printed table shows them), details.json's verdict per
     axis, the category's verdict; best category and failed runs beside it; every figure it names is in DIR."""
-    cfg = EvaluationConfig()
+    cfg = EvaluationConfig(verdict="faa")  # 14 runs: the FAA table alone (ICAO 95 % needs >= 59 runs)
     truth = make_truth(hz=4.0)
     rng = np.random.default_rng(7)
     results = []
@@ -150,3 +154,7 @@ def test_report_leads_with_the_verdict_contract(tmp_path):
         f"figure stanford: {str(tmp_path / 'stanford.png')!r} is not the figure embedded in report.html",
         f"report.html names histograms_dh.png, which is not in {str(tmp_path)!r}",
     ]
+
+
+def ok_fraction_upper(det: dict) -> float:
+    return float(det["categories"]["CAT I"]["failures"]["fraction_upper"])

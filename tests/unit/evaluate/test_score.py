@@ -15,7 +15,7 @@ from approachsim.evaluate.config import EvaluationConfig, parse_evaluation
 from approachsim.evaluate.score import RunScoreError, score_run
 from approachsim.evaluate.summary import contract_summary, details, verdicts
 
-CFG = EvaluationConfig()
+CFG = EvaluationConfig(verdict="faa")  # the FAA table's logic at 5-10 runs (the ICAO 95 % bound needs >= 59)
 CONTRACT_DH_KEYS = {
     "height_ft", "lateral_1sigma_ft", "vertical_1sigma_ft", "lateral_95_ft", "vertical_95_ft",
     "limit_lateral_1sigma_ft", "limit_vertical_1sigma_ft", "meets",
@@ -23,11 +23,11 @@ CONTRACT_DH_KEYS = {
 }
 
 
-def _campaign(errors_ned: list[np.ndarray], **truth_kw) -> tuple[dict, dict]:
+def _campaign(errors_ned: list[np.ndarray], cfg: EvaluationConfig = CFG, **truth_kw) -> tuple[dict, dict]:
     truth = make_truth(hz=4.0, **truth_kw)
-    rows = [score_run(truth, make_nav(truth, e), CFG)[0] for e in errors_ned]
+    rows = [score_run(truth, make_nav(truth, e), cfg)[0] for e in errors_ned]
     cols = {k: np.array([r[k] for r in rows]) for k in rows[0]}
-    res = verdicts(cols, CFG)
+    res = verdicts(cols, cfg)
     s = contract_summary(res, profile="synthetic", runs=len(rows), seed=0, closed_loop=False, failed_runs=0)
     return s, details(cols, res, CFG)
 
@@ -52,6 +52,21 @@ def test_constant_bias_cat_i_only():
     few, _ = _campaign([_e(20.0, 5.0)] * 5)  # the same errors from 5 runs: too few to meet
     assert few["decision_heights"]["CAT I"]["verdict"] == "indeterminate" and few["best_category"] is None
     assert few["decision_heights"]["CAT I"]["runs_needed"] == 10
+
+
+def test_default_verdict_adds_the_icao_95_bound():
+    """The default verdict is faa+icao (issue 41): the same 10 runs that meet CAT I on the FAA table are
+    indeterminate, since the ICAO 95th-percentile bound needs 59 runs (0.95^59 < 0.05); 60 such runs meet."""
+    s, _ = _campaign([_e(20.0, 5.0)] * 10, EvaluationConfig())
+    c1 = s["decision_heights"]["CAT I"]
+    assert c1["verdict"] == "indeterminate" and c1["runs_needed"] >= 59
+    s, _ = _campaign([_e(20.0, 5.0)] * 60, EvaluationConfig())
+    assert s["decision_heights"]["CAT I"]["verdict"] == "meets"  # 20 ft < 52.5 ft, 5 ft < 13.1 ft (16 / 4 m)
+    # 10 % of the runs 60 ft off laterally: RMS 19.6 ft meets FAA's 28.1 ft, the 95th percentile (60 ft) is beyond
+    # ICAO's 16 m = 52.5 ft
+    mix = [_e(60.0 if i % 10 == 0 else 5.0, 1.0) for i in range(200)]
+    assert _campaign(mix)[0]["decision_heights"]["CAT I"]["verdict"] == "meets"
+    assert _campaign(mix, EvaluationConfig())[0]["decision_heights"]["CAT I"]["verdict"] == "fails"
 
 
 def test_constant_bias_cat_ii_and_none():
@@ -171,6 +186,7 @@ def test_evaluation_section_parsing():
     assert (cfg.confidence, cfg.max_failure_fraction) == (0.95, 0.0)
     cfg = parse_evaluation(Section({"confidence": 0.99, "max_failure_fraction": 0.01}, "evaluation"))
     assert (cfg.confidence, cfg.max_failure_fraction) == (0.99, 0.01)
+    assert cfg.verdict == "faa+icao"  # the default (issue 41): the ICAO 95 % accuracy is in the verdict
     for bad, field in (
         ({"dh_cat1_ft": "200"}, "evaluation.dh_cat1_ft"),
         ({"dh_cat3_ft": 150}, "evaluation.dh_cat2_ft"),
@@ -198,3 +214,11 @@ def test_glidepath_deviation_error_couples_the_along_track_error():
     assert sc["cat1_along_m"] == pytest.approx(20.0, abs=1e-3)
     assert sc["cat1_gpdev_m"] == pytest.approx(sc["cat1_vertical_m"] + 20.0 * math.tan(GP), abs=1e-3)
     assert sc["cat1_gpdev_m"] == pytest.approx(20.0 * math.tan(GP), abs=0.01)  # ~1.05 m at 3 deg
+
+
+def test_flight_groups_give_every_open_loop_campaign_five():
+    """Open-loop flight groups (issue 41): at least 5 groups from 5 runs on, the profile's size from 125 runs."""
+    cfg = EvaluationConfig()
+    assert [cfg.group_size(n) for n in (4, 5, 20, 124, 125, 1000)] == [25, 1, 4, 24, 25, 25]
+    for n in range(5, 300):
+        assert -(-n // cfg.group_size(n)) >= 5
