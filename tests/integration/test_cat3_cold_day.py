@@ -1,13 +1,15 @@
-"""The CAT III candidate on a cold day (docs/cat3.md, "Off the standard day").
+"""The CAT III candidate on a cold day (docs/cat3.md, docs/baro.md).
 
-At ISA -30 the barometric altitude reads low by about dT / T0 of the height above the field (cold-is-low,
-sensors/atmosphere.py): some 100 ft at 1000 ft above the field, 5 ft at 50 ft. The candidate declares Gray &
-Maybeck's 100 ft / 1 h baro budget, so its filter leans on GBAS and the pseudolites for the vertical and the
-error at 50 ft stays near its standard-day value (0.84 ft RMS in 1000 closed-loop runs, docs/cat3.md). With the
-default 1 m / 100 s budget the same runs follow the baro's temperature error down to the decision height (6.6 ft
-RMS in 100 closed-loop runs): the test fails if the budget is narrowed back or the temperature error is lost.
-Open loop, one flown truth per group, integrity bank off (the accuracy is what is judged here). Measured, 6 runs,
-seed 1: 0.55 ft with the candidate's budget, 6.65 ft with the default's.
+At ISA -30 the barometric altitude reads low by about dT / T of the height above the field (cold-is-low,
+sensors/atmosphere.py): some 100 ft at 1000 ft above the field, 5 ft at 50 ft. The candidate carries the default
+physical baro (issue 39, docs/baro.md): the filter's bias and scale-factor states take the day's temperature error,
+so the CAT III vertical on a cold day stays within 1.6x of the ISA day's (issue 39's acceptance) and under 1.5 ft.
+(Until issue 39 the candidate hid the error behind a 100 ft / 1 h baro bias in truth and filter, which this test
+then pinned.) Finding: on the candidate the scale-factor state alone is not what keeps it: without it
+(temperature_scale_sigma = 0) the 6 runs gave 0.98 ft against 1.05 ft with it: at 50 ft GBAS, the pseudolites and
+the radar altimeter carry the vertical and the bias state absorbs the rest. Open loop, one flown truth per group,
+integrity bank off (the accuracy is what is judged here). Measured, 6 runs, seed 1: 1.05 ft at ISA -30, 0.88 ft on
+the ISA day (1.19x).
 """
 
 from __future__ import annotations
@@ -27,12 +29,10 @@ CANDIDATE = ROOT / "profiles" / "gbas-cat3-candidate.toml"
 pytestmark = pytest.mark.slow
 
 
-def _vertical_ft(tmp_path: Path, name: str, narrow_baro: bool) -> float:
+def _vertical_ft(tmp_path: Path, name: str, isa_dev_c: float) -> float:
     data = tomllib.loads(CANDIDATE.read_text(encoding="utf-8"))
-    assert data["sensors"]["baro"] == {"bias_sigma_m": 30.48, "bias_tau_s": 3600.0}
-    data["environment"]["isa_dev_C"] = -30.0
-    if narrow_baro:
-        del data["sensors"]["baro"]  # the default 1 m / 100 s
+    assert "bias_sigma_m" not in data.get("sensors", {}).get("baro", {})  # no 100 ft sponge
+    data["environment"]["isa_dev_C"] = isa_dev_c
     prof = parse_profile(data, source=CANDIDATE)
     prof = replace(prof, evaluation=replace(prof.evaluation, integrity=()))
     ev = evaluate_profile(prof, runs=6, seed=1, mode="open", out_dir=tmp_path / name, workers=2, progress=False)
@@ -40,8 +40,9 @@ def _vertical_ft(tmp_path: Path, name: str, narrow_baro: bool) -> float:
     return float(ev.summary["decision_heights"]["CAT III"]["vertical_1sigma_ft"])
 
 
-def test_the_candidates_baro_budget_keeps_cat3_vertical_on_a_cold_day(tmp_path):
-    wide = _vertical_ft(tmp_path, "wide", narrow_baro=False)
-    narrow = _vertical_ft(tmp_path, "narrow", narrow_baro=True)
-    assert wide < 1.5, wide  # CAT III limit 1.0 ft; 6 runs' RMS of a 0.84 ft population
-    assert narrow > 3.0, narrow  # the temperature error at 50 ft (about 5 ft) in the filter's altitude
+def test_the_physical_baro_keeps_cat3_vertical_on_a_cold_day(tmp_path):
+    cold = _vertical_ft(tmp_path, "cold", -30.0)
+    isa = _vertical_ft(tmp_path, "isa", 0.0)
+    print(f"CAT III vertical 1-sigma, 6 runs, same seeds: {cold:.2f} ft at ISA -30, {isa:.2f} ft on the ISA day")
+    assert cold < 1.5, cold  # CAT III limit 1.0 ft; 6 runs' RMS of a ~0.9-1.0 ft population
+    assert cold < 1.6 * isa, (cold, isa)  # issue 39's acceptance: within 1.6x of the ISA day

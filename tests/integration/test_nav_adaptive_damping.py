@@ -175,8 +175,12 @@ def test_verdict_rules_on_constructed_samples() -> None:
 @pytest.mark.slow
 def test_navigation_output_altitude_ordering_preregistered() -> None:
     """The issue's metric (navigation output). Expected: refuted (tanh worse than constant)."""
-    for seed in SEEDS:  # the navigation works at all: altitude rms at the baro's 1 m level, not diverged
-        assert all(0.5 < np.sqrt(m.mean()) < 2.0 for m in run_seed(seed)["output"].values())
+    # the navigation works at all: altitude rms at the physical baro's level (issue 39, docs/baro.md: 1 m bias,
+    # 1.5 m static-source error and the QNH report's 0.3 hPa, about 2.5 m: 3.1 m together; measured 2.5-3.0 m at
+    # seed 101), not diverged (the bound was 2 m with the 1 m baro before issue 39)
+    for seed in SEEDS:
+        rms = {k: float(np.sqrt(m.mean())) for k, m in run_seed(seed)["output"].items()}
+        assert all(0.5 < v < 6.0 for v in rms.values()), (seed, rms)
     _decide("output")
 
 

@@ -227,11 +227,14 @@ def control(flown):
 def test_time_constant_only_control_fails(control):
     """The control must fail the suite: without the gyro axis noise the turbulence's slow pitch and yaw excursions
     times the 100 ppm scale factor make the horizontal velocity over-confident. Measured (100 runs, seed 1): v_N
-    1.33 above its band at 64 % of the epochs, v_E 1.22 above at 21 % (the filter: 1.10 / 0.88, 5 % / 0 %)."""
+    1.33 above its band at 64 % of the epochs, v_E 1.22 above at 21 % (the filter: 1.10 / 0.88, 5 % / 0 %). With
+    issue 39's physical baro merged: v_N 1.19 above at 33 %, v_E 1.16 above at 12 %: it fails on the fraction above
+    its band, no longer on the ratio (RATIO_BAND's 1.25), so the test asserts the failure, not its form."""
     ratio, inside, above = per_state(control)
     failing = [STATES[c] for c in range(9) if not state_passes(ratio[c], inside[c], above[c])]
     assert {"v_N", "v_E"} & set(failing), (ratio[3:5], inside[3:5], above[3:5])
-    assert max(ratio[3], ratio[4]) > RATIO_BAND[1]
+    print(f"control: v_N / v_E e^2/P {ratio[3]:.2f} / {ratio[4]:.2f}, inside {inside[3]:.2f} / {inside[4]:.2f}, "
+          f"above {above[3]:.2f} / {above[4]:.2f}")
 
 
 if __name__ == "__main__":  # the measured figures: python tests/integration/test_nav_consistency_jsbsim.py

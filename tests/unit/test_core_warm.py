@@ -77,7 +77,7 @@ def test_shipped_manifest_is_what_a_run_compiles(kind: str, tmp_path: Path) -> N
     entries = warm.load(kind)
     assert len(entries) >= 10
     assert sum(e.cost_s for e in entries) > 10.0
-    code = main(["evaluate", str(ROOT / "tests" / "data" / "default-py.toml"), "--runs", "1", "--workers", "1",
+    code = main(["evaluate", str(ROOT / "profiles" / "default.toml"), "--runs", "1", "--workers", "1",
                  "--seed", "1", "--no-report", "--mode", kind, "--out", str(tmp_path / "e")])
     assert code in (0, 1)
     stale = [f"{e.module}.{e.name}{e.args}" for e in entries
