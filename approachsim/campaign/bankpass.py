@@ -148,8 +148,8 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
                   f_sum=np.zeros((1, 3)), out=rows, row0=0)
     o = _stacked_observations(records, np.asarray(truth.t_s, dtype=float)[epoch_rows::epoch_rows], tol, True, 1)
     used = np.flatnonzero(np.any(np.asarray(gnss.valid, dtype=bool)[0], axis=0))
-    return _core(nav, truth, modes, m, epoch_rows, runs[0].fs.x, np.asarray(runs[0].fs.P, dtype=float),
-                 runs[0].db_error, rows[0, epoch_rows::epoch_rows], None if hb_full is None else hb_full[0], o, used,
+    return _core(nav, truth, modes, m, epoch_rows, (runs[0].fs.x, np.asarray(runs[0].fs.P, dtype=float),
+                 runs[0].db_error), rows[0, epoch_rows::epoch_rows], None if hb_full is None else hb_full[0], o, used,
                  runs[0].arcs, memo=memo, x_off=x_off)
 
 
@@ -210,21 +210,22 @@ def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Arr
     used = np.flatnonzero(np.any(np.asarray(recs["gnss"].valid, dtype=bool)[k], axis=0))
     x_hat, P = group.keep["start"][k]
     main = group.keep["reduced_runs"][k] if "reduced_runs" in group.keep else None
-    return _core(nav, truth, modes, m, er, x_hat, P, group.keep["db"][k], group.keep["ins_epoch_rows"][k],
+    return _core(nav, truth, modes, m, er, (x_hat, P, group.keep["db"][k]), group.keep["ins_epoch_rows"][k],
                  None if hb is None else hb[0], o, used, main=main, memo=memo)
 
 
-def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, x_hat: Array, P_conv: Array,
-          db_error: Any, ins_ep: Array, hb1: Array | None, o: dict[str, Any], used: Array,
+def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, start: tuple[Array, Array, Any],
+          ins_ep: Array, hb1: Array | None, o: dict[str, Any], used: Array,
           arcs0: Array | None = None, main: Any = None, memo: TruthMemo | None = None,
           x_off: Array | None = None) -> BankPass | None:
-    """The pass from the run's start (x_hat, P_conv, its terrain-database error), its INS states at the epochs
+    """The pass from the run's start = (x_hat, P_conv, its terrain-database error), its INS states at the epochs
     ins_ep (E, 16), its baro held for the damping loop hb1 (m,) or None, its stacked observations o (one run) and
     the GNSS channels it measures; carrier phase: arcs0 (k,) the start's carrier arc ids (None: none yet), from
     which each copy's new arcs (its ambiguity resets) follow as in Navigator.compiled_pass. main: the group pass's
     own filter of the run on its reduced state (nav/reduced.ReducedRun), which is copy 0 (the same start, INS,
     observations and models in the same compiled pass): taken as copy 0 when its channels are the copies' (only the
     sub-filters are run), else None. memo: the truth's TruthMemo (the reference, the epoch models)."""
+    x_hat, P_conv, db_error = start
     lay = nav.layout
     eng = EpochEngine(nav)
     # the epochs and the reference (the truth at the epoch rows: nav/shared.py)
