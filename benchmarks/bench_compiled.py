@@ -102,7 +102,7 @@ def bench_compile() -> None:
         print(f"  cache: {sum(1 for _ in Path(d).rglob('*.nbi'))} index files, {size / 1e6:.1f} MB")
 
 
-def bench_ratios(repeat: int) -> None:
+def bench_ratios(repeat: int, profile: Path = PROFILE) -> None:
     """Raw JSBSim stepping, the truth flight, the closed loop (flight + sensors + INS + EKF + autopilot, and its
     NavRun) and the open-loop navigation pass of the same approach, interleaved `repeat` times in one warm process;
     min and median of wall and CPU time (the machine's speed drifts: the ratios of one pass are the figures)."""
@@ -116,7 +116,7 @@ def bench_ratios(repeat: int) -> None:
     from approachsim.sensors.suite import SensorSuite
 
     print(f"ratios: {load()}")
-    prof = load_profile(PROFILE)
+    prof = load_profile(profile)
     a = Approach(prof)
     budget = a.time_budget_s
     a.fly(seed=1, run=99, nav_source=NavInTheLoop(prof, seed=1, run=99, max_time_s=3.0), max_time_s=3.0)  # warm up
@@ -166,7 +166,7 @@ def bench_ratios(repeat: int) -> None:
         timed("nav", lambda nav=nav, tr=r.truth, recs=recs, st=st, i=i: nav.run(tr, recs, stream(1, i, "nav"),
                                                                                states=st))
     mn, md = min, statistics.median
-    print(f"  default profile, {n} steps at {prof.rates.imu_hz:g} Hz; {repeat} interleaved repeats; wall (CPU) s, "
+    print(f"  {Path(profile).name}, {n} steps at {prof.rates.imu_hz:g} Hz; {repeat} interleaved repeats; wall (CPU) s, "
           f"min / median")
     for k, what in (("raw", "raw JSBSim stepping (trim + run())"), ("truth", "flown on truth (Approach.fly)"),
                     ("closed", "closed loop (JSBSim + sensors + INS + EKF + autopilot, NavRun)"),
@@ -331,6 +331,7 @@ def main() -> None:
     ap.add_argument("part", choices=["compile", "ratios", "scaling", "dask", "evaluate", "_one"])
     ap.add_argument("n_one", nargs="?", type=int, default=0, help=argparse.SUPPRESS)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--profile", type=Path, default=PROFILE, help="ratios: the profile flown (default: the default)")
     ap.add_argument("--ns", type=int, nargs="+", default=[10, 100, 1000])
     ap.add_argument("--n", type=int, default=1000)
     ap.add_argument("--accuracy-only", action="store_true", help="scaling, dask: without the integrity bank")
@@ -339,7 +340,7 @@ def main() -> None:
     if args.part == "compile":
         bench_compile()
     elif args.part == "ratios":
-        bench_ratios(args.repeat)
+        bench_ratios(args.repeat, args.profile)
     elif args.part == "scaling":
         bench_scaling(args.ns, args.accuracy_only)
     elif args.part == "dask":

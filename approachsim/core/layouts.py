@@ -15,6 +15,7 @@ or widened moves every offset after it and nothing is numbered by hand anywhere 
                   `fly_step`'s parameter and state vectors: the components' vectors concatenated (terrain and the
                   monitor's windows, of run-dependent length, end them)
     NAV_WORK      the closed loop's navigation work vector (core/loop/nav_row.py)
+    SERVICE_TRUTH a GNSS service's truth shape (core/sensors/gnss.py service_errors; sensors/gnss/service.py)
     DIRECT        the addresses the compiled JSBSim calls take (core/loop/direct.py)
 
 tests/unit/test_core_layouts.py checks the layouts against the records they pack (Truth's fields, the autopilot's
@@ -229,6 +230,17 @@ NAV_WORK = Layout([
  W_ANY_BARO, W_BARO_LOOP, W_BARO_KERNEL, W_BARO_EXCL, W_BSET, W_BT0L, W_BEXP, W_BSF, W_BFLD, W_BCM1, W_N, W_M, W_NBE,
  W_NLAG, W_HB_T, W_HB_AGE) = NAV_WORK.starts()
 NW = NAV_WORK.size
+
+# --- a GNSS service's truth: fractions of the broadcast sigmas and the iono field's shape (service.py) ---------------
+SERVICE_TRUTH = Layout(_scalars(
+    "f_range", "f_iono", "f_tropo", "f_air",  # truth 1-sigma / broadcast 1-sigma of each term
+    "w_common", "w_grad", "w_local",          # square roots of the iono field's variance split (0, 0, 1: per channel)
+    "grad_ref_m",                             # d_5: the pierce distance the gradient term is scaled by, m
+    "tropo_common",                           # 1: one zenith tropo residual for all satellites; 0: per channel
+))
+(ST_F_RANGE, ST_F_IONO, ST_F_TROPO, ST_F_AIR, ST_W_COMMON, ST_W_GRAD, ST_W_LOCAL, ST_GRAD_REF,
+ ST_TROPO_COMMON) = SERVICE_TRUTH.starts()
+N_ST = SERVICE_TRUTH.size
 
 # --- the compiled JSBSim calls' addresses (core/loop/direct.py) ------------------------------------------------------
 WRITTEN = ("fcs/elevator-cmd-norm", "fcs/aileron-cmd-norm", "fcs/rudder-cmd-norm", "fcs/throttle-cmd-norm[0]",

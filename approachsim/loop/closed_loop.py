@@ -37,6 +37,7 @@ from approachsim.core.loop import aiding as ce
 from approachsim.core.loop import nav_row as ik
 from approachsim.core.nav import groups as kg
 from approachsim.core.nav import strapdown as sk
+from approachsim.core.sensors import gnss as gk
 from approachsim.loop import paths
 from approachsim.nav import errormodel as em
 from approachsim.nav import ins
@@ -47,6 +48,7 @@ from approachsim.nav.system import NavSystem, tuned_records
 from approachsim.records import Truth
 from approachsim.seeding import stream
 from approachsim.sensors.gnss.elevation import IONO_SHELL_M
+from approachsim.sensors.gnss.receiver import PreparedGnss
 from approachsim.sensors.states import start_states
 from approachsim.sensors.suite import SensorSuite
 
@@ -161,8 +163,9 @@ class FastEpoch:
     """loop_epoch's compiled entry point for this run's argument types (`_entry`; made at the first epoch)."""
     sig: tuple | None = None
     """The compiled channel sigmas' scratch and constants (NavInTheLoop._noise_arrays): guarded elevations, the
-    multipath curve's argument, cos, sin, exp, gse, gmp (n_sv,) and channel_sigmas' constants; None: the numpy
-    formulas (GBAS budget, no GPS channels)."""
+    multipath curve's argument, cos, sin, exp, gse, gmp (n_sv,) and channel_sigmas' constants; a GNSS service's:
+    guarded elevations, the argument, the elevations as (1, n_sv), slow, fast, total (1, n_sv), None and the filter's
+    service parameters; None: the numpy formulas (GBAS budget, no GPS channels)."""
     direct: bool = False
     """The epoch's sensor inputs come straight from the sensors' kernels (NavInTheLoop._direct_inputs: plain baro,
     radar altimeter and stand-alone code GNSS of one run), not from their records (`_epoch_inputs`, the oracle)."""
@@ -496,6 +499,10 @@ class NavInTheLoop:
         (and `compiled_sigmas`)."""
         if self.path.sigmas != "compiled":
             return None
+        if b.service is not None:  # the filter's own channel model (service.py filter_channel_sigmas_m)
+            g, arg = np.zeros(n_sv), np.zeros(n_sv)
+            return (g, arg, g.reshape(1, n_sv), *(np.zeros((1, n_sv)) for _ in range(3)), None,
+                    b.service.filter_params())
         do253 = b.multipath_model == "do253"
         gmp = np.zeros(n_sv) if do253 else _per_channel(b.multipath_m, n_sv).copy()
         return (*(np.zeros(n_sv) for _ in range(6)), gmp,
@@ -506,8 +513,9 @@ class NavInTheLoop:
         """NoiseModel.kernel_arrays(el) (nav/noise.py) with the elevation-free scalars kept: the GPS channel
         states' sigmas at el by the receiver budget's formulas, the same bits (el is finite or nan): a stand-alone
         budget's with numpy's cos, sin, exp and the rest compiled in numpy's order (closed_loop_epoch
-        channel_guard, channel_sigmas; FastEpoch.sig), else the budget's numpy (`_noise_arrays_numpy`, the
-        oracle)."""
+        channel_guard, channel_sigmas; FastEpoch.sig), a GNSS service's by its one kernel (core/sensors/gnss.py
+        service_channel_sigmas, as ServiceModel.filter_channel_sigmas_m), else the budget's numpy
+        (`_noise_arrays_numpy`, the oracle)."""
         fe = self._fast
         sg = fe.sig
         if el is None or sg is None or el.shape[0] != sg[0].shape[0]:
@@ -518,6 +526,9 @@ class NavInTheLoop:
             d.guarded = False
         else:
             ce.channel_guard(el, _EL_MIN, g, arg)
+        if gmp is None:  # a GNSS service: (g (1, k), slow, fast, total, None, the filter's parameters)
+            gk.service_channel_sigmas(c, consts, False, s, ex, gse)
+            return fe.q, s[0], ex[0]
         np.cos(g, out=c)
         np.sin(g, out=s)
         if consts[-1]:  # do253
@@ -642,6 +653,7 @@ class NavInTheLoop:
             gnss = (truth.r_ecef, g.r_sv, float(g.rx.mask_rad), mode, *consts, *series, g.bias,
                     g.errors.t_s, float(self.nav.nav.gps_sigma_scale), np.empty((1, 3)),
                     np.empty((g.r_sv.shape[0], 1) + g.r_sv.shape[2:]))
+            service = g.direct_service()
             plan = g.plan if g.rx.selection == "best4-fixed" else None
         else:
             n_ch, guard = 0, False
@@ -649,9 +661,10 @@ class NavInTheLoop:
             plan0 = np.zeros((1, 0), dtype=bool)
             gnss = (np.zeros((0, 3)), np.zeros((1, 0, 0, 3)), 0.0, 0, 0.0, False,
                     0.0, 0.0, 0.0, 0.0, 0.0, s3, s3, s3, s3, s3, z2, z1, 1.0, np.empty((1, 3)), np.zeros((1, 1, 0, 3)))
+            service = PreparedGnss.no_service()
         rho, r_sv, sig, el = np.empty((1, n_ch)), np.empty((n_ch, 3)), np.empty(n_ch), np.empty(n_ch)
         gs = (sg[0], sg[1]) if guard else (z1, z1)
-        args = [0, 0.0, 0.25 * self.dt, -1, -1, -1, plan0, (*baro, hold, baro_h), radalt, gnss,
+        args = [0, 0.0, 0.25 * self.dt, -1, -1, -1, plan0, (*baro, hold, baro_h), radalt, gnss, service,
                 (rho, r_sv, sig, el), (guard, _EL_MIN, *gs)]
         return _Direct(args=args, plan=plan, baro_h=baro_h, baro_r=baro_r, radalt_h=radalt_h,
                        rho=rho, r_sv=r_sv, sig=sig, el=el, no_rho=np.zeros((1, 0)), guard=guard,

@@ -15,7 +15,8 @@ from the configuration and the oracle switches, before the first row, and the ru
                         an adaptive loop, carrier phase; or the oracle switch `fast_epochs = False`)
     baro    "compiled"  a plain altimeter's damping-loop samples made in the compiled row; "python": a faulted one's
             (or one sensing an inversion: sensors/baro.py) by its model at the row; "none"
-    sigmas  "compiled"  the GPS channel sigmas of the compiled epoch compiled (core/loop/aiding.py channel_sigmas);
+    sigmas  "compiled"  the GPS channel sigmas of the compiled epoch compiled (core/loop/aiding.py channel_sigmas; a
+                        GNSS service's: core/sensors/gnss.py service_channel_sigmas);
             "numpy": the numpy formulas (GBAS, or `compiled_sigmas = False`); "none": no compiled epoch or no GPS
 
 The flight adds its own part, decided where JSBSim is (flight/run.py `flight_loop`): "direct" (JSBSim's C++ called
@@ -73,7 +74,8 @@ def epoch_unavailable(source: Any) -> str | None:
 def _direct_unavailable(source: Any) -> str | None:
     """Why the compiled epoch's sensor inputs cannot come straight from the sensors' kernels (None: they can): every
     aiding sensor needs its direct form: a plain (not faulted) baro and radar altimeter, a one-run, one-sky GPS
-    receiver of code ranging without GBAS or carrier phase (the pseudolite's record is made as before)."""
+    receiver of code ranging without GBAS or carrier phase, stand-alone or with a GNSS service (the pseudolite's
+    record is made as before)."""
     ps = source.prepared.sensors
     for name, kind in (("baro", PreparedBaro), ("radalt", PreparedRadalt), ("gnss", PreparedGnss)):
         p = ps.get(name)
@@ -86,8 +88,6 @@ def _direct_unavailable(source: Any) -> str | None:
     if g is not None:
         if g.rx.budget.gbas is not None:
             return "GBAS corrections: the receiver's records"
-        if g.rx.budget.service is not None:
-            return "a GNSS service (sensors/gnss/service.py): the receiver's records"
         if g.rx.carrier is not None:
             return "carrier phase: the receiver's records"
         if g.per_run or g.errors.batched:
@@ -126,10 +126,9 @@ def choose(source: Any) -> LoopPath:
     g = None if b is None else b.budget()
     if epoch == "generic" or g is None or source.nav.layout.n_sv == 0:
         sigmas = "none"
-    elif g.gbas is not None or g.service is not None or not source.compiled_sigmas:
+    elif g.gbas is not None or not source.compiled_sigmas:
         sigmas = "numpy"
-        reasons.append(("sigmas", "GBAS channel sigmas" if g.gbas is not None else (
-            "a GNSS service's broadcast sigmas" if g.service is not None else "compiled_sigmas = False")))
+        reasons.append(("sigmas", "GBAS channel sigmas" if g.gbas is not None else "compiled_sigmas = False"))
     else:
         sigmas = "compiled"
     return LoopPath(row, epoch, baro_path, sigmas, tuple(reasons))

@@ -115,8 +115,24 @@ GNSS_IN = 8
 
 
 @njit(cache=True)
+def _service_pseudoranges(rng: np.ndarray, el: np.ndarray, az: np.ndarray, sel: np.ndarray, p: np.ndarray,
+                          shape: np.ndarray, series: tuple, noise: np.ndarray, clk: np.ndarray, j: int,
+                          scr: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """sensors/gnss/receiver.py service_pseudoranges and the broadcast sigma_i (ServiceModel.sigma_m, into scr[7])
+    of one run's sample j on a one-sample sky: the same kernels on arrays of the same types (the sample's noise and
+    clock copied into scr's contiguous scratch), so the same bits as GnssReceiver.record's."""
+    one, slow, air, nz, b, gse, gmp, tot = scr
+    gk.service_errors(el, az, p, shape, series, j, slow, air)
+    for c in range(nz.shape[2]):
+        nz[0, 0, c] = noise[0, j, c]
+    b[0, 0] = clk[0, j]
+    gk.service_channel_sigmas(el[0], p, False, gse, gmp, tot)
+    return gk.pseudorange_sum(rng, sel, ((one, slow), (one, air), (one, nz)), b)
+
+
+@njit(cache=True)
 def direct_inputs(k: int, t: float, tol: float, jb: int, jr: int, jg: int, plan: np.ndarray, baro: tuple,
-                  radalt: tuple, gnss: tuple, out: tuple, guard: tuple) -> int:
+                  radalt: tuple, gnss: tuple, service: tuple, out: tuple, guard: tuple) -> int:
     """The closed loop's direct epoch inputs at truth row k (time t) in one call (loop/closed_loop.py
     `_direct_inputs`): the sensors' one-row kernels on the values their h_one / channels_one give them, the same
     kernels in the same order, so the same bits. Each sensor's constants, drawn errors, scratch and outputs come as
@@ -128,6 +144,9 @@ def direct_inputs(k: int, t: float, tol: float, jb: int, jr: int, jg: int, plan:
                   r_in, r_meas, r_sig, r_valid, radalt_h)
         gnss   = (r_ecef, r_sv_all, mask, mode, shell, do253, mp_m, ce2, iono_z, tropo_z, cn2, s_ce, s_iono, s_tropo,
                   s_mp, s_noise, clk, g_ts, scale, g_rx, g_sv)
+        service = (on, p, shape, series, noise, (one, slow, air, nz, b, gse, gmp, tot))   a GNSS service's truth
+                  (on: the pseudoranges are service_errors' instead of the stand-alone terms s_ce..s_noise; p, shape
+                  the packed parameters, series the unit series, noise m; then scratch, one-sample C arrays)
         out    = (rho, r_sv_out, sig_out, el_out);  guard = (guard, lo, g, mp_arg)
 
         baro sample jb (-1: none): p[0, q] = p_static[max(k - q, 0)] (q < len b_p), baro_apply -> b_hold[0]; when
@@ -138,6 +157,8 @@ def direct_inputs(k: int, t: float, tol: float, jb: int, jr: int, jg: int, plan:
             pseudoranges on the series' sample jg: rho (1, 24) (nan where not selected), r_sv_out = r_sv_all[0, jg],
             sig_out = sigma (times scale when scale != 1), el_out = elevations; guard: channel_guard(el_out, lo, g,
             mp_arg)                                                                         (PreparedGnss.channels_one)
+            with a service: receiver.service_pseudoranges on sample jg, sig_out the broadcast sigma_i
+                                                                                            (GnssReceiver.record)
 
     Returns the flags HAS_BARO | BARO_IN | RADALT_IN | GNSS_IN of what was set."""
     (p_static, b_w, b_set, b_t0l, b_exp, b_fld, b_cm1, b_sf, b_bias, b_noise, b_ts, b_p, b_out, b_hold,
@@ -180,9 +201,14 @@ def direct_inputs(k: int, t: float, tol: float, jb: int, jr: int, jg: int, plan:
                     g_sv[i, 0, s_, c] = r_sv_all[i, jg, s_, c]
         rng, u, el, az, vis, sel, pdop, f_iono, m_tropo, mp_scale, sigma = gk.sky(
             g_rx, g_sv, mask, mode, plan, shell, do253, mp_m, ce2, iono_z, tropo_z, cn2)
-        pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, s_ce[:, jg:jg + 1], s_iono[:, jg:jg + 1],
-                                    s_tropo[:, jg:jg + 1], s_mp[:, jg:jg + 1], s_noise[:, jg:jg + 1],
-                                    clk[:, jg:jg + 1])
+        on, sp, shape, series, noise, scr = service
+        if on:
+            pr, valid = _service_pseudoranges(rng, el, az, sel, sp, shape, series, noise, clk, jg, scr)
+            sigma = scr[7].reshape((1,) + scr[7].shape)
+        else:
+            pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, s_ce[:, jg:jg + 1],
+                                        s_iono[:, jg:jg + 1], s_tropo[:, jg:jg + 1], s_mp[:, jg:jg + 1],
+                                        s_noise[:, jg:jg + 1], clk[:, jg:jg + 1])
         n = pr.shape[2]
         for i in range(n):
             rho[0, i] = pr[0, 0, i] if valid[0, 0, i] else math.nan

@@ -15,6 +15,7 @@ same sample of a batch bit for bit.
     channel_sigmas     the navigation filter's GPS channel-state sigmas of a stand-alone budget, element by element
     service_channel_sigmas  a civil service's channel sigmas (broadcast, or the filter's own), element by element
     service_channel_terms   a civil service's broadcast range / iono / tropo / air sigmas, pierce distance
+    service_errors     a civil service's true slow (range + iono + tropo) and airborne errors per channel
     gbas_scales        the GBAS-corrected residual's scales and nominal sigma per channel (gnss/gbas.py)
     gbas_channel_sigmas the navigation filter's GPS channel-state sigmas under GBAS, element by element
     pseudorange_rates  line-of-sight range rate + clock drift + noise for every run
@@ -30,6 +31,7 @@ from numba import literal_unroll
 
 from approachsim import geo
 from approachsim.core import geodesy as gd
+from approachsim.core import layouts as L
 from approachsim.core.jit import njit
 from approachsim.core.sensors import gnss_errors as ge
 
@@ -382,6 +384,45 @@ def service_channel_terms(el: np.ndarray, p: np.ndarray, out: np.ndarray) -> Non
             out[i, c, 2] = t
             out[i, c, 3] = a
             out[i, c, 4] = ge.pierce_distance_m(e, p[6])
+
+
+@njit(cache=True)
+def service_errors(el: np.ndarray, az: np.ndarray, p: np.ndarray, shape: np.ndarray, series: tuple, j0: int,
+                   slow: np.ndarray, air: np.ndarray) -> None:
+    """A civil service's true errors (sensors/gnss/service.py ServiceModel.truth_errors, its numpy oracle), m, of
+    every run r at elevations / azimuths el, az (S, m, k) rad (run r on sky r, or on sky 0 when there is one sky),
+    into slow (range + iono + tropo) and air (R, m, k). p: the broadcast parameters (SERVICE_FIELDS, unit scales);
+    shape: the truth's fractions and the iono field's split (core/layouts.py SERVICE_TRUTH); series: the unit
+    series (range, iono_local, air, iono_field, tropo, tropo_local) (R, M, k | 3 | 1), read at samples j0 + i. With
+    the broadcast terms (r, I, T, a) = gnss_errors.service_terms(el, p) and pierce distance d:
+
+        range  f_r r e_r
+        iono   f_i I (w_c f_0 + (w_g d / d_5) (sin az f_1 + cos az f_2) + w_l e_l)   (f_0..2: the field's series)
+        tropo  f_t T (e_t (common zenith) or e_tl (per channel))
+        air    f_a a e_a                                               (numpy's operations in the oracle's order)"""
+    s_rng, s_loc, s_air, s_fld, s_trp, s_trl = series
+    n_run, m, k = slow.shape
+    one_sky = el.shape[0] == 1
+    fr, fi, ft, fa = shape[L.ST_F_RANGE], shape[L.ST_F_IONO], shape[L.ST_F_TROPO], shape[L.ST_F_AIR]
+    wc, wg, wl = shape[L.ST_W_COMMON], shape[L.ST_W_GRAD], shape[L.ST_W_LOCAL]
+    d5 = shape[L.ST_GRAD_REF]
+    tc = shape[L.ST_TROPO_COMMON] != 0.0
+    for r in range(n_run):
+        s = 0 if one_sky else r
+        for i in range(m):
+            j = j0 + i
+            for c in range(k):
+                e = el[s, i, c]
+                rt, io, tr, at = ge.service_terms(e, p)
+                iono = fi * io
+                g = iono * wg * ge.pierce_distance_m(e, p[6]) / d5
+                a = az[s, i, c]
+                di = (iono * wc * s_fld[r, j, 0] + g * math.sin(a) * s_fld[r, j, 1]
+                      + g * math.cos(a) * s_fld[r, j, 2] + iono * wl * s_loc[r, j, c])
+                t = ft * tr
+                dt = t * s_trp[r, j, 0] if tc else t * s_trl[r, j, c]
+                slow[r, i, c] = fr * rt * s_rng[r, j, c] + di + dt
+                air[r, i, c] = fa * at * s_air[r, j, c]
 
 
 @njit(cache=True)

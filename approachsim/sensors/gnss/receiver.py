@@ -115,6 +115,7 @@ from approachsim.sensors.gnss.constellation import Constellation, dops, look_ang
 from approachsim.sensors.gnss.elevation import IONO_SHELL_M, do253_multipath_sigma_m, iono_obliquity, tropo_mapping
 from approachsim.sensors.gnss.gbas import CARRIER_NOISE_M, SMOOTHING_TAU_S, GbasModel, station_geometry
 from approachsim.sensors.gnss.service import AIR_TAU_S, IONO_TAU_S, TROPO_TAU_S, ServiceModel
+from approachsim.sensors.gnss.service import SERIES as SERVICE_SERIES
 
 Array = np.ndarray
 
@@ -584,12 +585,7 @@ class GnssReceiver:
             b.multipath_model == "do253", float(b.multipath_m), b.clock_ephemeris_m**2, float(b.iono_zenith_m),
             float(b.tropo_zenith_m), b.code_noise_m**2)
         if b.service is not None:  # service.py: the correlated truth; the record's sigma the broadcast sigma_i
-            r_, io, tr, air = b.service.truth_errors(series, el, az)
-            full = (bias.shape[0],) + rng.shape[1:]
-            one = np.ones(rng.shape)
-            pr, valid = gk.pseudorange_sum(rng, sel, ((one, c(np.broadcast_to(r_ + io + tr, full))),
-                                                      (one, c(np.broadcast_to(air, full))), (one, c(series["noise"]))),
-                                           c(bias))
+            pr, valid = service_pseudoranges(b.service, rng, el, az, sel, series, bias, 0)
             sigma = b.service.sigma_m(el)
         elif b.gbas is None:
             pr, valid = gk.pseudoranges(rng, f_iono, m_tropo, mp_scale, sel, c(series["clock_ephemeris"]),
@@ -714,6 +710,36 @@ class GnssReceiver:
         return self.apply(truth, e, c)
 
 
+def service_pseudoranges(sv: ServiceModel, rng: Array, el: Array, az: Array, sel: Array,
+                         series: Mapping[str, Array], bias: Array, j0: int) -> tuple[Array, Array]:
+    """A service's pseudoranges (R, m, k) m and validity (core/sensors/gnss.py service_errors, pseudorange_sum) from
+    the sky's range, elevation, azimuth and selection (S, m, k) and the unit series (R, M, ...) read at samples
+    j0 + i, receiver clock bias (R, m) m: rho = |r_sv - r| + slow + air + noise + b_rx."""
+    c = np.ascontiguousarray
+    full = (bias.shape[0],) + rng.shape[1:]
+    slow, air = np.empty(full), np.empty(full)
+    gk.service_errors(el, az, sv.params(), sv.truth_shape(), tuple(c(series[n]) for n in SERVICE_SERIES), j0, slow,
+                      air)
+    noise = c(series["noise"][:, j0:j0 + full[1]])
+    one = np.ones(rng.shape)
+    return gk.pseudorange_sum(rng, sel, ((one, slow), (one, air), (one, noise)), c(bias))
+
+
+def service_group(sv: ServiceModel | None, series: Mapping[str, Array], k: int) -> tuple:
+    """core/loop/aiding.py direct_inputs' `service` group: (on, broadcast parameters, truth shape, the unit series
+    (1, M, ...), the noise series (1, M, k) m, scratch of one-sample C arrays for k channels); `on` False with
+    empty arrays of the same types when sv is None."""
+    c = np.ascontiguousarray
+    k = k if sv is not None else 0
+    scratch = (np.ones((1, 1, k)), np.empty((1, 1, k)), np.empty((1, 1, k)), np.empty((1, 1, k)), np.empty((1, 1)),
+               np.empty((1, k)), np.empty((1, k)), np.empty((1, k)))
+    if sv is None:
+        return (False, np.zeros(0), np.zeros(0), tuple(np.zeros((1, 0, 0)) for _ in SERVICE_SERIES),
+                np.zeros((1, 0, 0)), scratch)
+    return (True, sv.params(), sv.truth_shape(), tuple(c(series[n]) for n in SERVICE_SERIES), c(series["noise"]),
+            scratch)
+
+
 def _run_axis(errors: base.SensorErrors) -> dict[str, Array]:
     """The error series of `errors` with a run axis: name -> (R, m, ...) (a view for one run)."""
     return dict(errors.series) if errors.batched else {k: v[None] for k, v in errors.series.items()}
@@ -789,16 +815,27 @@ class PreparedGnss:
         ValueError unless a one-run, one-sky, stand-alone code receiver."""
         if self._direct is None:
             rx, e = self.rx, self.errors
-            if (rx.budget.gbas is not None or rx.budget.service is not None or rx.carrier is not None or self.per_run
-                    or e.batched):
-                raise ValueError("channels_one: a one-run stand-alone code receiver only")
+            if rx.budget.gbas is not None or rx.carrier is not None or self.per_run or e.batched:
+                raise ValueError("channels_one: a one-run code receiver without GBAS only")
             b = rx.budget
+            if b.service is None:
+                series = tuple(self.series[n] for n in ("clock_ephemeris", "iono_zenith", "tropo_zenith", "multipath",
+                                                        "noise"))
+            else:  # the service's series go by direct_service
+                series = tuple(np.zeros((1, 0, 0)) for _ in range(5))
             self._direct = ({"all": gk.MODE_ALL, "best4": gk.MODE_BEST4, "best4-fixed": gk.MODE_PLANNED}[rx.selection],
                          (IONO_SHELL_M, b.multipath_model == "do253", float(b.multipath_m), b.clock_ephemeris_m**2,
-                          float(b.iono_zenith_m), float(b.tropo_zenith_m), b.code_noise_m**2),
-                         tuple(self.series[n] for n in ("clock_ephemeris", "iono_zenith", "tropo_zenith", "multipath",
-                                                       "noise")))
+                          float(b.iono_zenith_m), float(b.tropo_zenith_m), b.code_noise_m**2), series)
         return self._direct
+
+    def direct_service(self) -> tuple:
+        """core/loop/aiding.py direct_inputs' `service` group for this receiver (service_group)."""
+        return service_group(self.rx.budget.service, self.series, self.r_sv.shape[2])
+
+    @staticmethod
+    def no_service() -> tuple:
+        """direct_inputs' `service` group of a receiver without a service (service_group: off)."""
+        return service_group(None, {}, 0)
 
     def channels_one(self, truth: Truth, j: int) -> tuple[Array, Array, Array, Array, Array]:
         """Sample j of a one-run, one-sky, stand-alone code receiver (no GBAS, no carrier phase) without the record:

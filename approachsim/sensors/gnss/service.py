@@ -87,6 +87,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from approachsim.core import layouts
 from approachsim.core.sensors import gnss as gk
 from approachsim.core.sensors import gnss_errors as ge
 from approachsim.sensors.gnss.elevation import IONO_SHELL_M
@@ -157,6 +158,8 @@ AIR_TAU_S = 100.0
 """Correlation time of the airborne smoothed-code error, s: the 100 s carrier-smoothing time constant."""
 IONO_FIELD_WEIGHTS = (0.75, 0.20, 0.05)
 """Variance split of the unit ionospheric field: common, planar gradient (at the 5 deg pierce distance), local."""
+SERIES = ("range", "iono_local", "air", "iono_field", "tropo", "tropo_local")
+"""The truth's unit series in core/sensors/gnss.py service_errors' order (receiver.py draws them, and "noise")."""
 GRADIENT_REFERENCE_EL_RAD = math.radians(5.0)
 """The elevation whose pierce distance d_5 normalizes the gradient term ((d / d_5)^2 of its variance)."""
 
@@ -346,6 +349,20 @@ class ServiceModel:
     def gradient_reference_m(self) -> float:
         """d_5: the pierce distance of a 5 deg satellite, m (the iono gradient term's unit)."""
         return float(ge.pierce_distance_m(GRADIENT_REFERENCE_EL_RAD, IONO_SHELL_M))
+
+    def truth_shape(self) -> Array:
+        """The packed truth shape of core/sensors/gnss.py service_errors (core/layouts.py SERVICE_TRUTH): the truth's
+        fractions, the iono field's variance split as square roots ((0, 0, 1) when every term is per channel:
+        truth = "broadcast", or the iono-free higher-order residual), d_5 and whether the tropo is one zenith
+        residual (truth_scales gives the same scales in numpy)."""
+        fr, fi, ft, fa = self.truth_fractions()
+        w0, wg, _ = IONO_FIELD_WEIGHTS
+        correlated = not (self.truth == "broadcast" or self.dual_frequency)
+        vals = {"f_range": fr, "f_iono": fi, "f_tropo": ft, "f_air": fa,
+                "w_common": math.sqrt(w0) if correlated else 0.0, "w_grad": math.sqrt(wg) if correlated else 0.0,
+                "w_local": math.sqrt(1.0 - w0 - wg) if correlated else 1.0,
+                "grad_ref_m": self.gradient_reference_m(), "tropo_common": 0.0 if self.truth == "broadcast" else 1.0}
+        return np.array([float(vals[n]) for n in layouts.SERVICE_TRUTH.names])
 
     def truth_scales(self, el_rad: Array, az_rad: Array) -> dict[str, Array]:
         """The truth's per-channel scales (m per unit series) at elevations / azimuths (..., k), rad: range, air,

@@ -29,8 +29,10 @@ def _profile(name: str, **sections):
     return parse_profile(d, source=path.resolve())
 
 
-def test_default_profile_takes_every_fast_form():
-    src = NavInTheLoop(load_profile(PY_DEFAULT), seed=1, run=0, max_time_s=30.0)
+@pytest.mark.parametrize("path", [PY_DEFAULT, PROFILES / "default.toml", PROFILES / "dfmc-sbas.toml"])
+def test_default_profile_takes_every_fast_form(path):
+    """The P(Y) file, the SBAS L1 default and DFMC SBAS: every part compiled, the epoch fused."""
+    src = NavInTheLoop(load_profile(path), seed=1, run=0, max_time_s=30.0)
     p = src.path
     assert (p.row, p.epoch, p.baro, p.sigmas) == ("compiled", "fused", "compiled", "compiled")
     assert p.reasons == () and p.name == "row=compiled epoch=fused baro=compiled sigmas=compiled"

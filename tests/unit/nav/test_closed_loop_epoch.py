@@ -26,10 +26,16 @@ PY_DEFAULT = PROFILES.parent / "tests" / "data" / "default-py.toml"
 """The P(Y) default the tests of its receiver load (tests/data/default-py.toml says why)."""
 
 
-def _profile(name: str, baro: dict | None = None, **nav):
-    path = PY_DEFAULT if name == "default.toml" else PROFILES / name
+SBAS_DEFAULT = "sbas-default"
+"""The shipped default (profiles/default.toml: SBAS L1), by this name here ("default.toml" is the P(Y) file)."""
+
+
+def _profile(name: str, baro: dict | None = None, gnss: dict | None = None, **nav):
+    path = PY_DEFAULT if name == "default.toml" else PROFILES / ("default.toml" if name == SBAS_DEFAULT else name)
     d = tomllib.loads(path.read_text(encoding="utf-8"))
     d.setdefault("nav", {}).update(nav)
+    if gnss:
+        d["sensors"]["gnss"].update(gnss)
     if baro:
         d["sensors"]["baro"].update(baro)
     return parse_profile(d, source=path.resolve())
@@ -43,10 +49,11 @@ def _fly(prof, fast: bool, seconds: float = 12.0):
     return src, res, src.result(res.truth)
 
 
-@pytest.mark.parametrize("name", ["default.toml", "gray-maybeck.toml"])
+@pytest.mark.parametrize("name", ["default.toml", "gray-maybeck.toml", SBAS_DEFAULT])
 def test_compiled_epoch_equals_the_navigator_path(name):
     """default: 24-channel GPS with channel states, baro damping loop, radar altimeter, converged start;
-    gray-maybeck: baro, radar altimeter, GPS and a pseudolite."""
+    gray-maybeck: baro, radar altimeter, GPS and a pseudolite; the SBAS default: a GNSS service's correlated truth
+    and the filter's own channel model (sensors/gnss/service.py)."""
     prof = _profile(name)
     src, res, nav = _fly(prof, True)
     src0, res0, nav0 = _fly(prof, False)
@@ -95,18 +102,24 @@ def _eq_inputs(got, want):
             assert np.shape(g) == np.shape(w) and np.asarray(g).dtype == np.asarray(w).dtype, i
 
 
-@pytest.mark.parametrize(("name", "nav", "baro"), [
-    ("default.toml", {}, None), ("gray-maybeck.toml", {}, None), ("hot-high-crosswind.toml", {}, None),
+@pytest.mark.parametrize(("name", "nav", "baro", "gnss"), [
+    ("default.toml", {}, None, None), ("gray-maybeck.toml", {}, None, None),
+    ("hot-high-crosswind.toml", {}, None, None),
     # no channel states: the pseudorange sigmas scaled in the fused kernel
-    ("default.toml", {"channel_states": False, "gps_sigma_scale": 1.5}, None),
+    ("default.toml", {"channel_states": False, "gps_sigma_scale": 1.5}, None, None),
     # a lagged static system: its weights at the start, before the truth's row 1 is flown (the draw's grid step)
-    ("default.toml", {}, {"lag_s": 1.0})])
-def test_direct_epoch_inputs_equal_the_records(name, nav, baro):
+    ("default.toml", {}, {"lag_s": 1.0}, None),
+    # GNSS services: SBAS L1's correlated iono field, DFMC's per-channel residual, every term per channel (truth =
+    # "broadcast"), and the broadcast sigma_i scaled without channel states
+    (SBAS_DEFAULT, {}, None, None), ("dfmc-sbas.toml", {}, None, None),
+    (SBAS_DEFAULT, {}, None, {"truth": "broadcast"}),
+    (SBAS_DEFAULT, {"channel_states": False, "gps_sigma_scale": 1.5}, None, None)])
+def test_direct_epoch_inputs_equal_the_records(name, nav, baro, gnss):
     """The compiled epoch's sensor inputs made straight from the baro's, radar altimeter's and GPS receiver's
     kernels in one compiled call (NavInTheLoop._direct_inputs, closed_loop_epoch.direct_inputs) are the inputs made
     from their one-row records (`_epoch_inputs`, the oracle) at every epoch row of a flown approach and at rows
     between (no sample there: the empty inputs), and the flight they steer is the same bits."""
-    prof = _profile(name, baro, **nav)
+    prof = _profile(name, baro, gnss, **nav)
     src, res, nav = _fly_inputs(prof, True)
     src0, res0, nav0 = _fly_inputs(prof, False)
     assert src._fast.direct and not src0._fast.direct
@@ -151,14 +164,21 @@ def test_configurations_without_direct_inputs_take_the_records(name, faults):
     assert len(nav.t_epoch_s) > 0 and np.all(np.isfinite(nav.solution.r_ecef))
 
 
-@pytest.mark.parametrize("multipath_model", ["do253", "nrc1995"])
+@pytest.mark.parametrize("multipath_model", ["do253", "nrc1995", "sbas-l1", "dfmc-sbas"])
 def test_compiled_channel_sigmas_equal_the_budget_numpy(multipath_model):
     """The compiled epoch's GPS channel sigmas (numpy's cos, sin, exp, the rest compiled in numpy's order:
-    NavInTheLoop._noise_arrays) are the receiver budget's numpy formulas' (`_noise_arrays_numpy`) bit for bit, at
-    elevations over the whole sky, below the noise model's 2 deg floor and nan (no elevation: 0.5 rad)."""
-    d = tomllib.loads(PY_DEFAULT.read_text(encoding="utf-8"))
-    d["sensors"]["gnss"]["multipath_model"] = multipath_model
-    prof = parse_profile(d, source=PY_DEFAULT.resolve())
+    NavInTheLoop._noise_arrays; a GNSS service's: the filter's own model by the one service kernel) are the receiver
+    budget's numpy formulas' (`_noise_arrays_numpy`) bit for bit, at elevations over the whole sky, below the noise
+    model's 2 deg floor and nan (no elevation: 0.5 rad)."""
+    if multipath_model.startswith(("sbas", "dfmc")):
+        path = PROFILES / ("default.toml" if multipath_model == "sbas-l1" else "dfmc-sbas.toml")
+        d = tomllib.loads(path.read_text(encoding="utf-8"))
+        assert d["sensors"]["gnss"]["service"] == multipath_model
+    else:
+        path = PY_DEFAULT
+        d = tomllib.loads(path.read_text(encoding="utf-8"))
+        d["sensors"]["gnss"]["multipath_model"] = multipath_model
+    prof = parse_profile(d, source=path.resolve())
     src, _, _ = _fly_inputs(prof, True, seconds=1.5)
     assert src._fast.sig is not None
     rng = np.random.default_rng(26)
