@@ -10,7 +10,9 @@ covariance, as campaigns run) follow on that truth. Printed per state (dp N E D 
 the receiver clock bias, m): the run-averaged e^2 / P over the approach after its first quarter (1 for a consistent
 filter; below 1 the filter over-claims), the fractions of epochs whose run average is inside / below / above the
 two-sided 95 % chi2(RUNS)/RUNS bounds, the filter's mean sigma, and the run-mean error over the sigma (RMS over the
-epochs: about 1 / sqrt(RUNS) when nothing is common to the runs). --set changes a profile key for this run (dotted
+epochs: about 1 / sqrt(RUNS) when nothing is common to the runs); with a GNSS service's zenith states, giz_0,
+giz_E, giz_N against the truth's ionospheric field (common part, east and north gradient per d_5) and gtz against
+its tropospheric zenith residual (m). --set changes a profile key for this run (dotted
 path, a TOML value: --set sensors.gnss.multipath_model='"nrc1995"'). Diagnostics on the truth: --slow-tau-s sets
 its clock/ephemeris, iono and tropo time constants to TAU; --ideal-imu-axes removes its gyro and/or accelerometer
 scale-factor and misalignment errors. --filter-turbulence builds the filter's gyro scale-factor / misalignment
@@ -57,7 +59,7 @@ def flown(profile: Path, runs: int, seed: int, sets: tuple[str, ...] = (), slow_
     from approachsim.flight.run import Approach
     from approachsim.profile import parse_profile
     from approachsim.sensors.gnss import receiver
-    from approachsim.sensors.states import measure_with_states
+    from approachsim.sensors.states import start_states
     from approachsim.sensors.suite import SensorSuite
 
     data = tomllib.loads(profile.read_text(encoding="utf-8"))
@@ -80,8 +82,18 @@ def flown(profile: Path, runs: int, seed: int, sets: tuple[str, ...] = (), slow_
         grade = dataclasses.replace(imu.grade, **{k: 0.0 for s in ideal_imu_axes.split(",") for k in zero[s]})
         suite = dataclasses.replace(suite, sensors=MappingProxyType(dict(suite.sensors) | {
             "imu": dataclasses.replace(imu, grade=grade)}))
-    recs, st = measure_with_states(suite, truth, seed=seed, runs=list(range(runs)))
-    return prof, truth, recs, st, runs
+    errors = suite.draw(truth.t_s, seed, list(range(runs)))
+    recs, st = suite.apply(truth, errors), start_states(suite, truth, errors, 0)
+    zen = {}  # the zenith states' truth per sample: the service's common iono field part, its tropo zenith residual
+    gnss = suite.sensors.get("gnss")
+    sv = getattr(getattr(gnss, "budget", None), "service", None)
+    if sv is not None:
+        e = errors.sensors["gnss"]
+        if sv.iono_zenith_state:
+            zen["giz"] = (np.asarray(e.t_s), gnss.iono_zenith_error({"iono_field": np.asarray(e.series["iono_field"])}))
+        if sv.tropo_zenith_state:
+            zen["gtz"] = (np.asarray(e.t_s), gnss.tropo_zenith_error({"tropo": np.asarray(e.series["tropo"])}))
+    return prof, truth, recs, st, runs, zen
 
 
 def navigate(fl: tuple, seed: int, filter_turbulence: str | None = None
@@ -92,7 +104,7 @@ def navigate(fl: tuple, seed: int, filter_turbulence: str | None = None
     from approachsim.nav.system import NavSystem
     from approachsim.seeding import stream
 
-    prof, truth, recs, st, runs = fl
+    prof, truth, recs, st, runs, zen = fl
     nav = NavSystem.from_profile(prof)
     if filter_turbulence is not None:
         nav = dataclasses.replace(nav, turbulence=filter_turbulence)
@@ -100,15 +112,32 @@ def navigate(fl: tuple, seed: int, filter_turbulence: str | None = None
     e = np.stack([r.true_error_nav for r in rs])
     d = np.diagonal(np.stack([r.P_nav for r in rs]), axis1=2, axis2=3)
     lay = rs[0].layout
+    names = STATES
     if lay.has("clk") and "gnss" in recs:  # the receiver clock bias: the filter's clk state against the truth's
         g = recs["gnss"]
         t_g, cb = np.asarray(g.t_s), np.asarray(g.clock_bias_m).reshape(runs, -1)
         ic = lay.i("clk")
         idx = [np.clip(np.searchsorted(t_g, r.t_epoch_s + 1e-9, side="right") - 1, 0, t_g.size - 1) for r in rs]
         ec = np.stack([r.x[:, ic] - cb[i, j] for i, (r, j) in enumerate(zip(rs, idx, strict=True))])
-        return (np.concatenate([e, ec[..., None]], axis=-1),
-                np.concatenate([d, np.stack([r.P_diag[:, ic] for r in rs])[..., None]], axis=-1), STATES + ("clk",))
-    return e, d, STATES
+        e = np.concatenate([e, ec[..., None]], axis=-1)
+        d = np.concatenate([d, np.stack([r.P_diag[:, ic] for r in rs])[..., None]], axis=-1)
+        names = names + ("clk",)
+    for g, (t_g, z) in zen.items():  # the zenith states against the truth's iono field / tropo zenith residual
+        if not lay.has(g):
+            continue
+        z = z.reshape(runs, t_g.size, -1)
+        idx = [np.clip(np.searchsorted(t_g, r.t_epoch_s + 1e-9, side="right") - 1, 0, t_g.size - 1) for r in rs]
+        for k, nm in enumerate(ZENITH_NAMES[g]):
+            iz = lay.i(g, k)
+            ez = np.stack([r.x[:, iz] - z[i, j, k] for i, (r, j) in enumerate(zip(rs, idx, strict=True))])
+            e = np.concatenate([e, ez[..., None]], axis=-1)
+            d = np.concatenate([d, np.stack([r.P_diag[:, iz] for r in rs])[..., None]], axis=-1)
+            names = names + (nm,)
+    return e, d, names
+
+
+ZENITH_NAMES = {"giz": ("giz_0", "giz_E", "giz_N"), "gtz": ("gtz",)}
+"""The zenith states' printed names: the iono field's common part, east and north gradient; the tropo residual."""
 
 
 def summary(e: np.ndarray, d: np.ndarray) -> dict[str, np.ndarray]:

@@ -13,6 +13,14 @@ States (a `StateLayout` says which are present and where):
               seed 003 eq. 1): the baro row and the loop see -(h - H_ref) sb
     clk  (2)  GPS receiver clock bias (m) and drift (m/s)   (seed 002 two-state clock, sec. 6)
     ac   (1)  baro damping-loop compensator, m/s^2 (only when the INS runs the 3rd-order loop, seed 003 eq. 3)
+    giz  (3)  zenith ionospheric field, m, Gauss-Markov: a single-frequency service's vertical ionospheric residual
+              field (SBAS L1, stand-alone L1 C/A; sensors/gnss/service.py), its common part and its east and north
+              planar gradient per d_5 (the pierce distance of a 5 deg satellite), in every GPS code row times the
+              satellite's obliquity F_pp(el) (1, (d / d_5) sin az, (d / d_5) cos az), d its pierce distance; gse then
+              keeps the field's local part
+    gtz  (1)  zenith tropospheric error, m, Gauss-Markov: a service's residual of the MOPS tropospheric model (one
+              zenith value, sensors/gnss/service.py), in every GPS code row times the satellite's mapping M(el);
+              gse then leaves the troposphere out
     gse  (k)  per-GPS-channel slow range error (SV clock/ephemeris + mapped iono + tropo), m, Gauss-Markov
     gmp  (k)  per-GPS-channel multipath, m, Gauss-Markov
     pmp  (p)  per-pseudolite multipath, m, Gauss-Markov
@@ -89,6 +97,10 @@ class StateLayout:
     carrier: bool = False
     """GPS carrier phase: per-channel ionospheric (gio) and float-ambiguity (amb) states after every other group
     (needs n_sv channels)."""
+    iono_zenith: bool = False
+    """The zenith ionospheric states giz (module docstring; needs n_sv channels)."""
+    tropo_zenith: bool = False
+    """The zenith tropospheric state gtz (module docstring; needs n_sv channels)."""
     index: dict[str, slice] = field(init=False, compare=False)
     n: int = field(init=False, compare=False)
 
@@ -100,6 +112,11 @@ class StateLayout:
             sizes.append(("clk", 2))
         if self.loop:
             sizes.append(("ac", 1))
+        for g, on, k in (("giz", self.iono_zenith, 3), ("gtz", self.tropo_zenith, 1)):
+            if on and not self.n_sv:
+                raise ValueError(f"StateLayout: the zenith state {g} needs the GPS channel states (n_sv > 0)")
+            if on:
+                sizes.append((g, k))
         if self.n_sv:
             sizes += [("gse", self.n_sv), ("gmp", self.n_sv)]
         if self.n_pl:
@@ -138,13 +155,14 @@ class StateLayout:
     def packed(self) -> Array:
         """The layout as kernels.errormodel's int64 array: lay[L_N] = n, lay[L_<group>] its first index (-1
         absent), lay[L_NSV], lay[L_NPL] the channel counts, lay[L_GIO], lay[L_AMB] the carrier groups, lay[L_PSY] the
-        pseudolites' sync group (built once per layout object: do not modify)."""
+        pseudolites' sync group, lay[L_GIZ], lay[L_GTZ] the zenith ionosphere and troposphere (built once per layout
+        object: do not modify)."""
         lay = np.full(ek.LAY_SIZE, -1, dtype=np.int64)
         lay[ek.L_N], lay[ek.L_NSV], lay[ek.L_NPL] = self.n, self.n_sv, self.n_pl
         for k, g in enumerate(ek.LAY_GROUPS):
             if g in self.index:
                 lay[1 + k] = self.index[g].start
-        for g, at in (("gio", ek.L_GIO), ("amb", ek.L_AMB), ("psy", ek.L_PSY)):  # carrier phase (kernels/carrier.py)
+        for g, at in (("gio", ek.L_GIO), ("amb", ek.L_AMB), ("psy", ek.L_PSY), ("giz", ek.L_GIZ), ("gtz", ek.L_GTZ)):
             if g in self.index:
                 lay[at] = self.index[g].start
         return lay
@@ -201,6 +219,14 @@ class ErrorNoise:
     """White rate noise of the gyro scale-factor / misalignment errors on body axes x, y, z, rad^2/s: (S + M) w_ib
     at the airframe's body-rate spectrum in the aided band (nav/noise.py gyro_axis_q); rotated to NED, added to
     the attitude's ARW."""
+    giz_sigma_m: float = 0.0
+    giz_gradient_sigma_m: float = 0.0
+    giz_tau_s: float = 1800.0
+    """The zenith ionospheric states giz: 1-sigma of the common part and of each gradient component (m) and their
+    correlation time (s) (sensors/gnss/service.py ServiceModel.filter_iono_zenith)."""
+    gtz_sigma_m: float = 0.0
+    gtz_tau_s: float = 3600.0
+    """The zenith tropospheric state gtz: 1-sigma (m) and correlation time (s) (ServiceModel.filter_tropo_zenith)."""
 
     @cached_property
     def _kernel_arrays(self) -> dict[int, tuple[Array, Array, Array]]:
@@ -416,6 +442,11 @@ def dynamics_reference(
         _markov(F, Qc, ix["psy"], noise.psy_sigma_m, noise.psy_tau_s)
     if layout.has("ram"):
         _markov(F, Qc, ix["ram"], noise.ram_sigma_m, noise.ram_tau_s)
+    if layout.has("giz"):
+        _markov(F, Qc, ix["giz"], np.array([noise.giz_sigma_m, noise.giz_gradient_sigma_m,
+                                            noise.giz_gradient_sigma_m]), noise.giz_tau_s)
+    if layout.has("gtz"):
+        _markov(F, Qc, ix["gtz"], noise.gtz_sigma_m, noise.gtz_tau_s)
     if layout.has("tdb"):
         _markov(F, Qc, ix["tdb"], 1.0, noise.tdb_correlation_m / max(float(np.hypot(vn, ve)), 1.0))
     _carrier_states(layout, noise, F, Qc)

@@ -13,6 +13,8 @@ Rows (index names from errormodel.StateLayout):
     radalt    z = (h_ins - T(ins)) - h_R = -dp_D - grad T . dp_h - rab - ram - sigma_db(x) tdb + v,
               R = (0.01 h)^2 + floor^2 (seed 002; rab, ram, tdb: errormodel, nav/terrain_db.py)
     range     z = |r_ins - r_tx| - rho  = e . dp - clk - gse - gmp (+ pseudolite terms: pmp, ptr, pclk or psy)
+              - F_pp(el) (giz_0 + (d / d_5)(sin az giz_E + cos az giz_N)) - M(el) gtz (a satellite's row, with the
+              zenith ionospheric / tropospheric states)
               + v   (seed 002 sec. 6)
               (- gio too with carrier phase, whose states split the ionosphere off gse: nav/noise.py)
     carrier   z = |r_ins - r_sv| - phi  = e . dp - clk - gse + gio - amb + v                 (sensors/gnss/carrier.py:
@@ -33,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from approachsim import geo
+from approachsim.core.sensors import gnss_errors as ge
 from approachsim.nav.base import ScalarMeasurement
 from approachsim.nav.errormodel import StateLayout
 from approachsim.nav.terrain_db import TerrainDbConfig, TerrainDbError
@@ -128,6 +131,18 @@ def radalt(
     return ScalarMeasurement(z=float(z - g_hat + h @ x_hat), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
 
 
+def iono_field_row(u_ned: Array) -> tuple[float, float, float]:
+    """(F, F (d / d_5) sin az, F (d / d_5) cos az) of a satellite in direction u_ned (unit, position -> satellite, NED):
+    the slant delay per unit of the zenith ionospheric field's common part and east / north planar gradient per d_5
+    (F = DO-229's F_pp, d the pierce distance: gnss_errors.iono_obliquity, pierce_distance_m)."""
+    cos_el = float(np.hypot(u_ned[0], u_ned[1]))
+    el = float(np.arctan2(-u_ned[2], cos_el))
+    f = ge.iono_obliquity(cos_el, ge.IONO_SHELL_M)
+    g = f * ge.pierce_distance_m(el, ge.IONO_SHELL_M) / ge.pierce_distance_m(ge.GRADIENT_REFERENCE_EL_RAD,
+                                                                             ge.IONO_SHELL_M)
+    return f, g * float(u_ned[1]) / cos_el, g * float(u_ned[0]) / cos_el
+
+
 def pseudorange(
     layout: StateLayout,
     x_hat: Array,
@@ -146,7 +161,9 @@ def pseudorange(
 
     z = |r_ins - r_tx| - rho ; g(x) = |r_ins - r_tx| - |r_ins - C' dp - r_tx| - clk - (channel errors);
     h: e' at dp (e the unit vector transmitter -> corrected position, NED), -1 at the receiver clock and
-    the channel's error states; pseudolite troposphere: -range at ptr. R = sigma^2 (white code noise), m.
+    the channel's error states, minus iono_field_row's (F_pp, F_pp (d / d_5) sin az, F_pp (d / d_5) cos az) at the
+    zenith ionospheric states giz, -M(el) at the zenith troposphere gtz (sin el = e_D: gnss_errors.tropo_mapping);
+    pseudolite troposphere: -range at ptr. R = sigma^2 (white code noise), m.
     """
     h = _row(layout)
     dp_hat = x_hat[layout.index["dp"]]
@@ -163,6 +180,10 @@ def pseudorange(
         h[layout.i("gmp", sv)] = -1.0
         if layout.has("gio"):
             h[layout.i("gio", sv)] = -1.0
+        if layout.has("giz"):  # the zenith ionospheric field at the pierce point seen from the corrected position
+            h[layout.index["giz"]] = -np.asarray(iono_field_row(-e_ned))
+        if layout.has("gtz"):  # the zenith troposphere times M(el), sin el = e_D
+            h[layout.i("gtz")] = -ge.tropo_mapping(float(e_ned[2]))
     if pl is not None and layout.has("pmp"):
         h[layout.i("pmp", pl)] = -1.0
         h[layout.i("ptr", pl)] = -rng_hat

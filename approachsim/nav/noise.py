@@ -47,6 +47,24 @@ sees. Not a time constant per channel: the compiled epochs share one Phi and one
 channels; over the 5-90 deg sky the drift-matched tau of the default budget spans 4445-6840 s, and a truth with all
 three processes at the filter's one tau changed the default profile's horizontal velocity e^2/P by 0.05 at most.
 
+The zenith states (the layout's giz and gtz, a GNSS service under the nominal filter model: sensors/gnss/service.py,
+docs/gnss-services.md). The truth draws a single-frequency ionospheric residual as ONE vertical field over the
+pierce points (75 % of its variance common to all, a planar gradient 20 % at the pierce distance d_5 of a 5 deg
+satellite, 5 % local), each satellite seeing it through its obliquity F_pp(el), and the tropospheric residual as
+one zenith value mapped by M(el). Per-channel states with those variances but independent between channels make
+the filter read the common parts as a receiver clock error of 1/n their size and over-state the channels'
+differences (sbas-lpv200, 60 runs: clock e^2/P 1.61-1.76, horizontal 0.42-0.53). So the field is three states giz
+(its common part at f_i sqrt(w0) sigma_vertical, its east and north gradient per d_5 at f_i sqrt(w_g)
+sigma_vertical each, the field's tau: ServiceModel.filter_iono_zenith), -F_pp(el) (1, (d / d_5) sin az, (d / d_5)
+cos az) in every GPS code row, d the pierce distance; the troposphere one state gtz (f_t sigma_TVE, its tau:
+ServiceModel.filter_tropo_zenith), -M(el) in every code row; the channel's slow state keeps the range residual and
+the field's local part F_pp f_i sigma_vertical sqrt(w_l) (gnss_errors.service_terms), so that the variances sum to
+the truth's per channel. Why the gradient as states: left in the channels as independent per channel, the gradient,
+whose coefficient follows the line of sight's horizontal direction and so aliases into the horizontal position,
+left the horizontal over-confident (sbas-lpv200, seeds 1 / 2 / 3: dp_N 1.35 / 1.57 / 1.15; 1.19 / 1.33 / 1.01 with
+the gradient states). Why the troposphere: per channel it made the DFMC filter's clock over-confident (1.53; 1.02
+with gtz).
+
 Gyro scale-factor and misalignment errors (`gyro_axis_q`): the IMU's (S + M) w_ib (random constants per run, the
 grade's sigmas) is process noise, not 9 filter states. In light turbulence it is what turns the drift-matched
 filter's along-track velocity over-confident (default profile: east velocity e^2/P 1.27 with them in the truth,
@@ -108,8 +126,8 @@ def slow_terms(bud: GnssErrorBudget, el_rad: Array, ionosphere: bool = True) -> 
     if bud.gbas is not None:
         s = bud.gbas.scales(el_rad, *REFERENCE_GEOMETRY)
         out = [(s["ground"], bud.gbas.ground_tau_s), (s["iono"], bud.iono_tau_s), (s["tropo"], bud.tropo_tau_s)]
-    elif bud.service is not None:
-        t = bud.service.terms_m(el_rad)
+    elif bud.service is not None:  # without the common parts the filter's zenith states carry (service.params)
+        t = bud.service.terms_m(el_rad, common=bud.service.tropo_zenith_state)
         out = [(t[..., 0], bud.service.range_tau_s), (t[..., 1], bud.iono_tau_s), (t[..., 2], bud.tropo_tau_s)]
     else:
         out = [(np.full(np.shape(el_rad), bud.clock_ephemeris_m), bud.clock_ephemeris_tau_s),
@@ -230,6 +248,12 @@ class NoiseModel:
             kw.update(gse_sigma_m=gse, gse_tau_s=slow_tau_s(bud), gmp_sigma_m=gmp, gmp_tau_s=bud.multipath_tau_s)
             if self.carrier:
                 kw.update(self._carrier_kw(el), gse_tau_s=slow_tau_s(bud, ionosphere=False), gio_tau_s=bud.iono_tau_s)
+            if self.layout.has("giz"):  # the service's common ionosphere (gse keeps the rest: filter_params)
+                giz_sigma, giz_grad, giz_tau = bud.service.filter_iono_zenith()
+                kw.update(giz_sigma_m=giz_sigma, giz_gradient_sigma_m=giz_grad, giz_tau_s=giz_tau)
+            if self.layout.has("gtz"):  # the service's tropospheric zenith residual (gse leaves it out)
+                gtz_sigma, gtz_tau = bud.service.filter_tropo_zenith()
+                kw.update(gtz_sigma_m=gtz_sigma, gtz_tau_s=gtz_tau)
         if self.sensors.pseudolite is not None:
             p = self.sensors.pseudolite
             kw.update(pmp_sigma_m=p.multipath_m, pmp_tau_s=p.multipath_tau_s)
@@ -311,6 +335,10 @@ class NoiseModel:
         if lay.has("gse"):
             d[lay.index["gse"]] = np.broadcast_to(nz.gse_sigma_m, (lay.n_sv,)) ** 2
             d[lay.index["gmp"]] = nz.gmp_sigma_m**2
+        if lay.has("giz"):
+            d[lay.index["giz"]] = [nz.giz_sigma_m**2, nz.giz_gradient_sigma_m**2, nz.giz_gradient_sigma_m**2]
+        if lay.has("gtz"):
+            d[lay.i("gtz")] = nz.gtz_sigma_m**2
         if lay.has("amb"):
             d[lay.index["gio"]] = np.broadcast_to(nz.gio_sigma_m, (lay.n_sv,)) ** 2
             d[lay.index["amb"]] = self.sensors.gnss.carrier.ambiguity_sigma_m**2

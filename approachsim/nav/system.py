@@ -90,6 +90,8 @@ def layout_for(nav: NavConfig, sensors: SensorsConfig) -> em.StateLayout:
         pl_clock=n_pl > 0 and not sensors.pseudolite.synchronized,
         pl_sync=n_pl > 0 and sensors.pseudolite.synchronized and sensors.pseudolite.sync_sigma_m > 0.0,
         carrier=carrier,
+        iono_zenith=bool(n_sv) and sensors.gnss.service is not None and sensors.gnss.service.iono_zenith_state,
+        tropo_zenith=bool(n_sv) and sensors.gnss.service is not None and sensors.gnss.service.tropo_zenith_state,
         **_radalt_states(sensors, nav),
     )
 

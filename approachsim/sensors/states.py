@@ -16,6 +16,9 @@ estimate exactly at `row`; None when the suite has no such sensor. Signs follow 
     amb  (N, 24) m    with carrier phase only: the float ambiguity of an arc beginning at the row's sample (the
                       receiver's pool entry there: exactly the ambiguity of every channel valid at the record's first
                       sample, where every arc begins; gnss/carrier.py)
+    giz  (N,)   m     a single-frequency service's common zenith ionospheric residual (service.py, the field's
+                      common part), which gse then leaves out (it holds F_pp(el) giz: receiver.channel_errors)
+    gtz  (N,)   m     a service's tropospheric zenith residual (nominal filter model), which gse then leaves out
     clk  (N, 2)       receiver clock bias (m) and drift (m/s) (clock.py; shared by GPS and pseudolites)
     bb   (N,)   m     baro slow bias (the drawn Gauss-Markov + static-source + QNH errors) + the day's deterministic
                       offset at the field; sb (N,) the scale factor on the height above the field: the drawn S and
@@ -72,6 +75,8 @@ class SensorStates:
     tdb: Array | None = None
     gio: Array | None = None
     amb: Array | None = None
+    giz: Array | None = None
+    gtz: Array | None = None
 
     @property
     def runs(self) -> int:
@@ -165,6 +170,22 @@ def _channels(at: _At) -> tuple[Array, ...] | None:
 def _gio(at: _At) -> Array | None:
     c = _channels(at)
     return None if c is None or len(c) < 3 else c[2]
+
+
+def _zenith(at: _At, kind: str) -> Array | None:
+    """The zenith ionospheric ("iono": the field's common part) or tropospheric ("tropo") residual (N,), m, of a
+    service whose filter carries it (receiver.py iono_zenith_error, tropo_zenith_error); None otherwise."""
+    s = at.sample("gnss")
+    if s is None:
+        return None
+    rx = at.suite.sensors["gnss"]
+    sv = getattr(getattr(rx, "budget", None), "service", None)
+    if sv is None or not (sv.iono_zenith_state if kind == "iono" else sv.tropo_zenith_state):
+        return None
+    e, j = s
+    key = "iono_field" if kind == "iono" else "tropo"
+    ser = {key: np.asarray(e.series[key])[:, j]}
+    return rx.iono_zenith_error(ser) if kind == "iono" else rx.tropo_zenith_error(ser)
 
 
 def _amb(at: _At) -> Array | None:
@@ -269,6 +290,8 @@ _EXTRACT: dict[str, Callable[[_At], Array | None]] = {
     "tdb": lambda at: None,  # filled by NavSystem.start from its database draw
     "gio": _gio,
     "amb": _amb,
+    "giz": lambda at: _zenith(at, "iono"),
+    "gtz": lambda at: _zenith(at, "tropo"),
 }
 """Filter state group -> its realized value from the drawn errors (one entry per group)."""
 

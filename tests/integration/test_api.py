@@ -100,8 +100,9 @@ def test_docs_api_examples_run():
 
 def test_worked_trade_study(capsys):
     """docs/examples/trade_study.py with 2 runs per variant: 4 variants on the same random numbers; SBAS L1
-    corrections take the lateral error at the decision heights from stand-alone L1 C/A's ~9 ft (its Klobuchar
-    ionosphere, studies/gnss-services/RESULTS.md) down to under 3 ft with either INS."""
+    corrections take the lateral error at the decision heights from stand-alone L1 C/A's (its Klobuchar ionosphere:
+    4.6-4.9 ft at 2 runs since the filter carries the ionospheric field's common part and gradient as states, ~9 ft
+    before; studies/gnss-services/RESULTS.md) down to under 3 ft with either INS (1.0-1.2 ft)."""
     ns = runpy.run_path(str(ROOT / "docs" / "examples" / "trade_study.py"))
     st = ns["main"](runs=2, seed=1, workers=1)
     assert [r["variant"] for r in st.rows] == ["nav-0.4+stand-alone", "nav-0.4+sbas", "nav-4.0+stand-alone",
@@ -110,7 +111,7 @@ def test_worked_trade_study(capsys):
     for grade in ("nav-0.4", "nav-4.0"):
         for cat in ("CATI", "CATII", "CATIII"):
             alone, sbas = (t.loc[f"{grade}+{s}", f"{cat}_lateral_1sigma_ft"] for s in ("stand-alone", "sbas"))
-            assert sbas < 3.0 < 5.0 < alone, (grade, cat, sbas, alone)
+            assert sbas < 3.0 < alone, (grade, cat, sbas, alone)
     assert all(ev.summary["runs"] == 2 and ev.failed_runs == 0 for ev in st.evaluations.values())
     assert "nav-4.0+sbas" in capsys.readouterr().out
 

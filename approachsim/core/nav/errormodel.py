@@ -41,7 +41,14 @@ L_GIO, L_AMB = 20, 21
 """The carrier-phase groups' first index (-1 absent): after every other group (kernels/carrier.py)."""
 L_PSY = 22
 """The synchronized pseudolites' time-sync error group psy (-1 absent)."""
-LAY_SIZE = 23
+L_GIZ = 23
+"""The zenith ionospheric states giz (3: the field's common part, its east and north planar gradient per d_5; -1
+absent): a single-frequency service's ionospheric residual field, in every GPS code row times the satellite's
+F_pp (1, (d / d_5) sin az, (d / d_5) cos az) (core/nav/measurements.py)."""
+L_GTZ = 24
+"""The zenith tropospheric state gtz (-1 absent): a service's tropospheric zenith residual, in every GPS code row
+times the satellite's mapping M(el) (core/nav/measurements.py)."""
+LAY_SIZE = 25
 LAY_GROUPS = ("dp", "dv", "psi", "bg", "ba", "bb", "sb", "clk", "ac", "gse", "gmp", "pmp", "ptr", "pclk", "rab",
               "ram", "tdb")
 """Group names in the order of lay[1:18]."""
@@ -51,12 +58,15 @@ Q_CLK_SF, Q_CLK_SG, Q_GSE_TAU, Q_GMP_TAU, Q_PMP_SIGMA, Q_PMP_TAU, Q_PCLK_SF, Q_P
 Q_RAM_SIGMA, Q_RAM_TAU, Q_TDB_L, Q_BARO_REF, Q_PSY_SIGMA, Q_PSY_TAU = range(16, 22)
 Q_GAX = 22
 """q[Q_GAX + k]: the gyro scale-factor / misalignment white rate noise of body axis k, rad^2/s (nav/noise.py)."""
-Q_SIZE = 25
+Q_GIZ_SIGMA, Q_GIZ_GRADIENT_SIGMA, Q_GIZ_TAU, Q_GTZ_SIGMA, Q_GTZ_TAU = 25, 26, 27, 28, 29
+"""The zenith ionospheric states' 1-sigma (common, each gradient component; m) and correlation time (s), the zenith
+tropospheric state's."""
+Q_SIZE = 30
 Q_FIELDS = ("gyro_arw_rad_sqrts", "accel_vrw_mps_sqrts", "gyro_bias_rw", "accel_bias_rw", "baro_bias_sigma_m",
             "baro_bias_tau_s", "baro_noise_sigma_m", "baro_rate_hz", "clock_sf", "clock_sg", "gse_tau_s",
             "gmp_tau_s", "pmp_sigma_m", "pmp_tau_s", "pclk_sf", "pclk_sg", "ram_sigma_m", "ram_tau_s",
             "tdb_correlation_m", "baro_ref_m", "psy_sigma_m", "psy_tau_s", "gyro_axis_q_x", "gyro_axis_q_y",
-            "gyro_axis_q_z")
+            "gyro_axis_q_z", "giz_sigma_m", "giz_gradient_sigma_m", "giz_tau_s", "gtz_sigma_m", "gtz_tau_s")
 """errormodel.ErrorNoise field of each q[Q_*], in index order."""
 
 LOOP_SIZE = 4
@@ -200,6 +210,13 @@ def dynamics(lay: np.ndarray, q: np.ndarray, gse_sigma: np.ndarray, gmp_sigma: n
     if lay[L_RAM] >= 0:
         one[0] = q[Q_RAM_SIGMA]
         _markov(F, Qc, lay[L_RAM], 1, one, q[Q_RAM_TAU])
+    if lay[L_GIZ] >= 0:
+        giz = np.empty(3)
+        giz[0], giz[1], giz[2] = q[Q_GIZ_SIGMA], q[Q_GIZ_GRADIENT_SIGMA], q[Q_GIZ_GRADIENT_SIGMA]
+        _markov(F, Qc, lay[L_GIZ], 3, giz, q[Q_GIZ_TAU])
+    if lay[L_GTZ] >= 0:
+        one[0] = q[Q_GTZ_SIGMA]
+        _markov(F, Qc, lay[L_GTZ], 1, one, q[Q_GTZ_TAU])
     if lay[L_TDB] >= 0:
         one[0] = 1.0
         _markov(F, Qc, lay[L_TDB], 1, one, q[Q_TDB_L] / max(math.hypot(vn, ve), 1.0))

@@ -29,6 +29,7 @@ import numpy as np
 from approachsim.core import geodesy as gk
 from approachsim.core.jit import njit
 from approachsim.core.nav import errormodel as ek
+from approachsim.core.sensors import gnss_errors as ge
 
 
 @njit(cache=True)
@@ -183,6 +184,36 @@ def los_row(h: np.ndarray, ip: int, c_en: np.ndarray, a0: float, a1: float, a2: 
 
 
 @njit(cache=True)
+def iono_field_row(c_en: np.ndarray, a0: float, a1: float, a2: float, rng_hat: float) -> tuple[float, float, float]:
+    """(F, F (d / d_5) sin az, F (d / d_5) cos az): the slant ionospheric delay per unit of the zenith field's common
+    part and of its east and north planar gradient (per d_5) for a satellite whose line of sight is d_hat = (a0, a1,
+    a2) (ECEF, m, satellite -> corrected position; `ranges`) of length rng_hat. F = gnss_errors.iono_obliquity
+    (DO-229's F_pp at IONO_SHELL_M), d = gnss_errors.pierce_distance_m the pierce point's ground distance (d_5 at
+    GRADIENT_REFERENCE_EL_RAD), el and az of the unit vector position -> satellite in NED (C = c_en ECEF -> NED):
+    the zenith ionospheric states' coefficients in the code row (with the minus sign of a range error)."""
+    u0, u1, u2 = a0 / rng_hat, a1 / rng_hat, a2 / rng_hat
+    n = -(c_en[0, 0] * u0 + c_en[0, 1] * u1 + c_en[0, 2] * u2)  # towards the satellite
+    e = -(c_en[1, 0] * u0 + c_en[1, 1] * u1 + c_en[1, 2] * u2)
+    up = c_en[2, 0] * u0 + c_en[2, 1] * u1 + c_en[2, 2] * u2
+    cos_el = math.sqrt(n * n + e * e)
+    f = ge.iono_obliquity(cos_el, ge.IONO_SHELL_M)
+    g = f * ge.pierce_distance_m(math.atan2(up, cos_el), ge.IONO_SHELL_M) / ge.pierce_distance_m(
+        ge.GRADIENT_REFERENCE_EL_RAD, ge.IONO_SHELL_M)
+    if cos_el == 0.0:
+        return f, 0.0, 0.0
+    return f, g * e / cos_el, g * n / cos_el
+
+
+@njit(cache=True)
+def zenith_mapping(c_en: np.ndarray, a0: float, a1: float, a2: float, rng_hat: float) -> float:
+    """M(el) (gnss_errors.tropo_mapping, RTCA DO-229 A.4.2.4) of a satellite whose line of sight is d_hat = (a0, a1,
+    a2) as iono_field_row's: sin el = the down component of the unit vector satellite -> position. The zenith
+    tropospheric state's coefficient in the code row."""
+    d = (c_en[2, 0] * a0 + c_en[2, 1] * a1 + c_en[2, 2] * a2) / rng_hat
+    return ge.tropo_mapping(d)
+
+
+@njit(cache=True)
 def _pseudorange(lay: np.ndarray, x_hat: np.ndarray, r_ins: np.ndarray, c_en: np.ndarray, r_tx: np.ndarray,
                  rho: float, sv: int, pl: int, h: np.ndarray, row: bool) -> float:
     """nu of a pseudorange row (and the row into h when `row`): nav/measurements.pseudorange's arithmetic."""
@@ -203,6 +234,18 @@ def _pseudorange(lay: np.ndarray, x_hat: np.ndarray, r_ins: np.ndarray, c_en: np
         if row:
             h[i] = -1.0
             h[j] = -1.0
+        i = lay[ek.L_GIZ]
+        if i >= 0:  # the zenith ionospheric field at the satellite's pierce point, from the corrected position
+            f0, fe, fn = iono_field_row(c_en, a0, a1, a2, rng_hat)
+            lin -= f0 * x_hat[i] + fe * x_hat[i + 1] + fn * x_hat[i + 2]
+            if row:
+                h[i], h[i + 1], h[i + 2] = -f0, -fe, -fn
+        i = lay[ek.L_GTZ]
+        if i >= 0:  # the zenith troposphere times the satellite's mapping
+            f = -zenith_mapping(c_en, a0, a1, a2, rng_hat)
+            lin += f * x_hat[i]
+            if row:
+                h[i] = f
     scale = 1.0
     if pl >= 0 and lay[ek.L_PMP] >= 0:
         i, t = lay[ek.L_PMP] + pl, lay[ek.L_PTR] + pl
@@ -233,8 +276,10 @@ def pseudorange(lay: np.ndarray, x_hat: np.ndarray, r_ins: np.ndarray, c_en: np.
                 rho: float, sigma: float, sv: int, pl: int, h: np.ndarray) -> tuple[float, float]:
     """A code pseudorange rho (m) to a satellite (sv its channel, else -1) or pseudolite (pl its unit, else -1),
     tightly coupled: z = |r_ins - r_tx| - rho, g(x) = |r_ins - r_tx| - |r_ins - C' dp - r_tx| (1 + T) - clk
-    - (channel errors). r_ins, r_tx (3,) ECEF m; c_en (3, 3) ECEF -> NED at the INS position. Row into h (n,):
-    e' (1 + T) at dp, -1 at clk and the channel's gse, gmp (pmp, pclk, psy), -range at ptr. Returns (nu, sigma^2)."""
+    - (channel errors) - F_pp (giz_0 + (d / d_5)(sin az giz_E + cos az giz_N)) - M gtz. r_ins, r_tx (3,) ECEF m;
+    c_en (3, 3) ECEF -> NED at the INS position. Row into h (n,): e' (1 + T) at dp, -1 at clk and the channel's gse,
+    gmp (pmp, pclk, psy), -range at ptr, and in a satellite's row minus iono_field_row's coefficients at the zenith
+    ionospheric states giz and -M (zenith_mapping) at the zenith troposphere gtz. Returns (nu, sigma^2)."""
     nu = _pseudorange(lay, x_hat, r_ins, c_en, r_tx, rho, sv, pl, h, True)
     return nu, sigma**2
 

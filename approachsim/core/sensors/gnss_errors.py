@@ -37,6 +37,12 @@ RAD_TO_DEG = 180.0 / math.pi
 """numpy's degrees() factor (npy_rad2deg: x * (180 / pi)); numba's math.degrees is the same product."""
 ELEVATION_FLOOR_RAD = math.radians(2.0)
 """The filter's elevation guard's floor (nav/noise.py), rad."""
+IONO_SHELL_M = 350e3
+"""Thin-shell ionosphere height h_I, m (Klobuchar / DO-229): the F_pp of the receiver's truth, the filter's channel
+noise and the filter's zenith ionospheric states' row (core/nav/measurements.py)."""
+GRADIENT_REFERENCE_EL_RAD = math.radians(5.0)
+"""The elevation whose pierce distance d_5 normalizes the ionospheric field's planar gradient (sensors/gnss/
+service.py: the truth's (d / d_5)^2 of its variance; the filter's gradient states per d_5)."""
 
 
 @njit(cache=True)
@@ -144,10 +150,17 @@ IONO_FREE = 1
 """iono_model: iono-free combination, the higher-order residual 40 / (261 + el_deg^2) + 0.018 m."""
 
 SERVICE_FIELDS = ("iono_model", "sigma_range_m", "sigma_vertical_iono_m", "tropo_zenith_m", "air_model", "gamma",
-                  "shell_m", "range_scale", "iono_scale", "tropo_scale", "air_scale")
+                  "shell_m", "range_scale", "iono_scale", "tropo_scale", "air_scale", "iono_common_weight",
+                  "iono_gradient_weight", "gradient_reference_m")
 """The layout of a service's parameter vector (service_sigmas' `p`), by name (sensors/gnss/service.py packs it).
 The four scales multiply the range, iono, tropo and air terms: ones for the broadcast sigmas, the nominal fractions
-for the navigation filter's own error model (service.py ServiceModel.filter_params)."""
+for the navigation filter's own error model (service.py ServiceModel.filter_params). The last three split the
+single-frequency ionosphere when the navigation filter carries part of its field in states: the channel keeps the
+variance share 1 - w_s - w_k + w_k (d / d_5)^2, w_s = iono_common_weight the share the states carry (the field's
+common part w0 and its planar gradient wg: service.py IONO_FIELD_WEIGHTS, so the local wl is left), w_k =
+iono_gradient_weight a gradient share left in the channel (0 with the gradient states), d the pierce distance,
+d_5 = gradient_reference_m; w_s = 0: the whole ionosphere (the broadcast sigmas, and every filter without the
+states)."""
 
 
 @njit(cache=True)
@@ -227,11 +240,16 @@ def service_terms(el_rad: float, p: np.ndarray) -> tuple[float, float, float, fl
 
         range  sigma_flt (SBAS L1), sigma_DFRE (DFMC SBAS) or sigma_URA (stand-alone)
         iono   F_pp sigma_vertical (IONO_L1: sigma_UIVE, or the Klobuchar tau_vert), F_pp at h_I = shell_m
-               (RTCA DO-229 J.2.3), or the iono-free higher-order residual (IONO_FREE; ED-259A)
+               (RTCA DO-229 J.2.3), times sqrt(1 - w_s - w_k + w_k (d / d_5)^2) when p[11] = w_s > 0 (the part the
+               filter's zenith states carry; SERVICE_FIELDS), or the iono-free higher-order residual (IONO_FREE;
+               ED-259A)
         tropo  tropo_zenith_m x 1.001 / sqrt(0.002001 + sin^2 el) (DO-229 A.4.2.4)
         air    gamma sigma_air (AAD-A / AAD-B; gamma 1 on L1, 2.588 L1/L5, 2.978 L1/L2) or ED-259A's"""
     if p[0] == IONO_L1:
         iono = p[2] * iono_obliquity(math.cos(el_rad), p[6])
+        if p[11] > 0.0:  # the field's part in the filter's zenith states: the channel keeps the rest
+            d = pierce_distance_m(el_rad, p[6]) / p[13]
+            iono *= math.sqrt(1.0 - p[11] - p[12] + p[12] * d * d)
     else:
         iono = iono_free_residual_m(el_rad)
     air_model = int(p[4])

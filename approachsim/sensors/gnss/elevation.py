@@ -10,11 +10,11 @@ from __future__ import annotations
 import numpy as np
 
 from approachsim import geo
+from approachsim.core.sensors.gnss_errors import IONO_SHELL_M
 
 Array = np.ndarray
 
-IONO_SHELL_M = 350e3
-"""Thin-shell ionosphere height, m (Klobuchar / DO-229)."""
+__all__ = ["IONO_SHELL_M", "do253_multipath_sigma_m", "iono_obliquity", "tropo_mapping"]
 
 
 def iono_obliquity(el_rad: Array) -> Array:

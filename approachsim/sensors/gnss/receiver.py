@@ -482,10 +482,13 @@ class GnssReceiver:
         one sample's error series (name -> (..., 24)) at elevations el_rad (rad): stand-alone E + F I + M T and the
         (scaled) multipath; GBAS s_gnd g + s_iono I + s_tropo T and s_mp m + s_noise n at the aircraft's geometry
         (x_air_m, dh_m, v_air_mps, broadcast against el_rad); a service (service.py): range + iono + tropo and the
-        airborne error, at the azimuths az_rad too (the iono field's gradient)."""
+        airborne error, at the azimuths az_rad too (the iono field's gradient); under the nominal filter model, whose
+        zenith states carry them (ServiceModel.iono_zenith_state, tropo_zenith_state), the slow error without the
+        ionospheric field's common part and the tropospheric zenith residual (F_pp(el) iono_zenith_error and M(el)
+        tropo_zenith_error)."""
         b = self.budget
         if b.service is not None:
-            r, io, tr, air = b.service.truth_errors(series, el_rad, az_rad)
+            r, io, tr, air = b.service.truth_errors(series, el_rad, az_rad, common=not b.service.tropo_zenith_state)
             return r + io + tr, air
         if b.gbas is None:
             slow = series["clock_ephemeris"] + iono_obliquity(el_rad) * series["iono_zenith"] + (
@@ -495,6 +498,16 @@ class GnssReceiver:
         sc = b.gbas.scales(el_rad, x_air_m, dh_m, v_air_mps)
         return (sc["ground"] * series["ground"] + sc["iono"] * series["iono"] + sc["tropo"] * series["tropo"],
                 sc["multipath"] * series["multipath"] + sc["noise"] * series["noise"])
+
+    def iono_zenith_error(self, series: Mapping[str, Array]) -> Array:
+        """The realized value (m) of the navigation filter's zenith ionospheric state from one sample's error series:
+        the common part of the service's vertical residual field (service.ServiceModel.truth_iono_zenith_m), (...,)."""
+        return self.budget.service.truth_iono_zenith_m(series)
+
+    def tropo_zenith_error(self, series: Mapping[str, Array]) -> Array:
+        """The realized value (m) of the navigation filter's zenith tropospheric state from one sample's error series
+        (service.ServiceModel.truth_tropo_zenith_m), (...,)."""
+        return self.budget.service.truth_tropo_zenith_m(series)
 
     def carrier_channel_errors(self, series: Mapping[str, Array], el_rad: Array, x_air_m: Array | None = None,
                                dh_m: Array | None = None, v_air_mps: Array | None = None) -> tuple[Array, Array, Array]:

@@ -160,7 +160,7 @@ IONO_FIELD_WEIGHTS = (0.75, 0.20, 0.05)
 """Variance split of the unit ionospheric field: common, planar gradient (at the 5 deg pierce distance), local."""
 SERIES = ("range", "iono_local", "air", "iono_field", "tropo", "tropo_local")
 """The truth's unit series in core/sensors/gnss.py service_errors' order (receiver.py draws them, and "noise")."""
-GRADIENT_REFERENCE_EL_RAD = math.radians(5.0)
+GRADIENT_REFERENCE_EL_RAD = ge.GRADIENT_REFERENCE_EL_RAD
 """The elevation whose pierce distance d_5 normalizes the gradient term ((d / d_5)^2 of its variance)."""
 
 
@@ -275,14 +275,19 @@ class ServiceModel:
         """gnss_errors' airborne model code of `aad`."""
         return {"A": ge.AIR_AAD_A, "B": ge.AIR_AAD_B, "ED-259A": ge.AIR_ED259A}[str(self.aad)]
 
-    def params(self, scales: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)) -> Array:
+    def params(self, scales: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0), common: bool = False) -> Array:
         """The packed parameter vector of gnss_errors.service_terms (SERVICE_FIELDS order): the broadcast sigmas, or
-        with `scales` on the (range, iono, tropo, air) terms."""
+        with `scales` on the (range, iono, tropo, air) terms; common: without what the navigation filter's zenith
+        states carry (iono_zenith_state, tropo_zenith_state): the ionosphere's common part on a single frequency and
+        the whole tropospheric residual (the tropo scale 0)."""
+        w0, wg, _ = IONO_FIELD_WEIGHTS if common and not self.dual_frequency else (0.0, 0.0, 0.0)
+        w0, wg = w0 + wg, 0.0  # the common part and the planar gradient are the filter's states: the local part left
         vals = {"iono_model": ge.IONO_FREE if self.dual_frequency else ge.IONO_L1,
                 "sigma_range_m": self.sigma_range_m(), "sigma_vertical_iono_m": self.sigma_vertical_iono_m(),
                 "tropo_zenith_m": ge.MOPS_TROPO_ZENITH_M, "air_model": self.air_model(), "gamma": self.gamma(),
                 "shell_m": IONO_SHELL_M, "range_scale": scales[0], "iono_scale": scales[1],
-                "tropo_scale": scales[2], "air_scale": scales[3]}
+                "tropo_scale": 0.0 if common else scales[2], "air_scale": scales[3], "iono_common_weight": w0,
+                "iono_gradient_weight": wg, "gradient_reference_m": self.gradient_reference_m()}
         return np.array([float(vals[k]) for k in ge.SERVICE_FIELDS])
 
     def filter_fractions(self) -> tuple[float, float, float, float]:
@@ -290,9 +295,39 @@ class ServiceModel:
         truth's fractions (filter_model = "nominal") or ones ("broadcast")."""
         return (1.0, 1.0, 1.0, 1.0) if self.filter_model == "broadcast" else TRUTH_FRACTIONS[self.service]
 
+    @property
+    def iono_zenith_state(self) -> bool:
+        """Whether the navigation filter carries the common part of the ionospheric residual field as one zenith
+        state (mapped by each satellite's F_pp): a single-frequency service (SBAS L1, stand-alone L1 C/A: both draw
+        the residual as one vertical field over the pierce points) with the nominal filter model. Not iono-free
+        (DFMC, P(Y): the higher-order residual is per channel), not the broadcast model (every term per channel)."""
+        return not self.dual_frequency and self.filter_model == "nominal"
+
+    @property
+    def tropo_zenith_state(self) -> bool:
+        """Whether the navigation filter carries the tropospheric residual as one zenith state (mapped by each
+        satellite's M(el)): the nominal filter model, whose truth draws it as one zenith value common to the
+        satellites (the broadcast model: per channel)."""
+        return self.filter_model == "nominal"
+
     def filter_params(self) -> Array:
-        """The packed parameters of the navigation filter's channel error model (params at filter_fractions)."""
-        return self.params(self.filter_fractions())
+        """The packed parameters of the navigation filter's channel error model (params at filter_fractions; without
+        the common parts its zenith states carry, under the nominal model)."""
+        return self.params(self.filter_fractions(), common=self.tropo_zenith_state)
+
+    def filter_iono_zenith(self) -> tuple[float, float, float]:
+        """The navigation filter's zenith ionospheric states (iono_zenith_state): the 1-sigma (m) of the vertical
+        residual field's common part f_i sqrt(w0) sigma_vertical and of each planar-gradient component (east,
+        north) per d_5, f_i sqrt(wg) sigma_vertical (the truth's terms, at the filter's fraction f_i), and their
+        correlation time, s (the field's, IONO_TAU_S)."""
+        w0, wg, _ = IONO_FIELD_WEIGHTS
+        s = self.filter_fractions()[1] * self.sigma_vertical_iono_m()
+        return s * math.sqrt(w0), s * math.sqrt(wg), IONO_TAU_S
+
+    def filter_tropo_zenith(self) -> tuple[float, float]:
+        """The navigation filter's zenith tropospheric state (tropo_zenith_state): its 1-sigma f_t sigma_TVE, m (the
+        truth's zenith residual of the MOPS model, at the filter's fraction), and correlation time TROPO_TAU_S, s."""
+        return self.filter_fractions()[2] * ge.MOPS_TROPO_ZENITH_M, TROPO_TAU_S
 
     def at_site(self, lat_rad: float, lon_rad: float) -> ServiceModel:
         """This service at the approach's location (the Klobuchar bound's geomagnetic latitude)."""
@@ -336,12 +371,13 @@ class ServiceModel:
         """DO-229's sigma_i (m) at elevations el_rad, rad (no guard: nan stays nan)."""
         return self.channel_sigmas_m(el_rad, guard=False)[2]
 
-    def terms_m(self, el_rad: Array) -> Array:
-        """(..., 5): the broadcast range, iono, tropo, air 1-sigmas (m) and the pierce distance (m) at el_rad."""
+    def terms_m(self, el_rad: Array, common: bool = False) -> Array:
+        """(..., 5): the broadcast range, iono, tropo, air 1-sigmas (m) and the pierce distance (m) at el_rad; common:
+        the ionosphere without its common part (params)."""
         el = np.asarray(el_rad, dtype=float)
         e2 = np.ascontiguousarray(el.reshape(-1, el.shape[-1]))
         out = np.empty(e2.shape + (5,))
-        gk.service_channel_terms(e2, self.params(), out)
+        gk.service_channel_terms(e2, self.params(common=common), out)
         return out.reshape(el.shape + (5,))
 
     # ---- truth ----
@@ -389,16 +425,43 @@ class ServiceModel:
                 "iono_common": common, "iono_east": grad * np.sin(az), "iono_north": grad * np.cos(az),
                 "iono_local": local}
 
-    def truth_errors(self, series: Mapping[str, Array], el_rad: Array,
-                     az_rad: Array | None) -> tuple[Array, Array, Array, Array]:
+    def truth_errors(self, series: Mapping[str, Array], el_rad: Array, az_rad: Array | None,
+                     common: bool = True) -> tuple[Array, Array, Array, Array]:
         """The true range, iono, tropo and airborne errors (m) of the channels at elevations / azimuths (..., k), rad,
         from the unit series (receiver.py draw: range, iono_local, air (..., k), iono_field (..., 3): common, east,
-        north; tropo (..., 1)), sample axes matching el_rad's (truth_scales; module docstring)."""
+        north; tropo (..., 1)), sample axes matching el_rad's (truth_scales; module docstring). common=False: without
+        the ionospheric field's common part and gradient and the tropospheric zenith residual (what the filter's
+        channel states carry beside its zenith states: truth_iono_zenith_m, truth_tropo_zenith_m)."""
         if az_rad is None:
             raise ValueError("a service's truth needs the satellites' azimuths (the iono field's gradient)")
         sc = self.truth_scales(el_rad, az_rad)
         f = np.asarray(series["iono_field"])
-        iono = (sc["iono_common"] * f[..., 0:1] + sc["iono_east"] * f[..., 1:2] + sc["iono_north"] * f[..., 2:3]
-                + sc["iono_local"] * series["iono_local"])
-        tropo = sc["tropo"] * series["tropo"] + sc["tropo_local"] * series["tropo_local"]
+        iono = sc["iono_local"] * series["iono_local"]
+        if common:
+            iono = (sc["iono_common"] * f[..., 0:1] + sc["iono_east"] * f[..., 1:2] + sc["iono_north"] * f[..., 2:3]
+                    + iono)
+        tropo = sc["tropo_local"] * series["tropo_local"]
+        if common:
+            tropo = sc["tropo"] * series["tropo"] + tropo
         return sc["range"] * series["range"], iono, tropo, sc["air"] * series["air"]
+
+    def truth_iono_zenith_m(self, series: Mapping[str, Array]) -> Array:
+        """The realized vertical ionospheric field's common part and planar gradient (east, north, per d_5), m
+        (..., 3): f_i sigma_vertical (sqrt(w0), sqrt(wg), sqrt(wg)) times the field's unit series (receiver.py draw:
+        iono_field): the values of the filter's zenith states, each channel's truth_errors iono holding F_pp(el)
+        (common + (d / d_5) (sin az east + cos az north)) of them (zeros when the truth has no field: iono-free or
+        truth = "broadcast")."""
+        f = np.asarray(series["iono_field"])
+        if self.truth == "broadcast" or self.dual_frequency:
+            return np.zeros_like(f)
+        w0, wg, _ = IONO_FIELD_WEIGHTS
+        return self.truth_fractions()[1] * self.sigma_vertical_iono_m() * np.sqrt([w0, wg, wg]) * f
+
+    def truth_tropo_zenith_m(self, series: Mapping[str, Array]) -> Array:
+        """The realized tropospheric zenith residual, m (...,): f_t sigma_TVE times the unit series (receiver.py draw:
+        tropo[..., 0]): the value of the filter's zenith tropospheric state (0 under truth = "broadcast", whose
+        troposphere is per channel)."""
+        t = np.asarray(series["tropo"])[..., 0]
+        if self.truth == "broadcast":
+            return np.zeros_like(t)
+        return self.truth_fractions()[2] * ge.MOPS_TROPO_ZENITH_M * t

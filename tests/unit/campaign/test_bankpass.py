@@ -46,6 +46,8 @@ def _profile(kind: str):
     if kind == "gbas":
         p = replace(p, sensors=replace(p.sensors, gnss=replace(p.sensors.gnss, corrections="gbas", gbas=GbasModel(),
                                                                selection="all")))
+    if kind == "sbas":  # SBAS L1, the nominal filter model: the zenith states (giz, gtz) kept whole in the reduction
+        p = replace(p, sensors=replace(p.sensors, gnss=load_profile(PROFILES / "sbas-lpv200.toml").sensors.gnss))
     if kind == "modes":  # no damping loop: the copies without the baro share the INS, so every mode is compiled
         pl = PseudoliteConfig(positions_rwy=((0.0, -150.0, 9.0),), synchronized=True)
         p = replace(p, nav=replace(p.nav, baro_loop="none"), sensors=replace(p.sensors, pseudolite=pl))
@@ -58,7 +60,7 @@ def _truth(prof):
 
 
 @pytest.mark.equality
-@pytest.mark.parametrize("kind", ["default", "pseudolite", "baro-outage", "gbas", "modes"])
+@pytest.mark.parametrize("kind", ["default", "pseudolite", "baro-outage", "gbas", "modes", "sbas"])
 def test_reduced_pass_equals_the_copies_pass(kind, monkeypatch):
     prof = _profile(kind)
     truth = _truth(prof)

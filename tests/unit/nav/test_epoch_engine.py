@@ -45,6 +45,8 @@ def _profile(kind: str):
     if kind == "gbas":  # GBAS corrections: the channel noise from its budget (core/sensors/gnss.gbas_channel_sigmas)
         p = replace(p, sensors=replace(p.sensors, gnss=replace(p.sensors.gnss, corrections="gbas", gbas=GbasModel(),
                                                                selection="all")))
+    if kind == "sbas":  # SBAS L1, the nominal filter model: the zenith ionospheric field and troposphere states
+        p = replace(p, sensors=replace(p.sensors, gnss=load_profile(PROFILES / "sbas-lpv200.toml").sensors.gnss))
     if kind == "pseudolite":
         pl = PseudoliteConfig(positions_rwy=((0.0, -150.0, 9.0), (-3000.0, 200.0, 30.0)), synchronized=False)
         p = replace(p, sensors=replace(p.sensors, pseudolite=pl))
@@ -65,6 +67,8 @@ def _navigate(prof, shared: bool, generic: bool, monkeypatch):
     with monkeypatch.context() as m:
         if generic:
             m.setattr(engine.EpochEngine, "of", classmethod(lambda cls, system: None))
+        if prof.sensors.gnss.service is not None:
+            assert nav.layout.has("giz") and nav.layout.has("gtz")
         return nav.run(truth, recs, [stream(4, r, "nav") for r in range(3)], shared_covariance=shared, states=st)
 
 
@@ -108,7 +112,7 @@ def _d_min(prof) -> float:
     return max(10.0, float(min(abs(p[1]) for p in pl.positions_rwy)))
 
 
-@pytest.mark.parametrize("kind", ["default", "fixed-sky-fault", "pseudolite", "gbas"])
+@pytest.mark.parametrize("kind", ["default", "fixed-sky-fault", "pseudolite", "gbas", "sbas"])
 @pytest.mark.parametrize("shared", [False, True])
 def test_engine_equals_the_generic_path(kind, shared, monkeypatch):
     prof = _profile(kind)
@@ -135,14 +139,14 @@ def test_engine_is_off_where_the_generic_path_is_needed():
     assert engine.EpochEngine.of(NavSystem.from_profile(DEFAULT)) is not None
 
 
-@pytest.mark.parametrize("kind", ["default", "pseudolite", "baro-outage", "gbas"])
+@pytest.mark.parametrize("kind", ["default", "pseudolite", "baro-outage", "gbas", "sbas"])
 def test_whole_pass_equals_the_per_epoch_engine(kind, monkeypatch):
     """Per-run skies with the shared covariance: the whole open-loop pass in one kernel call (Navigator.compiled_pass)
     against the epoch-by-epoch engine it replaces (the same arithmetic: equal to rounding), with a damping loop held
     during a baro outage and pseudolites with their states."""
     from approachsim.nav.navigator import Navigator
 
-    prof = _profile(kind if kind in ("pseudolite", "gbas") else "default")
+    prof = _profile(kind if kind in ("pseudolite", "gbas", "sbas") else "default")
     if kind == "baro-outage":
         prof = replace(prof, faults=(FaultSpec(sensor="baro", kind="outage", start_s=10.0, end_s=16.0),))
     assert prof.nav.baro_loop == "constant"

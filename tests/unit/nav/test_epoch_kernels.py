@@ -52,6 +52,8 @@ LAYOUTS = {
                                              terrain_db=True),
     "default": em.StateLayout(baro_scale=False, loop=True, n_sv=24, radalt_bias=True, radalt_markov=True,
                               terrain_db=True),
+    "sbas-zenith-states": em.StateLayout(loop=True, n_sv=24, iono_zenith=True, tropo_zenith=True, radalt_bias=True,
+                                         radalt_markov=True, terrain_db=True),
 }
 
 
@@ -63,8 +65,10 @@ def _noise(n_sv: int, rng: np.random.Generator) -> em.ErrorNoise:
         accel_bias_rw=2e-7, baro_bias_sigma_m=1.0, baro_bias_tau_s=100.0, clock_sf=0.009, clock_sg=0.035,
         gse_sigma_m=per, gmp_sigma_m=rng.uniform(0.1, 0.3, n_sv), gmp_tau_s=100.0, pmp_sigma_m=0.3,
         pclk_sf=0.01, pclk_sg=0.02, ram_sigma_m=0.2155, baro_ref_m=rng.uniform(0.0, 1700.0), psy_sigma_m=0.9,
-        psy_tau_s=600.0, **dict(zip(("gyro_axis_q_x", "gyro_axis_q_y", "gyro_axis_q_z"),
-                                     rng.uniform(0.0, 3e-12, 3).tolist(), strict=True)))
+        psy_tau_s=600.0, giz_sigma_m=rng.uniform(0.1, 2.0), giz_gradient_sigma_m=rng.uniform(0.05, 1.0),
+        giz_tau_s=1800.0, gtz_sigma_m=0.06, gtz_tau_s=3600.0,
+        **dict(zip(("gyro_axis_q_x", "gyro_axis_q_y", "gyro_axis_q_z"), rng.uniform(0.0, 3e-12, 3).tolist(),
+                   strict=True)))
 
 
 def _point(rng: np.random.Generator) -> tuple:
@@ -364,6 +368,8 @@ LAY_M = em.StateLayout(baro_scale=True, clock=True, loop=True, n_sv=6, n_pl=2, p
 LAY_PLAIN = em.StateLayout(baro_scale=False, clock=True, n_pl=1)
 LAY_SYNC = em.StateLayout(baro_scale=True, clock=True, loop=True, n_sv=3, n_pl=2, pl_sync=True, radalt_bias=True)
 """Synchronized pseudolites: a time-sync state psy per transmitter (and no pclk)."""
+LAY_GIZ = em.StateLayout(baro_scale=True, clock=True, loop=True, n_sv=6, n_pl=1, iono_zenith=True, tropo_zenith=True)
+"""A single-frequency service: the zenith ionospheric field giz and troposphere gtz in every satellite's row."""
 
 
 def _x_hat(lay: em.StateLayout, rng: np.random.Generator) -> np.ndarray:
@@ -455,14 +461,15 @@ def _geometry(rng: np.random.Generator):
     return r_ins, geo.c_ecef_to_ned(lat, lon)
 
 
-@pytest.mark.parametrize("tx", ["satellite", "satellite-no-channels", "pseudolite", "pseudolite-no-states",
-                                "pseudolite-sync"])
+@pytest.mark.parametrize("tx", ["satellite", "satellite-no-channels", "satellite-zenith-states", "pseudolite",
+                                "pseudolite-no-states", "pseudolite-sync"])
 def test_pseudorange_row_kernel_equals_reference(tx):
     """Satellites (gse / gmp channel states or none) and pseudolites (pmp, ptr, pclk, psy or none): h and nu equal to
     their rounding floors from the operands (2e7 m satellite ranges, 6.4e6 m ECEF coordinates): 7e-8 m for a
     satellite's nu, however small nu is (one ulp of a 2.2e7 m range is 3.7e-9 m)."""
     rng = np.random.default_rng(14)
-    lay = {"satellite": LAY_M, "pseudolite": LAY_M, "pseudolite-sync": LAY_SYNC}.get(tx, LAY_PLAIN)
+    lay = {"satellite": LAY_M, "pseudolite": LAY_M, "pseudolite-sync": LAY_SYNC,
+           "satellite-zenith-states": LAY_GIZ}.get(tx, LAY_PLAIN)
     sat = tx.startswith("satellite")
     h = np.empty(lay.n)
     worst = 0.0

@@ -145,7 +145,9 @@ def test_truth_is_overbounded() -> None:
 
 def test_filter_model_is_the_nominal_processes_and_pls_keep_the_broadcast() -> None:
     """The navigation filter's channel sigmas (filter_model = "nominal", the truth's default) are the nominal truth's
-    fractions of each broadcast term, slow = RSS of range, iono, tropo and fast = air, computed here from terms_m;
+    fractions of each broadcast term, slow = RSS of range, iono and tropo (without what the filter's zenith states
+    carry: the ionospheric field's common part and gradient on a single frequency, the tropospheric zenith residual;
+    tests/unit/nav/test_iono_zenith.py) and fast = air, computed here from terms_m;
     the broadcast sigma_i (what the protection levels use) does not depend on filter_model; filter_model =
     "broadcast" gives the broadcast terms back; and the receiver budget hands nav/noise.py the filter's model."""
     from approachsim.sensors.gnss.receiver import make_budget
@@ -155,7 +157,7 @@ def test_filter_model_is_the_nominal_processes_and_pls_keep_the_broadcast() -> N
     for name in ("sbas-l1", "dfmc-sbas", "dfmc", "l1ca", "py-pps"):
         nom, bc = ServiceModel(name), ServiceModel(name, filter_model="broadcast")
         assert nom.filter_model == "nominal" and ServiceModel(name, truth="broadcast").filter_model == "broadcast"
-        t = nom.terms_m(el)
+        t = nom.terms_m(el, common=True)  # without what the filter's zenith states carry (the iono field, the tropo)
         fr = np.array(TRUTH_FRACTIONS[name])
         slow, fast = nom.filter_channel_sigmas_m(el)
         np.testing.assert_allclose(slow, np.sqrt(((fr[:3] * t[..., :3]) ** 2).sum(-1)), rtol=1e-14)
