@@ -46,9 +46,12 @@ class SeparationResult:
     """(epochs,) int: the mode with the largest normalized separation (-1 when none detected)."""
 
 
-def separation(x0: Array, p0: Array, xk: Array, pk: Array, k_ff: float, k_fa: float, k_md: float) -> SeparationResult:
+def separation(x0: Array, p0: Array, xk: Array, pk: Array, k_ff: float, k_fa: float, k_md: float,
+               tested: Array | None = None) -> SeparationResult:
     """Solution separation on two axes. x0 (epochs, 2), p0 (epochs, 2) variances of the main solution;
-    xk (epochs, modes, 2), pk (epochs, modes, 2) of the sub-solutions (each axis its own variance, m^2)."""
+    xk (epochs, modes, 2), pk (epochs, modes, 2) of the sub-solutions (each axis its own variance, m^2).
+    tested (modes, 2) bool: the axes on which each mode's separation is a detection test (default every one); an
+    untested axis keeps its H1 term T + K_md sigma_k but never detects nor names a suspect."""
     x0, p0 = np.asarray(x0, float), np.asarray(p0, float)
     xk, pk = np.asarray(xk, float), np.asarray(pk, float)
     sig0 = np.sqrt(np.maximum(p0, 0.0))
@@ -56,9 +59,10 @@ def separation(x0: Array, p0: Array, xk: Array, pk: Array, k_ff: float, k_fa: fl
     sig_ss = np.sqrt(np.maximum(pk - p0[:, None, :], 1e-18))
     thr = k_fa * sig_ss
     delta = xk - x0[:, None, :]
-    ratio = np.abs(delta) / thr
+    on = np.ones(delta.shape[1:], bool) if tested is None else np.asarray(tested, bool)
+    ratio = np.where(on, np.abs(delta) / thr, 0.0)
     detected = np.any(ratio > 1.0, axis=(1, 2))
-    norm_sep = np.max(np.abs(delta) / sig_ss, axis=2)
+    norm_sep = np.max(np.where(on, np.abs(delta) / sig_ss, 0.0), axis=2)
     suspect = np.where(detected, np.argmax(norm_sep, axis=1), -1)
     pl_h0 = k_ff * sig0
     pl_h1 = np.max(thr + k_md * sigk, axis=1)

@@ -92,3 +92,19 @@ def test_identification_statistic_is_baardas_w_test_squared_in_any_units():
     scale = np.array([1e3, 1.0, 1.0, 1e-3])  # east in mm, clock in km
     np.testing.assert_allclose(identify_statistic(d * scale, pss * np.outer(scale, scale)), t, rtol=1e-8)
     assert np.mean(np.argmax(t, axis=1) == 2) > 0.95
+
+
+def test_untested_axis_neither_detects_nor_names_the_suspect() -> None:
+    """A mode's separation on an axis marked untested (campaign/integrity_bank.own_ins_bank: the baro's lateral axis
+    when its sub-filter runs its own INS) is no detection: a 10-sigma lateral separation of mode 0 detects with every
+    axis tested and not with its lateral axis off; the vertical test and the H1 protection level are unchanged."""
+    x0 = np.zeros((1, 2))
+    p0 = np.ones((1, 2))
+    xk = np.array([[[0.0, 10.0], [0.5, 0.0]]])
+    pk = np.full((1, 2, 2), 2.0)
+    every = separation(x0, p0, xk, pk, 6.0, 5.0, 3.0)
+    off = separation(x0, p0, xk, pk, 6.0, 5.0, 3.0, tested=np.array([[True, False], [True, True]]))
+    assert every.detected[0] and every.suspect[0] == 0
+    assert not off.detected[0] and off.suspect[0] == -1
+    np.testing.assert_array_equal(off.test_ratio[0, 1], every.test_ratio[0, 1])
+    np.testing.assert_array_equal(off.pl_m, every.pl_m)
