@@ -160,7 +160,7 @@ def test_pre_approach_response_is_linear_in_the_fault(setting, monkeypatch) -> N
     (core/nav/measurements.baro_nu): the fault moves the navigation's height by dh and the scale-factor estimate by
     dsb, so doubling the fault moves that term by 4 dh dsb instead of 2 dh dsb, and the first update passes at most
     2 |dh dsb| of it (the baro row's gain on the vertical position is below 1: sqrt(P_dpD / S) = 0.8 here) to the
-    solution (measured 2.2 mm of 0.48 m: GPS carries the vertical)."""
+    solution (measured 2.2 mm against that 0.48 m bound: GPS carries the vertical)."""
     prof, flown, idx, prn = setting
     t0 = float(flown.truth.t_s[0])
     seen = []
