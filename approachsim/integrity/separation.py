@@ -83,15 +83,26 @@ def identify(delta_full: Array, pss_full: Array) -> Array:
 def identify_statistic(delta_full: Array, pss_full: Array, rcond: float = 1e-10) -> Array:
     """Delta_k' (P_ss,k)^+ Delta_k (epochs, modes) for delta_full (epochs, modes, n) and pss_full
     (epochs, modes, n, n), computed on the correlation scale (each state divided by its separation sigma) so
-    that the pseudo-inverse's cut-off does not depend on the states' units (m, m/s, rad)."""
+    that the pseudo-inverse's cut-off does not depend on the states' units (m, m/s, rad).
+
+    P_ss is a covariance difference: in exact arithmetic positive semi-definite, in floating point it can have
+    slightly negative eigenvalues and non-positive diagonal entries. Those directions carry no separation
+    information: a state with P_ss,ii <= 0 is left out and the pseudo-inverse keeps the eigenvalues above rcond times
+    the largest (the positive part). Inverting a negative eigenvalue instead made the statistic of a 118 m
+    separation -8.6e15 and the bank exclude another satellite (the CAT III candidate, an 807 m pseudorange ramp
+    absorbed before the approach: HMI at every epoch)."""
     d = np.asarray(delta_full, float)
     P = np.asarray(pss_full, float)
-    sd = np.sqrt(np.maximum(np.einsum("...ii->...i", P), 1e-300))
-    z = d / sd
-    W = P / (sd[..., :, None] * sd[..., None, :])
+    var = np.einsum("...ii->...i", P)
+    ok = var > 0.0
+    sd = np.sqrt(np.where(ok, var, 1.0))
+    z = np.where(ok, d / sd, 0.0)
+    W = P / (sd[..., :, None] * sd[..., None, :]) * (ok[..., :, None] & ok[..., None, :])
     W = 0.5 * (W + np.swapaxes(W, -1, -2))
-    pinv = np.linalg.pinv(W, rcond=rcond, hermitian=True)
-    return np.einsum("...n,...nm,...m->...", z, pinv, z)
+    lam, V = np.linalg.eigh(W)
+    keep = lam > rcond * np.max(lam, axis=-1, keepdims=True)
+    c = np.einsum("...nm,...n->...m", V, z)
+    return np.sum(np.where(keep, c * c / np.where(keep, lam, 1.0), 0.0), axis=-1)
 
 
 def least_squares_bank(G: Array, w: Array) -> tuple[Array, Array]:
