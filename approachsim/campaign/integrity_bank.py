@@ -131,6 +131,8 @@ class BankEpochs:
     separations: tuple[Array, Array] | None = field(default=None, repr=False, compare=False)
     """(d9 (e, K, 9), p9 (e, K, 9, 9)): the sub-solutions' navigation-state separations x_k - x_0 and their
     covariances P_k - P_0, from which `identification` makes the statistic (only runs with a detection need it)."""
+    tested: Array | None = field(default=None, repr=False, compare=False)
+    """(K, 2) bool: the axes on which each mode's separation is a detection test (None: every one; own_ins_bank)."""
 
     def identification(self) -> Array | None:
         """wtest, or the statistic made from `separations` (once; kept), or None: identify on the approach axes."""
@@ -259,6 +261,25 @@ def second_level(detected: Array, stat: Array, ratio: float = SECOND_LEVEL_RATIO
     return mode, ok
 
 
+def own_ins_bank(ep: BankEpochs) -> BankEpochs:
+    """The bank whose baro mode's sub-filter runs its own INS (the damping loop drives the INS: run_bank): that
+    mode tested on the vertical axis only, and identification by the tested separations (no full-state
+    statistic). The baro measures height, so a baro fault reaches the lateral solution only through the INS
+    couplings, and with its own INS P_k - P_0 is not the separation's covariance there (the premise of
+    integrity/separation.py: a sub-filter on the same INS and model; with a shared INS, no loop, it holds). Measured
+    fault-free (tests/data/default-py.toml, run 5, physical baro): lateral P_k - P_0 from -7e-4 to 0.015 m^2 against
+    P_0 3.9 m^2, negative at some epochs, and separations up to 0.19 m: a normalized separation of 1e7, an alert
+    that says nothing about the baro. Its vertical axis, where the baro's information is (P_k - P_0 0.06 m^2), stays
+    tested (the fault-free normalized separation's largest 2.2, rms 0.8). For the same reason a bank with the baro
+    mode identifies by the tested separations (the largest normalized one, SeparationResult.suspect), not by the
+    full-state statistic Delta' (P_k - P_0)^+ Delta, which needs P_k - P_0 to be the separation's covariance: with
+    the baro's own INS it is indefinite (a 20 m baro step: the baro's statistic -9, the radar altimeter's 20759, and
+    the radar altimeter excluded while the baro's vertical separation alone was over its threshold)."""
+    tested = np.ones((len(ep.channels), 2), bool)
+    tested[np.asarray(ep.channels, dtype=int) == BARO_MODE, 1] = False
+    return dataclasses.replace(ep, wtest=None, separations=None, tested=tested)
+
+
 def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, window: Array | None = None,
                    confirm: bool = False, at_once: bool = False) -> CategoryIntegrity:
     """Protection levels, detection and the per-epoch counts of one category (Annex 10 alert limits at the
@@ -270,7 +291,7 @@ def score_category(ep: BankEpochs, req: IntegrityRequirement, epoch_hz: float, w
     n_modes = max(ep.ek.shape[1], 1)
     # K_md with the mode count: the faulted allocation is shared by the n_modes monitored modes (requirements.p_md)
     r = separation(ep.e0[sel], ep.p0[sel], ep.ek[sel], ep.pk[sel], req.k_ff(), req.k_fa(epoch_hz, 2 * n_modes),
-                   req.k_md(n_modes)) if ep.ek.shape[1] else _no_modes(ep, sel, req)
+                   req.k_md(n_modes), ep.tested) if ep.ek.shape[1] else _no_modes(ep, sel, req)
     al = np.stack([vertical_alert_limit_m(req, ep.height_m[sel]), lateral_alert_limit_m(req, ep.along_m[sel])],
                   axis=1)
     t = ep.t_s[sel]
@@ -390,4 +411,4 @@ def run_bank(profile: Any, truth: Any, seed: int, run: int, sensor_modes_on: boo
     navs = nav.run(truth, recs, [stream(seed, run, "nav") for _ in range(copies)],
                    shared_covariance=nav.shares_covariance(), states=states, copies=share, memo=memo)
     ep = bank_epochs(navs[0], navs[1:], channels, truth, profile.runway.heading_rad)
-    return ep, navs[0]
+    return (own_ins_bank(ep) if own_ins else ep), navs[0]

@@ -16,10 +16,14 @@ with the segment flown at the start state (as the converged start: Phi, Qd and t
 `initial._segment`), b_k the fault's value (a step m; a ramp rate x time since the onset), and the gain the
 converged filter's, K = P- H' (H P- H' + R)^-1 with P- = Phi P_conv Phi' + Qd: a fixed gain over the segment (the
 converged start's covariance; a fault older than the 600 s convergence segment is taken through the same gain:
-the approximation of a fixed geometry that the converged start already makes). The bank copies: copy 0 (the main
-filter) uses every row, copy k + 1 leaves out mode k's source (its rows never see a fault on that source, so the
-sub-filter without the faulted satellite starts clean, as a bank that ran through the segment would); every copy
-starts from the main filter's converged covariance (the bank's own convention). The recursion is evaluated as the
+the approximation of a fixed geometry that the converged start already makes). The segment is flown level at the
+start's height (the intermediate segment before the glidepath): with a baro scale-factor state sb the split of a
+vertical disturbance between the baro bias and sb (h - H_ref) depends on the height's change, so the response is
+that of a level segment, not of a descent (tests/unit/campaign/test_preapproach.py gives the numbers). The bank
+copies: copy 0 (the main filter) uses every row; the copy that leaves out the faulted source never sees the fault
+and starts clean (as a bank that ran through the segment would); every other copy takes the main filter's response
+(an approximation: with its own rows its response would differ by its separation's share); every copy starts from
+the main filter's converged covariance (the bank's own convention). The recursion is evaluated as the
 N steps of the augmented matrix [[A, g, g beta], [0, 1, beta], [0, 0, 1]] on (delta, b, 1), N = age x aiding rate,
 beta the ramp's increment per epoch (with the loop's x_f ahead of delta: `estimate_offsets`).
 

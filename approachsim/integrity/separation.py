@@ -46,9 +46,12 @@ class SeparationResult:
     """(epochs,) int: the mode with the largest normalized separation (-1 when none detected)."""
 
 
-def separation(x0: Array, p0: Array, xk: Array, pk: Array, k_ff: float, k_fa: float, k_md: float) -> SeparationResult:
+def separation(x0: Array, p0: Array, xk: Array, pk: Array, k_ff: float, k_fa: float, k_md: float,
+               tested: Array | None = None) -> SeparationResult:
     """Solution separation on two axes. x0 (epochs, 2), p0 (epochs, 2) variances of the main solution;
-    xk (epochs, modes, 2), pk (epochs, modes, 2) of the sub-solutions (each axis its own variance, m^2)."""
+    xk (epochs, modes, 2), pk (epochs, modes, 2) of the sub-solutions (each axis its own variance, m^2).
+    tested (modes, 2) bool: the axes on which each mode's separation is a detection test (default every one); an
+    untested axis keeps its H1 term T + K_md sigma_k but never detects nor names a suspect."""
     x0, p0 = np.asarray(x0, float), np.asarray(p0, float)
     xk, pk = np.asarray(xk, float), np.asarray(pk, float)
     sig0 = np.sqrt(np.maximum(p0, 0.0))
@@ -56,9 +59,10 @@ def separation(x0: Array, p0: Array, xk: Array, pk: Array, k_ff: float, k_fa: fl
     sig_ss = np.sqrt(np.maximum(pk - p0[:, None, :], 1e-18))
     thr = k_fa * sig_ss
     delta = xk - x0[:, None, :]
-    ratio = np.abs(delta) / thr
+    on = np.ones(delta.shape[1:], bool) if tested is None else np.asarray(tested, bool)
+    ratio = np.where(on, np.abs(delta) / thr, 0.0)
     detected = np.any(ratio > 1.0, axis=(1, 2))
-    norm_sep = np.max(np.abs(delta) / sig_ss, axis=2)
+    norm_sep = np.max(np.where(on, np.abs(delta) / sig_ss, 0.0), axis=2)
     suspect = np.where(detected, np.argmax(norm_sep, axis=1), -1)
     pl_h0 = k_ff * sig0
     pl_h1 = np.max(thr + k_md * sigk, axis=1)
@@ -79,15 +83,26 @@ def identify(delta_full: Array, pss_full: Array) -> Array:
 def identify_statistic(delta_full: Array, pss_full: Array, rcond: float = 1e-10) -> Array:
     """Delta_k' (P_ss,k)^+ Delta_k (epochs, modes) for delta_full (epochs, modes, n) and pss_full
     (epochs, modes, n, n), computed on the correlation scale (each state divided by its separation sigma) so
-    that the pseudo-inverse's cut-off does not depend on the states' units (m, m/s, rad)."""
+    that the pseudo-inverse's cut-off does not depend on the states' units (m, m/s, rad).
+
+    P_ss is a covariance difference: in exact arithmetic positive semi-definite, in floating point it can have
+    slightly negative eigenvalues and non-positive diagonal entries. Those directions carry no separation
+    information: a state with P_ss,ii <= 0 is left out and the pseudo-inverse keeps the eigenvalues above rcond times
+    the largest (the positive part). Inverting a negative eigenvalue instead made the statistic of a 118 m
+    separation -8.6e15 and the bank exclude another satellite (the CAT III candidate, an 807 m pseudorange ramp
+    absorbed before the approach: HMI at every epoch)."""
     d = np.asarray(delta_full, float)
     P = np.asarray(pss_full, float)
-    sd = np.sqrt(np.maximum(np.einsum("...ii->...i", P), 1e-300))
-    z = d / sd
-    W = P / (sd[..., :, None] * sd[..., None, :])
+    var = np.einsum("...ii->...i", P)
+    ok = var > 0.0
+    sd = np.sqrt(np.where(ok, var, 1.0))
+    z = np.where(ok, d / sd, 0.0)
+    W = P / (sd[..., :, None] * sd[..., None, :]) * (ok[..., :, None] & ok[..., None, :])
     W = 0.5 * (W + np.swapaxes(W, -1, -2))
-    pinv = np.linalg.pinv(W, rcond=rcond, hermitian=True)
-    return np.einsum("...n,...nm,...m->...", z, pinv, z)
+    lam, V = np.linalg.eigh(W)
+    keep = lam > rcond * np.max(lam, axis=-1, keepdims=True)
+    c = np.einsum("...nm,...n->...m", V, z)
+    return np.sum(np.where(keep, c * c / np.where(keep, lam, 1.0), 0.0), axis=-1)
 
 
 def least_squares_bank(G: Array, w: Array) -> tuple[Array, Array]:

@@ -1,6 +1,12 @@
 """The bank with the baro and the radar altimeter as fault modes (run_bank(sensor_modes_on=True)) on a flown
-approach: a 20 m baro step, misleading for the GPS-only bank (its PL never sees the baro), is detected and the baro
-excluded, and the output is no longer misleading; fault-free nothing is detected."""
+approach: a 50 m baro step, misleading for the GPS-only bank (its PL never sees the baro), is detected and the baro
+excluded, and the output is no longer misleading; fault-free nothing is detected.
+
+With issue 39's physical baro the filter carries a baro bias (sigma 3.1 m) and scale factor that absorb much of a
+step: a 20 m step is no longer misleading for the GPS-only bank (0 misleading epochs, measured), a 50 m one is (58).
+Fault-free, the baro mode is tested on the vertical axis only and the bank with it identifies by the tested
+separations (campaign/integrity_bank.tested_axes: its sub-filter runs its own INS, so P_k - P_0 is not the
+separation's covariance on the lateral axis or on the full state)."""
 
 from __future__ import annotations
 
@@ -19,10 +25,6 @@ ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.slow
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "finding after the merge of issue 39's physical baro (bias state, static-source and QNH errors) with the "
-    "sensor-mode bank: the fault-free run of this test alerts at CAT I (cat1_detected 1), so the baro step's "
-    "exclusion cannot be judged against a clean run; the sensor modes' thresholds were set on the 1 m baro"))
 def test_baro_step_detected_and_excluded_with_sensor_modes() -> None:
     prof = load_profile(ROOT / "tests" / "data" / "default-py.toml")
     truth, _, _ = flight_truth(prof, 1, 0)
@@ -32,9 +34,10 @@ def test_baro_step_detected_and_excluded_with_sensor_modes() -> None:
     clean = limit_states(ep, prof.evaluation, 1.0, t0)
     assert clean["cat1_detected"] == 0 and clean["cat1_mi"] == 0
     faulted = dataclasses.replace(prof, faults=(FaultSpec(sensor="baro", kind="step", start_s=150.0, target="h",
-                                                          magnitude=20.0),))
+                                                          magnitude=50.0),))
     old = limit_states(run_bank(faulted, truth, 1, 5)[0], prof.evaluation, 1.0, t0)
     new = limit_states(run_bank(faulted, truth, 1, 5, sensor_modes_on=True)[0], prof.evaluation, 1.0, t0)
-    assert old["cat1_detected"] == 0 and old["cat1_mi"] > 10  # measured: 92 misleading epochs, 9 m error
+    assert old["cat1_mi"] > 10  # measured: 58 misleading epochs (a GPS satellite excluded in its place)
     assert new["cat1_detected"] == 1 and new["cat1_excluded"] == BARO_MODE
-    assert new["cat1_mi"] == 0 and new["cat1_vmax_m"] < 0.5 * old["cat1_vmax_m"]
+    # excluded, the output is the baro-less sub-filter: back to the fault-free run's largest error (measured equal)
+    assert new["cat1_mi"] == 0 and new["cat1_vmax_m"] <= clean["cat1_vmax_m"] + 0.5

@@ -92,3 +92,41 @@ def test_identification_statistic_is_baardas_w_test_squared_in_any_units():
     scale = np.array([1e3, 1.0, 1.0, 1e-3])  # east in mm, clock in km
     np.testing.assert_allclose(identify_statistic(d * scale, pss * np.outer(scale, scale)), t, rtol=1e-8)
     assert np.mean(np.argmax(t, axis=1) == 2) > 0.95
+
+
+def test_untested_axis_neither_detects_nor_names_the_suspect() -> None:
+    """A mode's separation on an axis marked untested (campaign/integrity_bank.own_ins_bank: the baro's lateral axis
+    when its sub-filter runs its own INS) is no detection: a 10-sigma lateral separation of mode 0 detects with every
+    axis tested and not with its lateral axis off; the vertical test and the H1 protection level are unchanged."""
+    x0 = np.zeros((1, 2))
+    p0 = np.ones((1, 2))
+    xk = np.array([[[0.0, 10.0], [0.5, 0.0]]])
+    pk = np.full((1, 2, 2), 2.0)
+    every = separation(x0, p0, xk, pk, 6.0, 5.0, 3.0)
+    off = separation(x0, p0, xk, pk, 6.0, 5.0, 3.0, tested=np.array([[True, False], [True, True]]))
+    assert every.detected[0] and every.suspect[0] == 0
+    assert not off.detected[0] and off.suspect[0] == -1
+    np.testing.assert_array_equal(off.test_ratio[0, 1], every.test_ratio[0, 1])
+    np.testing.assert_array_equal(off.pl_m, every.pl_m)
+
+
+def test_identification_statistic_keeps_the_positive_part_of_the_separation_covariance() -> None:
+    """P_ss = P_k - P_0 in floating point can have a slightly negative eigenvalue or diagonal entry; those
+    directions carry no separation information and are left out (a negative eigenvalue inverted made a 118 m
+    separation's statistic -8.6e15 and the bank exclude another satellite: identify_statistic's docstring).
+    Mode 0: a 10-sigma separation on state 0 and 1 mm on a state whose separation variance is -1e-9 m^2 (dropped):
+    100. Mode 1: P_ss with eigenvalues 2 and -5e-7, the separation along the negative one's eigenvector
+    ((1, -1) / sqrt(2), 1 m) and 3 m along the positive one's: only the latter counts, 3^2 / 2."""
+    d = np.array([[[10.0, 1e-3], [3.0 / np.sqrt(2.0) + 1.0 / np.sqrt(2.0), 3.0 / np.sqrt(2.0) - 1.0 / np.sqrt(2.0)]]])
+    e = 1e-6
+    lam_neg = 1.0 - (1.0 - e)  # the matrix below has eigenvalues (2 - e +- sqrt(e^2 + 4)) / 2, about 2 and -e / 2
+    P = np.array([[[[1.0, 0.0], [0.0, -1e-9]], [[1.0, 1.0], [1.0, 1.0 - lam_neg]]]])
+    w = identify_statistic(d, P)
+    lam, V = np.linalg.eigh(P[0, 1])
+    assert lam[0] < 0.0 < lam[1]  # the second mode's covariance is indefinite, as built
+    expected_1 = float(V[:, 1] @ d[0, 1]) ** 2 / lam[1]
+    # the statistic is made on the correlation scale: its positive part differs from P's by the diagonal scaling's
+    # O(e) = 1e-6 turn of the eigenvectors
+    np.testing.assert_allclose(w[0], [100.0, expected_1], rtol=1e-5)
+    assert abs(expected_1 - 4.5) < 1e-3
+    assert np.argmax(w[0]) == 0
