@@ -57,6 +57,10 @@ class Runway:
     slope: float = 0.0
     """Longitudinal slope of the runway past the threshold, rise per metre (+: rising in the landing direction);
     the terrain past the threshold (Terrain, RUNWAY_SLOPE_EXTENT_M) follows it."""
+    lead_in: str = "none"
+    """The flight before the final (flight/path.py LEAD_INS): "none", the straight-in from start_distance_m;
+    "profgen", the PROFGEN-like pattern (downwind descent, two 90 deg turns, level segments, the glideslope
+    intercept from below), flown open loop over flat terrain; start_distance_m is then unused."""
 
     @property
     def frame(self) -> RunwayFrame:
@@ -208,6 +212,7 @@ def _runway(s: Section) -> Runway:
     tch = s.number("tch_ft", 50.0, lo=0.0, hi=200.0, unit="ft")
     start = s.number("start_distance_nmi", 10.0, lo=1.0, hi=30.0, unit="nmi")
     slope = s.number("slope_percent", 0.0, lo=-2.0, hi=2.0, unit="% (rise in the landing direction)")
+    lead_in = s.string("lead_in", "none", choices=("none", "profgen"))
     s.done()
     return Runway(
         threshold_lat_rad=math.radians(lat),
@@ -218,6 +223,7 @@ def _runway(s: Section) -> Runway:
         tch_m=tch * units.FT,
         start_distance_m=start * units.NMI,
         slope=slope / 100.0,
+        lead_in=lead_in,
     )
 
 
@@ -429,6 +435,9 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
     faults = parse_faults(fault_items, sensors, duration_s=duration, imu_hz=rates.imu_hz)
     nav = parse_nav(top.section("nav"))
     top.done()
+    if runway.lead_in != "none" and (len(terrain.along_m) > 1 or run.mode != "open"):
+        raise ProfileError("runway.lead_in: the PROFGEN-like lead-in is flown open loop (run.mode = \"open\") over "
+                           "flat terrain (no [terrain] table, a level runway): its pattern leaves the centreline")
     if sensors.gnss is not None and sensors.gnss.carrier is not None and not (
             nav.gps_coupling == "tight" and nav.channel_states):
         raise ProfileError("sensors.gnss.carrier_phase: needs [nav] gps_coupling = \"tight\" and channel_states = "
