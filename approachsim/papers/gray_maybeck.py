@@ -460,6 +460,35 @@ def row_verdict(direction_ok: bool, magnitude_ok: bool) -> str:
     return "does not reproduce"
 
 
+STRICT_FACTOR = 1.5
+"""The strict rule's factor: a level or % change within x1.5 of the paper's (the paper's own 15-run spread of a
+level is about x1.35, issue 43)."""
+STRICT_SMALL_PCT = 10.0
+"""Below this |paper %| the strict rule compares the % change by points, not by ratio."""
+STRICT_POINTS = 5.0
+"""The strict rule's tolerance in points where the paper's |%| < STRICT_SMALL_PCT."""
+
+
+def _within_factor(ours: float, paper: float, factor: float = STRICT_FACTOR) -> bool:
+    """ours within x factor of paper (both positive: paper / factor <= ours <= paper x factor)."""
+    return paper > 0.0 and ours > 0.0 and paper / factor <= ours <= paper * factor
+
+
+def strict_row(paper_a: float, paper_b: float, ours_a: float, ours_b: float) -> dict:
+    """The strict rule (issue 43) on one row of Tables 3-6: both levels within x1.5 of the paper's, and the % change
+    (a - b) / a with the paper's sign and within x1.5 of it, or within 5 points where the paper's |%| < 10.
+    Returns the three checks and 'reproduces' (all three)."""
+    p_pct = (paper_a - paper_b) / paper_a * 100.0
+    o_pct = (ours_a - ours_b) / ours_a * 100.0
+    same_sign = (p_pct > 0.0 and o_pct > 0.0) or (p_pct < 0.0 and o_pct < 0.0)
+    if abs(p_pct) < STRICT_SMALL_PCT:
+        pct_ok = same_sign and abs(o_pct - p_pct) <= STRICT_POINTS
+    else:
+        pct_ok = same_sign and _within_factor(abs(o_pct), abs(p_pct))
+    a_ok, b_ok = _within_factor(ours_a, paper_a), _within_factor(ours_b, paper_b)
+    return {"a": a_ok, "b": b_ok, "pct": pct_ok, "reproduces": a_ok and b_ok and pct_ok}
+
+
 def direction(pct_ci: Sequence[float] | None) -> str:
     """'reduction' (interval above 0), 'increase' (below 0) or 'indistinguishable' from a % change interval."""
     if pct_ci is None:
@@ -487,14 +516,16 @@ def table_claims(ours: dict, paper: dict) -> list[dict]:
                "pct": _inside(p_signed, rng_of("pct_range_paper_runs"))}
         out.append({"state": s, "paper_pct_signed": p_signed, "paper_direction": p_dir, "our_direction": o_dir,
                     "direction_reproduces": o_dir == p_dir, "paper_pct_inside_our_interval": bool(inside),
-                    "magnitude": mag, "verdict": row_verdict(o_dir == p_dir, mag["pct"])})
+                    "magnitude": mag, "verdict": row_verdict(o_dir == p_dir, mag["pct"]),
+                    "strict": strict_row(p_a, p_b, ours["a_ft"][j], ours["b_ft"][j])})
     return out
 
 
 def cell_counts(tables: dict) -> dict:
     """Over Tables 3-6: numeric cells (two levels and the % change per row) whose paper value lies inside our
-    paper-size range, rows whose direction reproduces, and rows by verdict."""
-    cells = mag = dirs = 0
+    paper-size range, rows whose direction reproduces, rows by verdict, and under the strict rule (strict_row) the
+    cells within it and the rows that reproduce."""
+    cells = mag = dirs = strict_cells = strict_rows = 0
     verdicts: dict[str, int] = {}
     for t in tables.values():
         for cl in t["claims"]:
@@ -502,8 +533,13 @@ def cell_counts(tables: dict) -> dict:
             mag += sum(bool(v) for v in cl["magnitude"].values())
             dirs += bool(cl["direction_reproduces"])
             verdicts[cl["verdict"]] = verdicts.get(cl["verdict"], 0) + 1
+            st = cl.get("strict")
+            if st is not None:
+                strict_cells += int(st["a"]) + int(st["b"]) + int(st["pct"])
+                strict_rows += int(st["reproduces"])
     rows = sum(verdicts.values())
-    return {"cells": cells, "magnitude_cells": mag, "rows": rows, "direction_rows": dirs, "verdicts": verdicts}
+    return {"cells": cells, "magnitude_cells": mag, "rows": rows, "direction_rows": dirs, "verdicts": verdicts,
+            "strict_cells": strict_cells, "strict_rows": strict_rows}
 
 
 def case_verdicts(summary: dict) -> dict:
