@@ -62,7 +62,7 @@ from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import Linearization
 from approachsim.flight.envelope import StabilityMonitor, check_envelope, unstabilized_reason
 from approachsim.flight.fdm import FDM, InitialCondition, TrimError
-from approachsim.flight.path import PathGuidance, lead_in_of
+from approachsim.flight.path import PathGuidance
 from approachsim.flight.trim import (
     CAS_TOLERANCE_MPS,
     PATH_TOLERANCE_RAD,
@@ -74,6 +74,7 @@ from approachsim.flight.turbulence import DrydenTurbulence
 from approachsim.flight.vectors import imu_point_constants
 from approachsim.flight.wind import varies as wind_varies
 from approachsim.glidepath import GlidePath
+from approachsim.leadin import lead_in_of
 from approachsim.profile import Profile
 from approachsim.records import NavigationSource, Truth
 from approachsim.seeding import stream, stream_int

@@ -18,9 +18,9 @@ from dataclasses import replace
 from approachsim import geo, units
 from approachsim.flight.aircraft import Aircraft
 from approachsim.flight.fdm import FDM, InitialCondition, TrimError
-from approachsim.flight.path import lead_in_of
 from approachsim.flight.wind import mean_wind_ned
 from approachsim.flight.wind import varies as wind_varies
+from approachsim.leadin import lead_in_of
 from approachsim.profile import Profile
 
 

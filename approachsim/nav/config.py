@@ -174,9 +174,9 @@ def parse_nav(s: Section) -> NavConfig:
     s.done()
     cfg = NavConfig(
         filter=name, filter_tuning=tuple(sorted(tuning.items())), aiding_rate_hz=rate, feedback=feedback,
-        gps_coupling=coupling, channel_states=channel, gps_sigma_scale=sigma_scale, clock_q_scale=clock_q, baro_loop=loop,
-        baro_loop_tau_s=tau,
-        baro_loop_b_per_m=b, initial_error=init, fde=fde, terrain_database=terrain_database,
+        gps_coupling=coupling, channel_states=channel, gps_sigma_scale=sigma_scale, clock_q_scale=clock_q,
+        baro_loop=loop, baro_loop_tau_s=tau, baro_loop_b_per_m=b, initial_error=init, fde=fde,
+        terrain_database=terrain_database,
     )
     try:
         cfg.make_filter()  # unknown filter or bad tuning fails at load, not an hour into a campaign

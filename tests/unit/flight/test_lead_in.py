@@ -9,9 +9,10 @@ import tomllib
 import numpy as np
 import pytest
 
+from approachsim import leadin as fp
 from approachsim import units
 from approachsim.config import ProfileError
-from approachsim.flight import path as fp
+from approachsim.flight.path import PathGuidance
 from approachsim.flight.run import Approach
 from approachsim.profile import parse_profile
 from approachsim.resources import shipped_profiles
@@ -83,7 +84,7 @@ def test_jsbsim_flies_the_pattern_on_the_autopilot(flown):
     assert result.termination == "reached stop height"
     tr = result.truth
     r, e = tr.r_rwy, tr.euler_rad
-    guide = fp.PathGuidance(lead, prof.runway.glidepath, 0.05)
+    guide = PathGuidance(lead, prof.runway.glidepath, 0.05)
     legs, cross, dz = np.zeros(len(r), int), np.zeros(len(r)), np.full(len(r), np.nan)
     for k in range(len(r)):
         leg, s, c, _ = guide.locate(r[k, 0], r[k, 1])
