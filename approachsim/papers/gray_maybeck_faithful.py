@@ -222,3 +222,24 @@ def faithful_settings(profile: Any, grade: Any) -> dict[str, Any]:
         "run.mode": "open",
         "evaluation.integrity": False,
     }
+
+
+PROFGEN_OUTAGE_WINDOWS_S: dict[int, tuple[tuple[float, float], ...]] = {
+    0: (),
+    1: ((100.0, 120.0),),
+    2: ((100.0, 120.0), (400.0, 420.0)),
+}
+"""The profgen variant's outages (gap fill, 20 s each as the faithful variant's): the single one on the downwind
+as it enters the first turn (100-120 s; the turn starts at 106 s), the second on the glide path at about 1150-900 ft
+above the threshold (400-420 s), inside radar-altimeter use ("use of radar altimeter occurs during the aircraft
+landing")."""
+
+PROFGEN_TUNING: dict[str, float] = {"nav.gps_sigma_scale": 15.35, "nav.clock_q_scale": 1.0}
+"""The frozen tuning of the profgen variant: the pick of tools/gray_maybeck_tuning.py on the reference case
+(docs/gray-maybeck/README.md, "Third pass"): the smallest true time-averaged position RMS whose filter sigmas are
+no smaller than the true RMS in every state."""
+
+
+PROFGEN_SETTINGS: tuple[tuple[str, object], ...] = (
+    ("runway.lead_in", "profgen"), ("nav.initial_error.start", "prior"), *PROFGEN_TUNING.items())
+"""The profgen variant's settings after the faithful variant's (papers/gray_maybeck.profgen_settings)."""
