@@ -234,10 +234,12 @@ as it enters the first turn (100-120 s; the turn starts at 106 s), the second on
 above the threshold (400-420 s), inside radar-altimeter use ("use of radar altimeter occurs during the aircraft
 landing")."""
 
-PROFGEN_TUNING: dict[str, float] = {"nav.gps_sigma_scale": 15.35, "nav.clock_q_scale": 1.0}
-"""The frozen tuning of the profgen variant: the pick of tools/gray_maybeck_tuning.py on the reference case
-(docs/gray-maybeck/README.md, "Third pass"): the smallest true time-averaged position RMS whose filter sigmas are
-no smaller than the true RMS in every state."""
+PROFGEN_TUNING: dict[str, float] = {"nav.gps_sigma_scale": 13.0, "nav.clock_q_scale": 10000.0}
+"""The frozen tuning of the profgen variant: the pick of tools/gray_maybeck_tuning.py on the reference case III
+(40 runs, seed 1; docs/gray-maybeck/README.md, "Third pass"): the smallest true time-averaged RMS of the four
+states together whose filter sigmas are no smaller than the true RMS in every state. R scale 12 under-claims the
+altitude (sigma 24.17 < true 25.14 ft), 13 is the first consistent one; the clock Q scales 100, 1000 and 10000 give
+the same errors within 0.1 ft (a flat optimum: the filter's clock free to absorb the common-mode range errors)."""
 
 
 PROFGEN_SETTINGS: tuple[tuple[str, object], ...] = (
