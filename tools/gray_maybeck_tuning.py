@@ -126,11 +126,23 @@ def sweep(case: gm.Case, truth: Any, seed: int, runs: list[int], scales: tuple, 
         rows.append({"gps_sigma_scale": s, "clock_q_scale": q, "true_rms_ft": true, "sigma_ft": sig,
                      "position_3d_ft": pos3, "four_states_ft": all4,
                      "consistent": all(sig[k] >= true[k] for k in STATES)})
-    ok = [r for r in rows if r["consistent"]]
-    best = min(ok, key=lambda r: r["four_states_ft"]) if ok else None
+    best = pick(rows)
     for r in rows:
         r["pick"] = r is best
     return rows
+
+
+def pick(rows: list[dict]) -> dict | None:
+    """The tuning procedure's choice: among the rows whose filter sigma >= true RMS in every state, the one with the
+    smallest true RMS of the four states together (None when no row is consistent). Each row: true_rms_ft and
+    sigma_ft per state."""
+    def consistent(r: dict) -> bool:
+        return all(r["sigma_ft"][k] >= r["true_rms_ft"][k] for k in STATES)
+
+    def total(r: dict) -> float:
+        return math.sqrt(sum(r["true_rms_ft"][k] ** 2 for k in STATES))
+    ok = [r for r in rows if consistent(r)]
+    return min(ok, key=total) if ok else None
 
 
 def cells(truth: Any, seed: int, runs: list[int], scales: tuple, q: float) -> list[dict]:
