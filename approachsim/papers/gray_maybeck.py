@@ -270,10 +270,9 @@ PROFGEN_ASSUMPTIONS = (
     "10 nmi final (runway.lead_in = \"profgen\"): a downwind descent from 3500 to 2500 ft above the threshold on "
     "3 deg, two 90 deg left turns of 2500 m radius (about 12 deg of bank) with a 1 nmi base between them, 2 nmi "
     "level on the localizer and the glideslope intercept from below 7.5 nmi out, 18.9 nmi and about 480 s in all, "
-    "flown by JSBSim on the approach autopilot; the filter runs from its start (start = \"prior\": the "
-    "free-inertial errors drawn as the INS's initial errors and as the filter's P0); the time averages cover the "
-    "whole flight from 10 s after its start (the paper's window: its simulation). The paper gives neither the "
-    "profile's length nor its legs.",
+    "flown by JSBSim on the approach autopilot; the filter runs from its start, from the faithful variant's converged "
+    "start (the aided sortie before it); the time averages cover the whole flight from 10 s after its start (the "
+    "paper's window: its simulation). The paper gives neither the profile's length nor its legs.",
     "Tuning (the profgen variant): R scale and clock Q from the sweep on the reference case "
     "(tools/gray_maybeck_tuning.py), frozen for all 16 cases (PROFGEN_TUNING); outages 100-120 s (entering the "
     "first turn) and 400-420 s (on the glide path, radar altimeter in use).",
@@ -293,8 +292,9 @@ PROFGEN_TUNING = gf.PROFGEN_TUNING
 
 
 def profgen_settings() -> list[tuple[str, Any]]:
-    """The profgen variant's settings after the faithful variant's: the lead-in (flight/path.py), the filter from the
-    start of it (its prior the free-inertial errors of the faithful variant, drawn: start = "prior"), the tuning."""
+    """The profgen variant's settings after the faithful variant's: the lead-in (flight/path.py) and the swept
+    tuning; the filter runs from the lead-in's start from the faithful variant's converged start
+    (gray_maybeck_faithful.PROFGEN_SETTINGS says why not the prior draw)."""
     return list(gf.PROFGEN_SETTINGS)
 
 

@@ -13,7 +13,7 @@ def test_profgen_cases_fly_the_lead_in_with_the_filter_from_its_start_and_the_fr
         prof = gm.case_profile(case, "profgen")
         assert prof.runway.lead_in == "profgen"
         assert prof.run.mode == "open"
-        assert prof.nav.initial_error.start == "prior"
+        assert prof.nav.initial_error.start == "converged"
         assert prof.nav.gps_sigma_scale == gm.PROFGEN_TUNING["nav.gps_sigma_scale"]
         assert prof.nav.clock_q_scale == gm.PROFGEN_TUNING["nav.clock_q_scale"]
         # the faithful variant's per-grade free-inertial prior is kept (papers/gray_maybeck_faithful.py)
