@@ -23,6 +23,7 @@ from approachsim.config import ProfileError, Section
 from approachsim.evaluate.config import EvaluationConfig, parse_evaluation
 from approachsim.geo import RunwayFrame
 from approachsim.glidepath import GlidePath
+from approachsim.leadin import LEAD_INS, lead_in_of
 from approachsim.nav.config import NavConfig, parse_nav
 from approachsim.resources import find_aircraft_file
 from approachsim.sensors import atmosphere
@@ -57,6 +58,10 @@ class Runway:
     slope: float = 0.0
     """Longitudinal slope of the runway past the threshold, rise per metre (+: rising in the landing direction);
     the terrain past the threshold (Terrain, RUNWAY_SLOPE_EXTENT_M) follows it."""
+    lead_in: str = "none"
+    """The flight before the final (flight/path.py LEAD_INS): "none", the straight-in from start_distance_m;
+    "profgen", the PROFGEN-like pattern (downwind descent, two 90 deg turns, level segments, the glideslope
+    intercept from below), flown open loop over flat terrain; start_distance_m is then unused."""
 
     @property
     def frame(self) -> RunwayFrame:
@@ -208,6 +213,7 @@ def _runway(s: Section) -> Runway:
     tch = s.number("tch_ft", 50.0, lo=0.0, hi=200.0, unit="ft")
     start = s.number("start_distance_nmi", 10.0, lo=1.0, hi=30.0, unit="nmi")
     slope = s.number("slope_percent", 0.0, lo=-2.0, hi=2.0, unit="% (rise in the landing direction)")
+    lead_in = s.string("lead_in", "none", choices=LEAD_INS)
     s.done()
     return Runway(
         threshold_lat_rad=math.radians(lat),
@@ -218,6 +224,7 @@ def _runway(s: Section) -> Runway:
         tch_m=tch * units.FT,
         start_distance_m=start * units.NMI,
         slope=slope / 100.0,
+        lead_in=lead_in,
     )
 
 
@@ -386,7 +393,8 @@ def _run(s: Section) -> RunDefaults:
 
 def _run_duration_estimate_s(runway: Runway, aircraft: AircraftChoice, env: Environment, source: Path | None) -> float:
     """Estimate (s) of a run's length, for checking fault times: the glidepath from the start distance to
-    50 ft above the threshold at the approach ground speed.
+    50 ft above the threshold at the approach ground speed (with a lead-in: its path length, at the TAS of its
+    pattern height).
 
     Ground speed = TAS - headwind; TAS = CAS sqrt(rho0 / rho) (incompressible, M < 0.3) at the approach's
     mid height in the ISA atmosphere with the profile's temperature deviation. The approach speed is the
@@ -401,6 +409,9 @@ def _run_duration_estimate_s(runway: Runway, aircraft: AircraftChoice, env: Envi
             raise ProfileError(f"aircraft.name: {str(path)!r} has no valid approach.approach_speed_kt") from None
     tan_gp = math.tan(runway.glidepath_rad)
     h_mid = runway.elevation_m + 0.5 * runway.start_distance_m * tan_gp
+    lead = lead_in_of(runway)
+    if lead is not None:  # the lead-in's length at the TAS of its pattern height
+        h_mid = runway.elevation_m + lead.pattern_height_m
     t_isa = 288.15 - 0.0065 * h_mid  # ISA troposphere, K
     p_ratio = (t_isa / 288.15) ** 5.25588  # p / p0
     rho_ratio = p_ratio * 288.15 / (t_isa + env.isa_dev_k)  # rho / rho0 with the temperature deviation
@@ -408,6 +419,8 @@ def _run_duration_estimate_s(runway: Runway, aircraft: AircraftChoice, env: Envi
     headwind = env.wind_speed_mps * math.cos(env.wind_from_rad - runway.heading_rad)
     ground_speed = max(tas - headwind, 0.3 * tas)
     path_m = runway.start_distance_m + (runway.tch_m - 50.0 * units.FT) / tan_gp
+    if lead is not None:
+        path_m = lead.length_m
     return path_m / ground_speed
 
 
@@ -429,6 +442,9 @@ def parse_profile(data: dict, source: Path | None = None) -> Profile:
     faults = parse_faults(fault_items, sensors, duration_s=duration, imu_hz=rates.imu_hz)
     nav = parse_nav(top.section("nav"))
     top.done()
+    if runway.lead_in != "none" and (len(terrain.along_m) > 1 or run.mode != "open"):
+        raise ProfileError("runway.lead_in: the PROFGEN-like lead-in is flown open loop (run.mode = \"open\") over "
+                           "flat terrain (no [terrain] table, a level runway): its pattern leaves the centreline")
     if sensors.gnss is not None and sensors.gnss.carrier is not None and not (
             nav.gps_coupling == "tight" and nav.channel_states):
         raise ProfileError("sensors.gnss.carrier_phase: needs [nav] gps_coupling = \"tight\" and channel_states = "

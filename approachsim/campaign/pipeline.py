@@ -248,6 +248,38 @@ def _approach_of(profile: Any, land: bool) -> Any:
     return Approach(profile, stop_height_m=approach_stop_height_m(profile))
 
 
+class _FlightKey:
+    """A profile held by what its open-loop flight depends on (runway, aircraft, environment, terrain, rates and the
+    stop height): the cases of a study that differ only in sensors or filter share one calm-air flight."""
+
+    def __init__(self, profile: Any) -> None:
+        self.profile = profile
+        self.key = (profile.runway, profile.aircraft, profile.environment, profile.terrain, profile.rates,
+                    approach_stop_height_m(profile))
+
+    def __hash__(self) -> int:
+        return hash(self.key)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, _FlightKey) and self.key == other.key
+
+
+@functools.lru_cache(maxsize=2)
+def _calm_flight(k: _FlightKey) -> Any:
+    """The one flight of a calm-air profile (kept per worker process by its _FlightKey): without turbulence nothing
+    of the flight depends on the seed or the run (the seed feeds only the Dryden noise), so every group's flight
+    is this one, bit for bit (tests/unit/campaign: flights of two seeds and runs are equal)."""
+    return _approach(k.profile).fly(seed=0, run=0)
+
+
+def group_flight(profile: Any, seed: int, first: int) -> Any:
+    """The open-loop flight of the group whose first run is `first`: flown with that run's turbulence, or, in calm
+    air, the profile's one flight (_calm_flight)."""
+    if profile.environment.turbulence == "none":
+        return _calm_flight(_FlightKey(profile))
+    return _approach(profile).fly(seed=seed, run=first)
+
+
 def approach_stop_height_m(profile: Any) -> float:
     """Where an approach run (not a landing) stops: the IMU 20 ft below the lowest decision height, at least 5 ft
     above the threshold, m."""
@@ -325,7 +357,7 @@ def open_loop_group(profile: Any, seed: int, runs: Sequence[int]) -> list[RunRes
 
     size = profile.evaluation.flight_group
     first = (runs[0] // size) * size
-    flight = _approach(profile).fly(seed=seed, run=first)
+    flight = group_flight(profile, seed, first)
     why = _reached_all(profile, flight)
     if why is not None:
         return [RunResult.failed(i, f"shared flight of runs {first}-{first + size - 1}: {why}") for i in runs]

@@ -52,12 +52,12 @@ def _figure_writer(name: str) -> Callable[[Any, Path], list[str]]:
 
 
 def reproduce(name: str, out_dir: Path, *, seed: int, runs: int, cases: list[str] | None = None,
-              closed: bool = False, sensitivity_runs: int | None = None) -> dict:
+              closed: bool = False, sensitivity_runs: int | None = None, trajectory: str = "final") -> dict:
     """Compute paper `name`'s reproduction, draw its figures, write DIR/<name>.json and DIR/<name>.md; return
     the JSON content (with the figure names under "figures"). A paper whose compute() takes out_dir (its
     campaigns' run stores) and cases (a subset of its cases) gets them; closed and sensitivity_runs go to a
     paper that has them (gray-maybeck: our closed-loop study instead of the faithful variant, and the
-    sensitivity table's runs)."""
+    sensitivity table's runs), trajectory too (gray-maybeck: "profgen", the PROFGEN-like lead-in variant)."""
     paper = importlib.import_module(PAPERS[name][0])
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -74,7 +74,8 @@ def reproduce(name: str, out_dir: Path, *, seed: int, runs: int, cases: list[str
         if "cases" not in params:
             raise ProfileError(f"--cases: {name} has no cases to choose from (gray-maybeck has)")
         extra["cases"] = cases
-    for key, val, flag in (("closed", closed, "--closed"), ("sensitivity_runs", sensitivity_runs, "--sensitivity")):
+    for key, val, flag in (("closed", closed, "--closed"), ("sensitivity_runs", sensitivity_runs, "--sensitivity"),
+                           ("trajectory", trajectory if trajectory != "final" else None, "--trajectory")):
         if val:
             if key not in params:
                 raise ProfileError(f"{flag}: {name} has no such option (gray-maybeck has)")
@@ -118,6 +119,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--closed", action="store_true",
                    help="gray-maybeck only: our closed-loop study (the regress baselines' cases) instead of the "
                         "faithful variant")
+    p.add_argument("--trajectory", choices=("final", "profgen"), default="final",
+                   help="gray-maybeck only: final (the straight 10 nmi final, default) or profgen (the PROFGEN-like "
+                        "lead-in with turns and level segments, the filter from its start, the swept tuning)")
     p.add_argument("--sensitivity", type=int, default=None, metavar="N",
                    help="gray-maybeck only: also the sensitivity table of the faithful variant's gap fills, N runs "
                         "per row and case (paired: the same seed and runs)")
@@ -138,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
     if args.sensitivity is not None and args.sensitivity < 2:
         raise ProfileError(f"--sensitivity: must be >= 2 runs, got {args.sensitivity}")
     result = reproduce(args.paper, args.out, seed=args.seed, runs=runs, cases=cases, closed=args.closed,
-                       sensitivity_runs=args.sensitivity)
+                       sensitivity_runs=args.sensitivity, trajectory=args.trajectory)
     print(f"{args.paper}: {runs} runs, seed {args.seed}")
     for line in importlib.import_module(PAPERS[args.paper][2]).headline(result):
         print(f"  {line}")

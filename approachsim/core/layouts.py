@@ -182,10 +182,11 @@ N_MN_STATE = MN_STATE.size
 F_PAR = Layout(_scalars("pitch_trim", "stop_h_m", "land", "tan_gp", "tch_m", "mon_floor_m", "wind_n_mps",
                         "wind_e_mps", "turbulent", "n_terrain", "x_gpi_m", "cone_a", "cone_b", "cone_c",
                         "wind_varies", "wind_log", "wind_z0_m", "wind_ref_m", "wind0_n_mps", "wind0_e_mps",
-                        "shear_top_m", "shear_bottom_m", "shear_n_mps", "shear_e_mps", "gear_x_m"))
+                        "shear_top_m", "shear_bottom_m", "shear_n_mps", "shear_e_mps", "gear_x_m",
+                        "div_vert_m", "div_lat_m"))
 (F_PITCH_TRIM, F_STOP_H, F_LAND, F_TAN_GP, F_TCH, F_MON_FLOOR, F_WIND_N, F_WIND_E, F_TURBULENT,
  F_N_TERRAIN, F_X_GPI, F_CA, F_CB, F_CC, F_WIND_VARIES, F_WIND_LOG, F_WIND_Z0, F_WIND_REF, F_WIND0_N, F_WIND0_E,
- F_SHEAR_TOP, F_SHEAR_BOTTOM, F_SHEAR_N, F_SHEAR_E, F_GEAR_X) = F_PAR.starts()
+ F_SHEAR_TOP, F_SHEAR_BOTTOM, F_SHEAR_N, F_SHEAR_E, F_GEAR_X, F_DIV_VERT, F_DIV_LAT) = F_PAR.starts()
 N_F_PAR = F_PAR.size
 F_STATE = Layout(_scalars("de", "da", "dr", "thr", "lowest_m", "td_x_m", "td_sink_mps", "mon", "mon_z_m", "mon_a",
                           "mon_b", "phi", "theta", "p", "q", "beta", "cas_mps", "h_gear_m", "tas_mps", "psi", "r",

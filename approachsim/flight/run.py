@@ -62,6 +62,7 @@ from approachsim.flight.autopilot import Autopilot, Geometry, Trim
 from approachsim.flight.design import Linearization
 from approachsim.flight.envelope import StabilityMonitor, check_envelope, unstabilized_reason
 from approachsim.flight.fdm import FDM, InitialCondition, TrimError
+from approachsim.flight.path import PathGuidance
 from approachsim.flight.trim import (
     CAS_TOLERANCE_MPS,
     PATH_TOLERANCE_RAD,
@@ -72,6 +73,8 @@ from approachsim.flight.trim import (
 from approachsim.flight.turbulence import DrydenTurbulence
 from approachsim.flight.vectors import imu_point_constants
 from approachsim.flight.wind import varies as wind_varies
+from approachsim.glidepath import GlidePath
+from approachsim.leadin import lead_in_of
 from approachsim.profile import Profile
 from approachsim.records import NavigationSource, Truth
 from approachsim.seeding import stream, stream_int
@@ -188,6 +191,8 @@ class Approach:
         self._start: InitialCondition | None = None
         self._gear: Array | None = None
         self._contact: Array | None = None
+        self.lead_in = lead_in_of(profile.runway)
+        """The lead-in path flown before the final (runway.lead_in; flight/path.py), None for a straight-in."""
 
     def start(self) -> InitialCondition:
         """The initial-condition command that JSBSim trims at the approach CAS on the glidepath in the profile's
@@ -215,7 +220,8 @@ class Approach:
         """The longest a run of this approach may fly (s): twice the still-air time to the threshold at the approach
         speed, at least 60 s; a run still flying then ends as "timeout". A navigation source sized for it
         (NavInTheLoop(max_time_s=...)) covers every row the flight can have."""
-        return max(60.0, 2.0 * self.profile.runway.start_distance_m / self.aircraft.approach_speed_mps)
+        length = self.profile.runway.start_distance_m if self.lead_in is None else self.lead_in.length_m
+        return max(60.0, 2.0 * length / self.aircraft.approach_speed_mps)
 
     @property
     def main_gear_lever_arms_m(self) -> Array:
@@ -281,6 +287,11 @@ class Approach:
         rw = prof.runway
         dt = self.dt_s
         src = None if nav_source is None or type(nav_source) is TruthSource else nav_source
+        if self.lead_in is not None:  # the autopilot flies the lead-in on guidance along its path (flight/path.py)
+            if src is not None:
+                raise ProfileError("runway.lead_in: the lead-in is flown open loop only (on the truth), not on a "
+                                   "navigation source")
+            src = PathGuidance(self.lead_in, GlidePath.of(rw), ac.gains.k_loc_d)
         ic = self.start()
         fdm = FDM(ac.jsbsim_model, dt)
         self._trim(fdm, ic)
@@ -472,6 +483,8 @@ class Approach:
             jsbsim_wind_ned_mps=(-ic.wind_speed_mps * math.cos(ic.wind_from_rad),
                                  -ic.wind_speed_mps * math.sin(ic.wind_from_rad)),
             gear_x_m=self.gear_arm_m if self.land else 0.0,
+            divergence_m=(math.inf, math.inf) if self.lead_in is not None else (fk.DIVERGED_VERTICAL_M,
+                                                                                fk.DIVERGED_LATERAL_M),
         )
         return par, st, nu
 

@@ -1,5 +1,8 @@
 """Where an approach starts: on the ideal glidepath at the profile's start distance, in landing configuration.
 
+With a lead-in (runway.lead_in, flight/path.py) the start is the lead-in's first point instead: its position,
+height and course, descending on the glidepath angle.
+
 The start point is on the extended centreline (runway frame x = -start distance, y = 0) at the glidepath
 height above the threshold, flying the runway heading at the approach speed (JSBSim's own CAS) along the
 earth-frame flight-path angle -glidepath, in the profile's wind; solve_start finds the initial-condition
@@ -17,6 +20,7 @@ from approachsim.flight.aircraft import Aircraft
 from approachsim.flight.fdm import FDM, InitialCondition, TrimError
 from approachsim.flight.wind import mean_wind_ned
 from approachsim.flight.wind import varies as wind_varies
+from approachsim.leadin import lead_in_of
 from approachsim.profile import Profile
 
 
@@ -28,8 +32,13 @@ def start_condition(profile: Profile, aircraft: Aircraft, *, still_air: bool = F
     rw = profile.runway
     frame = rw.frame
     along = -rw.start_distance_m if along_m is None else along_m
-    lat, lon, _ = geo.ecef_to_geodetic(frame.to_ecef([along, 0.0, 0.0]))
-    h = rw.elevation_m + float(rw.glidepath_height_m(along))
+    cross, heading = 0.0, rw.heading_rad
+    lead = lead_in_of(rw) if along_m is None else None
+    if lead is not None:  # the lead-in's start: descending on the glidepath angle on its first leg (flight/path.py)
+        along, cross, h_above, chi = lead.start
+        heading = (rw.heading_rad + chi) % (2.0 * math.pi)
+    lat, lon, _ = geo.ecef_to_geodetic(frame.to_ecef([along, cross, 0.0]))
+    h = rw.elevation_m + (h_above if lead is not None else float(rw.glidepath_height_m(along)))
     env = profile.environment
     wind = env.wind_speed_mps
     if not still_air and wind_varies(env):  # JSBSim's steady wind is the mean wind at the start (flight/wind.py)
@@ -42,7 +51,7 @@ def start_condition(profile: Profile, aircraft: Aircraft, *, still_air: bool = F
         lat_rad=float(lat),
         lon_rad=float(lon),
         h_m=h,
-        heading_rad=rw.heading_rad,
+        heading_rad=heading,
         cas_mps=aircraft.approach_speed_mps,
         gamma_rad=-rw.glidepath_rad,
         flaps_norm=aircraft.flaps_norm,

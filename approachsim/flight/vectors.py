@@ -160,7 +160,8 @@ def monitor_arrays(mon: Any) -> tuple[Array, Array, Array]:
 def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, terrain_along_m: Array,
                    terrain_height_m: Array, *, pitch_trim: float, stop_height_m: float, land: bool,
                    monitor_floor_m: float, wind_ned_mps: tuple[float, float], wind: Any | None = None,
-                   jsbsim_wind_ned_mps: tuple[float, float] = (0.0, 0.0), gear_x_m: float = 0.0
+                   jsbsim_wind_ned_mps: tuple[float, float] = (0.0, 0.0), gear_x_m: float = 0.0,
+                   divergence_m: tuple[float, float] = (fk.DIVERGED_VERTICAL_M, fk.DIVERGED_LATERAL_M)
                    ) -> tuple[Array, Array]:
     """fly_step's (par, st) for one flight: the IMU-point constants (imu_point_constants), the autopilot, monitor
     and turbulence (None: calm air) of the run (their oracles, fresh), the terrain profile (along-track distances
@@ -169,7 +170,9 @@ def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, terrain_al
     monitor stops at (m) and the steady wind (north, east, m/s; the air moves with it). wind: the profile's
     environment when its mean wind varies with height (flight/wind.py; None: it does not), then
     jsbsim_wind_ned_mps is JSBSim's steady wind (the mean wind at the start) and wind_ned_mps the reference wind;
-    gear_x_m: the main gear's distance behind the IMU along the runway (landing runs: the terrain under it)."""
+    gear_x_m: the main gear's distance behind the IMU along the runway (landing runs: the terrain under it);
+    divergence_m: the termination's limits on the distance from the glide path and from the centreline, m
+    (inf: none, while a lead-in's own guidance checks its path, flight/path.py)."""
     ap_par, ap_st = autopilot_arrays(ap)
     mn_par, mn_st, ring = monitor_arrays(mon)
     if turb is not None:
@@ -185,6 +188,7 @@ def flight_vectors(const: Array, ap: Any, mon: Any, turb: Any | None, terrain_al
     fpar[layouts.F_WIND_N], fpar[layouts.F_WIND_E] = wind_ned_mps[0], wind_ned_mps[1]
     fpar[layouts.F_TURBULENT] = float(turb is not None)
     fpar[layouts.F_GEAR_X] = gear_x_m
+    fpar[layouts.F_DIV_VERT], fpar[layouts.F_DIV_LAT] = divergence_m
     fpar[layouts.F_SHEAR_TOP], fpar[layouts.F_SHEAR_BOTTOM] = -math.inf, -math.inf  # no shear: never in force
     if wind is not None:
         fpar[layouts.F_WIND_VARIES] = 1.0

@@ -8,6 +8,8 @@
     channel_states = true          # per-channel range-error states (honest covariance) or white-noise R only
     gps_sigma_scale = 1.0          # channel_states = false only: the filter's pseudorange 1-sigma = this x the
                                    #   receiver's nominal (R tuning for the correlated errors left out of the states)
+    clock_q_scale = 1.0            # the filter's receiver-clock process noise Q = this x the oscillator's (Q tuning
+                                   #   of the 2-state clock, Gray & Maybeck sec. 6; the truth's clock is unchanged)
     baro_loop = "none"             # "none" | "constant" | "tanh" | "sinh": INS 3rd-order damping loop (seed 003)
     baro_loop_tau_s = 100.0        # loop time constant (seed 003 eq. 5), s
     baro_loop_b_per_m = 0.5        # adaptive slope b of tanh / sinh (eq. 7, 16), 1/m
@@ -103,6 +105,9 @@ class NavConfig:
     gps_sigma_scale: float = 1.0
     """The filter's pseudorange 1-sigma as a multiple of the receiver's nominal one (channel_states = false: the
     white-noise R that stands for the range errors the filter has no states for); 1.0: R = their full variance."""
+    clock_q_scale: float = 1.0
+    """The filter's receiver-clock process noise (both spectral densities S_f, S_g) as a multiple of the
+    oscillator's (nav/noise.py): Q tuning; the truth's clock draws the oscillator's own."""
     baro_loop: str = "none"
     baro_loop_tau_s: float = 100.0
     baro_loop_b_per_m: float = 0.5
@@ -143,6 +148,7 @@ def parse_nav(s: Section) -> NavConfig:
     if channel and sigma_scale != 1.0:
         raise ProfileError(f"{s.path}.gps_sigma_scale: tunes the white-noise R of a filter without channel states; "
                            "set channel_states = false or leave gps_sigma_scale at 1.0")
+    clock_q = s.number("clock_q_scale", 1.0, lo=1e-3, hi=1e6)
     loop = s.string("baro_loop", "none", choices=LOOP_FORMS)
     tau = s.number("baro_loop_tau_s", 100.0, lo=1.0, hi=10000.0, unit="s")
     b = s.number("baro_loop_b_per_m", 0.5, lo=0.0, lo_open=True, hi=100.0, unit="1/m")
@@ -168,8 +174,9 @@ def parse_nav(s: Section) -> NavConfig:
     s.done()
     cfg = NavConfig(
         filter=name, filter_tuning=tuple(sorted(tuning.items())), aiding_rate_hz=rate, feedback=feedback,
-        gps_coupling=coupling, channel_states=channel, gps_sigma_scale=sigma_scale, baro_loop=loop, baro_loop_tau_s=tau,
-        baro_loop_b_per_m=b, initial_error=init, fde=fde, terrain_database=terrain_database,
+        gps_coupling=coupling, channel_states=channel, gps_sigma_scale=sigma_scale, clock_q_scale=clock_q,
+        baro_loop=loop, baro_loop_tau_s=tau, baro_loop_b_per_m=b, initial_error=init, fde=fde,
+        terrain_database=terrain_database,
     )
     try:
         cfg.make_filter()  # unknown filter or bad tuning fails at load, not an hour into a campaign

@@ -267,6 +267,8 @@ class NoiseModel:
                       tdb_correlation_m=self.nav.terrain_database.correlation_m)
         qx, qy, qz = self.gyro_axis_q()
         q1 = self.clock().q(1.0)  # Q(1 s) = [[S_f + S_g / 3, S_g / 2], [., S_g]]
+        if self.nav.clock_q_scale != 1.0:  # the filter's Q tuning (nav.clock_q_scale); 1.0 leaves the bits alone
+            q1 = q1 * self.nav.clock_q_scale
         # one bb state for the truth's slow baro errors (BaroConfig.filter_bias: their variance and rate)
         bb_sigma, bb_tau = (b.filter_bias(atmosphere.height_per_hpa_m(self.baro_ref_m)) if b is not None
                             else (1.0, 100.0))

@@ -265,11 +265,37 @@ FAITHFUL_ASSUMPTIONS = (
 )
 
 
+PROFGEN_ASSUMPTIONS = (
+    "Trajectory (the profgen variant, issue 43): the PROFGEN-like lead-in of flight/path.py replaces the straight "
+    "10 nmi final (runway.lead_in = \"profgen\"): a downwind descent from 3500 to 2500 ft above the threshold on "
+    "3 deg, two 90 deg left turns of 2500 m radius (about 12 deg of bank) with a 1 nmi base between them, 2 nmi "
+    "level on the localizer and the glideslope intercept from below 7.5 nmi out, 18.9 nmi and about 480 s in all, "
+    "flown by JSBSim on the approach autopilot; the filter runs from its start, from the faithful variant's converged "
+    "start (the aided sortie before it); the time averages cover the whole flight from 10 s after its start (the "
+    "paper's window: its simulation). The paper gives neither the profile's length nor its legs.",
+    "Tuning (the profgen variant): R scale and clock Q from the sweep on the reference case "
+    "(tools/gray_maybeck_tuning.py), frozen for all 16 cases (PROFGEN_TUNING); outages 100-120 s (entering the "
+    "first turn) and 400-420 s (on the glide path, radar altimeter in use).",
+)
+"""The profgen variant's gap fills, after FAITHFUL_ASSUMPTIONS."""
+
+
 # --- the cases as profiles --------------------------------------------------------------------------------------
 
-VARIANTS = ("faithful", "closed")
-"""faithful: the paper's own setup (papers/gray_maybeck_faithful.py), the reproduction's headline; closed: our
-closed-loop study (today's PINNED values, the regress baselines)."""
+VARIANTS = ("faithful", "profgen", "closed")
+"""faithful: the paper's own setup (papers/gray_maybeck_faithful.py), the reproduction's headline; profgen: the
+faithful variant on the PROFGEN-like trajectory with the filter from its start and the swept tuning (issue 43,
+PROFGEN_SETTINGS); closed: our closed-loop study (today's PINNED values, the regress baselines)."""
+
+PROFGEN_OUTAGE_WINDOWS_S = gf.PROFGEN_OUTAGE_WINDOWS_S
+PROFGEN_TUNING = gf.PROFGEN_TUNING
+
+
+def profgen_settings() -> list[tuple[str, Any]]:
+    """The profgen variant's settings after the faithful variant's: the lead-in (flight/path.py) and the swept
+    tuning; the filter runs from the lead-in's start from the faithful variant's converged start
+    (gray_maybeck_faithful.PROFGEN_SETTINGS says why not the prior draw)."""
+    return list(gf.PROFGEN_SETTINGS)
 
 
 def case_settings(case: Case, variant: str = "closed") -> list[tuple[str, Any]]:
@@ -278,7 +304,7 @@ def case_settings(case: Case, variant: str = "closed") -> list[tuple[str, Any]]:
     settings win). variant "closed" is exactly the closed-loop study the regress baselines were made with."""
     if variant not in VARIANTS:
         raise ProfileError(f"gray-maybeck variant: must be one of {', '.join(VARIANTS)}; got {variant!r}")
-    windows = OUTAGE_WINDOWS_S if variant == "closed" else gf.OUTAGE_WINDOWS_S
+    windows = outage_windows(variant)
     faults = [{"sensor": "gnss", "kind": "outage", "start_s": a, "end_s": b}
               for a, b in windows[case.gps_outages]]
     own = [
@@ -289,9 +315,16 @@ def case_settings(case: Case, variant: str = "closed") -> list[tuple[str, Any]]:
     ]
     out = (list(PINNED) + (list(PINNED_RADALT) if case.radalt else [])
            + (list(PINNED_PSEUDOLITE) if case.pseudolite else []) + own)
-    if variant == "faithful":
+    if variant in ("faithful", "profgen"):
         out += list(faithful_overrides(case).items())
+    if variant == "profgen":
+        out += profgen_settings()
     return out
+
+
+def outage_windows(variant: str) -> dict[int, tuple[tuple[float, float], ...]]:
+    """The GPS outage windows of a variant (s from the run start), by number of outages."""
+    return {"closed": OUTAGE_WINDOWS_S, "faithful": gf.OUTAGE_WINDOWS_S, "profgen": PROFGEN_OUTAGE_WINDOWS_S}[variant]
 
 
 def faithful_overrides(case: Case) -> dict[str, Any]:
@@ -460,6 +493,35 @@ def row_verdict(direction_ok: bool, magnitude_ok: bool) -> str:
     return "does not reproduce"
 
 
+STRICT_FACTOR = 1.5
+"""The strict rule's factor: a level or % change within x1.5 of the paper's (the paper's own 15-run spread of a
+level is about x1.35, issue 43)."""
+STRICT_SMALL_PCT = 10.0
+"""Below this |paper %| the strict rule compares the % change by points, not by ratio."""
+STRICT_POINTS = 5.0
+"""The strict rule's tolerance in points where the paper's |%| < STRICT_SMALL_PCT."""
+
+
+def _within_factor(ours: float, paper: float, factor: float = STRICT_FACTOR) -> bool:
+    """ours within x factor of paper (both positive: paper / factor <= ours <= paper x factor)."""
+    return paper > 0.0 and ours > 0.0 and paper / factor <= ours <= paper * factor
+
+
+def strict_row(paper_a: float, paper_b: float, ours_a: float, ours_b: float) -> dict:
+    """The strict rule (issue 43) on one row of Tables 3-6: both levels within x1.5 of the paper's, and the % change
+    (a - b) / a with the paper's sign and within x1.5 of it, or within 5 points where the paper's |%| < 10.
+    Returns the three checks and 'reproduces' (all three)."""
+    p_pct = (paper_a - paper_b) / paper_a * 100.0
+    o_pct = (ours_a - ours_b) / ours_a * 100.0
+    same_sign = (p_pct > 0.0 and o_pct > 0.0) or (p_pct < 0.0 and o_pct < 0.0)
+    if abs(p_pct) < STRICT_SMALL_PCT:
+        pct_ok = same_sign and abs(o_pct - p_pct) <= STRICT_POINTS
+    else:
+        pct_ok = same_sign and _within_factor(abs(o_pct), abs(p_pct))
+    a_ok, b_ok = _within_factor(ours_a, paper_a), _within_factor(ours_b, paper_b)
+    return {"a": a_ok, "b": b_ok, "pct": pct_ok, "reproduces": a_ok and b_ok and pct_ok}
+
+
 def direction(pct_ci: Sequence[float] | None) -> str:
     """'reduction' (interval above 0), 'increase' (below 0) or 'indistinguishable' from a % change interval."""
     if pct_ci is None:
@@ -487,14 +549,16 @@ def table_claims(ours: dict, paper: dict) -> list[dict]:
                "pct": _inside(p_signed, rng_of("pct_range_paper_runs"))}
         out.append({"state": s, "paper_pct_signed": p_signed, "paper_direction": p_dir, "our_direction": o_dir,
                     "direction_reproduces": o_dir == p_dir, "paper_pct_inside_our_interval": bool(inside),
-                    "magnitude": mag, "verdict": row_verdict(o_dir == p_dir, mag["pct"])})
+                    "magnitude": mag, "verdict": row_verdict(o_dir == p_dir, mag["pct"]),
+                    "strict": strict_row(p_a, p_b, ours["a_ft"][j], ours["b_ft"][j])})
     return out
 
 
 def cell_counts(tables: dict) -> dict:
     """Over Tables 3-6: numeric cells (two levels and the % change per row) whose paper value lies inside our
-    paper-size range, rows whose direction reproduces, and rows by verdict."""
-    cells = mag = dirs = 0
+    paper-size range, rows whose direction reproduces, rows by verdict, and under the strict rule (strict_row) the
+    cells within it and the rows that reproduce."""
+    cells = mag = dirs = strict_cells = strict_rows = 0
     verdicts: dict[str, int] = {}
     for t in tables.values():
         for cl in t["claims"]:
@@ -502,8 +566,13 @@ def cell_counts(tables: dict) -> dict:
             mag += sum(bool(v) for v in cl["magnitude"].values())
             dirs += bool(cl["direction_reproduces"])
             verdicts[cl["verdict"]] = verdicts.get(cl["verdict"], 0) + 1
+            st = cl.get("strict")
+            if st is not None:
+                strict_cells += int(st["a"]) + int(st["b"]) + int(st["pct"])
+                strict_rows += int(st["reproduces"])
     rows = sum(verdicts.values())
-    return {"cells": cells, "magnitude_cells": mag, "rows": rows, "direction_rows": dirs, "verdicts": verdicts}
+    return {"cells": cells, "magnitude_cells": mag, "rows": rows, "direction_rows": dirs, "verdicts": verdicts,
+            "strict_cells": strict_cells, "strict_rows": strict_rows}
 
 
 def case_verdicts(summary: dict) -> dict:
@@ -588,12 +657,13 @@ def pseudolite_geometry(profile: Any, heights_ft: Sequence[float] = (1000.0, 200
 def compute(*, seed: int, runs: int, out_dir: Path | None = None,
             cases: Sequence[str] | None = None, workers: int | None = None,
             evaluate: Any = None, columns: Any = None, closed: bool = False,
-            sensitivity_runs: int | None = None) -> tuple[dict, dict]:
+            sensitivity_runs: int | None = None, trajectory: str = "final") -> tuple[dict, dict]:
     """Run every selected case (runs each, seed common to all) into out_dir/faithful/<case> (the faithful variant,
     open loop) or, closed=True, out_dir/cases/<case> (our closed-loop study), then build Tables 3-8; with
     sensitivity_runs, also the sensitivity table of the faithful variant's gap fills
-    (papers/gray_maybeck_sensitivity.py) at that many runs per row and case. Returns (the JSON result, the
-    per-case data for the figures).
+    (papers/gray_maybeck_sensitivity.py) at that many runs per row and case. trajectory "profgen": the profgen
+    variant (PROFGEN-like lead-in, filter from its start, the swept tuning) into out_dir/profgen/<case>. Returns (the
+    JSON result, the per-case data for the figures).
 
     evaluate, columns: the campaign stage's campaign.evaluation.evaluate_profile and campaign.outputs.columns,
     passed in by the command that composes the stages (a paper module never imports the flight stage)."""
@@ -604,9 +674,13 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
     evaluate_profile = evaluate
 
     chosen = select_cases(cases)
-    variant = "closed" if closed else "faithful"
+    if trajectory not in ("final", "profgen"):
+        raise ProfileError(f"--trajectory: must be final or profgen; got {trajectory!r}")
+    if closed and trajectory != "final":
+        raise ProfileError("--trajectory profgen: the lead-in is flown open loop (the faithful variant), not --closed")
+    variant = "closed" if closed else "profgen" if trajectory == "profgen" else "faithful"
     mode = "closed" if closed else "open"
-    windows = OUTAGE_WINDOWS_S if closed else gf.OUTAGE_WINDOWS_S
+    windows = outage_windows(variant)
     root = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="gray-maybeck-"))
     per_case: dict[int, dict] = {}
     ms_by_run: dict[int, dict[int, dict[str, float]]] = {}
@@ -615,7 +689,7 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
         # resume: a rerun into the same DIR reuses the finished runs of an identical campaign (the store checks
         # profile digest, seed and mode, and refuses a different one)
         ev = evaluate_profile(prof, runs=runs, seed=seed, mode=mode,
-                              out_dir=root / ("cases" if closed else "faithful") / case.roman,
+                              out_dir=root / ("cases" if closed else variant) / case.roman,
                               workers=workers, resume=True, progress=True)
         cols = columns(ev.results)
         ok_runs = [r.run for r in ev.results if r.ok]
@@ -643,7 +717,8 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
             "oscillator": prof.sensors.gnss.oscillator,
             "failure_reasons": failure_reasons(ev.details.get("failures", {})),
             "wall_s": ev.wall_s,
-            "overrides": faithful_overrides(case) if not closed else {},
+            "overrides": ({**faithful_overrides(case), **dict(profgen_settings())} if variant == "profgen"
+                          else faithful_overrides(case) if not closed else {}),
         }
         per_case[case.number]["claim"] = category_claim(case.number, per_case[case.number]["tables_7_8"])
     tables = {}
@@ -674,7 +749,8 @@ def compute(*, seed: int, runs: int, out_dir: Path | None = None,
         "tables": tables,
         "cell_counts": cell_counts(tables),
         "pinned": pinned,
-        "assumptions": list(ASSUMPTIONS if closed else FAITHFUL_ASSUMPTIONS),
+        "assumptions": list(ASSUMPTIONS if closed else FAITHFUL_ASSUMPTIONS)
+        + (list(PROFGEN_ASSUMPTIONS) if variant == "profgen" else []),
         "pattern": _pattern(per_case),
         "wall_s": float(sum(v["wall_s"] for v in per_case.values())),
     }

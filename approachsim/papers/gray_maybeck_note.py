@@ -31,7 +31,10 @@ RULE = (f"**Rule.** A row of Tables 3-6 *reproduces* when (1) its direction does
         f"% change lies inside the central 95 % of our % change computed from {PAPER_RUNS} runs drawn from ours "
         f"(the paper's Monte Carlo size, assumption 10: the spread its table would show if our model were the "
         f"truth). *Direction only*: (1) without (2). *Magnitude only*: (2) without (1). Each level (ft) is judged "
-        f"for magnitude by the same {PAPER_RUNS}-run range (yes / no after the value).")
+        f"for magnitude by the same {PAPER_RUNS}-run range (yes / no after the value). **Strict rule** (issue 43, "
+        f"column *strict*): both levels within x1.5 of the paper's and the % change with the paper's sign and within "
+        f"x1.5 of it (within 5 points where the paper's |%| < 10); a row that passes only the direction test is "
+        f"*direction*, not a reproduction.")
 
 
 def _ci(ci: Sequence[float] | None, fmt: str = ".1f") -> str:
@@ -95,6 +98,17 @@ def _failed(group: Sequence[str], result: dict) -> str:
             "per-case figures (the table uses the runs every case of it completed)")
 
 
+def _strict_word(st: dict | None) -> str:
+    """The strict rule's cell: reproduces, or which of level a, level b, % change miss."""
+    if st is None:
+        return ""
+    if st["reproduces"]:
+        return "reproduces"
+    miss = [k for k, w in (("a", "level a"), ("b", "level b"), ("pct", "% change")) if not st[k]]
+    return "no (" + ", ".join(w for k, w in (("a", "level a"), ("b", "level b"), ("pct", "% change"))
+                              if k in miss) + ")"
+
+
 def _table_section(tid: str, t: dict, result: dict) -> list[str]:
     o, p = t["ours"], t["paper"]
     a, b = "-".join(t["a_cases"]), "-".join(t["b_cases"])
@@ -105,8 +119,8 @@ def _table_section(tid: str, t: dict, result: dict) -> list[str]:
              f"bootstrap interval; braces: the central 95 % of the same number from {o.get('paper_runs', PAPER_RUNS)}"
              "-run draws (the magnitude rule).", "",
              f"| error state | paper {a} (ft) | ours {a} (ft) | paper {b} (ft) | ours {b} (ft) | paper % change "
-             "| ours % change | direction | verdict |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "| ours % change | direction | verdict | strict |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     rng_a = o.get("a_range_paper_runs_ft")
     rng_b = o.get("b_range_paper_runs_ft")
     rng_p = o.get("pct_range_paper_runs")
@@ -125,7 +139,7 @@ def _table_section(tid: str, t: dict, result: dict) -> list[str]:
             f"{o['b_ft'][j]:.2f}{_ci(bci)}{br(rng_b)}: {_yn(mag.get('b', False))} "
             f"| {cl['paper_pct_signed']:+.1f} % | {o['pct'][j]:+.1f} %{_ci(pci)}"
             f"{br(rng_p)}: {_yn(mag.get('pct', False))} | paper {cl['paper_direction']}, ours {cl['our_direction']}: "
-            f"{reproduces(cl['direction_reproduces'])} | {cl.get('verdict', '')} |")
+            f"{reproduces(cl['direction_reproduces'])} | {cl.get('verdict', '')} | {_strict_word(cl.get('strict'))} |")
     lines += ["", f"Numbers beside each row (Table {tid}):", ""]
     for j, s in enumerate(STATES):
         for grp, pv, ov in ((t["a_cases"], p["a_ft"][j], o["a_ft"][j]), (t["b_cases"], p["b_ft"][j], o["b_ft"][j])):
@@ -176,7 +190,9 @@ def note(result: dict, figures: Sequence[str]) -> str:
         lines += [f"**Tables 3-6 in short.** {cc['magnitude_cells']} of {cc['cells']} numeric cells (two levels and "
                   f"the % change per row) have the paper's value inside our {PAPER_RUNS}-run range; "
                   f"{cc['direction_rows']} of {cc['rows']} rows reproduce the direction; rows: "
-                  + ", ".join(f"{n} {k}" for k, n in sorted(v.items())) + ".", ""]
+                  + ", ".join(f"{n} {k}" for k, n in sorted(v.items())) + "."
+                  + (f" Strict rule: {cc['strict_rows']} of {cc['rows']} rows reproduce, {cc['strict_cells']} of "
+                     f"{cc['cells']} cells within it." if "strict_rows" in cc else ""), ""]
     lines += ["## Assumptions and gap fills", ""] + [f"- {a}" for a in result["assumptions"]]
     lines += _overrides_section(result) + [""]
     lines += ["## The cases (Table 2) and the truth / filter split", "",
@@ -422,7 +438,9 @@ def headline(result: dict) -> list[str]:
     if cc:
         out.append(f"Tables 3-6: {cc['magnitude_cells']}/{cc['cells']} cells in magnitude, {cc['direction_rows']}/"
                    f"{cc['rows']} rows in direction; rows " + ", ".join(f"{n} {k}" for k, n in
-                                                                         sorted(cc["verdicts"].items())))
+                                                                         sorted(cc["verdicts"].items()))
+                   + (f"; strict rule {cc['strict_rows']}/{cc['rows']} rows, {cc['strict_cells']}/{cc['cells']} "
+                      "cells" if "strict_rows" in cc else ""))
     for tid, t in result["tables"].items():
         o = t["ours"]
         cells = ", ".join(

@@ -80,6 +80,21 @@ def _outages(windows: Sequence[tuple[float, float]]) -> tuple[tuple[str, Any], .
     return (("faults", [{"sensor": "gnss", "kind": "outage", "start_s": a, "end_s": b} for a, b in windows]),)
 
 
+THIRD_PASS_ROWS: tuple[Row, ...] = (
+    Row("profgen-trajectory", "trajectory: the PROFGEN-like lead-in (runway.lead_in = profgen: downwind "
+        "descent, two 90 deg turns, level segments, glideslope intercept; 480 s) instead of the 10 nmi final; "
+        "start, R rule and outage times as the faithful variant's", (("runway.lead_in", "profgen"),), ALL_CASES),
+    Row("profgen-filter-start", "trajectory and the filter from its start: the lead-in with the free-inertial "
+        "prior drawn (start = prior) instead of the converged start",
+        (("runway.lead_in", "profgen"), ("nav.initial_error.start", "prior")), ALL_CASES),
+    Row("swept-tuning", "tuning: the swept R scale and clock Q (PROFGEN_TUNING, tools/gray_maybeck_tuning.py) on "
+        "the 10 nmi final instead of the R rule", tuple(gf.PROFGEN_TUNING.items()), ALL_CASES),
+    Row("profgen-variant", "the profgen variant whole: lead-in, filter from its start, swept tuning, its outage "
+        "times (100-120 s, 400-420 s)", gf.PROFGEN_SETTINGS + _outages(gf.PROFGEN_OUTAGE_WINDOWS_S[2]),
+        ALL_CASES),
+)
+"""Issue 43's trajectory and tuning rows (the third pass), at the end of ROWS."""
+
 ROWS: tuple[Row, ...] = (
     Row("pl-centreline", "pseudolite on the extended centreline, 1000 ft past the threshold, 30 ft up",
         _pl(1000.0, 0.0), PL_CASES),
@@ -113,6 +128,7 @@ ROWS: tuple[Row, ...] = (
         (("nav.initial_error.start", "prior"), ("nav.initial_error.position_m", 5.0),
          ("nav.initial_error.velocity_mps", 0.05), ("nav.initial_error.tilt_mrad", 0.05),
          ("nav.initial_error.heading_mrad", 0.5)), ALL_CASES),
+    *THIRD_PASS_ROWS,
 )
 """The sensitivity rows (module docstring)."""
 

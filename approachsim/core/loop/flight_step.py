@@ -136,6 +136,8 @@ from approachsim.core.layouts import (
     F_CA,
     F_CB,
     F_CC,
+    F_DIV_LAT,
+    F_DIV_VERT,
     F_GEAR_X,
     F_LAND,
     F_MON_FLOOR,
@@ -468,7 +470,8 @@ TERM_NONE, TERM_STOP, TERM_TOUCHDOWN, TERM_SHORT, TERM_GROUND, TERM_DIVERGED, TE
 DIVERGED_BANK_RAD = 1.0
 DIVERGED_VERTICAL_M = 300.0
 DIVERGED_LATERAL_M = 1500.0
-"""A run has diverged beyond these: bank, distance from the glidepath, from the centreline."""
+"""A run has diverged beyond these: bank, distance from the glidepath, from the centreline (the last two are the
+default of the parameters F_DIV_VERT, F_DIV_LAT: a lead-in, flight/path.py, checks them against its own path)."""
 
 
 @njit(cache=True)
@@ -746,8 +749,8 @@ def termination(fpar: Array, fst: Array, mpar: Array, mst: Array, ring: Array, i
     if wow_nose > 0.0 or wow_left > 0.0 or wow_right > 0.0 or h_agl <= 0.0:
         return TERM_GROUND
     dev = cone_deviation(x, y, z, 0.0, 0.0, 0.0, fpar[F_TAN_GP], fpar[F_X_GPI], fpar[F_CA], fpar[F_CB], fpar[F_CC])[0]
-    if (abs(phi) > DIVERGED_BANK_RAD or abs(dev) > DIVERGED_VERTICAL_M
-            or abs(y) > DIVERGED_LATERAL_M):
+    if (abs(phi) > DIVERGED_BANK_RAD or abs(dev) > fpar[F_DIV_VERT]
+            or abs(y) > fpar[F_DIV_LAT]):
         return TERM_DIVERGED
     if fpar[F_MON_FLOOR] < z < WATCH_HEIGHT_M:
         an, ae = vn_cg - fst[FS_WIND_N], ve_cg - fst[FS_WIND_E]
