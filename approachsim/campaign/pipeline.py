@@ -43,6 +43,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from approachsim import units
 from approachsim.campaign.result import RunResult
 from approachsim.config import ProfileError
@@ -264,12 +266,28 @@ class _FlightKey:
         return isinstance(other, _FlightKey) and self.key == other.key
 
 
+def _read_only(obj: Any, seen: set[int] | None = None) -> None:
+    """Mark every numpy array reachable through obj's dataclass fields read-only (a flight shared by many groups:
+    a write into it would reach the next group's runs; numpy raises instead)."""
+    seen = set() if seen is None else seen
+    if id(obj) in seen:
+        return
+    seen.add(id(obj))
+    if isinstance(obj, np.ndarray):
+        obj.flags.writeable = False
+    elif dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        for f in dataclasses.fields(obj):
+            _read_only(getattr(obj, f.name), seen)
+
+
 @functools.lru_cache(maxsize=2)
 def _calm_flight(k: _FlightKey) -> Any:
     """The one flight of a calm-air profile (kept per worker process by its _FlightKey): without turbulence nothing
     of the flight depends on the seed or the run (the seed feeds only the Dryden noise), so every group's flight
-    is this one, bit for bit (tests/unit/campaign: flights of two seeds and runs are equal)."""
-    return _approach(k.profile).fly(seed=0, run=0)
+    is this one, bit for bit (tests/unit/campaign: flights of two seeds and runs are equal); its arrays read-only."""
+    flight = _approach(k.profile).fly(seed=0, run=0)
+    _read_only(flight)
+    return flight
 
 
 def group_flight(profile: Any, seed: int, first: int) -> Any:

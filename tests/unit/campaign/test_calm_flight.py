@@ -34,3 +34,16 @@ def test_a_calm_flight_does_not_depend_on_seed_or_run():
     assert other != prof
     assert pipeline.group_flight(prof, 1, 0) is pipeline.group_flight(other, 3, 50)
     assert np.array_equal(pipeline.group_flight(prof, 1, 0).truth.r_ecef, a.truth.r_ecef)
+
+
+def test_the_shared_calm_flight_is_read_only():
+    """Every group reads the one calm-air flight: a write into its arrays would reach the next group's runs, so numpy
+    refuses it (pipeline._read_only)."""
+    f = pipeline.group_flight(_profile(), 1, 0)
+    assert not f.truth.h_m.flags.writeable and not f.truth.r_ecef.flags.writeable
+    try:
+        f.truth.h_m[0] = 0.0
+    except ValueError:
+        pass
+    else:
+        raise AssertionError("the shared flight's truth was writable")
