@@ -283,8 +283,9 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, start: tu
     sig = np.ascontiguousarray(np.broadcast_to(eng._code_sig[kept] if eng.channel_states else o["sig"][0][:, kept],
                                                (C, E, kr)), dtype=float)
     r_pl = o["r_pl"] if o["r_pl"] is not None else eng._none3
-    pl_sig = np.ascontiguousarray(np.broadcast_to(eng._pl_sig if eng.pl_states else o["pl_sig"],
-                                                  (E, pl_rho.shape[2])), dtype=float)
+    # a writable copy (a read-only view is another type to compiled code: class_epoch compiled twice)
+    pl_sig = np.array(np.broadcast_to(eng._pl_sig if eng.pl_states else o["pl_sig"],
+                                      (E, pl_rho.shape[2])), dtype=float)
     noise = nav.noise(None)
     q, gse_full, gmp_full = em.kernel_noise(noise, lay.n_sv)
     loop = em.kernel_loop(nav.loop_gains() if lay.has("ac") else None)

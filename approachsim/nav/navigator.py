@@ -448,8 +448,9 @@ class Navigator:
         sig = np.ascontiguousarray(sig, dtype=float)
         pl_rho = o["pl_rho"]
         r_pl = o["r_pl"] if o["r_pl"] is not None else eng._none3
-        pl_sig = np.ascontiguousarray(np.broadcast_to(eng._pl_sig if eng.pl_states else o["pl_sig"],
-                                                      (E, pl_rho.shape[2])), dtype=float)
+        # a writable copy (a read-only view is another type to compiled code: class_epoch compiled twice)
+        pl_sig = np.array(np.broadcast_to(eng._pl_sig if eng.pl_states else o["pl_sig"],
+                                          (E, pl_rho.shape[2])), dtype=float)
         # the channel states' Qd at each run's own sky (per-run skies; one sky: the model's own)
         ch_gio = np.zeros((N, E, 0))
         if lay.has("gse") and per_run_sky and k and eng.carrier:  # the slow state without the ionosphere (gio)

@@ -234,7 +234,33 @@ def run_epoch(X: np.ndarray, P: np.ndarray, model: ErrorModel, y: np.ndarray, f_
     if not ek.discretize(F, Qc, dt, phi, qd):
         return -1
     kcar.reset_ambiguities(phi, qd, model.lay, new, rows.amb_prior)
-    return class_epoch(X, P, phi, qd, True, y, y.reshape(1, 16), rows, obs, out, scr)
+    return class_epoch(X, P, phi, qd, True, y, _any(y.reshape(1, 16)), rows, _any_obs(obs), _any_out(out), scr,
+                       False)
+
+
+# One compilation of class_epoch. The bank's copies (copies_epoch) hand it the per-copy rows of their (N, E) pass
+# arrays, which numba types as strided ('A' layout); the per-run epoch's own arrays are contiguous ('C'). Numba
+# compiles a kernel once per argument type, so class_epoch's tree (about 3-4 s of CPU on a cold cache) was typed
+# and lowered twice. A slice with an explicit step (`a[::1]`) is typed 'A' whatever it views, so run_epoch passes
+# its arrays in the copies' types: the same elements, the same loops, the same bits (tools/*_identity.py).
+@njit(cache=True, inline="always")
+def _any(a: np.ndarray) -> np.ndarray:
+    """A 2-D array as the strided ('A') view of the same elements."""
+    return a[:, ::1]
+
+
+@njit(cache=True, inline="always")
+def _any_obs(obs: Obs) -> Obs:
+    """obs with the per-member arrays as copies_epoch types them (strided views of the same elements)."""
+    return Obs(obs.baro_h[::1], obs.baro_r, obs.radalt_h[::1], obs.ref_agl, obs.dbp, obs.db_x, obs.db_u,
+               obs.rho[:, ::1], obs.r_sv[:, ::1], obs.sig[::1], obs.cp[:, ::1], obs.pl_rho[:, ::1], obs.r_pl,
+               obs.pl_sig)
+
+
+@njit(cache=True, inline="always")
+def _any_out(out: Out) -> Out:
+    """out as copies_epoch types it (strided views of the same arrays: class_epoch writes through them)."""
+    return Out(out.codes[::1], out.nu[:, ::1], out.S[::1])
 
 
 @njit(cache=True)
