@@ -227,8 +227,8 @@ def run_epoch(X: np.ndarray, P: np.ndarray, model: ErrorModel, y: np.ndarray, f_
     F, Qc, phi, qd = scr.F, scr.Qc, scr.phi, scr.qd
     c_bn = y[6:15].reshape(3, 3)
     h_lin = y[2]
-    if model.lay[ek.L_SB] >= 0:  # the loop's sb coefficient at the navigation's height, the interval's midpoint
-        iv = model.lay[ek.L_DV] + 2  # (nav/errormodel.linear_height): navigation = INS less the estimated error
+    if model.lay[ek.L_SB] >= 0:  # the loop's sb coefficient at the navigation's height, with the loop the interval's
+        iv = model.lay[ek.L_DV] + 2  # midpoint (nav/errormodel.linear_height): navigation = INS less the estimate
         h_lin = ek.interval_height(model.lay, y[2] + X[0, model.lay[ek.L_DP] + 2], y[5] - X[0, iv], dt)
     ek.dynamics(model.lay, model.q, model.gse, model.gmp, y[0], h_lin, y[3:6], f_ned, c_bn, model.loop, held, F, Qc)
     kcar.dynamics(model.lay, model.gio, model.gio_tau, F, Qc)

@@ -27,10 +27,16 @@ def _F(lay: em.StateLayout, h_m: float) -> np.ndarray:
     return em.dynamics(lay, LAT, h_m, np.array([70.0, 0.0, V_D]), F_NED, np.eye(3), NOISE, GAINS)[0]
 
 
-def test_without_the_scale_factor_state_the_height_is_the_given_one():
-    lay = em.StateLayout(baro_scale=False, clock=False, loop=True)
-    assert em.interval_height(lay, 300.0, V_D, DT) == 300.0
-    assert ek.interval_height(lay.packed, 300.0, V_D, DT) == 300.0
+def test_without_the_scale_factor_state_or_the_loop_the_height_is_the_given_one():
+    """Only the loop's sb column moves with h at this scale: without the state or without the loop (the CAT III
+    candidates: sb, no loop) the model is taken where it was, bit for bit."""
+    x = np.zeros(em.StateLayout(baro_scale=True, clock=False, loop=False).n)
+    x[2] = 2.0
+    for sb, loop in ((False, True), (True, False), (False, False)):
+        lay = em.StateLayout(baro_scale=sb, clock=False, loop=loop)
+        assert em.interval_height(lay, 300.0, V_D, DT) == 300.0
+        assert ek.interval_height(lay.packed, 300.0, V_D, DT) == 300.0
+        assert em.linear_height(lay, 300.0, x[:lay.n], V_D, DT) == (302.0 if sb else 300.0)
 
 
 def test_with_it_the_midpoint_of_a_steady_descent():
