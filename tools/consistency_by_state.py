@@ -9,11 +9,12 @@ The profile is flown once on truth; RUNS seeded sensor realizations and open-loo
 covariance, as campaigns run) follow on that truth. Printed per state (dp N E D m, dv N E D m/s, psi N E D rad; clk
 the receiver clock bias, m): the run-averaged e^2 / P over the approach after its first quarter (1 for a consistent
 filter; below 1 the filter over-claims), the fractions of epochs whose run average is inside / below / above the
-two-sided 95 % chi2(RUNS)/RUNS bounds, the filter's mean sigma, and the run-mean error over the sigma (RMS over the
-epochs: about 1 / sqrt(RUNS) when nothing is common to the runs); with a GNSS service's zenith states, giz_0,
-giz_E, giz_N against the truth's ionospheric field (common part, east and north gradient per d_5) and gtz against
-its tropospheric zenith residual (m). --set changes a profile key for this run (dotted
-path, a TOML value: --set sensors.gnss.multipath_model='"nrc1995"'). Diagnostics on the truth: --slow-tau-s sets
+two-sided 95 % chi2(RUNS)/RUNS bounds, the filter's mean sigma, the run-mean error over the sigma (RMS over the
+epochs: about 1 / sqrt(RUNS) when nothing is common to the runs), each run's time-averaged e^2 / P's degrees of
+freedom per run and the 95 % sampling interval of the run-averaged ratio they give (summary()); with a GNSS
+service's zenith states, giz_0, giz_E, giz_N against the truth's ionospheric field (common part, east and north
+gradient per d_5) and gtz against its tropospheric zenith residual (m). --set changes a profile key for this run
+(dotted path, a TOML value: --set sensors.gnss.multipath_model='"nrc1995"'). Diagnostics on the truth: --slow-tau-s sets
 its clock/ephemeris, iono and tropo time constants to TAU; --ideal-imu-axes removes its gyro and/or accelerometer
 scale-factor and misalignment errors. --filter-turbulence builds the filter's gyro scale-factor / misalignment
 process noise at another turbulence level (none: the time-constant-only filter, the control of the suite).
@@ -144,16 +145,23 @@ def summary(e: np.ndarray, d: np.ndarray) -> dict[str, np.ndarray]:
     """Per state over the approach after its first quarter: the run-averaged e^2 / P (mean over epochs), the
     fractions of epochs whose run average is inside / below / above the two-sided 95 % chi2(R)/R bounds (R runs),
     the filter's mean sigma and the run-mean error over the sigma's RMS (a deterministic error common to the runs
-    on their one truth)."""
+    on their one truth); dof, each run's time-averaged e^2 / P's chi2 degrees of freedom (2 mean^2 / variance over
+    the runs: about 1 for a state whose error hardly changes over the approach, many for a fast one) and ratio_lo /
+    ratio_hi, the 95 % sampling interval of the run-averaged ratio they give for a consistent filter (chi2(R dof) /
+    (R dof)): how far one seed's ratio may fall from 1 by chance."""
     runs = e.shape[0]
     z = (e**2 / d).mean(axis=0)
     later = slice(z.shape[0] // 4, z.shape[0])
     lo, hi = chi2.ppf([0.025, 0.975], runs) / runs
     zc = z[later]
     sig = np.sqrt(d[:, later])
+    zr = (e[:, later] ** 2 / d[:, later]).mean(axis=1)  # each run's own time-averaged e^2 / P
+    dof = 2.0 * zr.mean(axis=0) ** 2 / np.maximum(zr.var(axis=0), 1e-300)  # its chi2 degrees of freedom per run
     return {"ratio": zc.mean(axis=0), "inside": np.mean((zc >= lo) & (zc <= hi), axis=0),
             "below": np.mean(zc < lo, axis=0), "above": np.mean(zc > hi, axis=0), "sigma": sig.mean(axis=(0, 1)),
             "common": np.sqrt(np.mean((e[:, later].mean(axis=0) / sig.mean(axis=0)) ** 2, axis=0)),
+            "dof": dof, "ratio_lo": chi2.ppf(0.025, runs * dof) / (runs * dof),
+            "ratio_hi": chi2.ppf(0.975, runs * dof) / (runs * dof),
             "bounds": np.array([lo, hi]), "epochs": np.array([z.shape[0], later.start])}
 
 
@@ -267,10 +275,12 @@ def main() -> None:
           + (f"; truth slow taus {a.slow_tau_s:g} s" if a.slow_tau_s is not None else "")
           + (f"; truth {a.ideal_imu_axes} without scale factor / misalignment" if a.ideal_imu_axes else "")
           + (f"; filter turbulence {a.filter_turbulence}" if a.filter_turbulence else ""))
-    print(f"  {'state':6s} {'e^2/P':>6s} {'inside':>7s} {'below':>6s} {'above':>6s} {'sigma':>10s} {'common':>7s}")
+    print(f"  {'state':6s} {'e^2/P':>6s} {'inside':>7s} {'below':>6s} {'above':>6s} {'sigma':>10s} {'common':>7s} "
+          f"{'dof/run':>7s} {'ratio 95 %':>12s}")
     for c, name in enumerate(names):
         print(f"  {name:6s} {s['ratio'][c]:6.2f} {s['inside'][c]:7.2f} {s['below'][c]:6.2f} {s['above'][c]:6.2f} "
-              f"{s['sigma'][c]:10.3g} {s['common'][c]:7.2f}")
+              f"{s['sigma'][c]:10.3g} {s['common'][c]:7.2f} {s['dof'][c]:7.2f} "
+              f"[{s['ratio_lo'][c]:.2f}, {s['ratio_hi'][c]:.2f}]")
 
 if __name__ == "__main__":
     main()

@@ -314,11 +314,26 @@ def _dw_in(lat: float, h: float, v: Array, r_n: float, r_e: float) -> tuple[Arra
     return d_dp, d_dv, np.array([om * cl, 0.0, -om * sl])
 
 
-def linear_height(layout: StateLayout, h_ins_m: float, x_hat: Array) -> float:
-    """The height (m) the per-run error model is linearized at: the INS height, or with a baro scale-factor state the
-    navigation's, h_ins + dp_D_hat (the damping loop drags the INS toward a baro off by sb (h - H_ref), and the
-    loop's sb coefficient -(h - H_ref) must be the true height's; nav/measurements.baro says why)."""
-    return h_ins_m + float(x_hat[layout.i("dp", 2)]) if layout.has("sb") else h_ins_m
+def linear_height(layout: StateLayout, h_ins_m: float, x_hat: Array, v_down_ins_mps: float = 0.0,
+                  dt_s: float = 0.0) -> float:
+    """The height (m) the per-run error model is linearized at over an aiding interval of dt_s ending at the INS
+    height h_ins_m and down velocity v_down_ins_mps: the INS height, or with a baro scale-factor state the
+    navigation's, h_ins + dp_D_hat, with the damping loop at the interval's midpoint (with v_D - dv_D_hat;
+    core/nav/errormodel.interval_height:
+    the damping loop drags the INS toward a baro off by sb (h - H_ref), and the loop's sb coefficient -(h - H_ref)
+    must be the true height's along the interval; nav/measurements.baro says why)."""
+    if not layout.has("sb"):
+        return h_ins_m
+    if not layout.has("ac"):  # no damping loop: the INS height and the estimate, as before the interval's midpoint
+        return h_ins_m + float(x_hat[layout.i("dp", 2)])
+    return ek.interval_height(layout.packed, h_ins_m + float(x_hat[layout.i("dp", 2)]),
+                              v_down_ins_mps - float(x_hat[layout.i("dv", 2)]), dt_s)
+
+
+def interval_height(layout: StateLayout, h_m: float, v_down_mps: float, dt_s: float) -> float:
+    """The height (m) a reference's interval model is taken at (h_m, v_down_mps at the interval's end): its midpoint
+    with a baro scale-factor state and the damping loop, else h_m (core/nav/errormodel.interval_height)."""
+    return float(ek.interval_height(layout.packed, h_m, v_down_mps, dt_s))
 
 
 def dynamics(

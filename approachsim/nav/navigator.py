@@ -321,8 +321,9 @@ class Navigator:
             if r_ins is None:
                 r_ins = ins.position_ecef(s)
             noise = system.noise(obs.elevations(i))
-            gains = system.loop_slopes(run.fs, em.linear_height(lay, float(s.h_m[i]), run.fs.x), noise)
-            F, Qc = em.dynamics(lay, float(s.lat_rad[i]), em.linear_height(lay, float(s.h_m[i]), run.fs.x), s.v_ned[i],
+            h_lin = em.linear_height(lay, float(s.h_m[i]), run.fs.x, float(s.v_ned[i, 2]), dt_epoch)
+            gains = system.loop_slopes(run.fs, h_lin, noise)
+            F, Qc = em.dynamics(lay, float(s.lat_rad[i]), h_lin, s.v_ned[i],
                                 f_ned_mean[i], s.c_bn[i], noise, gains, loop_held=held)
             phi, qd = em.discretize(F, Qc, dt_epoch)
             if new is not None:

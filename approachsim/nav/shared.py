@@ -105,7 +105,8 @@ class SharedCovariance:
         held = [nav.loop_held(obs, i) for i in range(len(runs))]
         models: dict[bool, tuple[Array, Array]] = {}
         for h in sorted(set(held)):
-            F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), float(ref.h_m[0]), ref.v_ned[0], f_ref, ref.c_bn[0],
+            h_lin = em.interval_height(lay, float(ref.h_m[0]), float(ref.v_ned[0, 2]), dt_epoch)
+            F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), h_lin, ref.v_ned[0], f_ref, ref.c_bn[0],
                                 noise, system.loop_gains(), loop_held=h)
             models[h] = em.discretize(F, Qc, dt_epoch)
         # carrier phase: the channels whose arc begins here reset their ambiguities (a class shares them: split on it)

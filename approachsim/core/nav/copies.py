@@ -39,7 +39,8 @@ def carrier_models(lay: np.ndarray, q: np.ndarray, gse: np.ndarray, gmp: np.ndar
     Qc = np.empty((n, n))
     for e in range(E):
         y = ref[e]
-        ek.dynamics(lay, q, gse, gmp, y[0], y[2], y[3:6], f_ref[e], ref_cbn[e], loop, held[e] != 0, F, Qc)
+        ek.dynamics(lay, q, gse, gmp, y[0], ek.interval_height(lay, y[2], y[5], dt[e]), y[3:6], f_ref[e], ref_cbn[e],
+                    loop, held[e] != 0, F, Qc)
         kcar.dynamics(lay, gio, gio_tau, F, Qc)
         if not ek.discretize(F, Qc, dt[e], phi[e], qd[e]):
             return -1 - e

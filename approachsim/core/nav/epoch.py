@@ -227,8 +227,9 @@ def run_epoch(X: np.ndarray, P: np.ndarray, model: ErrorModel, y: np.ndarray, f_
     F, Qc, phi, qd = scr.F, scr.Qc, scr.phi, scr.qd
     c_bn = y[6:15].reshape(3, 3)
     h_lin = y[2]
-    if model.lay[ek.L_SB] >= 0:  # the loop's sb coefficient at the navigation's height (nav/errormodel.linear_height)
-        h_lin = y[2] + X[0, model.lay[ek.L_DP] + 2]
+    if model.lay[ek.L_SB] >= 0:  # the loop's sb coefficient at the navigation's height, with the loop the interval's
+        iv = model.lay[ek.L_DV] + 2  # midpoint (nav/errormodel.linear_height): navigation = INS less the estimate
+        h_lin = ek.interval_height(model.lay, y[2] + X[0, model.lay[ek.L_DP] + 2], y[5] - X[0, iv], dt)
     ek.dynamics(model.lay, model.q, model.gse, model.gmp, y[0], h_lin, y[3:6], f_ned, c_bn, model.loop, held, F, Qc)
     kcar.dynamics(model.lay, model.gio, model.gio_tau, F, Qc)
     if not ek.discretize(F, Qc, dt, phi, qd):
@@ -387,7 +388,8 @@ def shared_pass(X: np.ndarray, P3: np.ndarray, model: ErrorModel, track: Track, 
         for hd in range(2):
             if hd == 1 and not any_held:
                 break
-            ek.dynamics(model.lay, model.q, model.gse, model.gmp, y[0], y[2], y[3:6], track.f_ref[e],
+            ek.dynamics(model.lay, model.q, model.gse, model.gmp, y[0],
+                        ek.interval_height(model.lay, y[2], y[5], track.dt[e]), y[3:6], track.f_ref[e],
                         track.ref_cbn[e], model.loop, hd == 1, scr.F, scr.Qc)
             kcar.dynamics(model.lay, model.gio, model.gio_tau, scr.F, scr.Qc)
             if not ek.discretize(scr.F, scr.Qc, track.dt[e], phi2[hd], qd2[hd]):
