@@ -32,7 +32,8 @@ CompileResultCacheImpl), kernels fall back to numba's own behaviour (tests/unit/
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import numba
@@ -62,6 +63,24 @@ class _Compiling(threading.local):
     def __init__(self) -> None:
         self.depth = 0
         self.frames: list[list] = []
+        self.entries: frozenset = frozenset()  # (module, name, argument types) Python calls too: entries_expected
+
+
+@contextmanager
+def entries_expected(keys: Iterable[tuple[str, str, tuple]]) -> Iterator[None]:
+    """Within the block (this thread), a kernel typed from compiled code whose (module, function name, argument
+    types) is in keys is compiled as the entry Python will call (numba's own compile: loaded from the file cache when
+    there, else compiled with its wrappers and saved), not as an internal overload. core/warm.py compiles a
+    manifest's entries in this block: a kernel that Python calls and a bigger kernel calls too is then typed and
+    lowered once, not once inside its caller and again for Python (cold cache, 2 to 3 s of CPU each for
+    errormodel.dynamics and discretize). The caller links the entry's library as plain numba does: the same
+    instructions (tools/*_identity.py)."""
+    old = _STATE.entries
+    _STATE.entries = frozenset(keys)
+    try:
+        yield
+    finally:
+        _STATE.entries = old
 
 
 _STATE = _Compiling()
@@ -158,6 +177,8 @@ def _internal_overloads(dispatcher: Any) -> Any:
             return compile_(sig)
         if args in dispatcher.overloads:
             return dispatcher.overloads[args].entry_point
+        if (dispatcher.py_func.__module__, dispatcher.py_func.__name__, args) in _STATE.entries:
+            return compile_(sig)  # Python calls it too (entries_expected): compile or load it as that entry
         codegen = dispatcher.targetctx.codegen()
         if not isinstance(codegen, _codegen.JITCPUCodegen):  # another target: numba's own
             return compile_(sig)

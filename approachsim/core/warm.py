@@ -104,17 +104,22 @@ def shares(entries: Sequence[Entry], n: int) -> list[list[Entry]]:
     return out
 
 
-def compile_entries(entries: Sequence[Entry]) -> int:
+def compile_entries(entries: Sequence[Entry], manifest: Sequence[Entry] | None = None) -> int:
     """Compile (or load from the file cache) each entry's kernel for its argument types; returns how many are
-    ready. An entry that no longer resolves or types is skipped: the run compiles what it needs as it goes."""
+    ready. An entry that no longer resolves or types is skipped: the run compiles what it needs as it goes. A
+    kernel of the manifest (default: entries) that a bigger one calls is compiled as its entry when first typed
+    (core/jit.entries_expected), so it compiles once whichever comes first."""
+    from approachsim.core.jit import entries_expected
+
     ready = 0
-    for e in entries:
-        try:
-            disp = getattr(importlib.import_module(e.module), e.name)
-            disp.compile(e.args)
-            ready += 1
-        except Exception:  # noqa: BLE001 - a stale entry must never stop a campaign
-            continue
+    with entries_expected((e.module, e.name, tuple(e.args)) for e in (entries if manifest is None else manifest)):
+        for e in entries:
+            try:
+                disp = getattr(importlib.import_module(e.module), e.name)
+                disp.compile(e.args)
+                ready += 1
+            except Exception:  # noqa: BLE001 - a stale entry must never stop a campaign
+                continue
     return ready
 
 
@@ -125,4 +130,5 @@ def compile_share(kind: str, counter: Any, workers: int) -> None:
         k = counter.value
         counter.value += 1
     if k < workers:
-        compile_entries(shares(load(kind), workers)[k])
+        entries = load(kind)
+        compile_entries(shares(entries, workers)[k], entries)

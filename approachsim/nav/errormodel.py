@@ -246,7 +246,9 @@ def kernel_noise(noise: ErrorNoise, n_sv: int) -> tuple[Array, Array, Array]:
     cache = noise._kernel_arrays
     if n_sv not in cache:
         q = np.array([float(getattr(noise, f)) for f in ek.Q_FIELDS])
-        per = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), (n_sv,))) if n_sv else np.zeros(0)
+        # copies, writable like the closed loop's per-epoch sigmas (a read-only view is another argument type to
+        # the compiled kernels: errormodel.dynamics compiled twice on a cold cache)
+        per = [np.array(np.broadcast_to(np.asarray(a, dtype=float), (n_sv,))) if n_sv else np.zeros(0)
                for a in (noise.gse_sigma_m, noise.gmp_sigma_m)]
         cache[n_sv] = (q, per[0], per[1])
     return cache[n_sv]
@@ -257,7 +259,7 @@ def kernel_carrier(noise: ErrorNoise, n_sv: int) -> tuple[Array, float]:
     and gio_tau_s. Cached on the noise object beside kernel_noise's (read-only)."""
     cache = noise._carrier_arrays
     if n_sv not in cache:
-        cache[n_sv] = (np.ascontiguousarray(np.broadcast_to(np.asarray(noise.gio_sigma_m, dtype=float), (n_sv,)))
+        cache[n_sv] = (np.array(np.broadcast_to(np.asarray(noise.gio_sigma_m, dtype=float), (n_sv,)))
                        if n_sv else np.zeros(0))
     return cache[n_sv], float(noise.gio_tau_s)
 

@@ -193,3 +193,63 @@ def test_guard_keeps_a_dispatcher_without_the_callee_internals():
     d = NoInternals()
     assert _internal_overloads(d) is d
     assert not hasattr(d, "compile")
+
+
+# entries_expected: a kernel Python calls too, met first inside a caller, is compiled once, as that entry
+
+
+@njit(cache=False)
+def _shared_leaf(x):  # noqa: ANN001, ANN202
+    return x * 5.0 - 1.0
+
+
+@njit(cache=False)
+def _shared_caller(x):  # noqa: ANN001, ANN202
+    return _shared_leaf(x) + 0.25
+
+
+def _compilations(call) -> list[str]:  # noqa: ANN001
+    """The names of the kernels numba compiles (not loads) while `call()` runs."""
+    from numba.core import event
+
+    names: list[str] = []
+
+    class Listener(event.Listener):
+        def on_start(self, ev):  # noqa: ANN001, ANN202
+            names.append(ev.data["dispatcher"].py_func.__name__)
+
+        def on_end(self, ev):  # noqa: ANN001, ANN202
+            pass
+
+    listener = Listener()
+    event.register("numba:compile", listener)
+    try:
+        call()
+    finally:
+        event.unregister("numba:compile", listener)
+    return names
+
+
+def test_an_expected_entry_typed_from_compiled_code_compiles_once():
+    from approachsim.core.jit import entries_expected
+
+    x = 1.5
+    key = (_shared_leaf.py_func.__module__, "_shared_leaf", (numba.types.float64,))
+    with entries_expected([key]):
+        first = _compilations(lambda: _shared_caller.compile((numba.types.float64,)))
+    assert first == ["_shared_caller", "_shared_leaf"]
+    # the leaf is already the entry Python calls: no second compilation, the same numbers
+    assert _compilations(lambda: _shared_leaf(x)) == []
+    assert _shared_leaf(x) == x * 5.0 - 1.0
+    assert _shared_caller(x) == (x * 5.0 - 1.0) + 0.25  # exact: small binary fractions
+    # without it (the default), the leaf met inside a caller is an internal overload and Python compiles it again
+    @njit(cache=False)
+    def leaf(y):  # noqa: ANN001, ANN202
+        return y * 5.0 - 1.0
+
+    @njit(cache=False)
+    def caller(y):  # noqa: ANN001, ANN202
+        return leaf(y) + 0.25
+
+    assert _compilations(lambda: caller(x)) == ["caller", "leaf"]
+    assert _compilations(lambda: leaf(x)) == ["leaf"]
