@@ -26,6 +26,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from approachsim.core.jit import entries_expected
+
 MANIFEST_DIR = Path(__file__).parent / "manifests"
 
 
@@ -109,8 +111,6 @@ def compile_entries(entries: Sequence[Entry], manifest: Sequence[Entry] | None =
     ready. An entry that no longer resolves or types is skipped: the run compiles what it needs as it goes. A
     kernel of the manifest (default: entries) that a bigger one calls is compiled as its entry when first typed
     (core/jit.entries_expected), so it compiles once whichever comes first."""
-    from approachsim.core.jit import entries_expected
-
     ready = 0
     with entries_expected((e.module, e.name, tuple(e.args)) for e in (entries if manifest is None else manifest)):
         for e in entries:

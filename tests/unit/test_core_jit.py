@@ -198,14 +198,18 @@ def test_guard_keeps_a_dispatcher_without_the_callee_internals():
 # entries_expected: a kernel Python calls too, met first inside a caller, is compiled once, as that entry
 
 
-@njit(cache=False)
-def _shared_leaf(x):  # noqa: ANN001, ANN202
-    return x * 5.0 - 1.0
+def _leaf_and_caller():  # noqa: ANN202
+    """Two fresh kernels (no overloads yet): leaf(x) = 5 x - 1 and caller(x) = leaf(x) + 0.25."""
 
+    @njit(cache=False)
+    def leaf(x):  # noqa: ANN001, ANN202
+        return x * 5.0 - 1.0
 
-@njit(cache=False)
-def _shared_caller(x):  # noqa: ANN001, ANN202
-    return _shared_leaf(x) + 0.25
+    @njit(cache=False)
+    def caller(x):  # noqa: ANN001, ANN202
+        return leaf(x) + 0.25
+
+    return leaf, caller
 
 
 def _compilations(call) -> list[str]:  # noqa: ANN001
@@ -234,22 +238,15 @@ def test_an_expected_entry_typed_from_compiled_code_compiles_once():
     from approachsim.core.jit import entries_expected
 
     x = 1.5
-    key = (_shared_leaf.py_func.__module__, "_shared_leaf", (numba.types.float64,))
+    leaf, caller = _leaf_and_caller()
+    key = (leaf.py_func.__module__, "leaf", (numba.types.float64,))
     with entries_expected([key]):
-        first = _compilations(lambda: _shared_caller.compile((numba.types.float64,)))
-    assert first == ["_shared_caller", "_shared_leaf"]
+        assert _compilations(lambda: caller.compile((numba.types.float64,))) == ["caller", "leaf"]
     # the leaf is already the entry Python calls: no second compilation, the same numbers
-    assert _compilations(lambda: _shared_leaf(x)) == []
-    assert _shared_leaf(x) == x * 5.0 - 1.0
-    assert _shared_caller(x) == (x * 5.0 - 1.0) + 0.25  # exact: small binary fractions
+    assert _compilations(lambda: leaf(x)) == []
+    assert leaf(x) == x * 5.0 - 1.0
+    assert caller(x) == (x * 5.0 - 1.0) + 0.25  # exact: small binary fractions
     # without it (the default), the leaf met inside a caller is an internal overload and Python compiles it again
-    @njit(cache=False)
-    def leaf(y):  # noqa: ANN001, ANN202
-        return y * 5.0 - 1.0
-
-    @njit(cache=False)
-    def caller(y):  # noqa: ANN001, ANN202
-        return leaf(y) + 0.25
-
+    leaf, caller = _leaf_and_caller()
     assert _compilations(lambda: caller(x)) == ["caller", "leaf"]
     assert _compilations(lambda: leaf(x)) == ["leaf"]
