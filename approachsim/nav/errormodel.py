@@ -241,27 +241,28 @@ class ErrorNoise:
 
 def kernel_noise(noise: ErrorNoise, n_sv: int) -> tuple[Array, Array, Array]:
     """The noise as kernels.errormodel's arrays: q (Q_SIZE,) the scalars at ek.Q_*, and the per-channel
-    gse_sigma_m, gmp_sigma_m broadcast to (n_sv,), m. Cached on the noise object (its arrays, like the cached
-    ones, are not to be modified: the object is frozen)."""
+    gse_sigma_m, gmp_sigma_m broadcast to (n_sv,), m. Packed once per noise object and channel count; each call
+    returns its own writable copies (a read-only array is another argument type to the compiled kernels, and a
+    shared cached array written by one caller would reach the next)."""
     cache = noise._kernel_arrays
     if n_sv not in cache:
         q = np.array([float(getattr(noise, f)) for f in ek.Q_FIELDS])
-        # copies, writable like the closed loop's per-epoch sigmas (a read-only view is another argument type to
-        # the compiled kernels: errormodel.dynamics compiled twice on a cold cache)
         per = [np.array(np.broadcast_to(np.asarray(a, dtype=float), (n_sv,))) if n_sv else np.zeros(0)
                for a in (noise.gse_sigma_m, noise.gmp_sigma_m)]
         cache[n_sv] = (q, per[0], per[1])
-    return cache[n_sv]
+    q, gse, gmp = cache[n_sv]
+    return q.copy(), gse.copy(), gmp.copy()
 
 
 def kernel_carrier(noise: ErrorNoise, n_sv: int) -> tuple[Array, float]:
     """The carrier-phase states' noise as kernels.carrier.dynamics' arguments: gio_sigma_m broadcast to (n_sv,) m,
-    and gio_tau_s. Cached on the noise object beside kernel_noise's (read-only)."""
+    and gio_tau_s. Packed once beside kernel_noise's; each call returns its own writable copy (kernel_noise says
+    why)."""
     cache = noise._carrier_arrays
     if n_sv not in cache:
         cache[n_sv] = (np.array(np.broadcast_to(np.asarray(noise.gio_sigma_m, dtype=float), (n_sv,)))
                        if n_sv else np.zeros(0))
-    return cache[n_sv], float(noise.gio_tau_s)
+    return cache[n_sv].copy(), float(noise.gio_tau_s)
 
 
 _NO_LOOP = np.zeros(ek.LOOP_SIZE)

@@ -96,3 +96,26 @@ def test_van_loan_matches_closed_form_random_walk():
     phi, qd = em.van_loan(F, np.diag([0.0, q]), 2.0)
     np.testing.assert_allclose(phi, [[1.0, 2.0], [0.0, 1.0]], atol=1e-14)
     np.testing.assert_allclose(qd, q * np.array([[8 / 3, 2.0], [2.0, 2.0]]), rtol=1e-12)
+
+
+def test_kernel_arrays_are_each_callers_own_writable_copies():
+    """kernel_noise / kernel_carrier pack once per noise object but hand every caller its own writable arrays: one
+    argument type for the compiled kernels (a read-only view compiled them twice), and a write by one caller cannot
+    reach the next."""
+    noise = em.ErrorNoise(
+        gyro_arw_rad_sqrts=1e-6, accel_vrw_mps_sqrts=1e-5, gyro_bias_rw=1e-9, accel_bias_rw=1e-7,
+        baro_bias_sigma_m=1.0, baro_bias_tau_s=100.0, clock_sf=0.1, clock_sg=0.01,
+        gse_sigma_m=np.array([2.0, 3.0, 4.0]), gmp_sigma_m=0.5, gio_sigma_m=np.array([1.0, 1.5, 2.0]),
+    )
+    q, gse, gmp = em.kernel_noise(noise, 3)
+    gio, _ = em.kernel_carrier(noise, 3)
+    assert all(a.flags.writeable and a.flags.c_contiguous for a in (q, gse, gmp, gio))
+    np.testing.assert_array_equal(gse, [2.0, 3.0, 4.0])
+    np.testing.assert_array_equal(gmp, [0.5, 0.5, 0.5])
+    q0 = q.copy()
+    q[:], gse[:], gmp[:], gio[:] = -1.0, -1.0, -1.0, -1.0
+    q2, gse2, gmp2 = em.kernel_noise(noise, 3)
+    np.testing.assert_array_equal(q2, q0)
+    np.testing.assert_array_equal(gse2, [2.0, 3.0, 4.0])
+    np.testing.assert_array_equal(gmp2, [0.5, 0.5, 0.5])
+    np.testing.assert_array_equal(em.kernel_carrier(noise, 3)[0], [1.0, 1.5, 2.0])
