@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
+from matplotlib.ticker import LogLocator, NullFormatter
 
 from approachsim import units
 from approachsim.campaign.result import RunResult
@@ -66,6 +67,9 @@ def fig_integrity_stanford(det: dict) -> Figure:
             ax.set_yscale("log")
             ax.set_xlim(lo, hi)
             ax.set_ylim(lo, hi)
+            for a in (ax.xaxis, ax.yaxis):  # minor ticks at 2 and 5 per decade, unlabelled: the default's 8 per
+                a.set_minor_locator(LogLocator(subs=(2.0, 5.0)))  # decade on 12 log axes were most of the report's
+                a.set_minor_formatter(NullFormatter())  # rendering time (2.2 -> 1.2 s of CPU for this figure)
             cnt = e["stanford"][axis]
             kw = {"fontsize": 8, "ha": "center", "va": "center",
                   "bbox": {"boxstyle": "round", "fc": "white", "alpha": 0.8, "lw": 0.5}}
