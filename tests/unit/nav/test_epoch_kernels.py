@@ -125,7 +125,8 @@ def test_packed_layout_and_noise_hold_every_group_and_field():
     assert [q[i] for i in range(ek.Q_SIZE)] == [float(getattr(noise, f)) for f in ek.Q_FIELDS]
     np.testing.assert_array_equal(gse, np.broadcast_to(noise.gse_sigma_m, 2))
     np.testing.assert_array_equal(gmp, noise.gmp_sigma_m)
-    assert em.kernel_noise(noise, 2)[0] is q  # packed once per object
+    again = em.kernel_noise(noise, 2)  # packed once per object and channel count, each caller its own copy
+    assert list(noise._kernel_arrays) == [2] and again[0] is not q and np.array_equal(again[0], q)
     # a layout without channel states ignores the noise's per-channel sigmas (a loosely coupled GPS)
     noise24 = _noise(24, np.random.default_rng(1))
     args = (LAYOUTS["minimal"], 0.6, 100.0, np.array([50.0, 3.0, 2.0]), np.array([0.0, 0.1, -9.8]), np.eye(3), noise24)
