@@ -226,10 +226,13 @@ NAV_WORK = Layout([
     ("bfld", 1), ("bcm1", 1),  # temperature correction: field geopotential elevation H_f (m) and c - 1
     ("n", 1), ("m", 1), ("nbe", 1), ("nlag", 1),  # sizes of the packed arrays: rows, IMU samples, baro, lag weights
     ("hb_t", 1), ("hb_age", 1),  # the held baro sample's time (s) and its age at the interval start (s)
+    ("xdot", 9),          # the rate of xnav (core/nav/output.nav_rate): m/s, m/s^2, rad/s
+    ("t_est", 1),         # the time of xnav (the last epoch), s
+    ("xnow", 9),          # scratch: the estimate at the row's time, xnav + (t - t_est) xdot
 ])
 (W_X, W_XNAV, W_FSUM, W_BG, W_BA, W_LOOP, W_HB, W_DT, W_MG, W_MA, W_CRWY, W_ORWY, W_HTHR, W_SNAP, W_EPOCH_ROWS,
  W_ANY_BARO, W_BARO_LOOP, W_BARO_KERNEL, W_BARO_EXCL, W_BSET, W_BT0L, W_BEXP, W_BSF, W_BFLD, W_BCM1, W_N, W_M, W_NBE,
- W_NLAG, W_HB_T, W_HB_AGE) = NAV_WORK.starts()
+ W_NLAG, W_HB_T, W_HB_AGE, W_XDOT, W_T_EST, W_XNOW) = NAV_WORK.starts()
 NW = NAV_WORK.size
 
 # --- a GNSS service's truth: fractions of the broadcast sigmas and the iono field's shape (service.py) ---------------

@@ -36,6 +36,7 @@ from approachsim.core.entry import entry_point
 from approachsim.core.loop import aiding as ce
 from approachsim.core.loop import nav_row as ik
 from approachsim.core.nav import groups as kg
+from approachsim.core.nav import output as ko
 from approachsim.core.nav import strapdown as sk
 from approachsim.core.sensors import gnss as gk
 from approachsim.loop import paths
@@ -157,6 +158,8 @@ class FastEpoch:
     PC: Array
     PD: Array
     PN: Array
+    XD: Array
+    """The estimate's rate after each epoch (core/nav/output.nav_rate), (epochs, 9)."""
     e: int = 0
     """The next history row."""
     call: Any = None
@@ -247,6 +250,11 @@ class NavInTheLoop:
         self._loop = ins.loop_vector(self.gains)
         self._guide = np.zeros(6)
         self.x_nav = np.zeros(9)
+        """The estimate in force (dp NED m, dv m/s, psi rad), its rate (core/nav/output.nav_rate) and time (s), and
+        the estimate carried to a row's time (core/nav/output.estimate_at): the guidance's."""
+        self.x_dot = np.zeros(9)
+        self.t_est = 0.0
+        self._x_now = np.zeros(9)
         self._c_rwy = np.ascontiguousarray(self.profile.runway.frame.c_ecef_to_rwy)
         self._o_rwy = np.ascontiguousarray(self.profile.runway.frame.origin_ecef)
         self._h_thr = float(self.profile.runway.elevation_m)
@@ -336,6 +344,7 @@ class NavInTheLoop:
                                 states=start_states(self.suite, truth, self.errors))
             self.navigator = Navigator(nav, s, runs, float(truth.t_s[0]), self.t_s.shape[0])
             self.x_nav = np.array(runs[0].fs.x[0:9], dtype=float)
+            self.x_dot, self.t_est = self.navigator.rate_in_force()[0][0], float(truth.t_s[0])
         navigator = self.navigator
         run = navigator.runs[0]
         if k > 0:
@@ -361,6 +370,7 @@ class NavInTheLoop:
                     self._hb_interval[:] = np.nan
                 navigator.epoch(k, float(truth.t_s[k]), obs, truth)
                 self.x_nav = np.array(run.fs.x[0:9], dtype=float)
+                self.x_dot, self.t_est = navigator.rate_in_force()[0][0], float(truth.t_s[k])
         if self.gains is not None and (b := self._apply("baro", k, truth)) is not None:
             # nan (an outage, or the baro excluded by FDE): the INS kernel's damping loop holds
             held = run.baro_excluded() or not bool(np.ravel(b.valid)[0])
@@ -371,7 +381,8 @@ class NavInTheLoop:
                 navigator.x[0, 2] = self.h_baro_hold
         navigator.record_row(k)
         g = self._guide
-        sk.guidance(navigator.x, self.x_nav, self._c_rwy, self._o_rwy, self._h_thr, g)  # feed-forward INS - x_hat
+        ko.estimate_at(self.x_nav, self.x_dot, self.t_est, float(truth.t_s[k]), self._x_now)
+        sk.guidance(navigator.x, self._x_now, self._c_rwy, self._o_rwy, self._h_thr, g)  # feed-forward INS - x_hat(t)
         return g[0:3].copy(), g[3:6].copy()  # copies: the kernel's buffer is rewritten at the next step
 
     # --- the compiled row (core/loop/nav_row.py): the flight loop steps the navigation in its own compiled call
@@ -491,7 +502,7 @@ class NavInTheLoop:
             budget=None if g is None else g.budget(), held_possible=lay.has("ac") and self.gains is not None,
             P=np.array(nav.runs[0].fs.P, dtype=float), X=np.zeros((1, n)), f_ned=np.zeros(3),
             XS=np.zeros((n_ep, n)), PP=np.zeros((n_ep, 3, 3)), PC=np.zeros(n_ep), PD=np.zeros((n_ep, n)),
-            PN=np.zeros((n_ep, 9, 9)), direct=self.path.epoch == "fused",
+            PN=np.zeros((n_ep, 9, 9)), XD=np.zeros((n_ep, 9)), direct=self.path.epoch == "fused",
             sig=self._sigma_scratch(None if g is None else g.budget(), lay.n_sv))
 
     def _sigma_scratch(self, b: Any, n_sv: int) -> tuple | None:
@@ -691,7 +702,7 @@ class NavInTheLoop:
                      r_pl, pl_sig)
         args = (nw, fe.X, fe.P, e, kg.ErrorModel(eng.lay, q, gse, gmp, eng.loop, fe.no_gio, 1.0), held,
                 t - nav.t_last, fe.f_ned, eng.rows, obs, kg.Out(eng.codes, eng._nu[:1], eng.S), eng.scr,
-                (fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic))
+                (fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic, fe.XD))
         if fe.call is None:
             fe.call = entry_point(ce.loop_epoch, *args)
         n_rows = fe.call(*args)
@@ -700,7 +711,9 @@ class NavInTheLoop:
         fe.e = e + 1
         run.statuses.add_epoch(eng.codes[:n_rows], t, eng._nu[0, :n_rows], eng.S[:n_rows])
         run.fs = FilterState(x=fe.XS[e].copy(), P=fe.P, memory=run.fs.memory)
-        nav.epoch_done(k, t, fe.XS[e:e + 1], fe.PP[e:e + 1], fe.PC[e:e + 1], fe.PD[e:e + 1], fe.PN[e:e + 1])
+        nav.epoch_done(k, t, fe.XS[e:e + 1], fe.PP[e:e + 1], fe.PC[e:e + 1], fe.PD[e:e + 1], fe.PN[e:e + 1],
+                       fe.XD[e:e + 1])
+        nw[layouts.W_T_EST] = t
         nw[layouts.W_SNAP] = nav.snap_index
         return True
 
@@ -710,6 +723,9 @@ class NavInTheLoop:
         nw = self._inloop.nw
         run = self.navigator.runs[0]
         nw[layouts.W_XNAV:layouts.W_XNAV + 9] = run.fs.x[0:9]
+        xd, t_est = self.navigator.rate_in_force()
+        nw[layouts.W_XDOT:layouts.W_XDOT + 9] = xd[0]
+        nw[layouts.W_T_EST] = t_est
         if self.nav.nav.feedback:
             nw[layouts.W_BG:layouts.W_BG + 3] = run.bg_fb
             nw[layouts.W_BA:layouts.W_BA + 3] = run.ba_fb

@@ -27,6 +27,7 @@ import numpy as np
 
 from approachsim import geo
 from approachsim.core.nav import epoch as ke
+from approachsim.core.nav import errormodel as kem
 from approachsim.core.nav import groups as kg
 from approachsim.core.nav import output as ko
 from approachsim.memo import TruthMemo
@@ -191,9 +192,16 @@ class Navigator:
         self.rows[:, 0] = self.x
         self.snap = np.zeros(n_rows, dtype=int)
         self._snaps: list[tuple[Array, Array, Array]] = []
+        self._rates: list[Array] = []
+        """Per snapshot: each run's estimate rate (N, 9) (core/nav/output.nav_rate; zeros at the start)."""
+        self._t_snap: list[float] = []
+        """Per snapshot: its time (s), the t_est of core/nav/output.estimate_at."""
+        self.interval_F: list[Array | None] = [None] * len(runs)
+        """Each run's error model F (n, n) of the interval that ended at this epoch (set by the aiding paths)."""
         self.f_sum = np.zeros((n, 3))
         """C_bn dv accumulated since the last epoch (NED, m/s): the mean specific force of the interval."""
         self.t_last = float(t0_s)
+        self._t0 = float(t0_s)
         self._ic = self.layout.i("clk") if self.layout.has("clk") else 0
         self.engine = EpochEngine.of(system)
         self.reduced_runs: list | None = None
@@ -274,7 +282,7 @@ class Navigator:
             self.x[:] = ins.pack(s)
         self.f_sum[:] = 0.0
         self.t_last = t_s
-        self._snapshot(epoch=True)
+        self._snapshot(epoch=True, t_s=t_s)
         self.record_row(row)
         h = self._hist
         h["t"].append(t_s)
@@ -282,19 +290,25 @@ class Navigator:
         h["snap"].append(len(self._snaps) - 1)
 
     def epoch_done(self, row: int, t_s: float, x: Array, p_pos: Array, p_clk: Array, p_diag: Array,
-                   p_nav: Array) -> None:
+                   p_nav: Array, x_rate: Array) -> None:
         """What `epoch` keeps after an epoch its caller ran itself (the closed loop's compiled epoch,
         core/loop/aiding.py, which has reset f_sum): the snapshot x (N, n), P's position block
-        (N, 3, 3), clock variance (N,), diagonal (N, n) and navigation block (N, 9, 9), and the epoch's history
-        entry (the caller records row `row` itself)."""
+        (N, 3, 3), clock variance (N,), diagonal (N, n) and navigation block (N, 9, 9), the estimate's rate (N, 9),
+        and the epoch's history entry (the caller records row `row` itself)."""
         self.t_last = t_s
         self._snaps.append((x, p_pos, p_clk))
+        self._rates.append(x_rate)
+        self._t_snap.append(t_s)
         h = self._hist
         h["pd"].append(p_diag)
         h["pnav"].append(p_nav)
         h["t"].append(t_s)
         h["row"].append(row)
         h["snap"].append(len(self._snaps) - 1)
+
+    def rate_in_force(self) -> tuple[Array, float]:
+        """(N, 9) the rate of each run's estimate in force and its time (s): core/nav/output.estimate_at's xd, t_est."""
+        return self._rates[-1], self._t_snap[-1]
 
     def loop_held(self, obs: Observations, i: int) -> bool:
         """Whether run i's damping loop held over the interval ending at this epoch (`loop_held`)."""
@@ -317,6 +331,7 @@ class Navigator:
                 if self.engine.own(X, P, y, np.ascontiguousarray(f_ned_mean[i]), obs.elevations(i), held,
                                    dt_epoch, obs, i, t, run.statuses, self.dbs[i], new):
                     run.fs = FilterState(x=X[0], P=P, memory=run.fs.memory)
+                    self.interval_F[i] = self.engine.F.copy()  # the kernel's scratch: the next run overwrites it
                     continue
             if r_ins is None:
                 r_ins = ins.position_ecef(s)
@@ -325,6 +340,7 @@ class Navigator:
             gains = system.loop_slopes(run.fs, h_lin, noise)
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), h_lin, s.v_ned[i],
                                 f_ned_mean[i], s.c_bn[i], noise, gains, loop_held=held)
+            self.interval_F[i] = F
             phi, qd = em.discretize(F, Qc, dt_epoch)
             if new is not None:
                 phi, qd = reset_arcs(lay, phi, qd, new, self._amb_prior())
@@ -496,8 +512,12 @@ class Navigator:
             self.x[:] = x0
             self.f_sum[:] = 0.0
             return False
+        rates = _pass_rates(kg.ErrorModel(eng.lay, q, gse, gmp, loop, gio, gio_tau), kg.Track(dt, ref, ref_cbn, f_ref),
+                            held, x_out)
         for e in range(E):  # what the per-epoch path keeps
             self._snaps.append((x_out[:, e], p33[:, e], pcc[:, e]))
+            self._rates.append(rates[:, e])
+            self._t_snap.append(float(t_e[e]))
             self._hist["pd"].append(pd[:, e])
             self._hist["pnav"].append(pnav[:, e])
         self._hist["t"].extend(t_e.tolist())
@@ -529,12 +549,19 @@ class Navigator:
 
     # --- output --------------------------------------------------------------------------------------------
 
-    def _snapshot(self, epoch: bool = False) -> None:
-        """Keep x, the position block of P and the clock variance: the estimate in force until the next epoch; at an
-        epoch also each run's P diagonal and navigation block (the filter history)."""
+    def _snapshot(self, epoch: bool = False, t_s: float | None = None) -> None:
+        """Keep x, the position block of P and the clock variance: the estimate in force until the next epoch, with
+        its rate F x (core/nav/output.nav_rate; F the interval's model each aiding path left in `_F`; zeros at the
+        start) and time t_s (the start's when None); at an epoch also each run's P diagonal and navigation block
+        (the filter history)."""
         ic = self._ic
         xs, pp, pc, pd, pn = [], [], [], [], []
-        for r in self.runs:
+        rates = np.zeros((len(self.runs), 9))
+        for i, r in enumerate(self.runs):
+            if epoch:
+                c = np.ascontiguousarray
+                ko.nav_rate(c(self.interval_F[i], dtype=float), c(r.fs.x, dtype=float), rates[i])
+                self.interval_F[i] = None
             P = self.system.filter.covariance(r.fs)
             xs.append(r.fs.x)
             pp.append(P[0:3, 0:3])
@@ -543,6 +570,8 @@ class Navigator:
                 pd.append(np.diagonal(P))
                 pn.append(P[0:9, 0:9])
         self._snaps.append((np.array(xs), np.array(pp), np.array(pc)))
+        self._rates.append(rates)
+        self._t_snap.append(self._t0 if t_s is None else float(t_s))
         if epoch:
             self._hist["pd"].append(np.array(pd))
             self._hist["pnav"].append(np.array(pn))
@@ -555,6 +584,9 @@ class Navigator:
         n = self.rows.shape[1] if n_rows is None else int(n_rows)
         snap = self.snap[:n]
         XS = np.stack([x for x, _, _ in self._snaps])  # (snaps, runs, n_states)
+        XD = np.stack(self._rates)  # (snaps, runs, 9)
+        T = np.array(self._t_snap)  # (snaps,)
+        t_rows = np.asarray(truth.t_s[:n], dtype=float)
         PP = np.stack([p for _, p, _ in self._snaps])  # (snaps, runs, 3, 3)
         PC = np.stack([c for _, _, c in self._snaps])  # (snaps, runs)
         lay = self.layout
@@ -567,7 +599,7 @@ class Navigator:
             sol = None
             if solutions is True or i in solutions:
                 xs = XS[:, i]
-                r_ecef, v_ned, euler = ko.corrected(self.rows[self.ins_of[i], :n], xs, snap)
+                r_ecef, v_ned, euler = ko.corrected(self.rows[self.ins_of[i], :n], t_rows, xs, XD[:, i], T, snap)
                 sol = NavSolution(
                     t_s=np.asarray(truth.t_s[:n], dtype=float),
                     r_ecef=r_ecef,
@@ -590,6 +622,27 @@ class Navigator:
                 P_nav=np.array([p[i] for p in h["pnav"]]).reshape(-1, 9, 9), true_error_nav=err, layout=lay,
             ))
         return out
+
+
+def _pass_rates(model: kg.ErrorModel, track: kg.Track, held: Array, X: Array) -> Array:
+    """(N, E, 9) the rate of each run's estimate after each epoch of a compiled pass (core/nav/output.nav_rate), F
+    the model core/nav/epoch.shared_pass linearized for the interval ending there (at the reference, with or without
+    the loop held); X (N, E, n) the estimates after the epochs, held (N, E) int."""
+    N, E, n = X.shape
+    out = np.zeros((N, E, 9))
+    F, Qc = np.zeros((n, n)), np.zeros((n, n))
+    for e in range(E):
+        y = track.ref[e]
+        for hd in (0, 1):
+            which = np.flatnonzero(held[:, e] == hd)
+            if which.size == 0:
+                continue
+            kem.dynamics(model.lay, model.q, model.gse, model.gmp, y[0],
+                         kem.interval_height(model.lay, y[2], y[5], track.dt[e]), y[3:6], track.f_ref[e],
+                         track.ref_cbn[e], model.loop, hd == 1, F, Qc)
+            for i in which:
+                ko.nav_rate(F, X[i, e], out[i, e])
+    return out
 
 
 def _stacked_observations(records: Any, t_e: Array, tol: float, batched: bool, n_runs: int) -> dict[str, Any]:

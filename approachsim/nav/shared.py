@@ -109,6 +109,9 @@ class SharedCovariance:
             F, Qc = em.dynamics(lay, float(ref.lat_rad[0]), h_lin, ref.v_ned[0], f_ref, ref.c_bn[0],
                                 noise, system.loop_gains(), loop_held=h)
             models[h] = em.discretize(F, Qc, dt_epoch)
+            for i in range(len(runs)):  # the interval's model: the estimate's rate after the epoch (Navigator)
+                if held[i] == h:
+                    nav.interval_F[i] = F
         # carrier phase: the channels whose arc begins here reset their ambiguities (a class shares them: split on it)
         new = nav.arc_resets(obs)
         self.split(np.column_stack([obs.schedule(), np.array(held, dtype=bool), new]))

@@ -2,7 +2,7 @@
 (core/nav/epoch.run_epoch) with what the Navigator does around it at an epoch of a feed-forward run, so that an
 epoch of the closed loop costs one kernel call plus the sensors' one-row records (loop/closed_loop.py `_fast_epoch`).
 
-    k = loop_epoch(nw, X, P, e, model, held, dt, f_ned, rows, obs, out, scr, (XS, PP, PC, PD, PN, ic))
+    k = loop_epoch(nw, X, P, e, model, held, dt, f_ned, rows, obs, out, scr, (XS, PP, PC, PD, PN, ic, XD))
                                             the groups of core/nav/groups.py
 
 in order:
@@ -12,7 +12,9 @@ in order:
     when k >= 0 (the model fitted the compiled discretization):
         XS[e] = x, PP[e] = P[0:3, 0:3], PC[e] = P[ic, ic], PD[e] = diag P, PN[e] = P[0:9, 0:9]
                                             the filter snapshot and epoch history (Navigator._snapshot(epoch=True))
-        f_sum <- 0;  the estimate in force x[0:9] -> the row's work vector (core/loop/nav_row.py W_XNAV);
+        XD[e] = F x (rows 0-8, core/nav/output.nav_rate; F the interval's model, scr.F)
+        f_sum <- 0;  the estimate in force x[0:9] and its rate -> the row's work vector (core/loop/nav_row.py
+        W_XNAV, W_XDOT; the caller sets its time W_T_EST);
         the "baro in the interval" flag W_ANY_BARO <- 0
 
 nw is the closed loop's work vector (core/layouts.py NAV_WORK): the INS state y at W_X, f_sum at W_FSUM.
@@ -33,6 +35,7 @@ from approachsim.core import layouts
 from approachsim.core.jit import njit
 from approachsim.core.nav import epoch as ke
 from approachsim.core.nav import groups as kg
+from approachsim.core.nav import output as ko
 from approachsim.core.sensors import baro as bk
 from approachsim.core.sensors import gnss as gk
 from approachsim.core.sensors import gnss_errors as ge
@@ -43,11 +46,12 @@ from approachsim.core.sensors import radalt as rk
 def loop_epoch(nw: np.ndarray, X: np.ndarray, P: np.ndarray, e: int, model: kg.ErrorModel, held: bool, dt: float,
                f_ned: np.ndarray, rows: kg.Rows, obs: kg.Obs, out: kg.Out, scr: kg.Scratch, hist: tuple) -> int:
     """The closed loop's epoch e (module docstring): core/nav/epoch.run_epoch on the run's INS state in the work
-    vector, then the Navigator's bookkeeping: hist = (XS, PP, PC, PD, PN, ic), the estimate, position block, clock
-    variance, diagonal and navigation block of P after each epoch, and the clock's index. Returns run_epoch's
+    vector, then the Navigator's bookkeeping: hist = (XS, PP, PC, PD, PN, ic, XD), the estimate, position block,
+    clock variance, diagonal and navigation block of P after each epoch, the clock's index, and the estimate's rate
+    (9,) after each epoch. Returns run_epoch's
     number of rows, or -1 (nothing changed: the model needs the numpy discretization, the caller takes the
     Navigator's path). f_ned (3,) scratch."""
-    XS, PP, PC, PD, PN, ic = hist
+    XS, PP, PC, PD, PN, ic, XD = hist
     for c in range(3):
         f_ned[c] = nw[layouts.W_FSUM + c] / dt
     y = nw[layouts.W_X:layouts.W_X + layouts.NX]
@@ -66,10 +70,12 @@ def loop_epoch(nw: np.ndarray, X: np.ndarray, P: np.ndarray, e: int, model: kg.E
         for j in range(9):
             PN[e, i, j] = P[i, j]
     PC[e] = P[ic, ic]
+    ko.nav_rate(scr.F, X[0], XD[e])
     for c in range(3):
         nw[layouts.W_FSUM + c] = 0.0
     for i in range(9):
         nw[layouts.W_XNAV + i] = X[0, i]
+        nw[layouts.W_XDOT + i] = XD[e, i]
     nw[layouts.W_ANY_BARO] = 0.0
     return k
 

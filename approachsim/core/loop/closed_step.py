@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from approachsim.core.jit import njit
+from approachsim.core.layouts import ROW_T
 from approachsim.core.loop import flight_step as fk
 from approachsim.core.loop import nav_row as ik
 
@@ -30,7 +31,7 @@ def fly_step_closed(k: int, raw: Any, buf: Array, nu: Array, par: Array, st: Arr
     cg, ca, rows, snap, baro_j, baro_e, lag_w, dth, dv, guidance = ik.views(nw, fa, ia)
     ncode = ik.nav_row(k, buf, nw, cg, ca, rows, snap, baro_j, baro_e, lag_w, dth, dv)
     if ncode == 0:
-        ik.nav_guidance(nw, guidance[k])
+        ik.nav_guidance(nw, buf[k, ROW_T], guidance[k])
         if code == fk.TERM_NONE:
             de, da, dr, thr = fk.fly_control(k, guidance, buf, par, st)
     return code, ncode, de, da, dr, thr, gn, ge, gd, terr_ft, near
@@ -41,5 +42,5 @@ def fly_control_closed(k: int, buf: Array, par: Array, st: Array, nw: Array, fa:
                        ) -> tuple[float, float, float, float]:
     """On the packed arrays: after Python acted at row k, the guidance into its row k and the autopilot on it."""
     guidance = ik.views(nw, fa, ia)[9]
-    ik.nav_guidance(nw, guidance[k])
+    ik.nav_guidance(nw, buf[k, ROW_T], guidance[k])
     return fk.fly_control(k, guidance, buf, par, st)

@@ -10,7 +10,8 @@ Per truth row k (k > 0), with the flight's row buffer buf (core/layouts.py TRUTH
     INS step (kernels/strapdown.py) with the baro held in the work vector (nan: the damping loop holds) and its age
                                t(k-1) - t(sample)
     rows[k] = the INS state; snap[k] = the filter snapshot in force
-    guidance = INS - x_hat (feed-forward) in the runway frame and NED (kernels/strapdown.guidance)
+    guidance = INS - x_hat(t) (feed-forward) in the runway frame and NED (kernels/strapdown.guidance), x_hat(t) the
+               last epoch's estimate carried to the row's time by its rate (core/nav/output.estimate_at)
 
 The work vector nw (core/layouts.py NAV_WORK) holds the one run's INS state and the small constants; the other arrays of
 the row are views of two packed arrays, fa (float64) and ia (int64) (`views`, `packed_sizes`), so that the flight
@@ -61,9 +62,13 @@ from approachsim.core.layouts import (
     W_NLAG,
     W_ORWY,
     W_SNAP,
+    W_T_EST,
     W_X,
+    W_XDOT,
     W_XNAV,
+    W_XNOW,
 )
+from approachsim.core.nav import output as ko
 from approachsim.core.nav import strapdown as sk
 
 NAV_START, NAV_BARO, NAV_EPOCH = 1, 2, 4
@@ -137,11 +142,14 @@ def nav_row(k: int, buf: np.ndarray, nw: np.ndarray, cg: np.ndarray, ca: np.ndar
 
 
 @njit(cache=True)
-def nav_guidance(nw: np.ndarray, out: np.ndarray) -> None:
-    """The guidance of the current INS state and estimate into out (6,): runway-frame position (m) and NED velocity
-    (m/s) of the feed-forward output INS - x_hat (kernels/strapdown.guidance)."""
+def nav_guidance(nw: np.ndarray, t: float, out: np.ndarray) -> None:
+    """The guidance of the current INS state at time t (s) into out (6,): runway-frame position (m) and NED
+    velocity (m/s) of the feed-forward output INS - x_hat(t) (kernels/strapdown.guidance), x_hat(t) the estimate in
+    force carried to t by its rate (core/nav/output.estimate_at)."""
     c = nw[W_CRWY:W_CRWY + 6].reshape(2, 3)
-    sk.guidance(nw[W_X:W_X + NX].reshape(1, NX), nw[W_XNAV:W_XNAV + 9], c, nw[W_ORWY:W_ORWY + 3], nw[W_HTHR], out)
+    x = nw[W_XNOW:W_XNOW + 9]
+    ko.estimate_at(nw[W_XNAV:W_XNAV + 9], nw[W_XDOT:W_XDOT + 9], nw[W_T_EST], t, x)
+    sk.guidance(nw[W_X:W_X + NX].reshape(1, NX), x, c, nw[W_ORWY:W_ORWY + 3], nw[W_HTHR], out)
 
 
 def packed_sizes(n: int, m: int, n_baro: int, n_lag: int) -> tuple[int, int]:

@@ -191,19 +191,24 @@ def test_closed_loop_steps_equal_the_open_loop_pass_to_rounding(feedback, cold):
 
 
 def test_output_kernel_equals_perturb_ecef_and_euler():
-    """kernels/output.corrected (the NavSolution of every row: INS - x_hat of the snapshot in force) against the
-    numpy path it replaced: ins.perturb with -x_hat, geo.geodetic_to_ecef, ins.euler_from_cbn."""
+    """kernels/output.corrected (the NavSolution of every row: INS - x_hat(t), the snapshot in force carried to
+    the row's time by its rate) against the numpy path: x + (t - T) xd, ins.perturb with -x_hat(t),
+    geo.geodetic_to_ecef, ins.euler_from_cbn."""
     rng = np.random.default_rng(11)
     s = _states(500, rng)
     rows = ins.pack(s)
     X = np.concatenate([rng.normal(0.0, 5.0, (40, 3)), rng.normal(0.0, 0.1, (40, 3)),
                         rng.normal(0.0, 1e-3, (40, 3)), rng.normal(0.0, 1.0, (40, 4))], axis=1)
     X[0, 6:9] = 1e-9  # tiny attitude correction: the Rodrigues series branch
+    XD = np.concatenate([rng.normal(0.0, 0.1, (40, 3)), rng.normal(0.0, 1e-3, (40, 3)),
+                         rng.normal(0.0, 1e-5, (40, 3))], axis=1)
+    T = np.sort(rng.uniform(0.0, 40.0, 40))
     snap = rng.integers(0, 40, 500)
+    t = T[snap] + rng.uniform(0.0, 1.0, 500)
     from approachsim.core.nav import output as ko
 
-    r, v, e = ko.corrected(rows, X, snap)
-    xs = X[snap]
+    r, v, e = ko.corrected(rows, t, X, XD, T, snap)
+    xs = X[snap][:, 0:9] + (t - T[snap])[:, None] * XD[snap]  # the same two operations per element
     o = ins.perturb(s, -xs[:, 0:3], -xs[:, 3:6], -xs[:, 6:9])
     _close(r, geo.geodetic_to_ecef(o.lat_rad, o.lon_rad, o.h_m), "r_ecef")
     _close(v, o.v_ned, "v_ned")
