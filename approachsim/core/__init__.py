@@ -16,7 +16,7 @@ by this package's sources alone (approachsim/__init__.py), so editing a stage ne
                       the filter's channel sigmas, the GBAS scales), scalar
     nav/           the navigation stage's arithmetic
         strapdown     the strapdown INS mechanization over many runs and IMU intervals (nav/ins.py)
-        output        the navigation output of every row, INS - x_hat
+        output        the navigation output of every row, INS - x_hat(t) (the estimate carried by its rate)
         errormodel    the error model's F, Qc and their discretization Phi, Qd (nav/errormodel.py)
         kalman        sparse predict, scalar Joseph update, shared-covariance update, the Riccati segment
         measurements  the baro, radar-altimeter and pseudorange rows with their innovations (nav/measurements.py)

@@ -577,8 +577,9 @@ class Navigator:
             self._hist["pnav"].append(np.array(pn))
 
     def results(self, truth: Truth, n_rows: int | None = None, solutions: Any = True) -> list[NavRun]:
-        """Each run's NavRun over the first n_rows rows (default: all): the solution at every row (INS - x_hat
-        of the snapshot in force, kernels/output.py), the status log and the epoch history. solutions: True, or a
+        """Each run's NavRun over the first n_rows rows (default: all): the solution at every row (INS - x_hat(t),
+        the snapshot in force carried to the row's time by its rate, core/nav/output.py), the status log and the
+        epoch history. solutions: True, or a
         set of run indices whose solution is assembled (the others get None: the integrity bank's sub-filters
         need only their epoch history)."""
         n = self.rows.shape[1] if n_rows is None else int(n_rows)
