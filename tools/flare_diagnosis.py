@@ -5,7 +5,8 @@ linear model of the flare loop's response to gusts.
     python tools/flare_diagnosis.py landings --runs 1 --turbulence none  # calm air (one flight: deterministic)
     python tools/flare_diagnosis.py model                                # the loop's gust response, its margins
     [--set NAME=VALUE ...]  AutopilotGains overrides (SI), e.g. --set k_flare=0.03 --set k_flare_i=0.005
-    model only: [--gust-ff K]  a pitch feed-forward -K u_g of the airspeed gust (rad s/m; not in the law: analysis)
+    model only: [--gust-ff K]  a pitch feed-forward -K u_g of the airspeed gust added to the law's flare_k_gust
+                (rad s/m; analysis); [--gear-fb C]  feed back the IMU's sink plus C l q (1: the main gear's)
 
 `landings` flies the crosswind case of tools/autoland_figures.py (default profile, 20 kt from the right, seed 1,
 runs 0..N-1, true-state guidance) and records, for each landing, the main gear's sink rate (the lower gear's,
@@ -170,13 +171,18 @@ def _longitudinal(lin, g):
     return a_cl, -g.k_theta * b, lin.vt_mps, (639.0 - 250.0) * units.IN, (648.0 - 639.0) * units.IN
 
 
-def gust_response(lin, g, w: np.ndarray, tau_s: float = 4.9, k_gust: float = 0.0) -> dict[str, np.ndarray]:
+def gust_response(lin, g, w: np.ndarray, tau_s: float = 4.9, k_gust: float = 0.0,
+                  gear_fb: float = 0.0) -> dict[str, np.ndarray]:
     """Complex gains from a horizontal (u, along the path, + headwind) and a vertical (w, + up) gust velocity to the
     main gear's and the IMU's sink rate at frequencies w (rad/s), the flare loop closed (autopilot.py linearized).
-    k_gust (rad s/m, analysis only, not in the law): a pitch feed-forward -k_gust u of the airspeed gust."""
+    The law's own airspeed-gust feed-forward -flare_k_gust u is in it; analysis only (not in the law): k_gust
+    (rad s/m) adds to it, gear_fb feeds back the IMU's sink plus this share of the lever-arm term (1: the main
+    gear's sink)."""
     a_cl, b_th, v, l_imu, l_gear = _longitudinal(lin, g)
     c_cg = np.array([0.0, v, -v, 0.0])  # sink of the CG: -V (theta - alpha)
     c_imu, c_gear = c_cg + np.array([0.0, 0.0, 0.0, -l_imu]), c_cg + np.array([0.0, 0.0, 0.0, l_gear])
+    fb = gear_fb
+    k_gust = k_gust + g.flare_k_gust
     out: dict[str, list] = {"gear_u": [], "gear_w": [], "imu_u": [], "imu_w": []}
     for om in w:
         p = 1j * om
@@ -189,11 +195,12 @@ def gust_response(lin, g, w: np.ndarray, tau_s: float = 4.9, k_gust: float = 0.0
             si_d, si_t = c_imu @ xd + feed, c_imu @ xt
             sg_d, sg_t = c_gear @ xd + feed, c_gear @ xt
             k = g.k_flare + g.k_flare_i / p
-            # theta_c = K (e_imu + s_gear / (tau p)) + T_path s_imu / (tau V) - k_gust u
+            sf_d, sf_t = (1.0 - fb) * si_d + fb * sg_d, (1.0 - fb) * si_t + fb * sg_t
+            # theta_c = K (e_fb + s_gear / (tau p)) + T_path s_fb / (tau V) - k_gust u
             lead = g.flare_t_path_s / (tau_s * v)
             ff = -k_gust if name == "u" else 0.0
-            th = (k * (si_d + sg_d / (tau_s * p)) + lead * si_d + ff) / (1.0 - k * (si_t + sg_t / (tau_s * p))
-                                                                         - lead * si_t)
+            th = (k * (sf_d + sg_d / (tau_s * p)) + lead * sf_d + ff) / (1.0 - k * (sf_t + sg_t / (tau_s * p))
+                                                                         - lead * sf_t)
             out["gear_" + name].append(sg_d + sg_t * th)
             out["imu_" + name].append(si_d + si_t * th)
     return {k: np.array(v) for k, v in out.items()}
@@ -210,13 +217,14 @@ def command_lag(lin, g) -> float:
     a3, b3 = a_cl[np.ix_(i3, i3)], b_th[i3]
     c_imu = np.array([v, -v, -l_imu])
     c_gear = np.array([v, -v, l_gear])
+    c_fb = c_imu
 
     def gain(p: complex, tau_s: float = 4.9) -> complex:
         xt = np.linalg.solve(p * np.eye(3) - a3, b3)
-        si, sg = c_imu @ xt, c_gear @ xt
+        sf, sg = c_fb @ xt, c_gear @ xt
         k = g.k_flare + g.k_flare_i / p
-        # theta_c = -s_c / V + T_path s_imu / (tau V) + K (s_imu - s_c)
-        th = (-1.0 / v - k) / (1.0 - k * si - g.flare_t_path_s / (tau_s * v) * si)
+        # theta_c = -s_c / V + T_path s_fb / (tau V) + K (s_fb - s_c)
+        th = (-1.0 / v - k) / (1.0 - k * sf - g.flare_t_path_s / (tau_s * v) * sf)
         return sg * th
 
     e = 1e-4
@@ -237,14 +245,14 @@ def dryden_psd(w: np.ndarray, h_ft: float, v_mps: float, w20_kt: float = 15.0) -
     return phi_u, phi_w
 
 
-def model(overrides: dict[str, float], k_gust: float = 0.0) -> dict:
+def model(overrides: dict[str, float], k_gust: float = 0.0, gear_fb: float = 0.0) -> dict:
     import control
 
     ap = Approach(load_profile(ROOT / "profiles" / "default.toml"))
     g = dataclasses.replace(ap.aircraft.gains, **overrides)
     lin = ap.linearization
     w = np.logspace(math.log10(0.3), 2.0, 600)
-    r = gust_response(lin, g, w, k_gust=k_gust)
+    r = gust_response(lin, g, w, k_gust=k_gust, gear_fb=gear_fb)
     phi_u, phi_w = dryden_psd(w, 25.0, lin.vt_mps)
     fps = 1.0 / units.FPS
 
@@ -252,8 +260,8 @@ def model(overrides: dict[str, float], k_gust: float = 0.0) -> dict:
         return float(np.sqrt(np.trapezoid(np.abs(r[key + "_u"]) ** 2 * phi_u, w)
                              + np.trapezoid(np.abs(r[key + "_w"]) ** 2 * phi_w, w)) * fps)
 
-    a_cl, b_th, v, l_imu, _ = _longitudinal(lin, g)
-    plant = control.ss(a_cl, b_th.reshape(4, 1), np.array([[0.0, -v, v, l_imu]]), 0.0)
+    a_cl, b_th, v, l_imu, l_gear = _longitudinal(lin, g)
+    plant = control.ss(a_cl, b_th.reshape(4, 1), np.array([[0.0, -v, v, l_imu - gear_fb * (l_imu + l_gear)]]), 0.0)
     s = control.tf("s")
     gm, pm, _, wc = control.margin((g.k_flare + g.k_flare_i / s) * plant)
     lag = command_lag(lin, g)
@@ -289,6 +297,7 @@ def main() -> None:
     ap.add_argument("--turbulence", default="light")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
     ap.add_argument("--gust-ff", type=float, default=0.0)
+    ap.add_argument("--gear-fb", type=float, default=0.0)
     ap.add_argument("--out", type=Path)
     a = ap.parse_args()
     overrides = {k: float(v) for k, v in (s.split("=", 1) for s in a.set)}
@@ -300,7 +309,8 @@ def main() -> None:
                **summary(rows, td)}
         _print_summary(out)
     else:
-        out = {"overrides": overrides, "gust_ff": a.gust_ff, **model(overrides, a.gust_ff)}
+        out = {"overrides": overrides, "gust_ff": a.gust_ff, "gear_fb": a.gear_fb,
+               **model(overrides, a.gust_ff, a.gear_fb)}
         print(json.dumps(out, indent=1))
     out["cpu_s"] = time.process_time() - t0
     if a.out:
