@@ -98,7 +98,7 @@ def landings(runs: int, wind_kt: float, turb: str, overrides: dict[str, float]) 
         td = touchdown_scalars(res.truth, arms)
         row = {"run": r, "termination": "touchdown", "gear": [], "imu": [], "lq": [],
                "td_gear": td["td_sink_mps"], "td_imu": td["td_imu_sink_mps"], "td_pitch_rad": td["td_pitch_rad"],
-               "td_cas_mps": td["td_cas_mps"]}
+               "td_cas_mps": td["td_cas_mps"], "td_x_m": td["td_x_m"]}
         # the gear's sink 0.5, 1.0, ... 4.0 s before touchdown (its correlation with the touchdown sink shows the
         # flare loop's oscillation)
         row["before"] = [float(tr[max(int(np.searchsorted(tr[:, 0], tr[-1, 0] - dt)) - 1, 0), 2])
@@ -151,6 +151,9 @@ def summary(rows: list[dict], td_sink_mps: float) -> dict:
             "td_imu_sink_fps": {"mean": float(np.mean([r["td_imu"] for r in ok]) * fps)},
             "td_pitch_deg": float(np.degrees(np.mean([r["td_pitch_rad"] for r in ok]))),
             "td_cas_kt": float(np.mean([r["td_cas_mps"] for r in ok]) / units.KT),
+            "td_x_ft": {"mean": float(np.mean([r["td_x_m"] for r in ok]) / units.FT),
+                        "sd": sd(np.array([r["td_x_m"] for r in ok]) / units.FT),
+                        "max": float(np.max([r["td_x_m"] for r in ok]) / units.FT)},
             "target_fps": td_sink_mps * fps,
             "miss_fps": float(td.mean()) - td_sink_mps * fps,
             "tracking_bias_fps": last["gear_time_mean"] - td_sink_mps * fps,
@@ -278,7 +281,8 @@ def _print_summary(s: dict) -> None:
     print(f"{s['touchdowns']} of {s['landings']} landed; touchdown sink {s['td_sink_fps']['mean']:.2f} +- "
           f"{s['td_sink_fps']['sd']:.2f} ft/s (target {s['target_fps']:.2f}: miss {s['miss_fps']:+.2f} = tracking "
           f"bias {s['tracking_bias_fps']:+.2f} + first passage {s['first_passage_fps']:+.2f}); pitch "
-          f"{s['td_pitch_deg']:.2f} deg, CAS {s['td_cas_kt']:.1f} kt")
+          f"{s['td_pitch_deg']:.2f} deg, CAS {s['td_cas_kt']:.1f} kt; main gear x {s['td_x_ft']['mean']:.0f} +- "
+          f"{s['td_x_ft']['sd']:.0f} ft (max {s['td_x_ft']['max']:.0f})")
     print("   h ft | gear mean +- sd | time mean | first passage | IMU mean +- sd | l q mean +- sd | command")
     for t in s["heights"]:
         print(f"  {t['h_ft']:5.2f} | {t['gear_mean']:5.2f} +- {t['gear_sd']:4.2f} | {t['gear_time_mean']:9.2f} | "
