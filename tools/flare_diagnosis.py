@@ -5,7 +5,8 @@ linear model of the flare loop's response to gusts.
     python tools/flare_diagnosis.py landings --runs 1 --turbulence none  # calm air (one flight: deterministic)
     python tools/flare_diagnosis.py model                                # the loop's gust response, its margins
     [--set NAME=VALUE ...]  AutopilotGains overrides (SI), e.g. --set k_flare=0.03 --set k_flare_i=0.005
-    model only: [--gust-ff K]  a pitch feed-forward -K u_g of the airspeed gust (rad s/m; not in the law: analysis)
+    model only: [--gust-ff K]  a pitch feed-forward -K u_g of the airspeed gust added to the law's flare_k_gust
+                (rad s/m; analysis); [--gear-fb C]  feed back the IMU's sink plus C l q (1: the main gear's)
 
 `landings` flies the crosswind case of tools/autoland_figures.py (default profile, 20 kt from the right, seed 1,
 runs 0..N-1, true-state guidance) and records, for each landing, the main gear's sink rate (the lower gear's,
@@ -97,7 +98,7 @@ def landings(runs: int, wind_kt: float, turb: str, overrides: dict[str, float]) 
         td = touchdown_scalars(res.truth, arms)
         row = {"run": r, "termination": "touchdown", "gear": [], "imu": [], "lq": [],
                "td_gear": td["td_sink_mps"], "td_imu": td["td_imu_sink_mps"], "td_pitch_rad": td["td_pitch_rad"],
-               "td_cas_mps": td["td_cas_mps"]}
+               "td_cas_mps": td["td_cas_mps"], "td_x_m": td["td_x_m"]}
         # the gear's sink 0.5, 1.0, ... 4.0 s before touchdown (its correlation with the touchdown sink shows the
         # flare loop's oscillation)
         row["before"] = [float(tr[max(int(np.searchsorted(tr[:, 0], tr[-1, 0] - dt)) - 1, 0), 2])
@@ -150,6 +151,9 @@ def summary(rows: list[dict], td_sink_mps: float) -> dict:
             "td_imu_sink_fps": {"mean": float(np.mean([r["td_imu"] for r in ok]) * fps)},
             "td_pitch_deg": float(np.degrees(np.mean([r["td_pitch_rad"] for r in ok]))),
             "td_cas_kt": float(np.mean([r["td_cas_mps"] for r in ok]) / units.KT),
+            "td_x_ft": {"mean": float(np.mean([r["td_x_m"] for r in ok]) / units.FT),
+                        "sd": sd(np.array([r["td_x_m"] for r in ok]) / units.FT),
+                        "max": float(np.max([r["td_x_m"] for r in ok]) / units.FT)},
             "target_fps": td_sink_mps * fps,
             "miss_fps": float(td.mean()) - td_sink_mps * fps,
             "tracking_bias_fps": last["gear_time_mean"] - td_sink_mps * fps,
@@ -170,13 +174,18 @@ def _longitudinal(lin, g):
     return a_cl, -g.k_theta * b, lin.vt_mps, (639.0 - 250.0) * units.IN, (648.0 - 639.0) * units.IN
 
 
-def gust_response(lin, g, w: np.ndarray, tau_s: float = 4.9, k_gust: float = 0.0) -> dict[str, np.ndarray]:
+def gust_response(lin, g, w: np.ndarray, tau_s: float = 4.9, k_gust: float = 0.0,
+                  gear_fb: float = 0.0) -> dict[str, np.ndarray]:
     """Complex gains from a horizontal (u, along the path, + headwind) and a vertical (w, + up) gust velocity to the
     main gear's and the IMU's sink rate at frequencies w (rad/s), the flare loop closed (autopilot.py linearized).
-    k_gust (rad s/m, analysis only, not in the law): a pitch feed-forward -k_gust u of the airspeed gust."""
+    The law's own airspeed-gust feed-forward -flare_k_gust u is in it; analysis only (not in the law): k_gust
+    (rad s/m) adds to it, gear_fb feeds back the IMU's sink plus this share of the lever-arm term (1: the main
+    gear's sink)."""
     a_cl, b_th, v, l_imu, l_gear = _longitudinal(lin, g)
     c_cg = np.array([0.0, v, -v, 0.0])  # sink of the CG: -V (theta - alpha)
     c_imu, c_gear = c_cg + np.array([0.0, 0.0, 0.0, -l_imu]), c_cg + np.array([0.0, 0.0, 0.0, l_gear])
+    fb = gear_fb
+    k_gust = k_gust + g.flare_k_gust
     out: dict[str, list] = {"gear_u": [], "gear_w": [], "imu_u": [], "imu_w": []}
     for om in w:
         p = 1j * om
@@ -189,11 +198,12 @@ def gust_response(lin, g, w: np.ndarray, tau_s: float = 4.9, k_gust: float = 0.0
             si_d, si_t = c_imu @ xd + feed, c_imu @ xt
             sg_d, sg_t = c_gear @ xd + feed, c_gear @ xt
             k = g.k_flare + g.k_flare_i / p
-            # theta_c = K (e_imu + s_gear / (tau p)) + T_path s_imu / (tau V) - k_gust u
+            sf_d, sf_t = (1.0 - fb) * si_d + fb * sg_d, (1.0 - fb) * si_t + fb * sg_t
+            # theta_c = K (e_fb + s_gear / (tau p)) + T_path s_fb / (tau V) - k_gust u
             lead = g.flare_t_path_s / (tau_s * v)
             ff = -k_gust if name == "u" else 0.0
-            th = (k * (si_d + sg_d / (tau_s * p)) + lead * si_d + ff) / (1.0 - k * (si_t + sg_t / (tau_s * p))
-                                                                         - lead * si_t)
+            th = (k * (sf_d + sg_d / (tau_s * p)) + lead * sf_d + ff) / (1.0 - k * (sf_t + sg_t / (tau_s * p))
+                                                                         - lead * sf_t)
             out["gear_" + name].append(sg_d + sg_t * th)
             out["imu_" + name].append(si_d + si_t * th)
     return {k: np.array(v) for k, v in out.items()}
@@ -210,13 +220,14 @@ def command_lag(lin, g) -> float:
     a3, b3 = a_cl[np.ix_(i3, i3)], b_th[i3]
     c_imu = np.array([v, -v, -l_imu])
     c_gear = np.array([v, -v, l_gear])
+    c_fb = c_imu
 
     def gain(p: complex, tau_s: float = 4.9) -> complex:
         xt = np.linalg.solve(p * np.eye(3) - a3, b3)
-        si, sg = c_imu @ xt, c_gear @ xt
+        sf, sg = c_fb @ xt, c_gear @ xt
         k = g.k_flare + g.k_flare_i / p
-        # theta_c = -s_c / V + T_path s_imu / (tau V) + K (s_imu - s_c)
-        th = (-1.0 / v - k) / (1.0 - k * si - g.flare_t_path_s / (tau_s * v) * si)
+        # theta_c = -s_c / V + T_path s_fb / (tau V) + K (s_fb - s_c)
+        th = (-1.0 / v - k) / (1.0 - k * sf - g.flare_t_path_s / (tau_s * v) * sf)
         return sg * th
 
     e = 1e-4
@@ -237,14 +248,14 @@ def dryden_psd(w: np.ndarray, h_ft: float, v_mps: float, w20_kt: float = 15.0) -
     return phi_u, phi_w
 
 
-def model(overrides: dict[str, float], k_gust: float = 0.0) -> dict:
+def model(overrides: dict[str, float], k_gust: float = 0.0, gear_fb: float = 0.0) -> dict:
     import control
 
     ap = Approach(load_profile(ROOT / "profiles" / "default.toml"))
     g = dataclasses.replace(ap.aircraft.gains, **overrides)
     lin = ap.linearization
     w = np.logspace(math.log10(0.3), 2.0, 600)
-    r = gust_response(lin, g, w, k_gust=k_gust)
+    r = gust_response(lin, g, w, k_gust=k_gust, gear_fb=gear_fb)
     phi_u, phi_w = dryden_psd(w, 25.0, lin.vt_mps)
     fps = 1.0 / units.FPS
 
@@ -252,8 +263,8 @@ def model(overrides: dict[str, float], k_gust: float = 0.0) -> dict:
         return float(np.sqrt(np.trapezoid(np.abs(r[key + "_u"]) ** 2 * phi_u, w)
                              + np.trapezoid(np.abs(r[key + "_w"]) ** 2 * phi_w, w)) * fps)
 
-    a_cl, b_th, v, l_imu, _ = _longitudinal(lin, g)
-    plant = control.ss(a_cl, b_th.reshape(4, 1), np.array([[0.0, -v, v, l_imu]]), 0.0)
+    a_cl, b_th, v, l_imu, l_gear = _longitudinal(lin, g)
+    plant = control.ss(a_cl, b_th.reshape(4, 1), np.array([[0.0, -v, v, l_imu - gear_fb * (l_imu + l_gear)]]), 0.0)
     s = control.tf("s")
     gm, pm, _, wc = control.margin((g.k_flare + g.k_flare_i / s) * plant)
     lag = command_lag(lin, g)
@@ -270,7 +281,8 @@ def _print_summary(s: dict) -> None:
     print(f"{s['touchdowns']} of {s['landings']} landed; touchdown sink {s['td_sink_fps']['mean']:.2f} +- "
           f"{s['td_sink_fps']['sd']:.2f} ft/s (target {s['target_fps']:.2f}: miss {s['miss_fps']:+.2f} = tracking "
           f"bias {s['tracking_bias_fps']:+.2f} + first passage {s['first_passage_fps']:+.2f}); pitch "
-          f"{s['td_pitch_deg']:.2f} deg, CAS {s['td_cas_kt']:.1f} kt")
+          f"{s['td_pitch_deg']:.2f} deg, CAS {s['td_cas_kt']:.1f} kt; main gear x {s['td_x_ft']['mean']:.0f} +- "
+          f"{s['td_x_ft']['sd']:.0f} ft (max {s['td_x_ft']['max']:.0f})")
     print("   h ft | gear mean +- sd | time mean | first passage | IMU mean +- sd | l q mean +- sd | command")
     for t in s["heights"]:
         print(f"  {t['h_ft']:5.2f} | {t['gear_mean']:5.2f} +- {t['gear_sd']:4.2f} | {t['gear_time_mean']:9.2f} | "
@@ -289,6 +301,7 @@ def main() -> None:
     ap.add_argument("--turbulence", default="light")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
     ap.add_argument("--gust-ff", type=float, default=0.0)
+    ap.add_argument("--gear-fb", type=float, default=0.0)
     ap.add_argument("--out", type=Path)
     a = ap.parse_args()
     overrides = {k: float(v) for k, v in (s.split("=", 1) for s in a.set)}
@@ -300,7 +313,8 @@ def main() -> None:
                **summary(rows, td)}
         _print_summary(out)
     else:
-        out = {"overrides": overrides, "gust_ff": a.gust_ff, **model(overrides, a.gust_ff)}
+        out = {"overrides": overrides, "gust_ff": a.gust_ff, "gear_fb": a.gear_fb,
+               **model(overrides, a.gust_ff, a.gear_fb)}
         print(json.dumps(out, indent=1))
     out["cpu_s"] = time.process_time() - t0
     if a.out:

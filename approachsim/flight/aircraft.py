@@ -198,6 +198,11 @@ def _gains(s: Section) -> AutopilotGains:
                                                      lo_open=True, unit="deg")),
         flare_t_path_s=s.number("flare_t_path_s", 0.0, lo=0.0, hi=10.0, unit="s"),
         flare_k_v=s.number("flare_k_v", 0.0, lo=0.0, hi=1.0),
+        flare_k_gust=s.number("flare_k_gust", 0.0, lo=0.0, hi=1.0),
+        flare_ge_k=s.number("flare_ge_k", 0.0, lo=0.0, hi=1.0),
+        flare_ge_decay_m=s.number("flare_ge_decay_ft", 1.0 / units.FT, lo=0.0, hi=500.0, lo_open=True, unit="ft")
+        * units.FT,
+        flare_ge_arp_m=s.number("flare_ge_arp_ft", 0.0, lo=0.0, hi=50.0, unit="ft") * units.FT,
     )
     s.done()
     return g

@@ -51,13 +51,17 @@ Landing runs (h_gear: main-gear height above the terrain, the radio altitude) ad
   guidance point's, s = v_down (the main gear's, l_g behind it, adds l_g q: a non-minimum-phase term that, fed back,
   would cancel the pitch loop's rate damping), and the pitch command feeds the commanded path forward:
       s_c = (h_gear - h_off) / tau,  e = s - s_c  (> 0: sinking too fast)
-      theta_c = theta_entry + (s_0 - s_c) / V + T_theta2 s / (tau V) + k_v (V_0 - V) + k_flare e + k_flare_i int e
+      theta_c = theta_entry + (s_0 - s_c) / V + T_theta2 s / (tau V) + k_v (V_0 - V) - k_u u_g
+                - (k_v V_0 / 2) ln(k_ge(h_gear) / k_ge(h_f)) + k_flare e + k_flare_i int e
   At constant speed and angle of attack the path angle follows pitch one for one, gamma / theta = 1 / (1 + T_theta2
   s) (T_theta2 = -1 / Z_alpha', the landing linearization's), so the pitch that flies the commanded path angle
   gamma_c = -s_c / V is gamma_c + T_theta2 gamma_c' with gamma_c' = s / (tau V): the first two terms; k_v (V_0 - V)
   is the angle of attack that holds the lift as the speed V (the smoothed true airspeed) falls below its entry
-  value V_0 (0 where ground effect cancels it, as in the 737 file); the PI on e takes up what they leave. The
-  throttle goes to idle below retard_height.
+  value V_0; k_u u_g (k_u = A[alpha, V] / A[alpha, alpha]) the angle of attack that holds it through the airspeed
+  gust u_g = V_tas - V (the true airspeed above the inertially smoothed air-mass speed); the ln term gives back
+  the angle of attack that ground effect's extra lift makes up (lift factor k_ge(h) = 1 + k_g exp(-(h + h_arp) /
+  h_g), a fit to the aircraft model's ground-effect table; (k_v V_0 / 2) = C_L / C_L_alpha); the PI on e takes up
+  what they leave. The throttle goes to idle below retard_height (0: thrust kept to contact).
 * a runway alignment below align_height (the 737 MAX's alignment mode engages at 450 ft radio altitude, 737 MAX
   FCOM): the rudder turns the heading onto the runway's and holds the sideslip that the crosswind then needs (the
   737 FCTM's sideslip technique: "prior to the flare the airplane centerline is aligned on or parallel to the
@@ -226,7 +230,8 @@ class Autopilot:
             # the guidance point's (module docstring: why not the main gear's), closing on a sloped surface as the
             # radio altitude sees it: h' = -vd - slope x'
             sink = vd + self.surface_slope * x0
-            theta_c, thr_flare = self._flare(h_gear, sink, v_air)
+            gust = tas - v_air if tas is not None and tas > 1.0 else 0.0  # the airspeed gust about the air mass
+            theta_c, thr_flare = self._flare(h_gear, sink, v_air, gust)
             thr = min(thr, thr_flare)
         self._theta_c = theta_c
         de = -g.k_theta * (theta_c - theta) + g.k_q * q
@@ -311,10 +316,11 @@ class Autopilot:
                 self._int_flare, self._theta_c, self._v_lag, self.int_t, self.int_b, self._flare_tau,
                 self._flare_h_off, float(self.aligning), self._flare_sink0, self._flare_v0, self.surface_slope)
 
-    def _flare(self, h_gear: float, sink: float, v_air: float) -> tuple[float, float]:
+    def _flare(self, h_gear: float, sink: float, v_air: float, gust: float) -> tuple[float, float]:
         """Exponential flare with its path feed-forward (module docstring): pitch command to fly the main gear's
         sink rate `sink` (m/s, + down) onto h'_c = -(h_gear - h_off) / tau, tau and h_off from the sink rate at
-        entry, at airspeed v_air (m/s); throttle limit (1 above the retard height, then idle)."""
+        entry, at airspeed v_air (m/s) with the airspeed gust `gust` (m/s, TAS above the air-mass speed); throttle
+        limit (1 above the retard height, then idle)."""
         g = self.g
         if not self.flaring:
             self.flaring = True
@@ -331,7 +337,12 @@ class Autopilot:
         v0 = max(v_air, 1.0)
         # feed-forward: the commanded path-angle change, led by the path's lag T_theta2 behind pitch
         ff = ((self._flare_sink0 - sink_c) / v0 + g.flare_t_path_s * sink / (tau * v0)
-              + g.flare_k_v * (self._flare_v0 - v_air))
+              + g.flare_k_v * (self._flare_v0 - v_air) - g.flare_k_gust * gust)
+        if g.flare_ge_k > 0.0:  # the ground effect's lift since flare entry, h_entry = tau (s_0 - s_td)
+            h0 = tau * (self._flare_sink0 - g.touchdown_sink_mps)
+            k_ge = 1.0 + g.flare_ge_k * math.exp(-(max(h_gear, 0.0) + g.flare_ge_arp_m) / g.flare_ge_decay_m)
+            k_ge0 = 1.0 + g.flare_ge_k * math.exp(-(h0 + g.flare_ge_arp_m) / g.flare_ge_decay_m)
+            ff -= 0.5 * g.flare_k_v * self._flare_v0 * math.log(k_ge / k_ge0)
         theta_c = self._theta_flare0 + ff + g.k_flare * e + g.k_flare_i * self._int_flare
         thr_limit = 1.0 if h_gear > g.retard_height_m else 0.0
         return theta_c, thr_limit

@@ -161,6 +161,18 @@ class AutopilotGains:
     flare_k_v: float = 0.0
     """Flare feed-forward: pitch per airspeed lost since flare entry at constant lift and path angle,
     A_alpha,V / (A_alpha,alpha + A_alpha,theta) of the landing linearization, rad s/m (0: none)."""
+    flare_k_gust: float = 0.0
+    """Flare feed-forward: pitch per airspeed gust (true airspeed above the inertially smoothed air-mass speed) at
+    constant lift, A_alpha,V / A_alpha,alpha of the landing linearization (Z_V / Z_alpha), rad s/m (0: none)."""
+    flare_ge_k: float = 0.0
+    """Flare feed-forward of ground effect: the lift factor's rise at the ground, k_ge(h) = 1 + flare_ge_k
+    exp(-h_arp / flare_ge_decay_m) (a fit to the JSBSim model's kCLge table), h_arp the aerodynamic reference
+    point's height (the main gear's plus flare_ge_arp_m); the pitch command gives back the angle of attack that
+    the extra lift makes up, (k_v V_0 / 2) ln(k_ge(h) / k_ge(h_entry)) (0: none)."""
+    flare_ge_decay_m: float = 1.0
+    """Height over which the ground-effect lift factor's rise falls by e, m."""
+    flare_ge_arp_m: float = 0.0
+    """Height of the aerodynamic reference point above the main gear's contact point, m."""
 
 
 @dataclass(frozen=True)

@@ -176,13 +176,20 @@ def test_guidance_flies_on_the_navigation_source():
 
 
 def test_calm_landing_flares_to_a_touchdown_in_the_zone():
-    """Landing run: the flare brings the main gear down in the touchdown zone with a normal sink rate."""
+    """Landing run: the flare brings the main gear down in the touchdown zone at the flare law's own touchdown
+    sink, within 0.3 ft/s in still air. The feed-forwards carry the nominal flare (path, speed, ground effect) and
+    the slow PI (0.65 rad/s crossover, below the gust band) takes up only part of what they miss: measured 1.77 ft/s
+    here and 1.89 ft/s at 20 kt crosswind (docs/touchdown.md sec. 4); the 0.5 ft/s goal of issue 40 is for the
+    turbulent mean, whose first-passage weighting adds 0.3-0.6 ft/s, so a calm miss beyond 0.3 ft/s would leave it
+    no room. The earlier slow loop with the retard at 25 ft landed here at 3.3-3.5 ft/s."""
     profile = _calm_default()
-    r = Approach(profile, land=True).fly(seed=1)
+    approach = Approach(profile, land=True)
+    r = approach.fly(seed=1)
     print(r.termination, r.touchdown_x_m / units.FT, r.touchdown_sink_mps / units.FPS)
     assert r.termination == "touchdown"  # main gear first (nose-gear contact is "ground contact")
     assert 1000.0 <= r.touchdown_x_m / units.FT <= 3000.0  # FAA touchdown zone: the first 3000 ft
-    assert 0.5 <= r.touchdown_sink_mps / units.FPS <= 6.0  # ft/s; 10 ft/s is a hard landing
+    target = approach.aircraft.gains.touchdown_sink_mps
+    assert abs(r.touchdown_sink_mps - target) / units.FPS <= 0.3  # ft/s; 10 ft/s is a hard landing
     # the flare raised the nose above the approach attitude
     t = r.truth
     assert t.euler_rad[-1, 1] > np.median(t.euler_rad[:, 1]) + np.radians(1.0)

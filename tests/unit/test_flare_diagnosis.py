@@ -21,7 +21,7 @@ _spec.loader.exec_module(fd)
 def _rows(sinks_mps: np.ndarray) -> list[dict]:
     n = len(fd.HEIGHTS_FT)
     return [{"termination": "touchdown", "gear": [s] * n, "imu": [s] * n, "lq": [0.0] * n, "td_gear": s,
-             "td_imu": s, "td_pitch_rad": 0.07, "td_cas_mps": 66.0, "entry_sink": 3.7,
+             "td_imu": s, "td_pitch_rad": 0.07, "td_cas_mps": 66.0, "td_x_m": 580.0, "entry_sink": 3.7,
              "before": [s] * len(fd.BEFORE_S)} for s in sinks_mps]
 
 

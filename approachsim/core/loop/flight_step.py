@@ -55,7 +55,11 @@ from approachsim.core.layouts import (
     AP_CONE_C,
     AP_CONV,
     AP_DT,
+    AP_FLARE_GE_ARP,
+    AP_FLARE_GE_DECAY,
+    AP_FLARE_GE_K,
     AP_FLARE_H,
+    AP_FLARE_K_GUST,
     AP_FLARE_K_V,
     AP_FLARE_T_PATH,
     AP_GEAR_ARM,
@@ -583,7 +587,14 @@ def autopilot_step(par: Array, st: Array, guide: tuple, air: tuple) -> tuple[flo
         st[APS_INT_FLARE] += e * dt
         v0 = max(v_air, 1.0)
         ff = ((st[APS_FLARE_SINK0] - sink_c) / v0 + par[AP_FLARE_T_PATH] * sink / (tau * v0)
-              + par[AP_FLARE_K_V] * (st[APS_FLARE_V0] - v_air))
+              + par[AP_FLARE_K_V] * (st[APS_FLARE_V0] - v_air)
+              - par[AP_FLARE_K_GUST] * ((tas - v_air) if tas > 1.0 else 0.0))
+        if par[AP_FLARE_GE_K] > 0.0:  # the ground effect's lift since flare entry, h_entry = tau (s_0 - s_td)
+            h0 = tau * (st[APS_FLARE_SINK0] - td)
+            k_ge = 1.0 + par[AP_FLARE_GE_K] * math.exp(-(max(h_gear, 0.0) + par[AP_FLARE_GE_ARP])
+                                                       / par[AP_FLARE_GE_DECAY])
+            k_ge0 = 1.0 + par[AP_FLARE_GE_K] * math.exp(-(h0 + par[AP_FLARE_GE_ARP]) / par[AP_FLARE_GE_DECAY])
+            ff -= 0.5 * par[AP_FLARE_K_V] * st[APS_FLARE_V0] * math.log(k_ge / k_ge0)
         theta_c = st[APS_THETA_FLARE0] + ff + par[AP_K_FLARE] * e + par[AP_K_FLARE_I] * st[APS_INT_FLARE]
         thr = min(thr, 1.0 if h_gear > par[AP_RETARD_H] else 0.0)
     st[APS_THETA_C] = theta_c

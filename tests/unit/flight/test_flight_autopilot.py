@@ -105,10 +105,11 @@ def test_the_flare_command_starts_at_the_entry_sink_and_ends_at_the_touchdown_si
 
 def test_the_flare_feeds_the_commanded_path_angle_forward(ap):
     """Pitch command of the flare (autopilot.py): at entry (zero sink-rate error) the theta_entry + T_theta2 s_0 /
-    (tau V) lead; one step later, with the sink held, the commanded path-angle change (s_0 - s_c) / V joins it and
-    the P and I terms act on e = s_0 - s_c. V: the smoothed true airspeed (here TAS = ground speed, no wind)."""
+    (tau V) lead; one step later, with the sink held, the commanded path-angle change (s_0 - s_c) / V joins it,
+    the ground effect's angle of attack -(k_v V_0 / 2) ln(k_ge(h) / k_ge(h_f)) with it, and the P and I terms act
+    on e = s_0 - s_c. V: the smoothed true airspeed (here TAS = ground speed, no wind: no speed change, no gust)."""
     g = ap.g
-    assert g.flare_t_path_s == pytest.approx(2.26) and g.k_flare == pytest.approx(0.1)
+    assert g.flare_t_path_s == pytest.approx(2.26) and g.k_flare == pytest.approx(0.03)
     h0, sink0, v = g.flare_height_m - 0.01, 3.8, 70.0
     vg = math.hypot(v, sink0)
     x = -300.0
@@ -121,7 +122,10 @@ def test_the_flare_feeds_the_commanded_path_angle_forward(ap):
     ap.step(x + 0.6, 0.0, _on_path(x), v, 0.0, sink0, 0.0, 0.02, 0.0, 0.0, 0.0, 72.0, h1, tas=vg)
     sink_c = (h1 - ap._flare_h_off) / tau
     e = sink0 - sink_c
-    want = (ap._theta_flare0 + (sink0 - sink_c) / vg + g.flare_t_path_s * sink0 / (tau * vg) + g.k_flare * e
+    k_ge = [1.0 + g.flare_ge_k * math.exp(-(h + g.flare_ge_arp_m) / g.flare_ge_decay_m) for h in (h1, h0)]
+    ge = -0.5 * g.flare_k_v * vg * math.log(k_ge[0] / k_ge[1])
+    assert ge < 0.0  # more lift near the ground: less angle of attack
+    want = (ap._theta_flare0 + (sink0 - sink_c) / vg + g.flare_t_path_s * sink0 / (tau * vg) + ge + g.k_flare * e
             + g.k_flare_i * e * ap.dt)
     assert ap._theta_c == pytest.approx(want, rel=1e-12)
 

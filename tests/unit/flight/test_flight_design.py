@@ -202,6 +202,58 @@ def test_flare_gains_are_the_linearizations(setup):
     s = control.tf("s")
     gm, pm, _, wc = control.margin((g.k_flare + g.k_flare_i / s) * plant)
     wn = float(np.max(np.abs(np.linalg.eigvals(a_cl))))
-    print(f"flare loop: PM {pm:.1f} deg at {wc:.2f} rad/s, GM {gm}, pitch loop natural frequency {wn:.2f} rad/s")
+    # MIL-F-8785C low-altitude Dryden scale of the horizontal gust at 25 ft, L_u = h / (0.177 + 0.000823 h)^1.2
+    h_ft = 25.0
+    l_u = h_ft / (0.177 + 0.000823 * h_ft) ** 1.2 * units.FT
+    corner = lin.vt_mps / l_u
+    print(f"flare loop: PM {pm:.1f} deg at {wc:.2f} rad/s, GM {gm}, pitch loop natural frequency {wn:.2f} rad/s, "
+          f"horizontal gust corner V / L_u {corner:.2f} rad/s")
     assert pm >= PM_MIN_DEG
+    assert not np.isfinite(gm) or 20.0 * np.log10(gm) >= GM_MIN_DB
     assert wc < wn
+    # below the gust band: a loop crossing inside it amplifies the gust at the main gear (docs/touchdown.md sec. 4)
+    assert wc < 0.5 * corner
+
+
+def test_flare_feed_forwards_are_the_linearizations(setup):
+    """The flare's angle-of-attack feed-forwards (aircraft file) against each shipped profile's landing
+    linearization: flare_k_v = A[alpha, V] / (A[alpha, alpha] + A[alpha, theta]) (speed lost at constant lift and
+    path) and flare_k_gust = A[alpha, V] / A[alpha, alpha] = Z_V / Z_alpha (an airspeed gust at constant lift),
+    rad s/m; one aircraft file serves the three profiles, whose speeds and densities differ (the default's 0.00838
+    and 0.00824; gray-maybeck's 14 % higher), hence 15 % as for T_theta2."""
+    from approachsim import units
+
+    lin, ac, gp = setup
+    g = ac.gains
+    a = lin.A
+    k_v = a[1, 0] / (a[1, 1] + a[1, 2]) / units.FT  # A[alpha, Vt] is per ft/s
+    k_gust = a[1, 0] / a[1, 1] / units.FT
+    print(f"k_v {k_v:.5f} (file {g.flare_k_v}), k_gust {k_gust:.5f} (file {g.flare_k_gust})")
+    assert g.flare_k_v == pytest.approx(k_v, rel=0.15)
+    assert g.flare_k_gust == pytest.approx(k_gust, rel=0.15)
+
+
+def test_flare_ground_effect_is_the_models_table():
+    """The flare's ground-effect lift factor 1 + k exp(-h_arp / h_g) (aircraft file flare_ge_*) against JSBSim's
+    737.xml kCLge table (lift factor against the reference point's height over the span, b = 94.7 ft): within
+    0.01 of every point (the fit's largest error is 0.006, and the flare's pitch follows ln k_ge, so 0.01 is 1 %
+    of the lift, 0.2 deg of angle of attack); the reference point's height above the main gear is 737.xml's AERORP
+    z less the main gear's z."""
+    import xml.etree.ElementTree as ET
+
+    import jsbsim
+
+    from approachsim import units
+    from approachsim.flight.aircraft import load_aircraft
+
+    g = load_aircraft(load_profile(PROFILES / "default.toml")).gains
+    root = ET.parse(Path(jsbsim.get_default_root_dir()) / "aircraft" / "737" / "737.xml").getroot()
+    span_ft = float(root.find("metrics/wingspan").text)
+    arp_z_in = float(root.find("metrics/location[@name='AERORP']/z").text)
+    gear_z_in = float(root.find("ground_reactions/contact[@name='Left Main Gear']/location/z").text)
+    assert g.flare_ge_arp_m == pytest.approx((arp_z_in - gear_z_in) * units.IN, abs=0.5 * units.IN)
+    table = root.find(".//function[@name='aero/function/kCLge']/table/tableData").text.split()
+    hb, k = np.array(table[0::2], float), np.array(table[1::2], float)
+    fit = 1.0 + g.flare_ge_k * np.exp(-hb * span_ft * units.FT / g.flare_ge_decay_m)
+    print("fit - table:", np.round(fit - k, 4))
+    assert np.max(np.abs(fit - k)) < 0.01
