@@ -344,7 +344,8 @@ class NavInTheLoop:
                                 states=start_states(self.suite, truth, self.errors))
             self.navigator = Navigator(nav, s, runs, float(truth.t_s[0]), self.t_s.shape[0])
             self.x_nav = np.array(runs[0].fs.x[0:9], dtype=float)
-            self.x_dot, self.t_est = self.navigator.rate_in_force()[0][0], float(truth.t_s[0])
+            xd, self.t_est = self.navigator.rate_in_force()
+            self.x_dot = xd[0]
         navigator = self.navigator
         run = navigator.runs[0]
         if k > 0:
@@ -370,7 +371,8 @@ class NavInTheLoop:
                     self._hb_interval[:] = np.nan
                 navigator.epoch(k, float(truth.t_s[k]), obs, truth)
                 self.x_nav = np.array(run.fs.x[0:9], dtype=float)
-                self.x_dot, self.t_est = navigator.rate_in_force()[0][0], float(truth.t_s[k])
+                xd, self.t_est = navigator.rate_in_force()
+                self.x_dot = xd[0]
         if self.gains is not None and (b := self._apply("baro", k, truth)) is not None:
             # nan (an outage, or the baro excluded by FDE): the INS kernel's damping loop holds
             held = run.baro_excluded() or not bool(np.ravel(b.valid)[0])

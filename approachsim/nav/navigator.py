@@ -201,7 +201,6 @@ class Navigator:
         self.f_sum = np.zeros((n, 3))
         """C_bn dv accumulated since the last epoch (NED, m/s): the mean specific force of the interval."""
         self.t_last = float(t0_s)
-        self._t0 = float(t0_s)
         self._ic = self.layout.i("clk") if self.layout.has("clk") else 0
         self.engine = EpochEngine.of(system)
         self.reduced_runs: list | None = None
@@ -282,7 +281,7 @@ class Navigator:
             self.x[:] = ins.pack(s)
         self.f_sum[:] = 0.0
         self.t_last = t_s
-        self._snapshot(epoch=True, t_s=t_s)
+        self._snapshot(epoch=True)
         self.record_row(row)
         h = self._hist
         h["t"].append(t_s)
@@ -549,11 +548,11 @@ class Navigator:
 
     # --- output --------------------------------------------------------------------------------------------
 
-    def _snapshot(self, epoch: bool = False, t_s: float | None = None) -> None:
+    def _snapshot(self, epoch: bool = False) -> None:
         """Keep x, the position block of P and the clock variance: the estimate in force until the next epoch, with
-        its rate F x (core/nav/output.nav_rate; F the interval's model each aiding path left in `_F`; zeros at the
-        start) and time t_s (the start's when None); at an epoch also each run's P diagonal and navigation block
-        (the filter history)."""
+        its rate F x (core/nav/output.nav_rate; F the interval's model each aiding path left in `interval_F`; zeros
+        at the start) and its time t_last; at an epoch also each run's P diagonal and navigation block (the filter
+        history)."""
         ic = self._ic
         xs, pp, pc, pd, pn = [], [], [], [], []
         rates = np.zeros((len(self.runs), 9))
@@ -571,7 +570,7 @@ class Navigator:
                 pn.append(P[0:9, 0:9])
         self._snaps.append((np.array(xs), np.array(pp), np.array(pc)))
         self._rates.append(rates)
-        self._t_snap.append(self._t0 if t_s is None else float(t_s))
+        self._t_snap.append(self.t_last)
         if epoch:
             self._hist["pd"].append(np.array(pd))
             self._hist["pnav"].append(np.array(pn))
@@ -602,7 +601,7 @@ class Navigator:
                 xs = XS[:, i]
                 r_ecef, v_ned, euler = ko.corrected(self.rows[self.ins_of[i], :n], t_rows, xs, XD[:, i], T, snap)
                 sol = NavSolution(
-                    t_s=np.asarray(truth.t_s[:n], dtype=float),
+                    t_s=t_rows,
                     r_ecef=r_ecef,
                     v_ned=v_ned,
                     euler_rad=euler,
