@@ -4,6 +4,7 @@ and the consistency suite of issue 39 (item 5).
     python tools/consistency_by_state.py PROFILE [--runs 60] [--seed 1] [--set KEY=VALUE ...]
         [--slow-tau-s TAU] [--ideal-imu-axes gyro|accel|gyro,accel] [--filter-turbulence LEVEL]
     python tools/consistency_by_state.py --suite [--runs 60] [--seeds 1 2] [--workers 1] [--out docs/consistency.md]
+    python tools/consistency_by_state.py PROFILE --pool --seeds 1 2 ... 20 [--runs 60] [--workers 2]
 
 The profile is flown once on truth; RUNS seeded sensor realizations and open-loop navigation runs (the shared
 covariance, as campaigns run) follow on that truth. Printed per state (dp N E D m, dv N E D m/s, psi N E D rad; clk
@@ -23,6 +24,12 @@ process noise at another turbulence level (none: the time-constant-only filter, 
 5434 ft field, the last three with the baro scale-factor state) at each seed, the profile's filter and the control
 on the same records, and writes the table with the acceptance of issue 39: every state's e^2/P in [0.8, 1.25],
 inside its band at >= 90 % of the epochs and above it at <= 5 %.
+
+--pool runs PROFILE at each of --seeds (each seed its own truth flight and RUNS sensor draws) and prints, per state,
+what one seed's 95 % check cannot say (pool_seeds): the mean of the seeds' run-averaged ratios with its standard
+error, the seeds' spread against the spread of chi2(R dof) / (R dof) sampling, the 95 % interval at the pooled dof,
+how many seeds fall outside it (a consistent filter: 5 % of them, binomial tail given) and a Kolmogorov-Smirnov test
+of the seeds' chi2 probabilities against the uniform distribution a consistent filter gives them.
 """
 
 from __future__ import annotations
@@ -165,6 +172,54 @@ def summary(e: np.ndarray, d: np.ndarray) -> dict[str, np.ndarray]:
             "bounds": np.array([lo, hi]), "epochs": np.array([z.shape[0], later.start])}
 
 
+def pool_seeds(ratio: np.ndarray, dof: np.ndarray, runs: int) -> dict[str, np.ndarray]:
+    """Per state (columns) over seeds (rows) of run-averaged ratios `ratio` (S, n) with their measured degrees of
+    freedom per run `dof` (S, n), RUNS runs each: mean and its standard error; the seeds' sd and the sd a consistent
+    filter's sampling gives, sqrt(2 / (R d)), d the seeds' mean dof; the 95 % interval of chi2(R d) / (R d); the
+    number of seeds outside it and the binomial probability of at least that many when each is outside with
+    probability 0.05; the Kolmogorov-Smirnov p-value of the seeds' chi2(R d) cdf values against the uniform."""
+    from scipy.stats import binom, kstest
+
+    r, d = np.atleast_2d(ratio), np.atleast_2d(dof)
+    s = r.shape[0]
+    n = runs * d.mean(axis=0)
+    lo, hi = chi2.ppf(0.025, n) / n, chi2.ppf(0.975, n) / n
+    outside = np.sum((r < lo) | (r > hi), axis=0)
+    u = chi2.cdf(r * n, n)
+    return {"mean": r.mean(axis=0), "se": r.std(axis=0, ddof=1) / np.sqrt(s), "sd": r.std(axis=0, ddof=1),
+            "sd_expected": np.sqrt(2.0 / n), "dof": d.mean(axis=0), "lo": lo, "hi": hi, "outside": outside,
+            "p_outside": binom.sf(outside - 1, s, 0.05),
+            "ks_p": np.array([kstest(u[:, c], "uniform").pvalue for c in range(r.shape[1])]),
+            "min": r.min(axis=0), "max": r.max(axis=0), "seeds": np.array(s)}
+
+
+def _seed_summary(profile: Path, runs: int, seed: int, sets: tuple[str, ...]) -> tuple[dict, tuple[str, ...]]:
+    """summary() of PROFILE flown at one seed (the profile's filter), and the state names."""
+    e, d, names = navigate(flown(profile, runs, seed, sets), seed)
+    return summary(e, d), names
+
+
+def run_pool(profile: Path, runs: int, seeds: list[int], sets: tuple[str, ...], workers: int) -> None:
+    """PROFILE at every seed (in `workers` processes); per state the seeds' ratios and pool_seeds printed."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=workers) as ex:
+        res = [f.result() for f in [ex.submit(_seed_summary, profile, runs, s, sets) for s in seeds]]
+    names = res[0][1]
+    ratio = np.array([r[0]["ratio"] for r in res])
+    p = pool_seeds(ratio, np.array([r[0]["dof"] for r in res]), runs)
+    print(f"{profile}: {len(seeds)} seeds x {runs} runs" + "".join(f"; {x}" for x in sets))
+    print(f"  {'state':6s} {'mean':>6s} {'se':>6s} {'sd':>6s} {'sd exp':>6s} {'dof':>5s} {'95 % of a seed':>14s} "
+          f"{'outside':>8s} {'P(>=)':>6s} {'KS p':>5s} {'min':>5s} {'max':>5s}")
+    for c, nm in enumerate(names):
+        print(f"  {nm:6s} {p['mean'][c]:6.3f} {p['se'][c]:6.3f} {p['sd'][c]:6.3f} {p['sd_expected'][c]:6.3f} "
+              f"{p['dof'][c]:5.2f} [{p['lo'][c]:5.2f}, {p['hi'][c]:5.2f}] {p['outside'][c]:4d}/{len(seeds):<3d} "
+              f"{p['p_outside'][c]:6.2f} {p['ks_p'][c]:5.2f} {p['min'][c]:5.2f} {p['max'][c]:5.2f}")
+    print("  per seed: " + "; ".join(f"s{s} " + " ".join(f"{nm} {ratio[i, c]:.2f}" for c, nm in enumerate(names)
+                                                      if nm in ("dp_N", "dp_E", "dp_D", "clk"))
+                                     for i, s in enumerate(seeds)))
+
+
 ROOT = Path(__file__).resolve().parents[1]
 SUITE: dict[str, tuple[str, tuple[str, ...]]] = {
     "default": ("profiles/default.toml", ()),
@@ -249,6 +304,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("profile", type=Path, nargs="?")
     ap.add_argument("--suite", action="store_true")
+    ap.add_argument("--pool", action="store_true", help="PROFILE at each of --seeds, pooled (module docstring)")
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--out", type=Path, default=None)
@@ -266,6 +322,9 @@ def main() -> None:
         return
     if a.profile is None:
         ap.error("PROFILE is required without --suite")
+    if a.pool:
+        run_pool(a.profile, a.runs, a.seeds, tuple(a.set), a.workers)
+        return
     fl = flown(a.profile, a.runs, a.seed, tuple(a.set), a.slow_tau_s, a.ideal_imu_axes)
     e, d, names = navigate(fl, a.seed, a.filter_turbulence)
     s = summary(e, d)

@@ -62,6 +62,24 @@ def test_conditioning_gives_cov_e_equal_P_conv_and_e_orthogonal_to_the_estimate(
     np.testing.assert_allclose(c_hat, (P0 - P_conv)[np.ix_(s, s)], atol=tol * np.max(np.diag(P0)))
 
 
+def test_conditioning_holds_in_mixed_units():
+    """The same law when the states carry the filter's units: gyro-bias-like variances of ~1e-14 next to a clock-like
+    1e4 (scaled by S, P -> S P S). Every state's drawn variance must be its P_conv's (the eigenvalue floor of the
+    conditional covariance relative to its largest eigenvalue zeroed the small states' independent part: their
+    variance came out at the part explained by x_s alone: 0.75, 0.71 and 0.95 of P_conv on the three small states)."""
+    P0, P_conv, s = _linear_case()
+    S = np.array([1e2, 1.0, 1e-7, 1.0, 1e-7, 1e2, 1e-7])
+    P0, P_conv = P0 * np.outer(S, S), P_conv * np.outer(S, S)
+    m, n = 40000, 7
+    g = np.random.default_rng(11)
+    x_s = g.standard_normal((m, 4)) * np.sqrt(np.diag(P0)[s])
+    e, _ = initial.condition(P_conv, P0[np.ix_(s, s)], s, x_s, g.standard_normal((m, n)))
+    sd = np.sqrt(np.diag(P_conv))
+    c_e = e.T @ e / m
+    tol = 5.0 * np.sqrt(2.0 / m)  # as above: 5 sampling sd of a normalized covariance element
+    assert np.max(np.abs(c_e - P_conv) / np.outer(sd, sd)) < tol
+
+
 def test_a_naive_independent_draw_is_not_orthogonal():
     """The check above can fail: e ~ N(0, P_conv) drawn independently of x_s has cov(e, x_hat) = -P_conv."""
     P0, P_conv, s = _linear_case()

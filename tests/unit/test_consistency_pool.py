@@ -1,0 +1,48 @@
+"""The seed pool of the consistency tool (tools/consistency_by_state.py pool_seeds, issue 38's consistency point):
+on synthetic seeds whose run-averaged ratios are drawn as a consistent filter's (chi2(R d) / (R d)) it must find
+nothing, and on seeds of a filter that over-claims by 20 % it must see the shift in every statistic."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+
+import numpy as np
+from scipy.stats import chi2
+
+ROOT = Path(__file__).resolve().parents[2]
+_spec = importlib.util.spec_from_file_location("consistency_by_state", ROOT / "tools" / "consistency_by_state.py")
+cb = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(cb)
+
+RUNS = 60
+DOF = np.array([1.0, 1.7, 7.0])
+"""Degrees of freedom per run of three states: a clock-like slow state, a position, a velocity."""
+
+
+def _seeds(n_seeds: int, scale: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    n = RUNS * DOF
+    r = np.random.default_rng(seed).chisquare(n, size=(n_seeds, DOF.size)) / n * scale
+    return r, np.broadcast_to(DOF, r.shape).copy()
+
+
+def test_consistent_seeds_pass() -> None:
+    p = cb.pool_seeds(*_seeds(400, 1.0, 11), RUNS)
+    # the pooled mean's standard error is sqrt(2 / (R d) / S): within 4 of them of 1
+    assert np.all(np.abs(p["mean"] - 1.0) < 4.0 * np.sqrt(2.0 / (RUNS * DOF) / 400))
+    assert np.allclose(p["sd_expected"], np.sqrt(2.0 / (RUNS * DOF)))
+    # the seeds' spread within 15 % of sampling (S = 400: the sd's own relative sd is about 1 / sqrt(2 S) = 3.5 %)
+    assert np.all(np.abs(p["sd"] / p["sd_expected"] - 1.0) < 0.15)
+    assert np.all(p["outside"] <= 0.05 * 400 + 4.0 * math.sqrt(400 * 0.05 * 0.95))
+    assert np.all(p["ks_p"] > 1e-3)
+    assert np.allclose(p["lo"], chi2.ppf(0.025, RUNS * DOF) / (RUNS * DOF))
+
+
+def test_over_claiming_filter_is_seen() -> None:
+    p = cb.pool_seeds(*_seeds(40, 0.8, 12), RUNS)
+    se = np.sqrt(2.0 / (RUNS * DOF) / 40) * 0.8
+    assert np.all(np.abs(p["mean"] - 0.8) < 4.0 * se)
+    # the velocity-like state (7 dof per run) is outside its interval at most seeds; the test's p-values vanish
+    assert p["outside"][2] > 30 and p["p_outside"][2] < 1e-10 and p["ks_p"][2] < 1e-10
+    assert np.all(p["ks_p"] < 0.05)
