@@ -75,8 +75,8 @@ NAV_GROUPS = ("dp", "dv", "psi", "ac")
 """Error-state groups that are INS states: their true value is the INS error, their start estimate 0."""
 
 EIG_FLOOR = 1e-12
-"""Eigenvalues of the conditional covariance's correlation form below this fraction of its largest are taken as 0
-(`conditioner`)."""
+"""Eigenvalues of the conditional covariance, each state in units of its converged sigma, below this fraction of the
+largest are taken as 0 (`conditioner`)."""
 
 _PSD_TOL = 1e-9
 """Relative tolerance of the Pi_ss >= P_conv[s, s] check (eigenvalues of Pi^-1/2 P_conv Pi^-1/2 above 1)."""
@@ -213,22 +213,19 @@ def conditioner(P_conv: Array, Pi_ss: Array, s: Array) -> Conditioner:
     # in the states' own scales: C mixes units (gyro bias variances ~1e-14 rad^2/s^2 beside the clock's 1e4 m^2), so a
     # floor relative to its largest eigenvalue zeroed whole state directions (the gyro biases' independent part: the
     # drawn estimation error came out smaller than P_conv, and the filter over-claimed the horizontal velocity by
-    # 20 % over the approach, docs/consistency.md); its eigen-decomposition is taken of the correlation form
-    # C_n = D^-1 C D^-1, D = diag(C)^1/2, where rounding is relative to 1 in every direction. A state whose
-    # conditional variance is below EIG_FLOOR of its P_conv is determined by x_s (a channel out of view: e = x) and
-    # its diagonal is rounding: it is taken as 0, not normalized
-    dc = np.diag(C)
-    sd = np.sqrt(np.where(dc > EIG_FLOOR * np.abs(np.diag(P_conv)), dc, 0.0))
+    # 20 % over the approach, docs/consistency.md); its eigen-decomposition is taken of D^-1 C D^-1, D =
+    # diag(P_conv)^1/2, each state in units of its own converged sigma, where rounding is relative to 1 everywhere
+    sd = np.sqrt(np.maximum(np.diag(P_conv), 0.0))
     inv = np.divide(1.0, sd, out=np.zeros_like(sd), where=sd > 0.0)
     w, V = np.linalg.eigh(inv[:, None] * C * inv[None, :])
     scale = max(float(np.max(np.abs(w))), 1e-300)
     if w.min() < -1e-9 * scale:
         raise ValueError(f"converged start: conditional covariance not positive ({w.min():.3g})")
-    # L = D V sqrt(Lambda) V' (L L' = C): V sqrt(Lambda) V' is C_n's symmetric square root, unique, so L is continuous
-    # in C. A factor V sqrt(Lambda) alone depends on the eigenvector basis, which rounding rotates freely within
-    # (near-)repeated eigenvalues: a rounding-level change of P_conv would then redraw the run. Eigenvalues of C_n
-    # below EIG_FLOOR of the largest are rounding (C is singular by design) and taken as 0: a square root turns a
-    # rounding change d of a zero eigenvalue into a sqrt(d) change of the draw
+    # L = D V sqrt(Lambda) V' (L L' = C): V sqrt(Lambda) V' is the scaled C's symmetric square root, unique, so L
+    # is continuous in C. A factor V sqrt(Lambda) alone depends on the eigenvector basis, which rounding rotates
+    # freely within (near-)repeated eigenvalues: a rounding-level change of P_conv would then redraw the run.
+    # Eigenvalues of the scaled C below EIG_FLOOR of the largest are rounding (C is singular by design) and taken
+    # as 0: a square root turns a rounding change d of a zero eigenvalue into a sqrt(d) change of the draw
     L = sd[:, None] * ((V * np.sqrt(np.where(w > EIG_FLOOR * scale, w, 0.0))[None, :]) @ V.T)
     return Conditioner(G, L, np.asarray(s), excess)
 

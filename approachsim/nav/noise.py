@@ -66,16 +66,19 @@ the gradient states). Why the troposphere: per channel it made the DFMC filter's
 with gtz).
 
 Gyro scale-factor and misalignment errors (`gyro_axis_q`): the IMU's (S + M) w_ib (random constants per run, the
-grade's sigmas) is process noise, not 9 filter states. In light turbulence it is what turns the drift-matched
-filter's along-track velocity over-confident (default profile: east velocity e^2/P 1.27 with them in the truth,
-0.99 without; 0.99 in calm air with them): the slow pitch and yaw excursions (periods 20-100 s) rotate the body
-through a few degrees and back, and 100 ppm of that is a few microradians of tilt the aiding removes only slowly. A
-white rate noise with the body rates' spectrum in that band (BODY_RATE_PSD, measured on the flown airframe) gives
-q_k = sf^2 S_k + mis^2 (S_i + S_j) per body axis; states would need the body rate in the compiled error dynamics
-(every epoch kernel's inputs), 9 more states in every covariance, and would estimate quantities that, at 100 ppm
-and 0.02 mrad, the approach's few degrees of rotation cannot observe. The accelerometer's scale factor and
-misalignment are in the ba prior (under 1 g they look like a bias); with both the gyro's and the accelerometer's
-removed from the truth the default profile's east velocity e^2/P is 0.99, as with the gyro's alone.
+grade's sigmas) is process noise, not 9 filter states. Integrated, it is an attitude error (S + M) Theta(t), Theta the
+integral of the body rate: in light turbulence the 737 rotates a few degrees and back, and 100 ppm of that is a few
+microradians of tilt that accelerates the horizontal velocity error until the aiding takes it out. The filter
+carries it as a white noise of the attitude error's rate per body axis, q_k = sf^2 W_k + mis^2 (W_i + W_j), W_k the
+white-noise equivalent of the airframe's rotation over the aided filter's velocity-error correlation time T = 25 s,
+Var(Theta_k(t + T) - Theta_k(t)) / T (BODY_ROTATION_Q, measured on the flown airframe by tools/body_rate_psd.py):
+the noise's increments over T have the variance sf^2 Var(delta Theta(T)) the truth's have. The body-rate spectrum over
+0.01-0.05 Hz, used before, is that equivalent's short-lag limit; the rotation being bounded, it overstated the pitch
+axis 2.7-fold at 25 s and, with the converged start's draw fixed (nav/initial.py conditioner), left the horizontal
+velocity over-claimed (default profile, seeds 1-2: e^2/P 0.81-0.93; docs/consistency.md). States would need the body
+rate in the compiled error dynamics (every epoch kernel's inputs), 9 more states in every covariance, and would
+estimate quantities that, at 100 ppm and 0.02 mrad, the approach's few degrees of rotation cannot observe. The
+accelerometer's scale factor and misalignment are in the ba prior (under 1 g they look like a bias).
 """
 
 from __future__ import annotations
@@ -104,15 +107,16 @@ SKY_SIN_EL = np.linspace(np.sin(np.radians(5.0)), 1.0, 16)
 """The reference sky of `slow_tau_s`: 16 elevations equally spaced in sin(el) from 5 deg to the zenith (equal solid
 angle above the default 5 deg mask)."""
 
-BODY_RATE_PSD: dict[str, tuple[float, float, float]] = {
+BODY_ROTATION_Q: dict[str, tuple[float, float, float]] = {
     "none": (0.0, 0.0, 0.0),
-    "light": (2.37e-6, 1.43e-4, 8.07e-5),
-    "moderate": (5.83e-6, 3.14e-4, 1.76e-4),
-    "severe": (1.31e-5, 7.07e-4, 3.96e-4),
+    "light": (3.08e-5, 5.23e-5, 3.51e-5),
+    "moderate": (7.44e-5, 1.15e-4, 8.05e-5),
+    "severe": (1.67e-4, 2.59e-4, 1.81e-4),
 }
-"""Two-sided PSD of the airframe's body rates (roll, pitch, yaw), rad^2/s^2/Hz, over 0.01-0.05 Hz, by turbulence
-level: tools/body_rate_psd.py on the default profile's 737 (seeds 1-3); severe, beyond the 737's approach limit, is
-moderate x (75 / 50)^2, the Dryden gust variance ratio (engineering choice)."""
+"""White-noise equivalent of the airframe's rotation (roll, pitch, yaw) over the aided filter's velocity-error
+correlation time, Var(Theta(t + 25 s) - Theta(t)) / 25 s, rad^2/s, by turbulence level: tools/body_rate_psd.py on
+the default profile's 737 (seeds 1-6; light +- 1.9e-6, 7.5e-6, 2.8e-6 over the seeds); severe, beyond the 737's
+approach limit, is moderate x (75 / 50)^2, the Dryden gust variance ratio (engineering choice)."""
 
 PSEUDOLITE_CLOCK = ("ocxo", 30.0, 0.03)
 """An unsynchronized pseudolite's transmitter clock: oscillator, bias and drift 1-sigma at the start (m, m/s)."""
@@ -161,7 +165,7 @@ class NoiseModel:
     baro_ref_m: float = 0.0
     """The baro scale factor's reference H_ref: the altimeter-setting reference (the field's height), m."""
     turbulence: str = "none"
-    """The environment's turbulence level (BODY_RATE_PSD): the body rates the gyro axis errors act on."""
+    """The environment's turbulence level (BODY_ROTATION_Q): the body rotation the gyro axis errors act on."""
     _cache: dict = field(default_factory=dict, init=False, compare=False, repr=False)
 
     def clock(self) -> ClockModel:
@@ -290,11 +294,12 @@ class NoiseModel:
 
     def gyro_axis_q(self) -> tuple[float, float, float]:
         """White rate noise (rad^2/s) on body axes x, y, z for the gyro scale-factor and misalignment errors the
-        filter has no states for: the error rate (S + M) w_ib, S and M random constants of 1-sigma gyro_sf and
-        gyro_misalign_rad (the grade), at the body-rate spectrum S_k of the turbulence level (BODY_RATE_PSD, the
-        0.01-0.05 Hz band), q_k = sf^2 S_k + mis^2 (S_i + S_j). Why process noise, not 9 states: module docstring."""
+        filter has no states for: the attitude error (S + M) Theta, S and M random constants of 1-sigma gyro_sf and
+        gyro_misalign_rad (the grade), Theta the body's rotation, white-noise equivalent W_k over the filter's
+        velocity-error time at the turbulence level (BODY_ROTATION_Q), q_k = sf^2 W_k + mis^2 (W_i + W_j). Why this
+        form, and why not 9 states: module docstring."""
         g = PRESETS[self.sensors.imu.grade]
-        s = np.asarray(BODY_RATE_PSD[self.turbulence])
+        s = np.asarray(BODY_ROTATION_Q[self.turbulence])
         q = g.gyro_sf**2 * s + g.gyro_misalign_rad**2 * (s.sum() - s)
         return float(q[0]), float(q[1]), float(q[2])
 
