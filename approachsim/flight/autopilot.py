@@ -231,8 +231,7 @@ class Autopilot:
             # radio altitude sees it: h' = -vd - slope x'
             sink = vd + self.surface_slope * x0
             gust = tas - v_air if tas is not None and tas > 1.0 else 0.0  # the airspeed gust about the air mass
-            theta_c, thr_flare = self._flare(h_gear, sink, v_air, gust)
-            thr = min(thr, thr_flare)
+            theta_c, thr = self._flare(h_gear, sink, v_air, gust, thr)
         self._theta_c = theta_c
         de = -g.k_theta * (theta_c - theta) + g.k_q * q
         psi, r = yaw if yaw is not None else (math.nan, 0.0)
@@ -316,7 +315,7 @@ class Autopilot:
                 self._int_flare, self._theta_c, self._v_lag, self.int_t, self.int_b, self._flare_tau,
                 self._flare_h_off, float(self.aligning), self._flare_sink0, self._flare_v0, self.surface_slope)
 
-    def _flare(self, h_gear: float, sink: float, v_air: float, gust: float) -> tuple[float, float]:
+    def _flare(self, h_gear: float, sink: float, v_air: float, gust: float, thr: float) -> tuple[float, float]:
         """Exponential flare with its path feed-forward (module docstring): pitch command to fly the main gear's
         sink rate `sink` (m/s, + down) onto h'_c = -(h_gear - h_off) / tau, tau and h_off from the sink rate at
         entry, at airspeed v_air (m/s) with the airspeed gust `gust` (m/s, TAS above the air-mass speed); throttle
@@ -344,8 +343,16 @@ class Autopilot:
             k_ge0 = 1.0 + g.flare_ge_k * math.exp(-(h0 + g.flare_ge_arp_m) / g.flare_ge_decay_m)
             ff -= 0.5 * g.flare_k_v * self._flare_v0 * math.log(k_ge / k_ge0)
         theta_c = self._theta_flare0 + ff + g.k_flare * e + g.k_flare_i * self._int_flare
-        thr_limit = 1.0 if h_gear > g.retard_height_m else 0.0
-        return theta_c, thr_limit
+        # the nose-gear floor below its height (its integral frozen there); a flare held on it has more lift than it
+        # wants (fast): idle while it holds
+        floor = g.flare_pitch_min_rad + math.atan(self.surface_slope)
+        if h_gear <= g.flare_pitch_min_height_m and theta_c < floor:
+            theta_c = floor
+            self._int_flare -= e * self.dt
+            thr = 0.0
+        if h_gear <= g.retard_height_m:
+            thr = 0.0
+        return theta_c, thr
 
 
 def _wrap(a: float) -> float:
