@@ -61,7 +61,12 @@ Landing runs (h_gear: main-gear height above the terrain, the radio altitude) ad
   gust u_g = V_tas - V (the true airspeed above the inertially smoothed air-mass speed); the ln term gives back
   the angle of attack that ground effect's extra lift makes up (lift factor k_ge(h) = 1 + k_g exp(-(h + h_arp) /
   h_g), a fit to the aircraft model's ground-effect table; (k_v V_0 / 2) = C_L / C_L_alpha); the PI on e takes up
-  what they leave. The throttle goes to idle below retard_height (0: thrust kept to contact).
+  what they leave. The throttle goes to idle below retard_height (0: thrust kept to contact). Below
+  pitch_min_height the pitch command is held at least at the nose-gear floor theta_min + atan(runway slope) (the
+  pitch at which the main gear touches first and takes the weight before the nose gear, with a margin: the aircraft
+  file), the integral frozen while it holds, and the throttle is at idle while it holds: a flare the floor holds has
+  more lift than it wants (it is fast: a tailwind's fall toward the ground raises the airspeed), so the speed the
+  floor keeps off the pitch is bled rather than floated.
 * a runway alignment below align_height (the 737 MAX's alignment mode engages at 450 ft radio altitude, 737 MAX
   FCOM): the rudder turns the heading onto the runway's and holds the sideslip that the crosswind then needs (the
   737 FCTM's sideslip technique: "prior to the flare the airplane centerline is aligned on or parallel to the
@@ -318,8 +323,9 @@ class Autopilot:
     def _flare(self, h_gear: float, sink: float, v_air: float, gust: float, thr: float) -> tuple[float, float]:
         """Exponential flare with its path feed-forward (module docstring): pitch command to fly the main gear's
         sink rate `sink` (m/s, + down) onto h'_c = -(h_gear - h_off) / tau, tau and h_off from the sink rate at
-        entry, at airspeed v_air (m/s) with the airspeed gust `gust` (m/s, TAS above the air-mass speed); throttle
-        limit (1 above the retard height, then idle)."""
+        entry, at airspeed v_air (m/s) with the airspeed gust `gust` (m/s, TAS above the air-mass speed), with the
+        nose-gear floor; thr the autothrottle's throttle, idle below the retard height and while the floor holds.
+        Returns (pitch command, throttle)."""
         g = self.g
         if not self.flaring:
             self.flaring = True
