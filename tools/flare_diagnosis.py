@@ -4,6 +4,7 @@ linear model of the flare loop's response to gusts.
     python tools/flare_diagnosis.py landings --runs 200 --out F.json     # 20 kt crosswind, light turbulence
     python tools/flare_diagnosis.py landings --runs 1 --turbulence none  # calm air (one flight: deterministic)
     python tools/flare_diagnosis.py model                                # the loop's gust response, its margins
+    python tools/flare_diagnosis.py retard                               # a retard's effect on the path (linear)
     [--set NAME=VALUE ...]  AutopilotGains overrides (SI), e.g. --set k_flare=0.03 --set k_flare_i=0.005
     model only: [--gust-ff K]  a pitch feed-forward -K u_g of the airspeed gust added to the law's flare_k_gust
                 (rad s/m; analysis); [--gear-fb C]  feed back the IMU's sink plus C l q (1: the main gear's)
@@ -277,6 +278,65 @@ def model(overrides: dict[str, float], k_gust: float = 0.0, gear_fb: float = 0.0
             "crossover_rad_s": float(wc), "pitch_loop_natural_rad_s": float(np.max(np.abs(np.linalg.eigvals(a_cl))))}
 
 
+def retard_response(lin, g, c: float, t_s: np.ndarray) -> np.ndarray:
+    """The CG's climb rate (m/s) at times t_s (s, ascending) after the throttle is cut by one unit, with the pitch
+    loop closed on the command theta_c = flare_k_v (V_0 - V) + c (the flare's speed feed-forward and a step c per
+    unit of throttle withheld, rad), the linearization's Vt, alpha, theta, q (speed free): the retard's effect on
+    the path that a feed-forward would have to cancel (docs/touchdown.md sec. 4, fifth part)."""
+    from scipy.linalg import expm
+
+    idx = [0, 1, 2, 3]
+    scale = np.diag([units.FPS, 1.0, 1.0, 1.0])
+    a = scale @ lin.A[np.ix_(idx, idx)] @ np.linalg.inv(scale)
+    b_thr, b_de = scale @ lin.B[idx, 0], scale @ lin.B[idx, 2]
+    # de = -k_theta (theta_c - theta) + k_q q with theta_c = -k_v V + c u
+    a_cl = a + np.outer(b_de, [g.k_theta * g.flare_k_v, 0.0, g.k_theta, g.k_q])
+    b = b_thr * -1.0 + (-g.k_theta * b_de) * c
+    out, x, t0 = [], np.zeros(4), 0.0
+    for t in t_s:
+        m = expm(np.block([[a_cl, b[:, None]], [np.zeros((1, 5))]]) * (t - t0))
+        x = m[:4, :4] @ x + m[:4, 4]
+        t0 = t
+        out.append(lin.vt_mps * (x[2] - x[1]))
+    return np.array(out)
+
+
+def retard_feed_forward(lin, g, horizon_s: float) -> float:
+    """The step in pitch command per unit of throttle withheld (rad) that leaves the height lost `horizon_s` after
+    the retard at zero, in the model of retard_response (linear in c: two evaluations)."""
+    t = np.linspace(0.0, horizon_s, 401)
+
+    def height(c: float) -> float:
+        return float(np.trapezoid(retard_response(lin, g, c, t), t))
+
+    h0, h1 = height(0.0), height(1.0)
+    return -h0 / (h1 - h0)
+
+
+def pitch_command_gain(lin, g) -> float:
+    """Pitch per pitch command at constant path (alpha and theta change together) with the proportional pitch loop
+    closed, M_de k_theta / (M_alpha + M_theta + M_de k_theta), over the angle of attack the trim elevator's own lift
+    adds, (A_aa + A_at + B_a,de (-(M_a + M_t) / M_de)) / (A_aa + A_at): how much of an angle-of-attack feed-forward
+    a pitch command delivers."""
+    a, b = lin.A, lin.B
+    m_a, m_de = a[3, 1] + a[3, 2], b[3, 2]
+    droop = m_de * g.k_theta / (m_a + m_de * g.k_theta)
+    lift = (a[1, 1] + a[1, 2] + b[1, 2] * (-m_a / m_de)) / (a[1, 1] + a[1, 2])
+    return droop * lift
+
+
+def retard(overrides: dict[str, float]) -> dict:
+    ap = Approach(load_profile(ROOT / "profiles" / "default.toml"))
+    g = dataclasses.replace(ap.aircraft.gains, **overrides)
+    lin = ap.linearization
+    t = np.arange(1.0, 8.0)
+    c = retard_feed_forward(lin, g, 5.3)
+    return {"pitch_command_gain": pitch_command_gain(lin, g),
+            "climb_rate_mps_1_to_7_s": [round(float(x), 3) for x in retard_response(lin, g, 0.0, t)],
+            "feed_forward_rad_per_unit_throttle": {f"{h:g} s": retard_feed_forward(lin, g, h) for h in (4.0, 5.3, 6.0)},
+            "climb_rate_with_it_5.3_s_mps": [round(float(x), 3) for x in retard_response(lin, g, c, t)]}
+
+
 def _print_summary(s: dict) -> None:
     print(f"{s['touchdowns']} of {s['landings']} landed; touchdown sink {s['td_sink_fps']['mean']:.2f} +- "
           f"{s['td_sink_fps']['sd']:.2f} ft/s (target {s['target_fps']:.2f}: miss {s['miss_fps']:+.2f} = tracking "
@@ -295,7 +355,7 @@ def _print_summary(s: dict) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=("landings", "model"))
+    ap.add_argument("what", choices=("landings", "model", "retard"))
     ap.add_argument("--runs", type=int, default=200)
     ap.add_argument("--wind-kt", type=float, default=20.0)
     ap.add_argument("--turbulence", default="light")
@@ -312,6 +372,9 @@ def main() -> None:
         out = {"runs": a.runs, "wind_kt": a.wind_kt, "turbulence": a.turbulence, "overrides": overrides,
                **summary(rows, td)}
         _print_summary(out)
+    elif a.what == "retard":
+        out = {"overrides": overrides, **retard(overrides)}
+        print(json.dumps(out, indent=1))
     else:
         out = {"overrides": overrides, "gust_ff": a.gust_ff, "gear_fb": a.gear_fb,
                **model(overrides, a.gust_ff, a.gear_fb)}

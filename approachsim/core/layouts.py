@@ -136,7 +136,8 @@ AP_GAINS = ("k_theta", "k_q", "k_gs_p", "k_gs_d", "k_gs_i", "k_v_p", "k_v_i", "t
             "tecs_seb_ff", "tecs_spd_weight", "tecs_rate_tau_s", "tecs_sink_max_mps", "tecs_climb_max_mps",
             "tecs_vert_acc_mps2", "align_height_m", "align_tau_s", "k_r_align", "k_beta_align", "k_phi_align",
             "k_da_align", "align_bank_max_rad", "align_cas_mps", "align_sideslip_max_rad", "flare_t_path_s",
-            "flare_k_v", "flare_k_gust", "flare_ge_k", "flare_ge_decay_m", "flare_ge_arp_m")
+            "flare_k_v", "flare_k_gust", "flare_ge_k", "flare_ge_decay_m", "flare_ge_arp_m",
+            "flare_pitch_min_rad", "flare_pitch_min_height_m")
 """flight.design.AutopilotGains fields, in the order of the autopilot parameter vector."""
 AP_PAR = Layout(_scalars(*AP_GAINS, "theta0_rad", "throttle0", "cas0_mps", "cos_heading", "sin_heading",
                          "heading_rad", "tan_gp", "x_gpi_m", "cone_a", "cone_b", "cone_c", "conv_per_east_m",
@@ -146,9 +147,9 @@ AP_PAR = Layout(_scalars(*AP_GAINS, "theta0_rad", "throttle0", "cas0_mps", "cos_
  AP_K_FLARE, AP_K_FLARE_I, AP_RETARD_H, AP_TECS, AP_T_H, AP_T_V, AP_K_THR, AP_K_TD, AP_K_TI, AP_K_PD, AP_K_PI,
  AP_SEB_FF, AP_SPD_W, AP_RATE_TAU, AP_SINK_MAX, AP_CLIMB_MAX, AP_VERT_ACC, AP_ALIGN_H, AP_ALIGN_TAU, AP_K_R_ALIGN,
  AP_K_BETA_ALIGN, AP_K_PHI_ALIGN, AP_K_DA_ALIGN, AP_ALIGN_BANK_MAX, AP_ALIGN_CAS, AP_ALIGN_BETA_MAX, AP_FLARE_T_PATH,
- AP_FLARE_K_V, AP_FLARE_K_GUST, AP_FLARE_GE_K, AP_FLARE_GE_DECAY, AP_FLARE_GE_ARP, AP_THETA0, AP_THR0, AP_CAS0,
- AP_CH, AP_SH, AP_HEADING, AP_TAN_GP, AP_X_GPI, AP_CONE_A, AP_CONE_B, AP_CONE_C, AP_CONV, AP_GEAR_ARM,
- AP_DT) = AP_PAR.starts()
+ AP_FLARE_K_V, AP_FLARE_K_GUST, AP_FLARE_GE_K, AP_FLARE_GE_DECAY, AP_FLARE_GE_ARP, AP_FLARE_PITCH_MIN,
+ AP_FLARE_PITCH_MIN_H, AP_THETA0, AP_THR0, AP_CAS0, AP_CH, AP_SH, AP_HEADING, AP_TAN_GP,
+ AP_X_GPI, AP_CONE_A, AP_CONE_B, AP_CONE_C, AP_CONV, AP_GEAR_ARM, AP_DT) = AP_PAR.starts()
 N_AP_PAR = AP_PAR.size
 AP_STATE = Layout(_scalars("int_d", "int_y", "e_f", "wind", "int_e", "flaring", "theta_flare0", "int_flare",
                            "theta_c", "v_lag", "int_t", "int_b", "flare_tau", "flare_h_off", "aligning",

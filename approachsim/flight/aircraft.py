@@ -203,6 +203,8 @@ def _gains(s: Section) -> AutopilotGains:
         flare_ge_decay_m=s.number("flare_ge_decay_ft", 1.0 / units.FT, lo=0.0, hi=500.0, lo_open=True, unit="ft")
         * units.FT,
         flare_ge_arp_m=s.number("flare_ge_arp_ft", 0.0, lo=0.0, hi=50.0, unit="ft") * units.FT,
+        flare_pitch_min_rad=math.radians(s.number("flare_pitch_min_deg", -90.0, lo=-90.0, hi=10.0, unit="deg")),
+        flare_pitch_min_height_m=s.number("flare_pitch_min_height_ft", 0.0, lo=0.0, hi=200.0, unit="ft") * units.FT,
     )
     s.done()
     return g

@@ -61,7 +61,12 @@ Landing runs (h_gear: main-gear height above the terrain, the radio altitude) ad
   gust u_g = V_tas - V (the true airspeed above the inertially smoothed air-mass speed); the ln term gives back
   the angle of attack that ground effect's extra lift makes up (lift factor k_ge(h) = 1 + k_g exp(-(h + h_arp) /
   h_g), a fit to the aircraft model's ground-effect table; (k_v V_0 / 2) = C_L / C_L_alpha); the PI on e takes up
-  what they leave. The throttle goes to idle below retard_height (0: thrust kept to contact).
+  what they leave. The throttle goes to idle below retard_height (0: thrust kept to contact). Below
+  pitch_min_height the pitch command is held at least at the nose-gear floor theta_min + atan(runway slope) (the
+  pitch at which the main gear touches first and takes the weight before the nose gear, with a margin: the aircraft
+  file), the integral frozen while it holds, and the throttle is at idle while it holds: a flare the floor holds has
+  more lift than it wants (it is fast: a tailwind's fall toward the ground raises the airspeed), so the speed the
+  floor keeps off the pitch is bled rather than floated.
 * a runway alignment below align_height (the 737 MAX's alignment mode engages at 450 ft radio altitude, 737 MAX
   FCOM): the rudder turns the heading onto the runway's and holds the sideslip that the crosswind then needs (the
   737 FCTM's sideslip technique: "prior to the flare the airplane centerline is aligned on or parallel to the
@@ -231,8 +236,7 @@ class Autopilot:
             # radio altitude sees it: h' = -vd - slope x'
             sink = vd + self.surface_slope * x0
             gust = tas - v_air if tas is not None and tas > 1.0 else 0.0  # the airspeed gust about the air mass
-            theta_c, thr_flare = self._flare(h_gear, sink, v_air, gust)
-            thr = min(thr, thr_flare)
+            theta_c, thr = self._flare(h_gear, sink, v_air, gust, thr)
         self._theta_c = theta_c
         de = -g.k_theta * (theta_c - theta) + g.k_q * q
         psi, r = yaw if yaw is not None else (math.nan, 0.0)
@@ -316,11 +320,12 @@ class Autopilot:
                 self._int_flare, self._theta_c, self._v_lag, self.int_t, self.int_b, self._flare_tau,
                 self._flare_h_off, float(self.aligning), self._flare_sink0, self._flare_v0, self.surface_slope)
 
-    def _flare(self, h_gear: float, sink: float, v_air: float, gust: float) -> tuple[float, float]:
+    def _flare(self, h_gear: float, sink: float, v_air: float, gust: float, thr: float) -> tuple[float, float]:
         """Exponential flare with its path feed-forward (module docstring): pitch command to fly the main gear's
         sink rate `sink` (m/s, + down) onto h'_c = -(h_gear - h_off) / tau, tau and h_off from the sink rate at
-        entry, at airspeed v_air (m/s) with the airspeed gust `gust` (m/s, TAS above the air-mass speed); throttle
-        limit (1 above the retard height, then idle)."""
+        entry, at airspeed v_air (m/s) with the airspeed gust `gust` (m/s, TAS above the air-mass speed), with the
+        nose-gear floor; thr the autothrottle's throttle, idle below the retard height and while the floor holds.
+        Returns (pitch command, throttle)."""
         g = self.g
         if not self.flaring:
             self.flaring = True
@@ -344,8 +349,16 @@ class Autopilot:
             k_ge0 = 1.0 + g.flare_ge_k * math.exp(-(h0 + g.flare_ge_arp_m) / g.flare_ge_decay_m)
             ff -= 0.5 * g.flare_k_v * self._flare_v0 * math.log(k_ge / k_ge0)
         theta_c = self._theta_flare0 + ff + g.k_flare * e + g.k_flare_i * self._int_flare
-        thr_limit = 1.0 if h_gear > g.retard_height_m else 0.0
-        return theta_c, thr_limit
+        # the nose-gear floor below its height (its integral frozen there); a flare held on it has more lift than it
+        # wants (fast): idle while it holds
+        floor = g.flare_pitch_min_rad + math.atan(self.surface_slope)
+        if h_gear <= g.flare_pitch_min_height_m and theta_c < floor:
+            theta_c = floor
+            self._int_flare -= e * self.dt
+            thr = 0.0
+        if h_gear <= g.retard_height_m:
+            thr = 0.0
+        return theta_c, thr
 
 
 def _wrap(a: float) -> float:

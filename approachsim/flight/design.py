@@ -173,6 +173,10 @@ class AutopilotGains:
     """Height over which the ground-effect lift factor's rise falls by e, m."""
     flare_ge_arp_m: float = 0.0
     """Height of the aerodynamic reference point above the main gear's contact point, m."""
+    flare_pitch_min_rad: float = -math.pi / 2.0
+    """Floor of the flare's pitch command above the runway surface's own pitch, rad."""
+    flare_pitch_min_height_m: float = 0.0
+    """Main-gear height below which the floor holds, m."""
 
 
 @dataclass(frozen=True)

@@ -53,3 +53,34 @@ def test_the_dryden_spectra_carry_their_variances():
     s_u = s_w / (0.177 + 0.000823 * h) ** 0.4
     assert math.isclose(np.trapezoid(phi_u, w), s_u**2, rel_tol=2e-3)
     assert math.isclose(np.trapezoid(phi_w, w), s_w**2, rel_tol=2e-3)
+
+
+def test_the_retard_model_and_the_pitch_command_gain():
+    """The retard analysis on the default profile's landing linearization: after a one-unit throttle cut the CG
+    sinks from the first 0.1 s and faster each second for 7 s with the speed feed-forward alone (the pitch loop
+    lags and droops under the ramping command); the step feed-forward that nulls the height lost at 5.3 s leaves
+    it there within 1 mm. The pitch command gain, a closed form, equals an independent linear solve of the
+    constant-path trim (alpha = theta, q = 0) for a speed change: the moment balance, the elevator of the
+    proportional loop and the lift balance with the elevator's own lift, solved for the command, within 1e-9."""
+    from approachsim.flight.run import Approach
+    from approachsim.profile import load_profile
+
+    ap = Approach(load_profile(ROOT / "profiles" / "default.toml"))
+    lin, g = ap.linearization, ap.aircraft.gains
+    h_dot = fd.retard_response(lin, g, 0.0, np.array([0.1]))[0]
+    t = np.arange(1.0, 8.0)
+    sink = fd.retard_response(lin, g, 0.0, t)
+    assert h_dot < 0.0 and np.all(np.diff(sink) < 0.0)
+    c = fd.retard_feed_forward(lin, g, 5.3)
+    tt = np.linspace(0.0, 5.3, 401)
+    assert abs(np.trapezoid(fd.retard_response(lin, g, c, tt), tt)) < 1e-3
+    # the constant-path trim: unknowns alpha (= theta), de, theta_c for a speed change dv
+    m_a, m_de = lin.A[3, 1], lin.B[3, 2]
+    a_av, a_aa, a_at, b_ade = lin.A[1, 0] / units.FT, lin.A[1, 1], lin.A[1, 2], lin.B[1, 2]
+    dv = -1.0
+    m = np.array([[m_a + lin.A[3, 2], m_de, 0.0],  # moment: M_alpha alpha + M_theta theta + M_de de = 0
+                  [-g.k_theta, 1.0, g.k_theta],  # de = -k_theta (theta_c - theta)
+                  [a_aa + a_at, b_ade, 0.0]])  # lift: A_aV dv + (A_aa + A_at) alpha + B_a,de de = 0
+    alpha, de, theta_c = np.linalg.solve(m, [0.0, 0.0, -a_av * dv])
+    alpha_bare = -a_av * dv / (a_aa + a_at)  # what flare_k_v intends: k_v (V_0 - V)
+    assert math.isclose(alpha_bare / theta_c, fd.pitch_command_gain(lin, g), rel_tol=1e-9)

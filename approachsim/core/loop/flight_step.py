@@ -61,6 +61,8 @@ from approachsim.core.layouts import (
     AP_FLARE_H,
     AP_FLARE_K_GUST,
     AP_FLARE_K_V,
+    AP_FLARE_PITCH_MIN,
+    AP_FLARE_PITCH_MIN_H,
     AP_FLARE_T_PATH,
     AP_GEAR_ARM,
     AP_HEADING,
@@ -596,7 +598,17 @@ def autopilot_step(par: Array, st: Array, guide: tuple, air: tuple) -> tuple[flo
             k_ge0 = 1.0 + par[AP_FLARE_GE_K] * math.exp(-(h0 + par[AP_FLARE_GE_ARP]) / par[AP_FLARE_GE_DECAY])
             ff -= 0.5 * par[AP_FLARE_K_V] * st[APS_FLARE_V0] * math.log(k_ge / k_ge0)
         theta_c = st[APS_THETA_FLARE0] + ff + par[AP_K_FLARE] * e + par[AP_K_FLARE_I] * st[APS_INT_FLARE]
-        thr = min(thr, 1.0 if h_gear > par[AP_RETARD_H] else 0.0)
+        # the nose-gear floor below its height: the pitch above the runway's own with which the main gear touches
+        # first and takes the weight before the nose gear, with its margin (aircraft file); the integral frozen there.
+        # A flare held on it has more lift than it wants (fast: a shear's airspeed gain): the throttle is at idle
+        # while it holds, and the speed the floor keeps off the pitch is bled instead of floated
+        floor = par[AP_FLARE_PITCH_MIN] + math.atan(st[APS_SURFACE_SLOPE])
+        if h_gear <= par[AP_FLARE_PITCH_MIN_H] and theta_c < floor:
+            theta_c = floor
+            st[APS_INT_FLARE] -= e * dt
+            thr = 0.0
+        if h_gear <= par[AP_RETARD_H]:
+            thr = 0.0
     st[APS_THETA_C] = theta_c
     de = -par[AP_K_THETA] * (theta_c - theta) + par[AP_K_Q] * q
     aligning = landing and psi == psi and (st[APS_ALIGNING] != 0.0 or h_gear <= par[AP_ALIGN_H])

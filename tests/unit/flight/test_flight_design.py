@@ -257,3 +257,42 @@ def test_flare_ground_effect_is_the_models_table():
     fit = 1.0 + g.flare_ge_k * np.exp(-hb * span_ft * units.FT / g.flare_ge_decay_m)
     print("fit - table:", np.round(fit - k, 4))
     assert np.max(np.abs(fit - k)) < 0.01
+
+
+def test_the_nose_gear_floor_is_the_gear_geometry():
+    """The flare's nose-gear floor (aircraft file flare_pitch_min_deg) is the pitch at which the main gear, touching
+    first, takes the aircraft's weight before the nose gear touches, plus a margin for the pitch's scatter: JSBSim's
+    737.xml puts the nose and main gear contact points at the same body z (so any nose-down pitch touches the nose
+    first), 490 in apart; at its static load split (CG x between them) the main struts compress by W (x_cg - x_n) /
+    (2 L k_m) and the nose strut by W (x_m - x_cg) / (L k_n), so the nose wheels stay clear while the mains take the
+    weight above atan((d_m - d_n) / L) = 0.62 deg at the heaviest landing weight (114,000 lb). The margin, 0.4 deg,
+    is about one sd of the touchdown pitch in light turbulence (0.39 deg in the 10 kt tailwind condition,
+    docs/touchdown.md sec. 5); the file's 1.0 deg is their sum, rounded to 0.05 deg."""
+    import math
+    import xml.etree.ElementTree as ET
+
+    import jsbsim
+
+    from approachsim.flight.aircraft import load_aircraft
+
+    ac = load_aircraft(load_profile(PROFILES / "default.toml"))
+    root = ET.parse(Path(jsbsim.get_default_root_dir()) / "aircraft" / "737" / "737.xml").getroot()
+
+    def contact(name: str) -> tuple[float, float, float]:
+        c = root.find(f"ground_reactions/contact[@name='{name}']")
+        return (float(c.find("location/x").text), float(c.find("location/z").text),
+                float(c.find("spring_coeff").text))
+
+    x_n, z_n, k_n = contact("Nose Gear")
+    x_m, z_m, k_m = contact("Left Main Gear")
+    assert z_n == z_m  # the same contact height: pitch 0 touches both at once
+    x_cg = float(root.find("mass_balance/location[@name='CG']/x").text)
+    span_in = x_m - x_n
+    w = ac.mass.max_landing_weight_lb
+    d_m = w * (x_cg - x_n) / span_in / 2.0 / k_m * 12.0  # in
+    d_n = w * (x_m - x_cg) / span_in / k_n * 12.0
+    geometric_deg = math.degrees(math.atan((d_m - d_n) / span_in))
+    floor_deg = math.degrees(ac.gains.flare_pitch_min_rad)
+    print(f"main strut {d_m:.2f} in, nose strut {d_n:.2f} in, geometric minimum {geometric_deg:.3f} deg, "
+          f"floor {floor_deg:.2f} deg")
+    assert floor_deg == pytest.approx(geometric_deg + 0.4, abs=0.05)

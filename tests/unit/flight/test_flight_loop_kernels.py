@@ -95,6 +95,8 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
     import dataclasses
 
     gains = dataclasses.replace(gains, tecs=law == "tecs")
+    if flare:  # the nose-gear floor high enough to bind part of the time under these inputs (and be left)
+        gains = dataclasses.replace(gains, flare_pitch_min_rad=math.radians(6.0), flare_pitch_min_height_m=30.0)
     rng = np.random.default_rng(5 + flare)
     n = 600
     x, y, z, v, att, cas, h_gear, tas, psi = _autopilot_inputs(rng, n, flare=flare)
@@ -102,7 +104,8 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
     ap.surface_slope = 0.012 if flare else 0.0  # the flare's closing speed on a 1.2 % runway slope
     par, st = fv.autopilot_arrays(ap)
     seen = {"pitch limited": 0, "bank limited": 0, "throttle 1": 0, "throttle 0": 0, "flaring": 0, "idle": 0,
-            "aligning": 0, "sideslip limited": 0, "full decrab": 0}
+            "aligning": 0, "sideslip limited": 0, "full decrab": 0, "floored": 0, "above the floor": 0}
+    floor = gains.flare_pitch_min_rad + math.atan(ap.surface_slope)
     sq = ap.trim.cas_mps / gains.align_cas_mps
     b_max = min(gains.align_sideslip_max_rad,  # the partial decrab's sideslip limit
                 gains.align_bank_max_rad / (gains.k_phi_align * sq * sq))
@@ -125,6 +128,9 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
         seen["throttle 0"] += want[3] == 0.0
         seen["flaring"] += ap.flaring
         seen["idle"] += ap.flaring and h_gear[k] <= gains.retard_height_m
+        below = ap.flaring and h_gear[k] <= gains.flare_pitch_min_height_m
+        seen["floored"] += below and ap.state()[layouts.APS_THETA_C] == floor and want[3] == 0.0
+        seen["above the floor"] += below and ap.state()[layouts.APS_THETA_C] > floor
         seen["aligning"] += ap.aligning
         eta = abs(math.remainder(psi[k] - 0.4, 2.0 * math.pi) + att[k, 4])  # crab + beta (convergence: < 1e-4)
         seen["sideslip limited"] += ap.aligning and eta > 1.05 * b_max
@@ -133,6 +139,7 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
     assert seen["throttle 1"] > 0 and seen["throttle 0"] > 0, seen
     if flare:
         assert seen["flaring"] > 100 and seen["idle"] > 0 and seen["aligning"] > 100, seen
+        assert seen["floored"] > 20 and seen["above the floor"] > 20, seen
         assert seen["sideslip limited"] > 20 and seen["full decrab"] > 20, seen
     else:
         assert seen["flaring"] == 0 and seen["aligning"] == 0, seen
