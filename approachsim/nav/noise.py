@@ -273,9 +273,11 @@ class NoiseModel:
         q1 = self.clock().q(1.0)  # Q(1 s) = [[S_f + S_g / 3, S_g / 2], [., S_g]]
         if self.nav.clock_q_scale != 1.0:  # the filter's Q tuning (nav.clock_q_scale); 1.0 leaves the bits alone
             q1 = q1 * self.nav.clock_q_scale
-        # one bb state for the truth's slow baro errors (BaroConfig.filter_bias: their variance and rate)
+        # one bb state for the truth's slow baro errors (BaroConfig.filter_bias: their variance and rate); without a
+        # baro there is no baro error: the state keeps 0 with zero variance (the converged start then leaves it out
+        # of the realized sensor states, as a baro with no slow error does)
         bb_sigma, bb_tau = (b.filter_bias(atmosphere.height_per_hpa_m(self.baro_ref_m)) if b is not None
-                            else (1.0, 100.0))
+                            else (0.0, 100.0))
         return em.ErrorNoise(
             gyro_arw_rad_sqrts=g.gyro_arw_rad_sqrts,
             accel_vrw_mps_sqrts=g.accel_vrw_mps_sqrts,

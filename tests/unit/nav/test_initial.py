@@ -173,6 +173,18 @@ def test_per_run_skies_get_their_own_converged_covariance():
     np.testing.assert_array_equal(s1.h_m, s.h_m[1:2])
 
 
+def test_converged_start_without_a_baro():
+    """A suite with its baro removed ([sensors.baro] enabled = false) starts converged: the filter's baro-bias
+    state has no baro error to carry, so it starts and stays at 0 with zero variance (it stopped the start before:
+    "no realized sensor value for filter state group 'bb'")."""
+    prof = replace(FIXED, sensors=replace(FIXED.sensors, baro=None))
+    nav, truth, recs, st, s, fl, P0 = _start_default(prof=prof)
+    j = nav.layout.i("bb")
+    assert "baro" not in recs and P0[j, j] == 0.0
+    assert all(r.fs.P[j, j] == 0.0 and r.fs.x[j] == 0.0 for r in fl)
+    assert np.all(np.isfinite(fl[0].fs.P)) and np.all(np.diag(fl[0].fs.P) >= 0.0)
+
+
 def test_prior_start_keeps_todays_draws():
     truth = synthetic.glidepath_descent(PROFILE.runway.frame, rate_hz=10.0, start_distance_m=70.0 * 5.0,
                                         ground_speed_mps=70.0)
