@@ -4,6 +4,7 @@ and the consistency suite of issue 39 (item 5).
     python tools/consistency_by_state.py PROFILE [--runs 60] [--seed 1] [--set KEY=VALUE ...]
         [--slow-tau-s TAU] [--ideal-imu-axes gyro|accel|gyro,accel] [--filter-turbulence LEVEL]
     python tools/consistency_by_state.py --suite [--runs 60] [--seeds 1 2] [--workers 1] [--out docs/consistency.md]
+    python tools/consistency_by_state.py --suite --pool --seeds 1 2 ... 10 [--workers 2] [--out docs/consistency.md]
     python tools/consistency_by_state.py PROFILE --pool --seeds 1 2 ... 20 [--runs 60] [--workers 2]
 
 The profile is flown once on truth; RUNS seeded sensor realizations and open-loop navigation runs (the shared
@@ -23,7 +24,11 @@ process noise at another turbulence level (none: the time-constant-only filter, 
 --suite runs the cases of SUITE (the default profile, the CAT III candidate, ISA -30 and +30 uncorrected and a
 5434 ft field, the last three with the baro scale-factor state) at each seed, the profile's filter and the control
 on the same records, and writes the table with the acceptance of issue 39: every state's e^2/P in [0.8, 1.25],
-inside its band at >= 90 % of the epochs and above it at <= 5 %.
+inside its band at >= 90 % of the epochs and above it at <= 5 %. With --pool the same statistics are averaged
+over the seeds (pooled_passes: the run-averaged ratio's mean over the seeds in [0.8, 1.25], the mean fraction of
+epochs inside the band >= 90 % and above it <= 5 %; a consistent filter gives 1, 0.95 and 0.025 whatever a state's
+time correlation), with how many seeds pass the per-seed acceptance and how many a consistent filter would
+(seed_pass_chance): the criterion a state with about one degree of freedom per run can meet.
 
 --pool runs PROFILE at each of --seeds (each seed its own truth flight and RUNS sensor draws) and prints, per state,
 what one seed's 95 % check cannot say (pool_seeds): the mean of the seeds' run-averaged ratios with its standard
@@ -279,32 +284,95 @@ def suite_table(results: dict[tuple[str, int], dict], runs: int, seeds: list[int
     return "\n".join(lines)
 
 
-def run_suite(runs: int, seeds: list[int], workers: int, out: Path | None) -> None:
-    """Every case of SUITE at every seed (in `workers` processes); the table printed and written to `out`."""
+def seed_pass_chance(dof: float, runs: int) -> float:
+    """The probability that a consistent filter's run-averaged ratio at one seed lies in RATIO_BAND: chi2(n) / n with
+    n = runs dof degrees of freedom (summary()'s dof per run)."""
+    n = runs * dof
+    return float(chi2.cdf(RATIO_BAND[1] * n, n) - chi2.cdf(RATIO_BAND[0] * n, n))
+
+
+def pooled(res: list[dict], c: int) -> dict[str, float]:
+    """State c of one filter's summaries at S seeds: the mean ratio and its standard error, the mean fractions of
+    epochs inside / above the band, the seeds' min and max ratio, the seeds passing the per-seed acceptance and the
+    seeds' mean dof per run (for seed_pass_chance)."""
+    r = np.array([x["ratio"][c] for x in res])
+    dof = float(np.mean([x["dof"][c] for x in res]))
+    return {"mean": float(r.mean()), "se": float(r.std(ddof=1) / np.sqrt(r.size)) if r.size > 1 else float("nan"),
+            "inside": float(np.mean([x["inside"][c] for x in res])),
+            "above": float(np.mean([x["above"][c] for x in res])), "min": float(r.min()), "max": float(r.max()),
+            "seeds_pass": int(sum(passes(x, c) for x in res)), "dof": dof}
+
+
+def pooled_passes(pc: dict[str, float]) -> bool:
+    """Issue 39's acceptance on the seeds' averages (pooled())."""
+    return (RATIO_BAND[0] <= pc["mean"] <= RATIO_BAND[1] and pc["inside"] >= INSIDE_MIN
+            and pc["above"] <= ABOVE_MAX)
+
+
+def pooled_table(results: dict[tuple[str, int], dict], runs: int, seeds: list[int]) -> str:
+    """The markdown table of the pooled suite (one block per case: per state, filter and control, averaged over the
+    seeds)."""
+    lines = []
+    for case, (path, sets) in SUITE.items():
+        res = {f: [results[(case, s)][f] for s in seeds] for f in ("filter", "control")}
+        names = res["filter"][0]["names"]
+        lines += [f"### {case} (pooled)", "", f"`{path}`" + "".join(f" `--set {x}`" for x in sets)
+                  + f"; {len(seeds)} seeds x {runs} runs; per state the seeds' mean e^2/P +- its standard error, "
+                  "the mean fractions of epochs inside / above each seed's 95 % band, the seeds' range, the seeds "
+                  "passing the per-seed acceptance against the number a consistent filter passes on average "
+                  "(its ratio alone in [0.8, 1.25]: chi2 at the measured dof per run); pass: mean e^2/P in [0.8, "
+                  "1.25], mean inside >= 0.90, mean above <= 0.05.", "",
+                  "| state | filter e^2/P | inside | above | seeds' range | seeds passing (consistent) | pass | "
+                  "control e^2/P | inside | above | pass |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|"]
+        ok = {"filter": True, "control": True}
+        for c, n in enumerate(names):
+            pf, pk = pooled(res["filter"], c), pooled(res["control"], c)
+            chance = seed_pass_chance(pf["dof"], runs) * len(seeds)
+            ok["filter"] &= pooled_passes(pf)
+            ok["control"] &= pooled_passes(pk)
+            lines.append(f"| {n} | {pf['mean']:.3f} +- {pf['se']:.3f} | {pf['inside']:.2f} | {pf['above']:.2f} | "
+                         f"{pf['min']:.2f}-{pf['max']:.2f} | {pf['seeds_pass']}/{len(seeds)} ({chance:.1f}) | "
+                         f"{'yes' if pooled_passes(pf) else '**no**'} | {pk['mean']:.3f} +- {pk['se']:.3f} | "
+                         f"{pk['inside']:.2f} | {pk['above']:.2f} | {'yes' if pooled_passes(pk) else '**no**'} |")
+        lines += ["", f"Every state passes (pooled): filter {'yes' if ok['filter'] else '**no**'}, control "
+                  f"{'yes' if ok['control'] else 'no'}.", ""]
+    return "\n".join(lines)
+
+
+def run_suite(runs: int, seeds: list[int], workers: int, out: Path | None, pool: bool = False) -> None:
+    """Every case of SUITE at every seed (in `workers` processes); the table (pool: pooled_table, under POOL_MARK)
+    printed and written to `out`."""
     from concurrent.futures import ProcessPoolExecutor
 
     jobs = [(c, s) for c in SUITE for s in seeds]
     with ProcessPoolExecutor(max_workers=workers) as ex:
         futs = {j: ex.submit(suite_case, j[0], j[1], runs) for j in jobs}
         results = {j: f.result() for j, f in futs.items()}
-    table = suite_table(results, runs, seeds)
+    table = pooled_table(results, runs, seeds) if pool else suite_table(results, runs, seeds)
     print(table)
     if out is not None:
+        mark, other = (POOL_MARK, TABLE_MARK) if pool else (TABLE_MARK, POOL_MARK)
         text = out.read_text(encoding="utf-8") if out.exists() else ""
-        head = text.split(TABLE_MARK)[0] if TABLE_MARK in text else text
-        out.write_text(head + TABLE_MARK + "\n\n" + table, encoding="utf-8")
-        (out.with_suffix(".json")).write_text(json.dumps({f"{c} / seed {s}": r for (c, s), r in results.items()},
-                                                         indent=1), encoding="utf-8")
+        head, _, rest = text.partition(mark)
+        tail = rest[rest.index(other):] if other in rest else ""
+        if not rest and other in head:  # the mark is new: before the other table
+            head, tail = head[:head.index(other)], head[head.index(other):]
+        out.write_text(head + mark + "\n\n" + table + ("\n" + tail if tail else ""), encoding="utf-8")
+        js = json.dumps({f"{c} / seed {s}": r for (c, s), r in results.items()}, indent=1)
+        out.with_name(out.stem + ("-pooled" if pool else "") + ".json").write_text(js, encoding="utf-8")
 
 
 TABLE_MARK = "<!-- consistency suite table: tools/consistency_by_state.py --suite writes below -->"
+POOL_MARK = "<!-- pooled consistency suite table: tools/consistency_by_state.py --suite --pool writes below -->"
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("profile", type=Path, nargs="?")
     ap.add_argument("--suite", action="store_true")
-    ap.add_argument("--pool", action="store_true", help="PROFILE at each of --seeds, pooled (module docstring)")
+    ap.add_argument("--pool", action="store_true", help="PROFILE (or with --suite every case) at each of --seeds, "
+                    "pooled (module docstring)")
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--out", type=Path, default=None)
@@ -318,7 +386,7 @@ def main() -> None:
                     help="the filter's gyro axis process noise at this turbulence level (default: the profile's)")
     a = ap.parse_args()
     if a.suite:
-        run_suite(a.runs, a.seeds, a.workers, a.out)
+        run_suite(a.runs, a.seeds, a.workers, a.out, a.pool)
         return
     if a.profile is None:
         ap.error("PROFILE is required without --suite")

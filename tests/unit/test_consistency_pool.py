@@ -9,6 +9,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 from scipy.stats import chi2
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -46,3 +47,31 @@ def test_over_claiming_filter_is_seen() -> None:
     # the velocity-like state (7 dof per run) is outside its interval at most seeds; the test's p-values vanish
     assert p["outside"][2] > 30 and p["p_outside"][2] < 1e-10 and p["ks_p"][2] < 1e-10
     assert np.all(p["ks_p"] < 0.05)
+
+
+def test_seed_pass_chance_is_chi2_sampling() -> None:
+    """One seed's chance of a ratio in [0.8, 1.25] for a consistent filter: chi2(R d) / (R d) drawn 200000 times
+    (the frequency's sd sqrt(p (1 - p) / 200000) < 1.2e-3: 5 of them)."""
+    rng = np.random.default_rng(21)
+    for d in (1.0, 1.3, 5.0):
+        n = RUNS * d
+        r = rng.chisquare(n, 200_000) / n
+        p = np.mean((r >= 0.8) & (r <= 1.25))
+        assert abs(cb.seed_pass_chance(d, RUNS) - p) < 6e-3
+    assert cb.seed_pass_chance(1.0, RUNS) < 0.8 < cb.seed_pass_chance(5.0, RUNS)
+
+
+def _summary(ratio: float, inside: float, above: float, dof: float = 1.3) -> dict:
+    return {"ratio": [ratio], "inside": [inside], "above": [above], "dof": [dof]}
+
+
+def test_pooled_acceptance_averages_the_seeds() -> None:
+    """The pooled acceptance judges the seeds' means: a seed outside the band does not fail a state whose mean is
+    inside; a 20 % over-claim at every seed does."""
+    seeds = [_summary(1.35, 0.45, 0.55), _summary(0.95, 1.0, 0.0), _summary(0.85, 1.0, 0.0), _summary(0.9, 1.0, 0.0)]
+    pc = cb.pooled(seeds, 0)
+    assert pc["mean"] == pytest.approx(1.0125) and pc["seeds_pass"] == 3
+    assert pc["inside"] == pytest.approx(0.8625) and not cb.pooled_passes(pc)  # the one seed's epochs above
+    pc = cb.pooled([_summary(1.1, 0.97, 0.03)] + seeds[1:], 0)
+    assert cb.pooled_passes(pc)
+    assert not cb.pooled_passes(cb.pooled([_summary(0.78, 0.9, 0.0)] * 4, 0))
