@@ -694,6 +694,12 @@ class NavInTheLoop:
         eng = nav.engine
         baro_h, baro_r, radalt_h, rho, r_sv, sig, el, pl_rho, r_pl, pl_sig = inputs
         q, gse, gmp = self._noise_arrays(el)
+        gse_r = fe.no_gio
+        if eng.gbas_scale is not None and el is not None:  # the channel states at the INS geometry: nav/gbas_scale.py
+            g, m, r = eng.gbas_scale.interval(np.reshape(el, (1, -1)), nw[layouts.W_X:layouts.W_X + layouts.NX],
+                                              t - nav.t_last)
+            n_sv = gse.shape[0]
+            gse, gmp, gse_r = (np.ascontiguousarray(np.broadcast_to(a[0], (n_sv,))) for a in (g, m, r))
         held = fe.held_possible and nw[layouts.W_ANY_BARO] == 0.0
         if run.fs.P is not fe.P:  # the Navigator's path ran an epoch (or the start): its P from now on
             fe.P = np.array(run.fs.P, dtype=float)
@@ -702,7 +708,7 @@ class NavInTheLoop:
         e = fe.e
         obs = kg.Obs(baro_h, baro_r, radalt_h, 0.0, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig, fe.no_cp, pl_rho,
                      r_pl, pl_sig)
-        args = (nw, fe.X, fe.P, e, kg.ErrorModel(eng.lay, q, gse, gmp, eng.loop, fe.no_gio, 1.0), held,
+        args = (nw, fe.X, fe.P, e, kg.ErrorModel(eng.lay, q, gse, gmp, eng.loop, fe.no_gio, 1.0, gse_r), held,
                 t - nav.t_last, fe.f_ned, eng.rows, obs, kg.Out(eng.codes, eng._nu[:1], eng.S), eng.scr,
                 (fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic, fe.XD))
         if fe.call is None:

@@ -32,6 +32,7 @@ from approachsim.nav import errormodel as em
 from approachsim.nav import measurements as meas
 from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import KalmanFilter, UpdateStatus, optimal_policy
+from approachsim.nav.gbas_scale import GbasScale
 from approachsim.nav.observations import Observations
 from approachsim.sensors.gnss.elevation import IONO_SHELL_M
 from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
@@ -213,6 +214,8 @@ class EpochEngine:
         self._pl_sig = np.full(lay.n_pl, self.pl_sigma_states)  # with pseudolite states: code noise + survey
         self._nu = np.zeros((1, _MAX_ROWS))
         self._gbas = None
+        self.gbas_scale = GbasScale.of(system)
+        """GBAS code ranging: the channel states' scale along the approach (nav/gbas_scale.py), else None."""
         self._service = None
         if g is not None:  # the channel-noise budget of channel_sigmas
             bud = g.budget()
@@ -240,7 +243,8 @@ class EpochEngine:
         """The GPS channel states' slow and fast 1-sigma (m) at elevations el (N, k) rad, each element on its own:
         the receiver budget's channel_sigmas_m with nav/noise.py's elevation guard, compiled. Stand-alone:
         core/sensors/gnss.channel_sigmas; GBAS corrections: core/sensors/gnss.gbas_channel_sigmas at
-        gbas.REFERENCE_GEOMETRY (the filter's elevation-only channel noise, as nav/noise.py builds it)."""
+        gbas.REFERENCE_GEOMETRY (the filter's elevation-only channel noise, as nav/noise.py builds it; the epochs
+        take the aircraft's geometry from `gbas_scale` instead)."""
         el = np.ascontiguousarray(el, dtype=float)
         gse, gmp = np.empty(el.shape), np.empty(el.shape)
         if self._service is not None:
@@ -334,19 +338,31 @@ class EpochEngine:
         (16,) with the mean specific force f_ned (3,), discretized over dt, then every update), in place on X (1, n)
         and P. False when the model needs the numpy discretization (nothing changed: take the generic path). new (k,):
         carrier phase, the channels whose arc begins here (`new_arcs`; their ambiguities reset)."""
-        q, gse, gmp = self.system.noise_model.kernel_arrays(elevation_rad)
+        q, gse, gmp, gse_r = self.model_sigmas(elevation_rad, y, dt)
         if self.carrier:
             gio, gio_tau = em.kernel_carrier(self.system.noise_model.noise(elevation_rad), self.system.layout.n_sv)
             new = self._no_new if new is None else np.asarray(new, dtype=np.int64)
         else:
             gio, gio_tau, new = self._none1, 1.0, self._no_new
         nu = self._nu[:1]
-        k = ke.run_epoch(X, P, kg.ErrorModel(self.lay, q, gse, gmp, self.loop, gio, gio_tau), y, f_ned, held, dt, new,
+        k = ke.run_epoch(X, P, kg.ErrorModel(self.lay, q, gse, gmp, self.loop, gio, gio_tau, gse_r), y, f_ned, held,
+                         dt, new,
                          self.rows, self._obs(obs, [i], [db]), kg.Out(self.codes, nu, self.S), self.scr)
         if k < 0:
             return False
         statuses.add_epoch(self.codes[:k], t_s, nu[0, :k], self.S[:k])
         return True
+
+    def model_sigmas(self, elevation_rad: Array | None, y: Array, dt: float) -> tuple[Array, Array, Array, Array]:
+        """(q, gse, gmp, gse_r): a per-run epoch's noise arrays (NoiseModel.kernel_arrays) and, under GBAS, the
+        channel sigmas at the linearization point y's (16,) geometry with their scale over the interval dt
+        (nav/gbas_scale.py; gse_r (0,) otherwise)."""
+        q, gse, gmp = self.system.noise_model.kernel_arrays(elevation_rad)
+        if self.gbas_scale is None or elevation_rad is None:
+            return q, gse, gmp, self._none1
+        g, m, r = self.gbas_scale.interval(np.asarray(elevation_rad, dtype=float).reshape(1, -1), y, dt)
+        n_sv = gse.shape[0]
+        return (q, *(np.ascontiguousarray(np.broadcast_to(a[0], (n_sv,))) for a in (g, m, r)))
 
     def singletons(self, X: Array, P3: Array, phi2: Array, qd2: Array, held: Array, obs: Observations, t_s: float,
                    dt: float, ins_y: Array, ref_y: Array, ref_agl_m: float, statuses: list[StatusBuffer],
@@ -377,12 +393,17 @@ class EpochEngine:
         else:
             pl_rho, r_pl, pl_sig = np.zeros((N, 0)), self._none3, self._none1
         ch_gio, f_gio = np.zeros((N, 0)), 0.0
-        if lay.has("gse") and obs.has_gnss and obs.per_run_sky:  # one sky: qd2 is already at its elevations
-            el = np.ascontiguousarray(obs.gnss_el_rad, dtype=float)
+        gse_r = np.zeros((N, 0))
+        # one sky: qd2 is already at its elevations (but under GBAS at the reference geometry: set here)
+        if lay.has("gse") and obs.has_gnss and (obs.per_run_sky or self.gbas_scale is not None):
+            el = np.ascontiguousarray(np.broadcast_to(obs.gnss_el_rad, (N, np.shape(obs.gnss_el_rad)[-1])),
+                                      dtype=float)
             nz = self.system.noise_model.noise(None)
             if self.carrier:
                 ch_gse, ch_gio, ch_gmp = self.carrier_channel_sigmas(el)
                 f_gio = float(-np.expm1(-2.0 * dt / nz.gio_tau_s))
+            elif self.gbas_scale is not None:  # at the reference's geometry, scaled over the interval
+                ch_gse, ch_gmp, gse_r = self.gbas_scale.interval(el, ref_y, dt)
             else:
                 ch_gse, ch_gmp = self.channel_sigmas(el)
             f_gse, f_gmp = (float(-np.expm1(-2.0 * dt / tau)) for tau in (nz.gse_tau_s, nz.gmp_tau_s))
@@ -398,7 +419,7 @@ class EpochEngine:
         S = np.zeros((N, _MAX_ROWS))
         n_rows = np.zeros(N, dtype=np.int64)
         ke.copies_epoch(X, P3, phi2, qd2, held, ref_y, np.ascontiguousarray(ins_y),
-                        kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio),
+                        kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r),
                         kg.Obs(baro_h, baro_r, radalt_h, ref_agl_m, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho, r_pl,
                                pl_sig), new, self.rows, kg.Out(codes, nu, S), n_rows, self.scr)
         for i in range(N):

@@ -37,6 +37,7 @@ from approachsim.nav import terrain_db as tdb
 from approachsim.nav.base import FilterState, UpdateStatus
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, new_arcs, reset_arcs, stacked_new_arcs
 from approachsim.nav.fde import FdeState
+from approachsim.nav.gbas_scale import GbasScale
 from approachsim.nav.observations import BARO, Observations
 from approachsim.records import NavSolution, Truth
 
@@ -203,6 +204,8 @@ class Navigator:
         self.t_last = float(t0_s)
         self._ic = self.layout.i("clk") if self.layout.has("clk") else 0
         self.engine = EpochEngine.of(system)
+        self.gbas_scale = GbasScale.of(system)
+        """GBAS code ranging: the channel states' scale along the approach (nav/gbas_scale.py), else None."""
         self.reduced_runs: list | None = None
         """compiled_pass on each run's reduced state: each run's nav/reduced.ReducedRun (else None)."""
         """The compiled epoch (nav/engine.py), or None: the generic path."""
@@ -341,6 +344,9 @@ class Navigator:
                                 f_ned_mean[i], s.c_bn[i], noise, gains, loop_held=held)
             self.interval_F[i] = F
             phi, qd = em.discretize(F, Qc, dt_epoch)
+            if self.gbas_scale is not None and obs.has_gnss:  # the channel states at the INS's geometry
+                phi, qd = self.gbas_scale.apply(phi, qd, obs.elevations(i), self.x[self.ins_of[i]], dt_epoch,
+                                                noise.gse_tau_s)
             if new is not None:
                 phi, qd = reset_arcs(lay, phi, qd, new, self._amb_prior())
             if self.engine is not None and run.fde is None:  # the compiled updates on the numpy discretization
@@ -469,8 +475,13 @@ class Navigator:
                                           (E, pl_rho.shape[2])), dtype=float)
         # the channel states' Qd at each run's own sky (per-run skies; one sky: the model's own)
         ch_gio = np.zeros((N, E, 0))
+        gse_r = np.zeros((N, E, 0))
         if lay.has("gse") and per_run_sky and k and eng.carrier:  # the slow state without the ionosphere (gio)
             ch_gse, ch_gio, ch_gmp = eng.carrier_channel_sigmas(el)
+        elif lay.has("gse") and k and self.gbas_scale is not None:  # at the truth's geometry, scaled per interval
+            el_all = np.broadcast_to(el, (N, E, k)).reshape(N * E, k)
+            ch_gse, ch_gmp, gse_r = self.gbas_scale.interval(el_all, np.tile(ref, (N, 1)), np.tile(dt, N))
+            ch_gse, ch_gmp, gse_r = ch_gse.reshape(N, E, k), ch_gmp.reshape(N, E, k), gse_r.reshape(N, E, k)
         elif lay.has("gse") and per_run_sky and k:
             ch_gse, ch_gmp = eng.channel_sigmas(el.reshape(N * E, k))
             ch_gse, ch_gmp = ch_gse.reshape(N, E, k), ch_gmp.reshape(N, E, k)
@@ -493,7 +504,8 @@ class Navigator:
         done = -1
         if per_run_sky and k and lay.has("gse") and not eng.carrier:  # each run on its reduced state
             args = (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse,
-                    f_gmp, ins_y, baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig)
+                    f_gmp, gse_r, ins_y, baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl,
+                    pl_sig)
             self.reduced_runs = []
             done = reduced.reduced_singletons(system, truth, eng, args,
                                               (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav), self._ic,
@@ -501,9 +513,9 @@ class Navigator:
             if done < 0:
                 self.reduced_runs = None
         if done < 0:
-            done = ke.shared_pass(X, P3, kg.ErrorModel(eng.lay, q, gse, gmp, loop, gio, gio_tau),
+            done = ke.shared_pass(X, P3, kg.ErrorModel(eng.lay, q, gse, gmp, loop, gio, gio_tau, eng._none1),
                                   kg.Track(dt, ref, ref_cbn, f_ref), held,
-                                  kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio), ins_y,
+                                  kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r), ins_y,
                                   kg.Obs(baro_h, baro_r, radalt_h, ref_agl, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho,
                                          r_pl, pl_sig), new, eng.rows,
                                   kg.PassOut(codes, nu, S, n_rows, x_out, pd, pnav, p33, pcc, self._ic), eng.scr)
@@ -511,7 +523,8 @@ class Navigator:
             self.x[:] = x0
             self.f_sum[:] = 0.0
             return False
-        rates = _pass_rates(kg.ErrorModel(eng.lay, q, gse, gmp, loop, gio, gio_tau), kg.Track(dt, ref, ref_cbn, f_ref),
+        rates = _pass_rates(kg.ErrorModel(eng.lay, q, gse, gmp, loop, gio, gio_tau, eng._none1),
+                            kg.Track(dt, ref, ref_cbn, f_ref),
                             held, x_out)
         for e in range(E):  # what the per-epoch path keeps
             self._snaps.append((x_out[:, e], p33[:, e], pcc[:, e]))

@@ -15,7 +15,8 @@ state is clock/ephemeris + iono + tropo, the fast one the multipath; with GBAS c
 the slow state is the ground + iono + tropo residual and the fast one the airborne multipath + smoothed receiver
 noise (the white code noise left is the 2 mm carrier-phase noise: the budget's code_noise_m). The GBAS iono and
 tropo residuals grow with the aircraft's distance from and height above the reference point; the elevation-only
-noise here takes them at gbas.REFERENCE_GEOMETRY (the start of a 10 nmi final), conservative closer in.
+noise here (and P0) takes them at gbas.REFERENCE_GEOMETRY (the start of a 10 nmi final); the epochs move the slow
+state to the aircraft's geometry (nav/gbas_scale.py).
 
 Carrier phase ([sensors.gnss] carrier_phase, the layout's gio and amb states): the ionospheric part of the slow state
 gets its own per-channel state gio (Gauss-Markov at iono_tau_s, sigma the iono part of the budget at the elevation)

@@ -122,11 +122,10 @@ class SharedCovariance:
             self._aid_engine(nav, ref, t, dt_epoch, obs, held, models, new)
             return s
         # x- = Phi x+ (row by row: no batch-size-dependent BLAS path)
-        X = np.stack([nav.with_resets(*models[held[i]], new[i])[0] @ r.fs.x for i, r in enumerate(runs)])
+        X = np.stack([self._model(nav, models, held, obs, new, i, ref, dt_epoch)[0] @ r.fs.x
+                      for i, r in enumerate(runs)])
         for c, members in self.classes():
-            phi, qd = models[held[members[0]]]
-            qd = system.noise_model.channel_qd(qd, obs.elevations(members[0]), dt_epoch) if obs.per_run_sky else qd
-            self.predict_class(c, *nav.with_resets(phi, qd, new[members[0]]))
+            self.predict_class(c, *self._model(nav, models, held, obs, new, members[0], ref, dt_epoch))
         r_ins = ins.position_ecef(s)
         r_ref = ins.position_ecef(ref)[0]
         x0 = np.zeros(lay.n)
@@ -160,6 +159,20 @@ class SharedCovariance:
             run.fs = FilterState(x=X[i], P=self.P[self.of_run[i]], memory=run.fs.memory)
         return s
 
+    @staticmethod
+    def _model(nav: Any, models: dict, held: list, obs: Observations, new: Array, i: int, ref: ins.InsState,
+               dt_epoch: float) -> tuple[Array, Array]:
+        """Run i's class model (phi, qd): the epoch's model for its hold, the GPS channel states' Qd at its own sky
+        (per-run skies), under GBAS their scale along the reference (nav/gbas_scale.py), its new arcs reset."""
+        system = nav.system
+        phi, qd = models[held[i]]
+        if obs.per_run_sky:
+            qd = system.noise_model.channel_qd(qd, obs.elevations(i), dt_epoch)
+        if nav.gbas_scale is not None and obs.has_gnss:
+            phi, qd = nav.gbas_scale.apply(phi, qd, obs.elevations(i), ins.pack(ref)[0], dt_epoch,
+                                           system.noise_model.noise(None).gse_tau_s)
+        return nav.with_resets(phi, qd, new[i])
+
     def _aid_engine(self, nav: Any, ref: ins.InsState, t: float, dt_epoch: float, obs: Observations, held: list,
                     models: dict, new: Array) -> None:
         """`aid`'s predict and updates by core/nav/epoch.class_epoch in shared mode (rows at the truth), one call
@@ -170,10 +183,7 @@ class SharedCovariance:
         r_ref = ins.position_ecef(ref)[0]
         ref_agl = float(ref.h_m[0] - system.terrain_h(r_ref))
         for c, members in self.classes():
-            phi, qd = models[held[members[0]]]
-            if obs.per_run_sky:
-                qd = system.noise_model.channel_qd(qd, obs.elevations(members[0]), dt_epoch)
-            phi, qd = nav.with_resets(phi, qd, new[members[0]])
+            phi, qd = self._model(nav, models, held, obs, new, members[0], ref, dt_epoch)
             X = np.stack([runs[i].fs.x for i in members])
             P = self.P[c]  # its own array (split copies)
             ins_y = nav.x[nav.ins_of[members]]

@@ -234,6 +234,7 @@ def run_epoch(X: np.ndarray, P: np.ndarray, model: ErrorModel, y: np.ndarray, f_
     kcar.dynamics(model.lay, model.gio, model.gio_tau, F, Qc)
     if not ek.discretize(F, Qc, dt, phi, qd):
         return -1
+    ek.scale_channels(phi, model.lay, model.gse_r)
     kcar.reset_ambiguities(phi, qd, model.lay, new, rows.amb_prior)
     return class_epoch(X, P, phi, qd, True, y, _any(y.reshape(1, 16)), rows, _any_obs(obs), _any_out(out), scr,
                        False)
@@ -294,6 +295,21 @@ def _with_resets(phi: np.ndarray, qd: np.ndarray, lay: np.ndarray, new: np.ndarr
 
 
 @njit(cache=True, inline="always")
+def _scale_states(x: np.ndarray, P: np.ndarray, ig: int, r: np.ndarray) -> None:
+    """x (n,) and P (n, n) of one copy, in place, with the slow channel states' scale r (k,) (ChannelQd.gse_r):
+    x <- D x, P <- D P D, D = 1 but r[c] at gse_c (Phi D = D Phi: the predict then is errormodel.scale_channels's
+    D Phi)."""
+    n = P.shape[0]
+    for c in range(r.shape[0]):
+        a = ig + c
+        x[a] = x[a] * r[c]
+        for j in range(n):
+            P[a, j] = P[a, j] * r[c]
+        for j in range(n):
+            P[j, a] = P[j, a] * r[c]
+
+
+@njit(cache=True, inline="always")
 def copies_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndarray, which: np.ndarray,
                  ref: np.ndarray, ins: np.ndarray, chan: ChannelQd, obs: Obs, new: np.ndarray, rows: Rows, out: Out,
                  n_rows: np.ndarray, scr: Scratch) -> None:
@@ -320,6 +336,8 @@ def copies_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndar
         if io >= 0:
             for c in range(chan.gio.shape[1]):
                 qd_tmp[io + c, io + c] = chan.gio[i, c] ** 2 * chan.f_gio
+        if chan.gse_r.shape[1] > 0:
+            _scale_states(X[i], P3[i], ig, chan.gse_r[i])
         reset = _any_new(new[i])
         ready = last == hd and not reset
         phi = _with_resets(phi_h[hd], qd_tmp, lay, new[i], rows.amb_prior, scr.phi_tmp)
@@ -340,7 +358,7 @@ def pass_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndarra
     every copy's estimate and covariance after the epoch into out[:, e] (x, pd, pnav; p33 and pcc when kept)."""
     copies_epoch(X, P3, phi_h, qd_h, which[:, e], ref, ins[:, e],
                  ChannelQd(chan.gse[:, e], chan.gmp[:, e], chan.gio[:, e], chan.f_gse[e], chan.f_gmp[e],
-                           chan.f_gio[e]),
+                           chan.f_gio[e], chan.gse_r[:, e]),
                  Obs(obs.baro_h[:, e], obs.baro_r[e], obs.radalt_h[:, e], obs.ref_agl[e], obs.dbp, obs.db_x, obs.db_u,
                      obs.rho[:, e], obs.r_sv[:, e], obs.sig[:, e], obs.cp[:, e], obs.pl_rho[:, e], obs.r_pl,
                      obs.pl_sig[e]),

@@ -94,11 +94,13 @@ Nominal 1-sigma (the record's sigma_m): sqrt(s_gnd^2 + s_iono^2 + s_tropo^2 + s_
 Annex's sigma_i^2 = sigma_pr_gnd^2 + sigma_tropo^2 + sigma_pr_air^2 + sigma_iono^2 (and the 2 mm white).
 
 The navigation filter's channel states (nav/noise.py): the slow state carries ground + iono + tropo (correlation time
-the shortest of theirs), the fast state the airborne multipath and noise (both correlated over the smoothing time),
-the white w is the pseudorange rows' R.
+their drift-matched combination), the fast state the airborne multipath and noise (both correlated over the
+smoothing time), the white w is the pseudorange rows' R.
 The iono and tropo terms depend on where the aircraft is; `channel_sigmas_m` takes that geometry, and without it
-(the elevation-only noise the filter uses today) evaluates them at REFERENCE_GEOMETRY, the start of a 10 nmi final
-on a 3 deg path at 140 kt: the largest residual such an approach sees (conservative closer in).
+(the filter's prior P0, the elevation-only noise) evaluates them at REFERENCE_GEOMETRY, the start of a 10 nmi final
+on a 3 deg path at 140 kt. Along the approach the filter's slow state follows the aircraft's own geometry as the
+truth's does (nav/gbas_scale.py: the state's scale over each interval, since 2026-12-05; before, the filter kept the
+reference geometry's sigma, which over-claimed the horizontal position by a quarter on the CAT III candidate).
 
 `GbasModel` holds the configuration and the numpy formulas, the oracle of the compiled kernels
 (core/sensors/gnss.py gbas_scales, pseudorange_sum, and gbas_channel_sigmas: the filter's channel sigmas for a
