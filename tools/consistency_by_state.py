@@ -352,19 +352,26 @@ def run_suite(runs: int, seeds: list[int], workers: int, out: Path | None, pool:
     table = pooled_table(results, runs, seeds) if pool else suite_table(results, runs, seeds)
     print(table)
     if out is not None:
-        mark, other = (POOL_MARK, TABLE_MARK) if pool else (TABLE_MARK, POOL_MARK)
         text = out.read_text(encoding="utf-8") if out.exists() else ""
-        head, _, rest = text.partition(mark)
-        tail = rest[rest.index(other):] if other in rest else ""
-        if not rest and other in head:  # the mark is new: before the other table
-            head, tail = head[:head.index(other)], head[head.index(other):]
-        out.write_text(head + mark + "\n\n" + table + ("\n" + tail if tail else ""), encoding="utf-8")
+        out.write_text(with_table(text, POOL_MARK if pool else TABLE_MARK, table), encoding="utf-8")
         js = json.dumps({f"{c} / seed {s}": r for (c, s), r in results.items()}, indent=1)
         out.with_name(out.stem + ("-pooled" if pool else "") + ".json").write_text(js, encoding="utf-8")
 
 
 TABLE_MARK = "<!-- consistency suite table: tools/consistency_by_state.py --suite writes below -->"
 POOL_MARK = "<!-- pooled consistency suite table: tools/consistency_by_state.py --suite --pool writes below -->"
+END_MARK = "<!-- end of table -->"
+
+
+def with_table(text: str, mark: str, table: str) -> str:
+    """text with the table after `mark` replaced by `table`: up to the next END_MARK (to the end of the text when
+    none follows), the mark and table appended when the text has no mark."""
+    block = mark + "\n\n" + table.rstrip("\n") + "\n\n" + END_MARK + "\n"
+    if mark not in text:
+        return text.rstrip("\n") + "\n\n" + block
+    head, _, rest = text.partition(mark)
+    _, found, tail = rest.partition(END_MARK)
+    return head + block + (tail.lstrip("\n") and "\n" + tail.lstrip("\n") if found else "")
 
 
 def main() -> None:

@@ -75,3 +75,15 @@ def test_pooled_acceptance_averages_the_seeds() -> None:
     pc = cb.pooled([_summary(1.1, 0.97, 0.03)] + seeds[1:], 0)
     assert cb.pooled_passes(pc)
     assert not cb.pooled_passes(cb.pooled([_summary(0.78, 0.9, 0.0)] * 4, 0))
+
+
+def test_tables_replace_only_their_own_block() -> None:
+    """The suite's two tables (per seed, pooled) each replace their own block of a document and keep the prose
+    between and after them; a document without the marks gets the table appended."""
+    doc = cb.with_table("intro\n", cb.TABLE_MARK, "seed table")
+    doc = cb.with_table(doc + "\n## Pooled\n\nprose\n", cb.POOL_MARK, "pooled table")
+    doc = cb.with_table(doc + "\nafter\n", cb.TABLE_MARK, "seed table 2")
+    doc = cb.with_table(doc, cb.POOL_MARK, "pooled table 2")
+    assert doc.count(cb.END_MARK) == 2 and "seed table\n" not in doc and "pooled table\n" not in doc
+    assert doc.index("seed table 2") < doc.index("## Pooled") < doc.index("prose") < doc.index("pooled table 2")
+    assert doc.startswith("intro\n") and doc.rstrip().endswith("after")
