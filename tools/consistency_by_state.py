@@ -279,7 +279,7 @@ def suite_table(results: dict[tuple[str, int], dict], runs: int, seeds: list[int
                 row.append("yes" if all(passes(r[f], c) for r in res) else "**no**")
             lines.append("| " + " | ".join(row) + " |")
         ok = {f: all(passes(r[f], c) for r in res for c in range(len(names))) for f in ("filter", "control")}
-        lines += ["", f"Every state passes: filter {'yes' if ok['filter'] else '**no**'}, control "
+        lines += ["", f"Acceptance met by every state: filter {'yes' if ok['filter'] else '**no**'}, control "
                   f"{'yes' if ok['control'] else 'no'}.", ""]
     return "\n".join(lines)
 
@@ -335,7 +335,7 @@ def pooled_table(results: dict[tuple[str, int], dict], runs: int, seeds: list[in
                          f"{pf['min']:.2f}-{pf['max']:.2f} | {pf['seeds_pass']}/{len(seeds)} ({chance:.1f}) | "
                          f"{'yes' if pooled_passes(pf) else '**no**'} | {pk['mean']:.3f} +- {pk['se']:.3f} | "
                          f"{pk['inside']:.2f} | {pk['above']:.2f} | {'yes' if pooled_passes(pk) else '**no**'} |")
-        lines += ["", f"Every state passes (pooled): filter {'yes' if ok['filter'] else '**no**'}, control "
+        lines += ["", f"Pooled acceptance met by every state: filter {'yes' if ok['filter'] else '**no**'}, control "
                   f"{'yes' if ok['control'] else 'no'}.", ""]
     return "\n".join(lines)
 
