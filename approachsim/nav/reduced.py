@@ -250,8 +250,9 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
         xg, xm = X[i, ig + drop].copy(), X[i, im + drop].copy()
         pg, pm = P3[i, ig + drop, ig + drop].copy(), P3[i, im + drop, im + drop].copy()
         kred.lone_states(np.ascontiguousarray(phi1[:, lay1.i("gse"), lay1.i("gse")]),
-                    np.ascontiguousarray(phi1[:, lay1.i("gmp"), lay1.i("gmp")]), ch_gse[i], ch_gmp[i], f_gse, f_gmp,
-                    gse_r[i], drop, ig, im, xg, xm, pg, pm, x_out[i], pd[i])
+                    np.ascontiguousarray(phi1[:, lay1.i("gmp"), lay1.i("gmp")]),
+                    kg.ChannelQd(ch_gse[i], ch_gmp[i], np.zeros((E, 0)), f_gse, f_gmp, np.zeros(E), gse_r[i]),
+                    drop, ig, im, xg, xm, pg, pm, x_out[i], pd[i])
         # the final state and covariance (the dropped states' rows and columns stay zero off the diagonal)
         X[i, idx] = Xr[0]
         X[i, ig + drop], X[i, im + drop] = xg, xm
