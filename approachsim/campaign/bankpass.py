@@ -290,11 +290,17 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, start: tu
     q, gse_full, gmp_full = em.kernel_noise(noise, lay.n_sv)
     loop = em.kernel_loop(nav.loop_gains() if lay.has("ac") else None)
     ch_gio = np.zeros((C, E, 0))
-    gse_r = np.zeros((C, E, 0))
+    gse_r = gio_r = np.zeros((C, E, 0))
     if red.has("gse") and kr and carrier:  # the slow state without the ionosphere (gio): Navigator.compiled_pass
-        # (numpy elementwise, on every channel as the navigation's pass, then the kept ones)
-        sky = eng.carrier_channel_sigmas(o["el"][0])
-        ch_gse, ch_gio, ch_gmp = (np.ascontiguousarray(np.broadcast_to(a[:, kept], (C, E, kr))) for a in sky)
+        # (numpy elementwise, on every channel as the navigation's pass, then the kept ones; GBAS: at the truth's
+        # geometry, gse and gio scaled apart)
+        if eng.gbas_scale is not None:
+            sky = eng.gbas_scale.carrier_interval(o["el"][0], ref, dt_e)
+            ch_gse, ch_gio, ch_gmp, gse_r, gio_r = (np.ascontiguousarray(np.broadcast_to(a[:, kept], (C, E, kr)))
+                                                    for a in sky)
+        else:
+            sky = eng.carrier_channel_sigmas(o["el"][0])
+            ch_gse, ch_gio, ch_gmp = (np.ascontiguousarray(np.broadcast_to(a[:, kept], (C, E, kr))) for a in sky)
     elif red.has("gse") and kr and eng.gbas_scale is not None:  # Navigator.compiled_pass: the truth's geometry
         g1, m1, r1 = eng.gbas_scale.interval(el, ref, dt_e)
         ch_gse, ch_gmp, gse_r = (np.ascontiguousarray(np.broadcast_to(a, (C, E, kr))) for a in (g1, m1, r1))
@@ -326,7 +332,8 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, start: tu
     rows, scr = eng.rows._replace(lay=red.packed), kg.scratch(n)
     if carrier:  # core/nav/epoch.shared_pass's carrier step (core/nav/copies.bank_epochs with the carrier states)
         f_gio = -np.expm1(-2.0 * dt_e / nz.gio_tau_s)
-        kcp.bank_epochs(X, P3, phi, qd, ref, kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r), ins_y,
+        kcp.bank_epochs(X, P3, phi, qd, ref, kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r, gio_r),
+                        ins_y,
                         kg.Obs(baro_h, o["baro_r"], radalt_h, ref_agl, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho,
                                r_pl, pl_sig), new, rows,
                         kg.PassOut(codes, nu, S, n_rows, x_out, pd, pnav, np.zeros((C, E, 0, 0)), np.zeros((C, 0)), 0),
@@ -338,7 +345,8 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, start: tu
               pnav[1:].copy())
         none = np.zeros((C - 1, E, 0))
         kcp.bank_epochs(X[1:].copy(), P3[1:].copy(), phi, qd, ref,
-                        kg.ChannelQd(c(ch_gse[1:]), c(ch_gmp[1:]), none, f_gse, f_gmp, np.zeros(E), c(gse_r[1:])),
+                        kg.ChannelQd(c(ch_gse[1:]), c(ch_gmp[1:]), none, f_gse, f_gmp, np.zeros(E), c(gse_r[1:]),
+                                     none),
                         c(ins_y[1:]),
                         kg.Obs(c(baro_h[1:]), o["baro_r"], c(radalt_h[1:]), ref_agl, c(dbp[1:]), db_x, c(db_u[1:]),
                                c(rho[1:]), c(r_sv[1:]), c(sig[1:]), none, c(pl_rho[1:]), r_pl, pl_sig),
@@ -350,7 +358,7 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, start: tu
             a[1:] = b
     else:
         none = np.zeros((C, E, 0))
-        kcp.bank_epochs(X, P3, phi, qd, ref, kg.ChannelQd(ch_gse, ch_gmp, none, f_gse, f_gmp, np.zeros(E), gse_r),
+        kcp.bank_epochs(X, P3, phi, qd, ref, kg.ChannelQd(ch_gse, ch_gmp, none, f_gse, f_gmp, np.zeros(E), gse_r, none),
                         ins_y,
                         kg.Obs(baro_h, o["baro_r"], radalt_h, ref_agl, dbp, db_x, db_u, rho, r_sv, sig, none, pl_rho,
                                r_pl, pl_sig), np.zeros((C, E, 0), np.int64), rows,

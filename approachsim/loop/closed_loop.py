@@ -708,7 +708,8 @@ class NavInTheLoop:
         e = fe.e
         obs = kg.Obs(baro_h, baro_r, radalt_h, 0.0, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig, fe.no_cp, pl_rho,
                      r_pl, pl_sig)
-        args = (nw, fe.X, fe.P, e, kg.ErrorModel(eng.lay, q, gse, gmp, eng.loop, fe.no_gio, 1.0, gse_r), held,
+        model = kg.ErrorModel(eng.lay, q, gse, gmp, eng.loop, fe.no_gio, 1.0, gse_r, fe.no_gio)
+        args = (nw, fe.X, fe.P, e, model, held,
                 t - nav.t_last, fe.f_ned, eng.rows, obs, kg.Out(eng.codes, eng._nu[:1], eng.S), eng.scr,
                 (fe.XS, fe.PP, fe.PC, fe.PD, fe.PN, nav._ic, fe.XD))
         if fe.call is None:

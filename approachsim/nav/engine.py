@@ -338,31 +338,41 @@ class EpochEngine:
         (16,) with the mean specific force f_ned (3,), discretized over dt, then every update), in place on X (1, n)
         and P. False when the model needs the numpy discretization (nothing changed: take the generic path). new (k,):
         carrier phase, the channels whose arc begins here (`new_arcs`; their ambiguities reset)."""
-        q, gse, gmp, gse_r = self.model_sigmas(elevation_rad, y, dt)
         if self.carrier:
-            gio, gio_tau = em.kernel_carrier(self.system.noise_model.noise(elevation_rad), self.system.layout.n_sv)
             new = self._no_new if new is None else np.asarray(new, dtype=np.int64)
         else:
-            gio, gio_tau, new = self._none1, 1.0, self._no_new
+            new = self._no_new
         nu = self._nu[:1]
-        k = ke.run_epoch(X, P, kg.ErrorModel(self.lay, q, gse, gmp, self.loop, gio, gio_tau, gse_r), y, f_ned, held,
-                         dt, new,
+        k = ke.run_epoch(X, P, self.model_sigmas(elevation_rad, y, dt), y, f_ned, held, dt, new,
                          self.rows, self._obs(obs, [i], [db]), kg.Out(self.codes, nu, self.S), self.scr)
         if k < 0:
             return False
         statuses.add_epoch(self.codes[:k], t_s, nu[0, :k], self.S[:k])
         return True
 
-    def model_sigmas(self, elevation_rad: Array | None, y: Array, dt: float) -> tuple[Array, Array, Array, Array]:
-        """(q, gse, gmp, gse_r): a per-run epoch's noise arrays (NoiseModel.kernel_arrays) and, under GBAS, the
-        channel sigmas at the linearization point y's (16,) geometry with their scale over the interval dt
-        (nav/gbas_scale.py; gse_r (0,) otherwise)."""
-        q, gse, gmp = self.system.noise_model.kernel_arrays(elevation_rad)
-        if self.gbas_scale is None or elevation_rad is None:
-            return q, gse, gmp, self._none1
-        g, m, r = self.gbas_scale.interval(np.asarray(elevation_rad, dtype=float).reshape(1, -1), y, dt)
-        n_sv = gse.shape[0]
-        return (q, *(np.ascontiguousarray(np.broadcast_to(a[0], (n_sv,))) for a in (g, m, r)))
+    def model_sigmas(self, elevation_rad: Array | None, y: Array, dt: float) -> kg.ErrorModel:
+        """A per-run epoch's error model constants: the noise arrays (NoiseModel.kernel_arrays, with carrier phase
+        errormodel.kernel_carrier) and, under GBAS, the channel sigmas at the linearization point y's (16,)
+        geometry with their scales over the interval dt (nav/gbas_scale.py; gse_r, gio_r (0,) otherwise)."""
+        nm = self.system.noise_model
+        q, gse, gmp = nm.kernel_arrays(elevation_rad)
+        gio, gio_tau = (em.kernel_carrier(nm.noise(elevation_rad), self.system.layout.n_sv) if self.carrier
+                        else (self._none1, 1.0))
+        gse_r = gio_r = self._none1
+        if self.gbas_scale is not None and elevation_rad is not None:
+            el = np.asarray(elevation_rad, dtype=float).reshape(1, -1)
+            n_sv = gse.shape[0]
+
+            def c(a: Array) -> Array:
+                return np.ascontiguousarray(np.broadcast_to(a[0], (n_sv,)))
+
+            if self.carrier:
+                g, i, m, r, r_io = self.gbas_scale.carrier_interval(el, y, dt)
+                gse, gio, gmp, gse_r, gio_r = c(g), c(i), c(m), c(r), c(r_io)
+            else:
+                g, m, r = self.gbas_scale.interval(el, y, dt)
+                gse, gmp, gse_r = c(g), c(m), c(r)
+        return kg.ErrorModel(self.lay, q, gse, gmp, self.loop, gio, gio_tau, gse_r, gio_r)
 
     def singletons(self, X: Array, P3: Array, phi2: Array, qd2: Array, held: Array, obs: Observations, t_s: float,
                    dt: float, ins_y: Array, ref_y: Array, ref_agl_m: float, statuses: list[StatusBuffer],
@@ -393,13 +403,16 @@ class EpochEngine:
         else:
             pl_rho, r_pl, pl_sig = np.zeros((N, 0)), self._none3, self._none1
         ch_gio, f_gio = np.zeros((N, 0)), 0.0
-        gse_r = np.zeros((N, 0))
+        gse_r = gio_r = np.zeros((N, 0))
         # one sky: qd2 is already at its elevations (but under GBAS at the reference geometry: set here)
         if lay.has("gse") and obs.has_gnss and (obs.per_run_sky or self.gbas_scale is not None):
             el = np.ascontiguousarray(np.broadcast_to(obs.gnss_el_rad, (N, np.shape(obs.gnss_el_rad)[-1])),
                                       dtype=float)
             nz = self.system.noise_model.noise(None)
-            if self.carrier:
+            if self.carrier and self.gbas_scale is not None:  # the reference's geometry, gse and gio scaled apart
+                ch_gse, ch_gio, ch_gmp, gse_r, gio_r = self.gbas_scale.carrier_interval(el, ref_y, dt)
+                f_gio = float(-np.expm1(-2.0 * dt / nz.gio_tau_s))
+            elif self.carrier:
                 ch_gse, ch_gio, ch_gmp = self.carrier_channel_sigmas(el)
                 f_gio = float(-np.expm1(-2.0 * dt / nz.gio_tau_s))
             elif self.gbas_scale is not None:  # at the reference's geometry, scaled over the interval
@@ -419,7 +432,7 @@ class EpochEngine:
         S = np.zeros((N, _MAX_ROWS))
         n_rows = np.zeros(N, dtype=np.int64)
         ke.copies_epoch(X, P3, phi2, qd2, held, ref_y, np.ascontiguousarray(ins_y),
-                        kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r),
+                        kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r, gio_r),
                         kg.Obs(baro_h, baro_r, radalt_h, ref_agl_m, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho, r_pl,
                                pl_sig), new, self.rows, kg.Out(codes, nu, S), n_rows, self.scr)
         for i in range(N):

@@ -20,12 +20,14 @@ without GBAS). P0 (nav/noise.py) and the converged start take the sigmas at gbas
 10 nmi final: the first interval scales from the aircraft's geometry then, not from the reference one, so a start at
 another distance keeps P0's channel variances until the approach's geometry has moved them.
 
-With carrier phase the ionospheric part has its own states (gio) and the slow state gse the rest: both stay at
-REFERENCE_GEOMETRY (`GbasScale.of` gives None), conservative closer in.
+With carrier phase the ionospheric part has its own states (gio) and the slow state gse the rest (ground and
+troposphere): each is scaled the same way by its own sigma's ratio (`carrier_interval`; a sigma of 0, no gradient,
+scales by 1).
 
-    scale = GbasScale.of(system)                   # None: no GBAS, or carrier phase
-    gse, gmp, r = scale.interval(el, y, dt)        # the channel sigmas at G(t) and r, per row of y
-    phi, qd = scale.apply(phi, qd, el, y, dt, tau) # a per-run model: D Phi, the channel Qd at G(t)
+    scale = GbasScale.of(system)                       # None: no GBAS channel states
+    gse, gmp, r = scale.interval(el, y, dt)            # the channel sigmas at G(t) and r, per row of y
+    gse, gio, gmp, r, r_io = scale.carrier_interval(el, y, dt)   # carrier phase: gse, gio scaled apart
+    phi, qd = scale.apply(phi, qd, el, y, dt, noise)   # a per-run model: D Phi, the channel Qd at G(t)
 """
 
 from __future__ import annotations
@@ -38,6 +40,7 @@ import numpy as np
 from approachsim import geo
 from approachsim.core.nav import errormodel as ek
 from approachsim.core.sensors import gnss as gk
+from approachsim.sensors.gnss.gbas import GbasModel
 
 Array = np.ndarray
 
@@ -54,20 +57,24 @@ class GbasScale:
     """core/sensors/gnss.gbas_channel_sigmas's constants."""
     lay: Array
     """The filter's packed state layout (errormodel.StateLayout.packed)."""
+    model: GbasModel
+    """The GBAS model (its numpy carrier-phase split, gbas.GbasModel.carrier_channel_sigmas_m)."""
+    carrier: bool
+    """Carrier phase: the slow state without the ionosphere, and the ionosphere states gio."""
 
     @classmethod
     def of(cls, system: Any) -> GbasScale | None:
-        """The scale of a navigation system whose GPS is GBAS-corrected code with channel states, else None."""
+        """The scale of a navigation system whose GPS is GBAS-corrected with channel states, else None."""
         g = system.sensors.gnss
         lay = system.layout
-        if g is None or not lay.has("gse") or lay.has("gio"):
+        if g is None or not lay.has("gse"):
             return None
         bud = g.budget()
         if bud.gbas is None:
             return None
         st = np.asarray(bud.gbas.station_ecef(system.runway), dtype=float)
         h = float(geo.ecef_to_geodetic(st)[2])
-        return cls(st, h, bud.gbas.channel_kernel_args(), lay.packed)
+        return cls(st, h, bud.gbas.channel_kernel_args(), lay.packed, bud.gbas, lay.has("gio"))
 
     def geometry(self, y: Array, dt_s: float | Array) -> tuple[Array, Array]:
         """G(t) and G(t - dt) (M, 3): (x_air m, dh m, v_air m/s) of packed navigation states y (M, 16) (lat, lon rad,
@@ -107,14 +114,43 @@ class GbasScale:
         g0, _ = self.sigmas(el, before)
         return gse, gmp, gse / g0
 
-    def apply(self, phi: Array, qd: Array, el: Array, y: Array, dt_s: float, tau_s: float) -> tuple[Array, Array]:
+    def carrier_interval(self, el: Array, y: Array, dt_s: float | Array) -> tuple[Array, ...]:
+        """Carrier phase: (gse, gio, gmp, r_gse, r_gio) (M, k): the slow state without the ionosphere
+        sqrt(ground^2 + tropo^2), the ionosphere and the fast state's sigmas at G(t) (gbas.GbasModel
+        .carrier_channel_sigmas_m with nav/noise.py's elevation guard) and the two slow groups' scales over the
+        interval, as `interval`."""
+        el = np.atleast_2d(np.asarray(el, dtype=float))
+        y = np.broadcast_to(np.atleast_2d(np.asarray(y, dtype=float)), (el.shape[0], np.shape(y)[-1]))
+        e = np.maximum(np.nan_to_num(el, nan=0.5), np.radians(2.0))
+        now, before = self.geometry(y, dt_s)
+        gse, gio, gmp = (np.ascontiguousarray(np.broadcast_to(a, e.shape), dtype=float) for a in
+                         self.model.carrier_channel_sigmas_m(e, now[:, :1], now[:, 1:2], now[:, 2:3]))
+        g0, i0, _ = self.model.carrier_channel_sigmas_m(e, before[:, :1], before[:, 1:2], before[:, 2:3])
+        return gse, gio, gmp, _ratio(gse, g0), _ratio(gio, i0)
+
+    def apply(self, phi: Array, qd: Array, el: Array, y: Array, dt_s: float, noise: Any) -> tuple[Array, Array]:
         """A per-run (or one-sky class's) model over the interval: copies of phi with the slow channel states'
-        diagonal times r (core/nav/errormodel.scale_channels) and of qd with their entries S(el, G(t))^2 (1 -
-        exp(-2 dt / tau_s)), for the channels' elevations el (k,) rad and the linearization point y (16,)."""
-        gse, _, r = self.interval(np.asarray(el, dtype=float)[None], np.asarray(y, dtype=float)[None], dt_s)
+        diagonal times r (core/nav/errormodel.scale_channels; with carrier phase the gse and gio groups each by
+        its own) and of qd with their entries S(el, G(t))^2 (1 - exp(-2 dt / tau)), tau the group's
+        (noise: errormodel.ErrorNoise), for the channels' elevations el (k,) rad and the linearization point y
+        (16,)."""
+        el1, y1 = np.asarray(el, dtype=float)[None], np.asarray(y, dtype=float)[None]
+        if self.carrier:
+            gse, gio, _, r, r_io = self.carrier_interval(el1, y1, dt_s)
+            groups = [(ek.L_GSE, gse, r, noise.gse_tau_s), (ek.L_GIO, gio, r_io, noise.gio_tau_s)]
+        else:
+            gse, _, r = self.interval(el1, y1, dt_s)
+            groups = [(ek.L_GSE, gse, r, noise.gse_tau_s)]
         phi, qd = np.array(phi, dtype=float), np.array(qd, dtype=float)
-        ek.scale_channels(phi, self.lay, np.ascontiguousarray(r[0]))
-        ig = int(self.lay[ek.L_GSE])
-        k = np.arange(ig, ig + gse.shape[1])
-        qd[k, k] = gse[0] ** 2 * -np.expm1(-2.0 * dt_s / tau_s)
+        for grp, sig, ratio, tau in groups:
+            i0 = int(self.lay[grp])
+            ek.scale_channels(phi, i0, np.ascontiguousarray(ratio[0]))
+            k = np.arange(i0, i0 + sig.shape[1])
+            qd[k, k] = sig[0] ** 2 * -np.expm1(-2.0 * dt_s / tau)
         return phi, qd
+
+
+def _ratio(now: Array, before: Array) -> Array:
+    """now / before, 1 where before is 0 (a term switched off: nothing to scale)."""
+    return np.divide(now, before, out=np.ones(np.broadcast_shapes(now.shape, np.shape(before))),
+                     where=np.asarray(before) > 0.0)

@@ -345,8 +345,7 @@ class Navigator:
             self.interval_F[i] = F
             phi, qd = em.discretize(F, Qc, dt_epoch)
             if self.gbas_scale is not None and obs.has_gnss:  # the channel states at the INS's geometry
-                phi, qd = self.gbas_scale.apply(phi, qd, obs.elevations(i), self.x[self.ins_of[i]], dt_epoch,
-                                                noise.gse_tau_s)
+                phi, qd = self.gbas_scale.apply(phi, qd, obs.elevations(i), self.x[self.ins_of[i]], dt_epoch, noise)
             if new is not None:
                 phi, qd = reset_arcs(lay, phi, qd, new, self._amb_prior())
             if self.engine is not None and run.fde is None:  # the compiled updates on the numpy discretization
@@ -475,13 +474,17 @@ class Navigator:
                                           (E, pl_rho.shape[2])), dtype=float)
         # the channel states' Qd at each run's own sky (per-run skies; one sky: the model's own)
         ch_gio = np.zeros((N, E, 0))
-        gse_r = np.zeros((N, E, 0))
-        if lay.has("gse") and per_run_sky and k and eng.carrier:  # the slow state without the ionosphere (gio)
-            ch_gse, ch_gio, ch_gmp = eng.carrier_channel_sigmas(el)
-        elif lay.has("gse") and k and self.gbas_scale is not None:  # at the truth's geometry, scaled per interval
+        gse_r = gio_r = np.zeros((N, E, 0))
+        if lay.has("gse") and k and self.gbas_scale is not None:  # GBAS: at the truth's geometry, scaled per interval
             el_all = np.broadcast_to(el, (N, E, k)).reshape(N * E, k)
-            ch_gse, ch_gmp, gse_r = self.gbas_scale.interval(el_all, np.tile(ref, (N, 1)), np.tile(dt, N))
-            ch_gse, ch_gmp, gse_r = ch_gse.reshape(N, E, k), ch_gmp.reshape(N, E, k), gse_r.reshape(N, E, k)
+            if eng.carrier:  # gse without the ionosphere, gio, each scaled by its own sigma
+                sky = self.gbas_scale.carrier_interval(el_all, np.tile(ref, (N, 1)), np.tile(dt, N))
+                ch_gse, ch_gio, ch_gmp, gse_r, gio_r = (a.reshape(N, E, k) for a in sky)
+            else:
+                sky = self.gbas_scale.interval(el_all, np.tile(ref, (N, 1)), np.tile(dt, N))
+                ch_gse, ch_gmp, gse_r = (a.reshape(N, E, k) for a in sky)
+        elif lay.has("gse") and per_run_sky and k and eng.carrier:  # the slow state without the ionosphere (gio)
+            ch_gse, ch_gio, ch_gmp = eng.carrier_channel_sigmas(el)
         elif lay.has("gse") and per_run_sky and k:
             ch_gse, ch_gmp = eng.channel_sigmas(el.reshape(N * E, k))
             ch_gse, ch_gmp = ch_gse.reshape(N, E, k), ch_gmp.reshape(N, E, k)
@@ -513,9 +516,10 @@ class Navigator:
             if done < 0:
                 self.reduced_runs = None
         if done < 0:
-            done = ke.shared_pass(X, P3, kg.ErrorModel(eng.lay, q, gse, gmp, loop, gio, gio_tau, eng._none1),
+            model = kg.ErrorModel(eng.lay, q, gse, gmp, loop, gio, gio_tau, eng._none1, eng._none1)
+            done = ke.shared_pass(X, P3, model,
                                   kg.Track(dt, ref, ref_cbn, f_ref), held,
-                                  kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r), ins_y,
+                                  kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r, gio_r), ins_y,
                                   kg.Obs(baro_h, baro_r, radalt_h, ref_agl, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho,
                                          r_pl, pl_sig), new, eng.rows,
                                   kg.PassOut(codes, nu, S, n_rows, x_out, pd, pnav, p33, pcc, self._ic), eng.scr)
@@ -523,7 +527,7 @@ class Navigator:
             self.x[:] = x0
             self.f_sum[:] = 0.0
             return False
-        rates = _pass_rates(kg.ErrorModel(eng.lay, q, gse, gmp, loop, gio, gio_tau, eng._none1),
+        rates = _pass_rates(kg.ErrorModel(eng.lay, q, gse, gmp, loop, gio, gio_tau, eng._none1, eng._none1),
                             kg.Track(dt, ref, ref_cbn, f_ref),
                             held, x_out)
         for e in range(E):  # what the per-epoch path keeps

@@ -225,7 +225,7 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
         kcp.bank_epochs(Xr, Pr, phi, qd, ref,
                         kg.ChannelQd(np.ascontiguousarray(ch_gse[sel]), np.ascontiguousarray(ch_gmp[sel]), none, f_gse,
                                      f_gmp, np.zeros(E), np.ascontiguousarray(gse_r[sel] if gse_r.shape[2] else
-                                                                              gse_r[i:i + 1])), ins_y[i:i + 1],
+                                                                              gse_r[i:i + 1]), none), ins_y[i:i + 1],
                         kg.Obs(baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], ref_agl, dbp[i:i + 1], db_x, db_u[i:i + 1],
                                np.ascontiguousarray(rho[sel]), np.ascontiguousarray(r_sv[sel]),
                                np.ascontiguousarray(sig[sel]), none, pl_rho[i:i + 1], r_pl, pl_sig),
@@ -251,7 +251,8 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
         pg, pm = P3[i, ig + drop, ig + drop].copy(), P3[i, im + drop, im + drop].copy()
         kred.lone_states(np.ascontiguousarray(phi1[:, lay1.i("gse"), lay1.i("gse")]),
                     np.ascontiguousarray(phi1[:, lay1.i("gmp"), lay1.i("gmp")]),
-                    kg.ChannelQd(ch_gse[i], ch_gmp[i], np.zeros((E, 0)), f_gse, f_gmp, np.zeros(E), gse_r[i]),
+                    kg.ChannelQd(ch_gse[i], ch_gmp[i], np.zeros((E, 0)), f_gse, f_gmp, np.zeros(E), gse_r[i],
+                                 np.zeros((E, 0))),
                     drop, ig, im, xg, xm, pg, pm, x_out[i], pd[i])
         # the final state and covariance (the dropped states' rows and columns stay zero off the diagonal)
         X[i, idx] = Xr[0]

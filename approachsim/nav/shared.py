@@ -170,7 +170,7 @@ class SharedCovariance:
             qd = system.noise_model.channel_qd(qd, obs.elevations(i), dt_epoch)
         if nav.gbas_scale is not None and obs.has_gnss:
             phi, qd = nav.gbas_scale.apply(phi, qd, obs.elevations(i), ins.pack(ref)[0], dt_epoch,
-                                           system.noise_model.noise(None).gse_tau_s)
+                                           system.noise_model.noise(None))
         return nav.with_resets(phi, qd, new[i])
 
     def _aid_engine(self, nav: Any, ref: ins.InsState, t: float, dt_epoch: float, obs: Observations, held: list,

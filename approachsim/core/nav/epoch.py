@@ -234,7 +234,8 @@ def run_epoch(X: np.ndarray, P: np.ndarray, model: ErrorModel, y: np.ndarray, f_
     kcar.dynamics(model.lay, model.gio, model.gio_tau, F, Qc)
     if not ek.discretize(F, Qc, dt, phi, qd):
         return -1
-    ek.scale_channels(phi, model.lay, model.gse_r)
+    ek.scale_channels(phi, model.lay[ek.L_GSE], model.gse_r)
+    ek.scale_channels(phi, model.lay[ek.L_GIO], model.gio_r)
     kcar.reset_ambiguities(phi, qd, model.lay, new, rows.amb_prior)
     return class_epoch(X, P, phi, qd, True, y, _any(y.reshape(1, 16)), rows, _any_obs(obs), _any_out(out), scr,
                        False)
@@ -338,6 +339,8 @@ def copies_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndar
                 qd_tmp[io + c, io + c] = chan.gio[i, c] ** 2 * chan.f_gio
         if chan.gse_r.shape[1] > 0:
             _scale_states(X[i], P3[i], ig, chan.gse_r[i])
+        if chan.gio_r.shape[1] > 0:
+            _scale_states(X[i], P3[i], io, chan.gio_r[i])
         reset = _any_new(new[i])
         ready = last == hd and not reset
         phi = _with_resets(phi_h[hd], qd_tmp, lay, new[i], rows.amb_prior, scr.phi_tmp)
@@ -358,7 +361,7 @@ def pass_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndarra
     every copy's estimate and covariance after the epoch into out[:, e] (x, pd, pnav; p33 and pcc when kept)."""
     copies_epoch(X, P3, phi_h, qd_h, which[:, e], ref, ins[:, e],
                  ChannelQd(chan.gse[:, e], chan.gmp[:, e], chan.gio[:, e], chan.f_gse[e], chan.f_gmp[e],
-                           chan.f_gio[e], chan.gse_r[:, e]),
+                           chan.f_gio[e], chan.gse_r[:, e], chan.gio_r[:, e]),
                  Obs(obs.baro_h[:, e], obs.baro_r[e], obs.radalt_h[:, e], obs.ref_agl[e], obs.dbp, obs.db_x, obs.db_u,
                      obs.rho[:, e], obs.r_sv[:, e], obs.sig[:, e], obs.cp[:, e], obs.pl_rho[:, e], obs.r_pl,
                      obs.pl_sig[e]),

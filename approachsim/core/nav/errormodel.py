@@ -87,14 +87,14 @@ def _markov(F: np.ndarray, Qc: np.ndarray, i0: int, k: int, sigma: np.ndarray, t
 
 
 @njit(cache=True)
-def scale_channels(phi: np.ndarray, lay: np.ndarray, r: np.ndarray) -> None:
-    """The slow channel states' scale over an interval on its Phi (n, n), in place: Phi[gse_c, gse_c] times r[c]
-    (r (k,), k <= n_sv; nothing when k = 0). A Gauss-Markov error of a time-varying 1-sigma S(t), x = S u with u
-    of unit variance: x(t + dt) = (S(t + dt) / S(t)) exp(-dt / tau) x(t) + w, Var w = S(t + dt)^2 (1 - exp(-2 dt /
-    tau)) (the GBAS residual's scale follows the aircraft: sensors/gnss/gbas.py)."""
-    ig = lay[L_GSE]
+def scale_channels(phi: np.ndarray, i0: int, r: np.ndarray) -> None:
+    """A channel group's scale over an interval on its Phi (n, n), in place: Phi[i0 + c, i0 + c] times r[c]
+    (r (k,): the slow states from lay[L_GSE], the ionosphere states from lay[L_GIO]; nothing when k = 0). A
+    Gauss-Markov error of a time-varying 1-sigma S(t), x = S u with u of unit variance: x(t + dt) = (S(t + dt) /
+    S(t)) exp(-dt / tau) x(t) + w, Var w = S(t + dt)^2 (1 - exp(-2 dt / tau)) (the GBAS residual's scale follows
+    the aircraft: sensors/gnss/gbas.py)."""
     for c in range(r.shape[0]):
-        phi[ig + c, ig + c] *= r[c]
+        phi[i0 + c, i0 + c] *= r[c]
 
 
 @njit(cache=True)

@@ -142,7 +142,9 @@ class ErrorModel(NamedTuple):
     """Their correlation time, s."""
     gse_r: np.ndarray
     """The slow channel states' scale over the interval (n_sv,): Phi[gse_c, gse_c] times gse_r[c] (GBAS: the
-    channel's sigma at the epoch's geometry over the interval start's, nav/engine.py gbas_interval); (0,): none."""
+    channel's sigma at the epoch's geometry over the interval start's, nav/gbas_scale.py); (0,): none."""
+    gio_r: np.ndarray
+    """... and the ionosphere states' (carrier phase under GBAS; (0,): none)."""
 
 
 class Track(NamedTuple):
@@ -172,6 +174,8 @@ class ChannelQd(NamedTuple):
     """The slow channel states' scale over the interval per copy (N, k) (a pass: (N, E, k)): copy i's gse_c
     estimate and P row and column times gse_r[i, c] before the predict (ErrorModel.gse_r's D Phi, as D P D: the
     channel states' rows and columns of Phi hold only their diagonal); (N, 0): none."""
+    gio_r: np.ndarray
+    """... and the ionosphere states' (carrier phase under GBAS; (N, 0): none)."""
 
 
 class Scratch(NamedTuple):

@@ -9,6 +9,7 @@ must equal the per-run D Phi form."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -97,8 +98,8 @@ def test_sigmas_are_the_budgets(system, scale) -> None:
 
 def test_the_state_variance_follows_the_geometry(system, scale) -> None:
     """P <- r^2 a^2 P + S(G(t))^2 (1 - a^2) from S(G(t0))^2 stays S(G(t))^2 along the flown path (the geometry a
-    second back within 1e-2 m of 2e4 m: relative 1e-6 a step, 260 steps), and the high satellites' slow sigma
-    shrinks toward the threshold (the ionospheric term with the distance)."""
+    second back within 1e-2 m, of a term's x_air + 2 tau v_air >= 1.4e4 m: 7e-7 a step, 260 steps), and the high
+    satellites' slow sigma shrinks toward the threshold (the ionospheric term with the distance)."""
     tau = system.noise_model.noise(None).gse_tau_s
     a2 = math.exp(-2.0 / tau)
     t = np.arange(0.0, 261.0, 1.0)
@@ -108,7 +109,7 @@ def test_the_state_variance_follows_the_geometry(system, scale) -> None:
     for k in range(1, t.size):
         gse, _, r = scale.interval(el, y[k], 1.0)
         p = r[0] ** 2 * a2 * p + gse[0] ** 2 * (1.0 - a2)
-        np.testing.assert_allclose(p, gse[0] ** 2, rtol=1e-4)
+        np.testing.assert_allclose(p, gse[0] ** 2, rtol=3e-4)
     first = scale.sigmas(el, scale.geometry(y[:1], 1.0)[0])[0][0]
     assert np.all(gse[0] / first < 0.8) and np.all(gse[0] / first > 0.2)
 
@@ -116,7 +117,6 @@ def test_the_state_variance_follows_the_geometry(system, scale) -> None:
 def test_copies_scale_equals_the_per_run_scale(system) -> None:
     """The copies' D P D before the predict (core/nav/epoch._scale_states) equals the per-run D Phi
     (core/nav/errormodel.scale_channels): Phi's channel rows and columns hold only their diagonal."""
-    lay = system.layout.packed
     n, ig, k = system.layout.n, system.layout.i("gse"), system.layout.n_sv
     rng = np.random.default_rng(5)
     phi = np.eye(n) + 0.01 * rng.standard_normal((n, n))
@@ -128,7 +128,7 @@ def test_copies_scale_equals_the_per_run_scale(system) -> None:
     x = rng.standard_normal(n)
     r = 1.0 - 0.01 * rng.random(k)
     phi_s = phi.copy()
-    ek.scale_channels(phi_s, lay, r)
+    ek.scale_channels(phi_s, ig, r)
     x2, P2 = x.copy(), P.copy()
     ke._scale_states(x2, P2, ig, r)
     # the same products in another order: eps times the operands' size (|Phi| |P| |Phi| over n terms)
@@ -137,9 +137,38 @@ def test_copies_scale_equals_the_per_run_scale(system) -> None:
     np.testing.assert_allclose(phi @ x2, phi_s @ x, rtol=0, atol=4 * n * EPS * np.abs(phi).max() * np.abs(x).max())
 
 
-def test_only_gbas_code_ranging_is_scaled() -> None:
-    """Stand-alone GPS has no GBAS scale; neither has GBAS with carrier phase (its gio / gse states stay at the
-    reference geometry, nav/gbas_scale.py)."""
+def test_only_gbas_is_scaled() -> None:
+    """Stand-alone GPS has no GBAS scale."""
     assert GbasScale.of(NavSystem.from_profile(load_profile(PROFILES / "default.toml"))) is None
-    carrier = NavSystem.from_profile(load_profile(PROFILES / "gbas-carrier-cat3-candidate.toml"))
-    assert carrier.layout.has("gio") and GbasScale.of(carrier) is None
+
+
+def test_carrier_phase_scales_the_ionosphere_and_the_rest_apart() -> None:
+    """With carrier phase the ionosphere states (gio) and the slow states without it (gse: ground and troposphere)
+    each keep their own variance at G(t) along the path; no gradient (sigma_vig 0): the ionosphere's scale is 1."""
+    nav = NavSystem.from_profile(load_profile(PROFILES / "gbas-carrier-cat3-candidate.toml"))
+    sc = GbasScale.of(nav)
+    assert nav.layout.has("gio") and sc is not None and sc.carrier
+    nz = nav.noise_model.noise(None)
+    a_se, a_io = math.exp(-2.0 / nz.gse_tau_s), math.exp(-2.0 / nz.gio_tau_s)
+    t = np.arange(0.0, 261.0, 1.0)
+    y = _rows(nav.runway, t)
+    el = np.radians(np.array([[8.0, 25.0, 45.0, 75.0]]))
+    gse, gio, _, _, _ = sc.carrier_interval(el, y[0], 1.0)
+    p_se, p_io = gse[0] ** 2, gio[0] ** 2
+    first = gse[0], gio[0]
+    for k in range(1, t.size):
+        gse, gio, _, r, r_io = sc.carrier_interval(el, y[k], 1.0)
+        p_se = r[0] ** 2 * a_se * p_se + gse[0] ** 2 * (1.0 - a_se)
+        p_io = r_io[0] ** 2 * a_io * p_io + gio[0] ** 2 * (1.0 - a_io)
+        # the back-step's geometry error (<= 1e-2 m a step, one sign on this path) over the ionospheric term's
+        # x_air + 2 tau v_air >= 1.4e4 m: <= 7e-7 a step, 2e-4 over 260 steps
+        np.testing.assert_allclose(p_se, gse[0] ** 2, rtol=3e-4)
+        np.testing.assert_allclose(p_io, gio[0] ** 2, rtol=3e-4)
+    # the ionosphere with the distance (x_air + 2 tau v_air: 3.3e4 -> 1.5e4 m); the rest with the troposphere's height
+    # term, most at low elevation (28 cm at 5 deg 10 nmi out, nil over the threshold), the ground term unchanged
+    assert np.all(gio[0] / first[1] < 0.6)
+    assert np.all(gse[0] < first[0]) and np.all(gse[0] / first[0] > 0.5) and gse[0][-1] / first[0][-1] > 0.9
+    flat = GbasScale(sc.station_ecef, sc.station_h_m, sc.kernel_args, sc.lay,
+                     replace(sc.model, sigma_vig_per_m=0.0), True)
+    _, gio0, _, _, r_io0 = flat.carrier_interval(el, y[100], 1.0)
+    assert np.all(gio0 == 0.0) and np.all(r_io0 == 1.0)
