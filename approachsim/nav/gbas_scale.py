@@ -40,7 +40,7 @@ import numpy as np
 from approachsim import geo
 from approachsim.core.nav import errormodel as ek
 from approachsim.core.sensors import gnss as gk
-from approachsim.sensors.gnss.gbas import GbasModel
+from approachsim.sensors.gnss.gbas import GbasModel, station_geometry
 
 Array = np.ndarray
 
@@ -86,11 +86,10 @@ class GbasScale:
         lat0 = lat - v[:, 0] * dt / (r_n + h)
         lon0 = lon - v[:, 1] * dt / ((r_e + h) * np.cos(lat))
         h0 = h + v[:, 2] * dt
-        v_air = np.hypot(v[:, 0], v[:, 1])
         out = []
-        for la, lo, hh in ((lat, lon, h), (lat0, lon0, h0)):
-            d = geo.geodetic_to_ecef(la, lo, hh) - self.station_ecef
-            out.append(np.column_stack([np.sqrt(np.einsum("ij,ij->i", d, d)), hh - self.station_h_m, v_air]))
+        for la, lo, hh in ((lat, lon, h), (lat0, lon0, h0)):  # the truth's formula (gbas.station_geometry)
+            g = station_geometry(geo.geodetic_to_ecef(la, lo, hh), hh, v, self.station_ecef, self.station_h_m)
+            out.append(np.column_stack(g))
         return out[0], out[1]
 
     def sigmas(self, el: Array, geom: Array) -> tuple[Array, Array]:
