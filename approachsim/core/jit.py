@@ -216,6 +216,43 @@ def _internal_overloads(dispatcher: Any) -> Any:
     return dispatcher
 
 
+def _fast_flag_values() -> bool:
+    """Make numba's TargetConfig.values (the compile flags as a dict) build the dict from the class's defaults
+    merged with the options set, instead of calling one property per option. Numba hashes and compares the flags
+    on every typing of a call to an overloaded function (typing.templates: the flags are in the implementation
+    cache's key, each hash and comparison building values() anew: about 370 000 times, ~3 s of CPU, on a closed
+    loop's cold compile). The dict is the same (keys, order, values: an option's property returns its set value
+    or its default), so every hash, comparison and compilation is. Returns whether installed: the guard leaves
+    numba's own where TargetConfig is not built as this numba's (options of Option with a default, _values)."""
+    try:
+        from numba.core import targetconfig as tc
+    except ImportError:  # pragma: no cover - another numba
+        return False
+    cls = getattr(tc, "TargetConfig", None)
+    option = getattr(tc, "Option", None)
+    if cls is None or option is None or "_values" not in getattr(cls, "__slots__", ()) \
+            or not isinstance(getattr(option, "default", None), property) or not hasattr(cls, "values"):
+        return False
+    if getattr(cls.values, "_approachsim_fast", False):
+        return True
+    defaults: dict[type, dict[str, Any]] = {}  # per TargetConfig class: its options' defaults, in options order
+
+    def values(self: Any) -> dict[str, Any]:
+        kind = type(self)
+        d = defaults.get(kind)
+        if d is None:
+            d = defaults[kind] = {k: o.default for k, o in kind.options.items()}
+        return {**d, **self._values}
+
+    values._approachsim_fast = True  # type: ignore[attr-defined]
+    values.__doc__ = cls.values.__doc__
+    cls.values = values
+    return True
+
+
+FAST_FLAG_VALUES = _fast_flag_values()
+
+
 def njit(fn: Callable | None = None, **options: Any) -> Any:
     """numba.njit(**options) whose calls from compiled code compile once per argument type and as internal
     overloads (module docstring); use as `@njit` or `@njit(cache=True, ...)`. An `inline="always"` kernel is typed

@@ -75,11 +75,15 @@ def gauss_markov(z: Array, sigma: float | Array, tau_s: float | Array, dt_s: flo
     z = np.asarray(z, dtype=float)
     sigma = np.broadcast_to(np.asarray(sigma, dtype=float), z.shape[1:])
     a = np.exp(-dt_s / np.broadcast_to(np.asarray(tau_s, dtype=float), z.shape[1:]))
-    z2 = z.reshape(z.shape[0], -1)
+    # every argument C-contiguous and writeable (copies where not: a column slice of z, a broadcast sigma), so the
+    # kernel compiles once, not once per layout and read-only flag (4 copies on a closed-loop run's cold cache)
+    def own(x: Array) -> Array:
+        return np.require(x, dtype=float, requirements=("C", "W"))
+
+    z2 = own(z.reshape(z.shape[0], -1))
     out = np.empty(z2.shape)
-    noise_kernels.first_order(z2, np.ascontiguousarray(sigma.reshape(-1)),
-                              np.ascontiguousarray((sigma * np.sqrt(1.0 - a * a)).reshape(-1)),
-                              np.ascontiguousarray(np.asarray(a).reshape(-1)), out)
+    noise_kernels.first_order(z2, own(sigma.reshape(-1)), own((sigma * np.sqrt(1.0 - a * a)).reshape(-1)),
+                              own(np.asarray(a).reshape(-1)), out)
     return out.reshape(z.shape)
 
 

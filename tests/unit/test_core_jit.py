@@ -250,3 +250,43 @@ def test_an_expected_entry_typed_from_compiled_code_compiles_once():
     leaf, caller = _leaf_and_caller()
     assert _compilations(lambda: caller(x)) == ["caller", "leaf"]
     assert _compilations(lambda: leaf(x)) == ["leaf"]
+
+
+def _values_by_property(cfg) -> dict:  # noqa: ANN001
+    """TargetConfig.values as numba writes it: one property per option."""
+    return {k: getattr(cfg, k) for k in cfg.options}
+
+
+def test_fast_flag_values_equal_numba_own():
+    from numba.core.compiler import Flags
+
+    from approachsim.core.jit import FAST_FLAG_VALUES
+
+    assert FAST_FLAG_VALUES  # this numba's TargetConfig is the one the fast path is written for
+    default = Flags()
+    custom = Flags()
+    custom.release_gil = True
+    custom.boundscheck = True
+    custom.no_cpython_wrapper = True
+    custom.error_model = "numpy"
+    copied = Flags(copy_from=custom)
+    for cfg in (default, custom, copied):
+        fast, own = cfg.values(), _values_by_property(cfg)
+        assert list(fast.items()) == list(own.items())  # keys, order and values
+        assert hash(cfg) == hash(tuple(sorted(own)))  # numba's __hash__: over the sorted option names
+    assert custom == copied and custom != default
+    assert hash(custom) == hash(copied)
+
+
+def test_fast_flag_values_guard(monkeypatch):
+    from numba.core import targetconfig as tc
+
+    from approachsim.core import jit
+
+    class Plain:  # a config class not built as numba's TargetConfig: no _values slot
+        def values(self) -> dict:
+            return {}
+
+    monkeypatch.setattr(tc, "TargetConfig", Plain)
+    assert jit._fast_flag_values() is False
+    assert not getattr(Plain.values, "_approachsim_fast", False)

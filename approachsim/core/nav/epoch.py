@@ -119,7 +119,7 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, o
     r_ref = np.empty(3)
     c_ins = np.empty((3, 3))
     c_ref = np.empty((3, 3))
-    _ecef(ref, r_ref)
+    _ecef(ref[::1], r_ref)  # strided as ins[m] is: _ecef compiles once
     gk.c_ecef_to_ned(ref[0], ref[1], c_ref)
     k = 0
     empty_u = np.zeros(0)
@@ -256,7 +256,7 @@ def _any(a: np.ndarray) -> np.ndarray:
 def _any_obs(obs: Obs) -> Obs:
     """obs with the per-member arrays as copies_epoch types them (strided views of the same elements)."""
     return Obs(obs.baro_h[::1], obs.baro_r, obs.radalt_h[::1], obs.ref_agl, obs.dbp, obs.db_x, obs.db_u,
-               obs.rho[:, ::1], obs.r_sv[:, ::1], obs.sig[::1], obs.cp[:, ::1], obs.pl_rho[:, ::1], obs.r_pl,
+               obs.rho[:, ::1], obs.r_sv[:, ::1], obs.sig[::1], obs.cp[:, ::1], obs.pl_rho[:, ::1], obs.r_pl[:, ::1],
                obs.pl_sig)
 
 
@@ -346,7 +346,7 @@ def copies_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndar
         phi = _with_resets(phi_h[hd], qd_tmp, lay, new[i], rows.amb_prior, scr.phi_tmp)
         obs_i = Obs(obs.baro_h[i:i + 1], obs.baro_r, obs.radalt_h[i:i + 1], obs.ref_agl, obs.dbp[i:i + 1], obs.db_x,
                     obs.db_u[i:i + 1], obs.rho[i:i + 1], obs.r_sv[i], obs.sig[i], obs.cp[i:i + 1],
-                    obs.pl_rho[i:i + 1], obs.r_pl, obs.pl_sig)
+                    obs.pl_rho[i:i + 1], _any(obs.r_pl), obs.pl_sig)
         n_rows[i] = class_epoch(X[i:i + 1], P3[i], phi, qd_tmp, False, ref, ins[i:i + 1], rows, obs_i,
                                 Out(out.codes[i], out.nu[i:i + 1], out.S[i]), scr, ready)
         last = -1 if reset else hd

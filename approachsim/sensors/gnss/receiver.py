@@ -735,7 +735,9 @@ def service_pseudoranges(sv: ServiceModel, rng: Array, el: Array, az: Array, sel
                       air)
     noise = c(series["noise"][:, j0:j0 + full[1]])
     one = np.ones(rng.shape)
-    return gk.pseudorange_sum(rng, sel, ((one, slow), (one, air), (one, noise)), c(bias))
+    # the bias writeable (a read-only one typed a second compilation of the kernel on a cold cache)
+    return gk.pseudorange_sum(rng, sel, ((one, slow), (one, air), (one, noise)),
+                              np.require(bias, dtype=float, requirements=("C", "W")))
 
 
 def service_group(sv: ServiceModel | None, series: Mapping[str, Array], k: int) -> tuple:
