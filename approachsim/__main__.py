@@ -1,5 +1,5 @@
 """`python -m approachsim` runs the command line."""
 
-from approachsim.cli import main
+from approachsim.cli import run
 
-raise SystemExit(main())
+run()

@@ -23,7 +23,8 @@ import time
 from pathlib import Path
 
 COMPILE_NOTE = ("compiling the kernels (the first campaign of this kind after installing or changing approachsim: "
-                "usually 1-2 min on 2 cores, then cached), no time estimate until the first runs finish")
+                "under half a minute on 2 cores for the default profile, then cached), no time estimate until the "
+                "first runs finish")
 
 
 def cache_dir() -> Path | None:
