@@ -28,6 +28,7 @@ from approachsim.nav.config import NavConfig, parse_nav
 from approachsim.resources import find_aircraft_file
 from approachsim.sensors import atmosphere
 from approachsim.sensors.config import SensorsConfig, parse_faults, parse_sensors
+from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY, approach_geometry
 
 TURBULENCE_LEVELS = ("none", "light", "moderate", "severe")
 QNH_REPORTS = ("exact", "whole_hpa")
@@ -202,6 +203,17 @@ class Profile:
     nav: NavConfig = field(default_factory=NavConfig)
     """The navigation system ([nav]: filter by name and its tuning, aiding rate, feedback, baro loop, initial
     INS errors; nav/config.py)."""
+
+    def gbas_geometry(self) -> tuple[float, float, float]:
+        """GBAS: (x_air m, dh m, v_air m/s) at the approach's start (gbas.approach_geometry of the start distance,
+        glidepath, threshold crossing height and approach speed), where the filter's channel noise and P0 take the
+        distance-dependent sigmas (nav/noise.py); gbas.REFERENCE_GEOMETRY without GBAS (unused) or with a lead-in
+        (its final starts where the pattern ends)."""
+        g, rwy = self.sensors.gnss, self.runway
+        if g is None or g.gbas is None or rwy.lead_in != "none":
+            return REFERENCE_GEOMETRY
+        return approach_geometry(rwy.start_distance_m, rwy.glidepath_rad, rwy.tch_m,
+                                 approach_cas_mps(self.aircraft, self.source))
 
 
 def _runway(s: Section) -> Runway:
@@ -391,6 +403,18 @@ def _run(s: Section) -> RunDefaults:
     return RunDefaults(runs=runs, seed=seed, mode=mode)
 
 
+def approach_cas_mps(aircraft: AircraftChoice, source: Path | None) -> float:
+    """The approach speed (calibrated airspeed), m/s: the profile's [aircraft] approach_speed_kt, else the aircraft
+    file's approach.approach_speed_kt (looked up beside source, then the shipped aircraft)."""
+    if aircraft.approach_speed_mps is not None:
+        return aircraft.approach_speed_mps
+    path = find_aircraft_file(aircraft.name, source)
+    try:
+        return float(tomllib.loads(path.read_text(encoding="utf-8"))["approach"]["approach_speed_kt"]) * units.KT
+    except (tomllib.TOMLDecodeError, KeyError, TypeError, ValueError):
+        raise ProfileError(f"aircraft.name: {str(path)!r} has no valid approach.approach_speed_kt") from None
+
+
 def _run_duration_estimate_s(runway: Runway, aircraft: AircraftChoice, env: Environment, source: Path | None) -> float:
     """Estimate (s) of a run's length, for checking fault times: the glidepath from the start distance to
     50 ft above the threshold at the approach ground speed (with a lead-in: its path length, at the TAS of its
@@ -400,13 +424,7 @@ def _run_duration_estimate_s(runway: Runway, aircraft: AircraftChoice, env: Envi
     mid height in the ISA atmosphere with the profile's temperature deviation. The approach speed is the
     profile's, else the aircraft file's (approachsim.resources lookup).
     """
-    cas = aircraft.approach_speed_mps
-    if cas is None:
-        path = find_aircraft_file(aircraft.name, source)
-        try:
-            cas = float(tomllib.loads(path.read_text(encoding="utf-8"))["approach"]["approach_speed_kt"]) * units.KT
-        except (tomllib.TOMLDecodeError, KeyError, TypeError, ValueError):
-            raise ProfileError(f"aircraft.name: {str(path)!r} has no valid approach.approach_speed_kt") from None
+    cas = approach_cas_mps(aircraft, source)
     tan_gp = math.tan(runway.glidepath_rad)
     h_mid = runway.elevation_m + 0.5 * runway.start_distance_m * tan_gp
     lead = lead_in_of(runway)

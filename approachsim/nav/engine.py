@@ -35,7 +35,6 @@ from approachsim.nav.base import KalmanFilter, UpdateStatus, optimal_policy
 from approachsim.nav.gbas_scale import GbasScale
 from approachsim.nav.observations import Observations
 from approachsim.sensors.gnss.elevation import IONO_SHELL_M
-from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
 
 Array = np.ndarray
 
@@ -243,8 +242,8 @@ class EpochEngine:
         """The GPS channel states' slow and fast 1-sigma (m) at elevations el (N, k) rad, each element on its own:
         the receiver budget's channel_sigmas_m with nav/noise.py's elevation guard, compiled. Stand-alone:
         core/sensors/gnss.channel_sigmas; GBAS corrections: core/sensors/gnss.gbas_channel_sigmas at
-        gbas.REFERENCE_GEOMETRY (the filter's elevation-only channel noise, as nav/noise.py builds it; the epochs
-        take the aircraft's geometry from `gbas_scale` instead)."""
+        the approach's start (NoiseModel.gbas_geometry: the filter's elevation-only channel noise, as nav/noise.py
+        builds it; the epochs take the aircraft's geometry from `gbas_scale` instead)."""
         el = np.ascontiguousarray(el, dtype=float)
         gse, gmp = np.empty(el.shape), np.empty(el.shape)
         if self._service is not None:
@@ -252,7 +251,7 @@ class EpochEngine:
         elif self._gbas is None:
             gk.channel_sigmas(el, *self._sky_budget, gse, gmp)
         else:
-            x, dh, v = (np.full(el.shape[0], g) for g in REFERENCE_GEOMETRY)
+            x, dh, v = (np.full(el.shape[0], g) for g in self.system.noise_model.gbas_geometry)
             gk.gbas_channel_sigmas(el, x, dh, v, *self._gbas, gse, gmp)
         return gse, gmp
 

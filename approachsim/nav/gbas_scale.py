@@ -16,9 +16,10 @@ is x_c = S_c(t) u_c with u_c of unit variance, so over an aiding interval dt
 when it was S^2 at the last). G(t) is the linearization point's (the reference trajectory of the shared covariance,
 a run's own INS solution in the per-run filter), G(t - dt) the same point moved back along its velocity over dt
 (straight flight; the speed held), the elevation held at el_c(t) (a satellite's elevation change stays in the Qd, as
-without GBAS). P0 (nav/noise.py) and the converged start take the sigmas at gbas.REFERENCE_GEOMETRY, the start of a
-10 nmi final: the first interval scales from the aircraft's geometry then, not from the reference one, so a start at
-another distance keeps P0's channel variances until the approach's geometry has moved them.
+without GBAS). P0 (nav/noise.py) and the converged start take the sigmas at the approach's own start
+(NoiseModel.gbas_geometry, gbas.approach_geometry: the profile's start distance, glidepath, threshold crossing height
+and approach speed), so the first interval scales from where the filter's variances are; until 2026-12-05 they were
+at gbas.REFERENCE_GEOMETRY (a 10 nmi final's start) whatever the start, and a longer final began mismatched.
 
 With carrier phase the ionospheric part has its own states (gio) and the slow state gse the rest (ground and
 troposphere): each is scaled the same way by its own sigma's ratio (`carrier_interval`; a sigma of 0, no gradient,

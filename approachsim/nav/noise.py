@@ -15,8 +15,9 @@ state is clock/ephemeris + iono + tropo, the fast one the multipath; with GBAS c
 the slow state is the ground + iono + tropo residual and the fast one the airborne multipath + smoothed receiver
 noise (the white code noise left is the 2 mm carrier-phase noise: the budget's code_noise_m). The GBAS iono and
 tropo residuals grow with the aircraft's distance from and height above the reference point; the elevation-only
-noise here (and P0) takes them at gbas.REFERENCE_GEOMETRY (the start of a 10 nmi final); the epochs move the slow
-state to the aircraft's geometry (nav/gbas_scale.py).
+noise here (and P0) takes them at the approach's start (`NoiseModel.gbas_geometry`, gbas.approach_geometry; before
+2026-12-05 always at gbas.REFERENCE_GEOMETRY, the start of a 10 nmi final, so that a longer final started with its
+channel variances mismatched); the epochs move the slow state to the aircraft's geometry (nav/gbas_scale.py).
 
 Carrier phase ([sensors.gnss] carrier_phase, the layout's gio and amb states): the ionospheric part of the slow state
 gets its own per-channel state gio (Gauss-Markov at iono_tau_s, sigma the iono part of the budget at the elevation)
@@ -123,13 +124,14 @@ PSEUDOLITE_CLOCK = ("ocxo", 30.0, 0.03)
 """An unsynchronized pseudolite's transmitter clock: oscillator, bias and drift 1-sigma at the start (m, m/s)."""
 
 
-def slow_terms(bud: GnssErrorBudget, el_rad: Array, ionosphere: bool = True) -> list[tuple[Array, float]]:
+def slow_terms(bud: GnssErrorBudget, el_rad: Array, ionosphere: bool = True,
+               gbas_geometry: tuple[float, float, float] = REFERENCE_GEOMETRY) -> list[tuple[Array, float]]:
     """The slow range-error processes the sensor draws at elevations el_rad (k,), rad: [(1-sigma (k,) m, tau s)].
-    Stand-alone: clock/ephemeris, F(el) I_z, M(el) T_z; GBAS: ground, iono, tropo at gbas.REFERENCE_GEOMETRY; a
-    service: its broadcast range, iono and tropo terms (service.terms_m). ionosphere=False leaves the iono out
-    (carrier phase, where it has its own state)."""
+    Stand-alone: clock/ephemeris, F(el) I_z, M(el) T_z; GBAS: ground, iono, tropo at gbas_geometry (x_air m, dh m,
+    v_air m/s: gbas.approach_geometry); a service: its broadcast range, iono and tropo terms (service.terms_m).
+    ionosphere=False leaves the iono out (carrier phase, where it has its own state)."""
     if bud.gbas is not None:
-        s = bud.gbas.scales(el_rad, *REFERENCE_GEOMETRY)
+        s = bud.gbas.scales(el_rad, *gbas_geometry)
         out = [(s["ground"], bud.gbas.ground_tau_s), (s["iono"], bud.iono_tau_s), (s["tropo"], bud.tropo_tau_s)]
     elif bud.service is not None:  # without the common parts the filter's zenith states carry (service.params)
         t = bud.service.terms_m(el_rad, common=bud.service.tropo_zenith_state)
@@ -141,7 +143,8 @@ def slow_terms(bud: GnssErrorBudget, el_rad: Array, ionosphere: bool = True) -> 
     return out if ionosphere else [out[0], out[2]]
 
 
-def slow_tau_s(bud: GnssErrorBudget, ionosphere: bool = True) -> float:
+def slow_tau_s(bud: GnssErrorBudget, ionosphere: bool = True,
+               gbas_geometry: tuple[float, float, float] = REFERENCE_GEOMETRY) -> float:
     """The filter's one slow channel state's correlation time, s: the drift-matched (variance-weighted harmonic)
     combination of the processes it lumps over the reference sky SKY_SIN_EL,
 
@@ -150,7 +153,7 @@ def slow_tau_s(bud: GnssErrorBudget, ionosphere: bool = True) -> float:
     so that with the summed variance the state has both the sensor's stationary variance and its mean drift rate
     E[(x(t + dt) - x(t))^2] = 2 dt sum sigma_i^2 / tau_i (dt << tau): the quantity that sets what a slow range
     error does over an approach (module docstring: why one state, not one per process or a tau per channel)."""
-    terms = slow_terms(bud, np.arcsin(SKY_SIN_EL), ionosphere)
+    terms = slow_terms(bud, np.arcsin(SKY_SIN_EL), ionosphere, gbas_geometry)
     var = sum(float(np.sum(np.square(s))) for s, _ in terms)
     rate = sum(float(np.sum(np.square(s))) / tau for s, tau in terms)
     return var / rate if rate > 0.0 else max(tau for _, tau in terms)
@@ -167,6 +170,9 @@ class NoiseModel:
     """The baro scale factor's reference H_ref: the altimeter-setting reference (the field's height), m."""
     turbulence: str = "none"
     """The environment's turbulence level (BODY_ROTATION_Q): the body rotation the gyro axis errors act on."""
+    gbas_geometry: tuple[float, float, float] = REFERENCE_GEOMETRY
+    """GBAS: (x_air m, dh m, v_air m/s) of the channel noise and P0, the approach's start (gbas.approach_geometry;
+    nav/system.py); the epochs move the slow state to the aircraft's geometry (nav/gbas_scale.py)."""
     _cache: dict = field(default_factory=dict, init=False, compare=False, repr=False)
 
     def clock(self) -> ClockModel:
@@ -195,7 +201,7 @@ class NoiseModel:
         """The GPS channel states' 1-sigma (m) at elevation_rad (k,): slow range error (clock/ephemeris, mapped
         iono and tropo) and multipath (per channel under DO-253, one value under NRC 1995)."""
         el = np.maximum(np.nan_to_num(elevation_rad, nan=0.5), np.radians(2.0))
-        return self.sensors.gnss.budget().channel_sigmas_m(el)
+        return self.sensors.gnss.budget().channel_sigmas_m(el, *self.gbas_geometry)
 
     @property
     def carrier(self) -> bool:
@@ -206,7 +212,7 @@ class NoiseModel:
         """ErrorNoise's channel fields under carrier phase at elevations el (k,) (already floored): gse without the
         ionosphere, gio the ionosphere (module docstring)."""
         bud = self.sensors.gnss.budget()
-        gse, gio, gmp = bud.carrier_channel_sigmas_m(el)
+        gse, gio, gmp = bud.carrier_channel_sigmas_m(el, *self.gbas_geometry)
         return dict(gse_sigma_m=gse, gio_sigma_m=gio, gmp_sigma_m=gmp)
 
     def carrier_sigma_m(self) -> float:
@@ -249,10 +255,12 @@ class NoiseModel:
             el = np.full(24, np.radians(30.0)) if elevation_rad is None else np.nan_to_num(elevation_rad, nan=0.5)
             el = np.maximum(el, np.radians(2.0))
             # per channel at its elevation (do253: the sensor's sigma_mp), one multipath value under nrc1995
-            gse, gmp = bud.channel_sigmas_m(el)
-            kw.update(gse_sigma_m=gse, gse_tau_s=slow_tau_s(bud), gmp_sigma_m=gmp, gmp_tau_s=bud.multipath_tau_s)
+            gse, gmp = bud.channel_sigmas_m(el, *self.gbas_geometry)
+            kw.update(gse_sigma_m=gse, gse_tau_s=slow_tau_s(bud, gbas_geometry=self.gbas_geometry), gmp_sigma_m=gmp,
+                      gmp_tau_s=bud.multipath_tau_s)
             if self.carrier:
-                kw.update(self._carrier_kw(el), gse_tau_s=slow_tau_s(bud, ionosphere=False), gio_tau_s=bud.iono_tau_s)
+                kw.update(self._carrier_kw(el), gse_tau_s=slow_tau_s(bud, False, self.gbas_geometry),
+                          gio_tau_s=bud.iono_tau_s)
             if self.layout.has("giz"):  # the service's common ionosphere (gse keeps the rest: filter_params)
                 giz_sigma, giz_grad, giz_tau = bud.service.filter_iono_zenith()
                 kw.update(giz_sigma_m=giz_sigma, giz_gradient_sigma_m=giz_grad, giz_tau_s=giz_tau)

@@ -53,6 +53,7 @@ from approachsim.nav.shared import SharedCovariance
 from approachsim.records import Truth
 from approachsim.seeding import substream
 from approachsim.sensors.config import DEFAULT_SENSORS, SensorsConfig
+from approachsim.sensors.gnss.gbas import REFERENCE_GEOMETRY
 from approachsim.sensors.states import SensorStates
 
 Array = np.ndarray
@@ -109,23 +110,28 @@ class NavSystem:
     layout: em.StateLayout = field(compare=False)
     turbulence: str = "none"
     """The environment's turbulence level: the gyro axis errors' process noise (nav/noise.py gyro_axis_q)."""
+    gbas_geometry: tuple[float, float, float] = REFERENCE_GEOMETRY
+    """GBAS: the approach's start (x_air m, dh m, v_air m/s; gbas.approach_geometry), where the filter's channel
+    noise and P0 take the distance-dependent sigmas (nav/noise.py)."""
     noise_model: NoiseModel = field(init=False, compare=False, repr=False)
     rows: MeasurementRows = field(init=False, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "noise_model", NoiseModel(self.sensors, self.nav, self.layout, self.baro_ref_m,
-                                                                 self.turbulence))
+                                                                 self.turbulence, self.gbas_geometry))
         object.__setattr__(self, "rows", MeasurementRows(self.layout, self.sensors, self.nav, self.runway,
                                                          self.terrain_h))
 
     @classmethod
     def build(cls, nav: NavConfig = DEFAULT_NAV, sensors: SensorsConfig = DEFAULT_SENSORS,
-              runway: geo.RunwayFrame | None = None, terrain: Any = None, turbulence: str = "none") -> NavSystem:
+              runway: geo.RunwayFrame | None = None, terrain: Any = None, turbulence: str = "none",
+              gbas_geometry: tuple[float, float, float] = REFERENCE_GEOMETRY) -> NavSystem:
         """From configs; runway defaults to a frame at SFO 28R, terrain to flat at the threshold height; turbulence
-        the environment's level (nav/noise.py BODY_ROTATION_Q)."""
+        the environment's level (nav/noise.py BODY_ROTATION_Q); gbas_geometry the approach's start (GBAS only)."""
         rwy = runway or geo.RunwayFrame(np.radians(37.6117), np.radians(-122.3581), 4.0, np.radians(298.0))
         return cls(nav=nav, sensors=sensors, runway=rwy, terrain_h=TerrainDatabase(rwy, terrain),
-                   filter=nav.make_filter(), layout=layout_for(nav, sensors), turbulence=turbulence)
+                   filter=nav.make_filter(), layout=layout_for(nav, sensors), turbulence=turbulence,
+                   gbas_geometry=gbas_geometry)
 
     @classmethod
     def from_profile(cls, profile: Any) -> NavSystem:
@@ -133,8 +139,9 @@ class NavSystem:
         profiles are equal (and hash alike), so what a truth's memo keeps for one serves the other (`_prepared`)."""
         nav = getattr(profile, "nav", DEFAULT_NAV)
         env = getattr(profile, "environment", None)
+        geometry = profile.gbas_geometry() if hasattr(profile, "gbas_geometry") else REFERENCE_GEOMETRY
         return cls.build(nav, profile.sensors, profile.runway.frame, profile.terrain,
-                         turbulence=getattr(env, "turbulence", "none"))
+                         turbulence=getattr(env, "turbulence", "none"), gbas_geometry=geometry)
 
     @property
     def baro_ref_m(self) -> float:

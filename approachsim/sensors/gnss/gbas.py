@@ -96,11 +96,13 @@ Annex's sigma_i^2 = sigma_pr_gnd^2 + sigma_tropo^2 + sigma_pr_air^2 + sigma_iono
 The navigation filter's channel states (nav/noise.py): the slow state carries ground + iono + tropo (correlation time
 their drift-matched combination), the fast state the airborne multipath and noise (both correlated over the
 smoothing time), the white w is the pseudorange rows' R.
-The iono and tropo terms depend on where the aircraft is; `channel_sigmas_m` takes that geometry, and without it
-(the filter's prior P0, the elevation-only noise) evaluates them at REFERENCE_GEOMETRY, the start of a 10 nmi final
-on a 3 deg path at 140 kt. Along the approach the filter's slow state follows the aircraft's own geometry as the
-truth's does (nav/gbas_scale.py: the state's scale over each interval, since 2026-12-05; before, the filter kept the
-reference geometry's sigma, which over-claimed the horizontal position by a quarter on the CAT III candidate).
+The iono and tropo terms depend on where the aircraft is; `channel_sigmas_m` takes that geometry: the filter's
+prior P0 and elevation-only noise take the approach's start (`approach_geometry`: the profile's start distance,
+glidepath, threshold crossing height and approach speed; nav/system.py), and without one REFERENCE_GEOMETRY, the
+start of a 10 nmi final on a 3 deg path at 140 kt. Along the approach the filter's slow state follows the
+aircraft's own geometry as the truth's does (nav/gbas_scale.py: the state's scale over each interval, since
+2026-12-05; before, the filter kept the reference geometry's sigma, which over-claimed the horizontal position by a
+quarter on the CAT III candidate).
 
 `GbasModel` holds the configuration and the numpy formulas, the oracle of the compiled kernels
 (core/sensors/gnss.py gbas_scales, pseudorange_sum, and gbas_channel_sigmas: the filter's channel sigmas for a
@@ -143,10 +145,19 @@ CARRIER_NOISE_M = 0.002
 """White noise left on the smoothed code, m: the carrier-phase tracking jitter (module docstring)."""
 TROPO_MAPPING_A = 0.002
 """The GBAS tropospheric mapping 1 / sqrt(0.002 + sin^2 theta) (module docstring)."""
-REFERENCE_GEOMETRY = (10.0 * units.NMI, 10.0 * units.NMI * math.tan(math.radians(3.0)) + 50.0 * units.FT,
-                      140.0 * units.KT)
-"""(x_air m, dh m, v_air m/s) of the elevation-only channel noise: 10 nmi from the reference point on a 3 deg path
-with a 50 ft threshold crossing height, 140 kt (module docstring)."""
+
+
+def approach_geometry(start_distance_m: float, glidepath_rad: float, tch_m: float,
+                      speed_mps: float) -> tuple[float, float, float]:
+    """(x_air m, dh m, v_air m/s) at the start of a straight-in final, the geometry of the filter's elevation-only
+    channel noise and P0 (nav/noise.py): start_distance_m from the reference point (taken at the threshold), on the
+    glidepath glidepath_rad with the threshold crossing height tch_m, at speed_mps."""
+    return start_distance_m, start_distance_m * math.tan(glidepath_rad) + tch_m, speed_mps
+
+
+REFERENCE_GEOMETRY = approach_geometry(10.0 * units.NMI, math.radians(3.0), 50.0 * units.FT, 140.0 * units.KT)
+"""approach_geometry of a 10 nmi final on a 3 deg path with a 50 ft threshold crossing height at 140 kt: the
+default when no approach is given (module docstring)."""
 
 
 @dataclass(frozen=True)

@@ -172,3 +172,27 @@ def test_carrier_phase_scales_the_ionosphere_and_the_rest_apart() -> None:
                      replace(sc.model, sigma_vig_per_m=0.0), True)
     _, gio0, _, _, r_io0 = flat.carrier_interval(el, y[100], 1.0)
     assert np.all(gio0 == 0.0) and np.all(r_io0 == 1.0)
+
+
+def test_p0_at_the_approach_start():
+    """P0's GBAS channel variances are the budget's at the approach's own start (gbas.approach_geometry of the
+    profile's start distance, glidepath, TCH and speed): the shipped 10 nmi candidate's is REFERENCE_GEOMETRY
+    exactly (its figures unchanged), a 25 nmi final's has the larger distance-dependent ionospheric term."""
+    base = load_profile(PROFILES / "gbas-cat3-candidate.toml")
+    assert base.gbas_geometry() == gb.REFERENCE_GEOMETRY
+    far = replace(base, runway=replace(base.runway, start_distance_m=25.0 * 1852.0))
+    g = far.gbas_geometry()
+    x = 25.0 * 1852.0
+    assert g == (x, x * math.tan(base.runway.glidepath_rad) + base.runway.tch_m, 140.0 * 1852.0 / 3600.0)
+    el = np.radians(np.linspace(6.0, 85.0, 24))  # one elevation per channel
+    bud = base.sensors.gnss.budget()
+    for prof, geom in ((base, gb.REFERENCE_GEOMETRY), (far, g)):
+        sys_ = NavSystem.from_profile(prof)
+        assert sys_.noise_model.gbas_geometry == geom
+        p0 = sys_.noise_model.initial_covariance(el)
+        gse = np.diag(p0)[sys_.layout.index["gse"]]
+        want = bud.channel_sigmas_m(el, *geom)[0] ** 2
+        np.testing.assert_allclose(gse, want, rtol=4 * EPS, atol=0)  # the same numpy formula: a few roundings
+    near_s = bud.channel_sigmas_m(el, *gb.REFERENCE_GEOMETRY)[0]
+    far_s = bud.channel_sigmas_m(el, *g)[0]
+    assert np.all(far_s > near_s)  # sigma_iono grows with x_air (Annex 10 App. B)
