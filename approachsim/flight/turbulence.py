@@ -22,12 +22,12 @@ its boundary (step() takes and returns SI).
 
 from __future__ import annotations
 
-import bisect
 import math
 
 import numpy as np
 
 from approachsim import units
+from approachsim.core.loop.flight_step import dryden_scales
 from approachsim.core.tables import COEFF_EVERY, POE_ALT_FT, POE_SIGMA_FPS  # the kernel's table, once
 
 LEVELS = {
@@ -38,39 +38,17 @@ LEVELS = {
 }
 """Profile turbulence level -> (MIL-F-8785C wind speed at 20 ft, ft/s; probability-of-exceedance index)."""
 
+_POE_ALT = np.asarray(POE_ALT_FT, dtype=float)
+_POE_SIGMA = tuple(np.asarray(row, dtype=float) for row in POE_SIGMA_FPS)
+"""The probability-of-exceedance table as the kernel takes it (heights, ft; one sigma row per index, ft/s)."""
 
 
 def scales(h_ft: float, w20_fps: float, index: int) -> tuple[float, float, float, float]:
-    """Scale lengths L_u, L_w (ft) and intensities sigma_u, sigma_w (ft/s) at height h_ft above ground.
-
-    Below 1000 ft: MIL-F-8785C low-altitude model (figs. 10, 11); above 2000 ft: L = 1750 ft and sigma from
-    the probability-of-exceedance table (fig. 7); linear in between (as JSBSim). Heights clipped at 10 ft.
-    """
-    h = max(h_ft, 10.0)
-    if h <= 1000.0:
-        den = 0.177 + 0.000823 * h
-        sig_w = 0.1 * w20_fps
-        return h / den**1.2, h, sig_w / den**0.4, sig_w
-    sig_hi = _interp(h, POE_ALT_FT, POE_SIGMA_FPS[index - 1])
-    if h <= 2000.0:
-        f = (h - 1000.0) / 1000.0
-        L = 1000.0 + f * 750.0
-        s = 0.1 * w20_fps + f * (sig_hi - 0.1 * w20_fps)
-        return L, L, s, s
-    return 1750.0, 1750.0, sig_hi, sig_hi
-
-
-def _interp(x: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> float:
-    """Piecewise-linear interpolation held at the ends (numpy.interp for one float, without its overhead)."""
-    if x <= xs[0]:
-        return ys[0]
-    i = bisect.bisect_right(xs, x)
-    if i >= len(xs):
-        return ys[-1]
-    x0, x1 = xs[i - 1], xs[i]
-    return ys[i - 1] + (x - x0) / (x1 - x0) * (ys[i] - ys[i - 1])
-
-
+    """Scale lengths L_u, L_w (ft) and intensities sigma_u, sigma_w (ft/s) at height h_ft above ground, for the
+    probability-of-exceedance index `index`: core/loop/flight_step.dryden_scales, the formula's one copy
+    (MIL-F-8785C low-altitude model below 1000 ft, figs. 10, 11; above 2000 ft L = 1750 ft and sigma from the table
+    of fig. 7; linear in between, as JSBSim; heights clipped at 10 ft)."""
+    return dryden_scales(float(h_ft), float(w20_fps), _POE_ALT, _POE_SIGMA[index - 1])
 
 
 class DrydenTurbulence:

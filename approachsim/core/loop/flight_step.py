@@ -650,7 +650,7 @@ def autopilot_step(par: Array, st: Array, guide: tuple, air: tuple) -> tuple[flo
 @njit(cache=True)
 def dryden_scales(h_ft: float, w20_fps: float, alt_ft: Array, sigma_fps: Array) -> tuple[float, float, float, float]:
     """Scale lengths L_u, L_w (ft) and intensities sigma_u, sigma_w (ft/s) at height h_ft above the ground
-    (flight/turbulence.scales, the oracle): MIL-F-8785C low-altitude model below 1000 ft, the level's
+    (flight/turbulence.scales calls it): MIL-F-8785C low-altitude model below 1000 ft, the level's
     probability-of-exceedance row sigma_fps at alt_ft above 2000 ft, linear in between; heights clipped at 10 ft."""
     h = max(h_ft, 10.0)
     if h <= 1000.0:

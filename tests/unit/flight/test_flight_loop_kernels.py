@@ -145,15 +145,32 @@ def test_autopilot_kernel_equals_the_oracle_bit_for_bit(gains, flare, law):
         assert seen["flaring"] == 0 and seen["aligning"] == 0, seen
 
 
-def test_dryden_scales_equal_the_oracle_across_the_regimes():
+def test_dryden_scales_follow_the_standard_across_the_regimes():
+    """The kernel's three regimes and the table's held ends against the standard's forms written here (MIL-F-8785C:
+    the low-altitude model below 1000 ft, numpy.interp of the fig. 7 row above 2000 ft, linear in between). The
+    interpolation rounds in another order than numpy.interp's: the tolerance is a few eps of the table's sigmas
+    (under 20 ft/s), 4 eps x 20 = 1.8e-14 ft/s; the scale lengths' arithmetic is the same expression (equal)."""
     heights = np.concatenate([[-5.0, 0.0, 10.0, 1000.0, 2000.0, 500.0, 1750.0, 80000.0, 90000.0],
                               np.random.default_rng(2).uniform(0.0, 90000.0, 400)])
+    tol = 4 * np.finfo(float).eps * 20.0
     for level, (w20, index) in (("light", (25.0, 3)), ("moderate", (50.0, 4)), ("severe", (75.0, 6))):
         turb = DrydenTurbulence(level, np.random.default_rng(0), 1, DT, 0.0)
         par, _ = fv.dryden_arrays(turb)
         alt, sig = par[layouts.TB_PAR.slice("poe_alt_ft")], par[layouts.TB_PAR.slice("poe_sigma_fps")]
-        for h in heights:
-            assert fk.dryden_scales(h, w20, alt, sig) == scales(h, w20, index), (level, h)
+        for h_in in heights:
+            h = max(h_in, 10.0)
+            L_u, L_w, s_u, s_w = fk.dryden_scales(h_in, w20, alt, sig)
+            if h <= 1000.0:
+                den = 0.177 + 0.000823 * h
+                assert (L_u, L_w) == (h / den**1.2, h), (level, h)
+                assert s_w == 0.1 * w20 and s_u == 0.1 * w20 / den**0.4, (level, h)
+                continue
+            table = float(np.interp(h, alt, sig))
+            f = min((h - 1000.0) / 1000.0, 1.0)
+            want = 0.1 * w20 + f * (table - 0.1 * w20) if h <= 2000.0 else table
+            assert abs(s_u - want) <= tol and s_w == s_u, (level, h, s_u, want)
+            assert L_u == L_w == (1000.0 + f * 750.0 if h <= 2000.0 else 1750.0), (level, h)
+        assert scales(1500.0, w20, index) == fk.dryden_scales(1500.0, w20, alt, sig)  # the same table
 
 
 @pytest.mark.parametrize("level", ["light", "moderate", "severe"])
