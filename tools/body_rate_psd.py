@@ -39,6 +39,28 @@ def rotation_q(w: np.ndarray, dt: float, lag_s: float = LAG_S) -> np.ndarray:
     return (d * d).mean(axis=0) / (k * dt)
 
 
+def rotation_var(w: np.ndarray, dt: float) -> np.ndarray:
+    """Var(Theta - its mean over the approach) (rad^2) per column of w (n, 3): the stationary variance of the
+    rotation a gyro scale-factor / misalignment error acts on (Theta as in rotation_q)."""
+    th = np.cumsum(w - w.mean(axis=0), axis=0) * dt
+    return th.var(axis=0)
+
+
+def rotation_tau(w: np.ndarray, dt: float, max_lag_s: float = 120.0) -> np.ndarray:
+    """Correlation time (s) of Theta per column of w (n, 3): the first lag at which the autocorrelation of Theta
+    (its mean removed) falls to 1/e (max_lag_s when it does not)."""
+    th = np.cumsum(w - w.mean(axis=0), axis=0) * dt
+    th = th - th.mean(axis=0)
+    out = np.full(w.shape[1], max_lag_s)
+    var = (th * th).mean(axis=0)
+    for c in range(w.shape[1]):
+        for k in range(1, int(round(max_lag_s / dt))):
+            if (th[k:, c] * th[:-k, c]).mean() < var[c] / np.e:
+                out[c] = k * dt
+                break
+    return out
+
+
 def rate_psd(w: np.ndarray, dt: float) -> np.ndarray:
     """Two-sided PSD (rad^2/s^2/Hz) of each column of w (n, 3) averaged over RATE_BAND_HZ."""
     f, p = welch(w - w.mean(axis=0), fs=1.0 / dt, nperseg=min(len(w), int(round(128.0 / dt))), axis=0)
@@ -60,17 +82,25 @@ def main() -> None:
     prof0 = parse_profile(data, source=a.profile.resolve())
     for level in a.turbulence:
         prof = replace(prof0, environment=replace(prof0.environment, turbulence=level))
-        q, r = [], []
+        q, r, v, t = [], [], [], []
         for seed in a.seeds:
             tr = Approach(prof).fly(seed=seed, run=0).truth
             w, dt = np.asarray(tr.w_ib_body), float(tr.t_s[1] - tr.t_s[0])
             q.append(rotation_q(w, dt, a.lag_s))
             r.append(rate_psd(w, dt))
+            v.append(rotation_var(w, dt))
+            t.append(rotation_tau(w, dt))
         s, se = np.mean(q, axis=0), np.std(q, axis=0, ddof=1) / np.sqrt(len(q))
         b = np.mean(r, axis=0)
         print(f"{level:9s} rotation over {a.lag_s:g} s: roll {s[0]:.3g} pitch {s[1]:.3g} yaw {s[2]:.3g} rad^2/s "
               f"(+- {se[0]:.2g}, {se[1]:.2g}, {se[2]:.2g}; seeds {a.seeds}); body-rate PSD 0.01-0.05 Hz: roll "
               f"{b[0]:.3g} pitch {b[1]:.3g} yaw {b[2]:.3g} rad^2/s^2/Hz")
+        vm, vs = np.mean(v, axis=0), np.std(v, axis=0, ddof=1) / np.sqrt(len(v))
+        tm, ts = np.mean(t, axis=0), np.std(t, axis=0, ddof=1) / np.sqrt(len(t))
+        print(f"{level:9s} Var(Theta - mean): roll {vm[0]:.3g} pitch {vm[1]:.3g} yaw {vm[2]:.3g} rad^2 "
+              f"(+- {vs[0]:.2g}, "
+              f"{vs[1]:.2g}, {vs[2]:.2g}); 1/e time of Theta: roll {tm[0]:.3g} pitch {tm[1]:.3g} yaw {tm[2]:.3g} s "
+              f"(+- {ts[0]:.2g}, {ts[1]:.2g}, {ts[2]:.2g}); per seed tau {np.round(t, 1).tolist()}")
 
 
 if __name__ == "__main__":

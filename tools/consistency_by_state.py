@@ -198,22 +198,29 @@ def pool_seeds(ratio: np.ndarray, dof: np.ndarray, runs: int) -> dict[str, np.nd
             "min": r.min(axis=0), "max": r.max(axis=0), "seeds": np.array(s)}
 
 
-def _seed_summary(profile: Path, runs: int, seed: int, sets: tuple[str, ...]) -> tuple[dict, tuple[str, ...]]:
-    """summary() of PROFILE flown at one seed (the profile's filter), and the state names."""
-    e, d, names = navigate(flown(profile, runs, seed, sets), seed)
+def _seed_summary(profile: Path, runs: int, seed: int, sets: tuple[str, ...], truth_kw: dict | None = None,
+                  filter_turbulence: str | None = None) -> tuple[dict, tuple[str, ...]]:
+    """summary() of PROFILE flown at one seed (truth_kw: flown()'s truth options; filter_turbulence: navigate()'s),
+    and the state names."""
+    e, d, names = navigate(flown(profile, runs, seed, sets, **(truth_kw or {})), seed, filter_turbulence)
     return summary(e, d), names
 
 
-def run_pool(profile: Path, runs: int, seeds: list[int], sets: tuple[str, ...], workers: int) -> None:
-    """PROFILE at every seed (in `workers` processes); per state the seeds' ratios and pool_seeds printed."""
+def run_pool(profile: Path, runs: int, seeds: list[int], sets: tuple[str, ...], workers: int,
+             truth_kw: dict | None = None, filter_turbulence: str | None = None) -> None:
+    """PROFILE at every seed (in `workers` processes); per state the seeds' ratios and pool_seeds printed (truth_kw,
+    filter_turbulence: _seed_summary's)."""
     from concurrent.futures import ProcessPoolExecutor
 
     with ProcessPoolExecutor(max_workers=workers) as ex:
-        res = [f.result() for f in [ex.submit(_seed_summary, profile, runs, s, sets) for s in seeds]]
+        res = [f.result() for f in [ex.submit(_seed_summary, profile, runs, s, sets, truth_kw, filter_turbulence)
+                                    for s in seeds]]
     names = res[0][1]
     ratio = np.array([r[0]["ratio"] for r in res])
     p = pool_seeds(ratio, np.array([r[0]["dof"] for r in res]), runs)
-    print(f"{profile}: {len(seeds)} seeds x {runs} runs" + "".join(f"; {x}" for x in sets))
+    print(f"{profile}: {len(seeds)} seeds x {runs} runs" + "".join(f"; {x}" for x in sets)
+          + "".join(f"; truth {k} {v}" for k, v in (truth_kw or {}).items() if v)
+          + (f"; filter turbulence {filter_turbulence}" if filter_turbulence else ""))
     print(f"  {'state':6s} {'mean':>6s} {'se':>6s} {'sd':>6s} {'sd exp':>6s} {'dof':>5s} {'95 % of a seed':>14s} "
           f"{'outside':>8s} {'P(>=)':>6s} {'KS p':>5s} {'min':>5s} {'max':>5s}")
     for c, nm in enumerate(names):
@@ -398,7 +405,8 @@ def main() -> None:
     if a.profile is None:
         ap.error("PROFILE is required without --suite")
     if a.pool:
-        run_pool(a.profile, a.runs, a.seeds, tuple(a.set), a.workers)
+        run_pool(a.profile, a.runs, a.seeds, tuple(a.set), a.workers,
+                 {"slow_tau_s": a.slow_tau_s, "ideal_imu_axes": a.ideal_imu_axes}, a.filter_turbulence)
         return
     fl = flown(a.profile, a.runs, a.seed, tuple(a.set), a.slow_tau_s, a.ideal_imu_axes)
     e, d, names = navigate(fl, a.seed, a.filter_turbulence)
