@@ -1,19 +1,19 @@
-"""The flown airframe's rotation as white noise over the aided filter's velocity-error time: the source of
-nav/noise.py BODY_ROTATION_Q.
+"""The flown airframe's rotation and what a gyro scale-factor / misalignment error makes of it: the source of
+nav/noise.py's gyro axis figures (SF_DRIFT_Q; on branch i39g also BODY_ROTATION, the eps states').
 
-    python tools/body_rate_psd.py PROFILE [--seeds 1 2 3 4 5 6] [--turbulence light moderate severe] [--lag-s 25]
+    python tools/body_rate_psd.py PROFILE [--seeds 1 2 3 4 5 6] [--turbulence light moderate] [--lag-s 25]
+        [--drift [--draws 200]]
 
-Flies the profile (run 0 of each seed) at each turbulence level and prints, per body axis (roll, pitch, yaw), the
-white-noise equivalent of the body's rotation over a lag T: Var(Theta(t + T) - Theta(t)) / T, rad^2/s, Theta(t) the
-integral of the inertial body rate w_ib (its mean over the approach removed). A gyro scale-factor / misalignment
-error (S + M) w_ib integrates into an attitude error (S + M) Theta(t), and the filter carries it as a white noise of
-the attitude error's rate (nav/noise.py gyro_axis_q): that noise's increments over T have variance q T, the
-truth's sf^2 Var(delta Theta(T)). T is the aided filter's horizontal velocity errors' correlation time (1/e of their
-autocorrelation: 23-30 s on the default profile, seeds 1-2), the time over which the tilt error accelerates them
-before the aiding takes it out. Turbulence's rotation is bounded (Theta's increments saturate at about 2 x
-(0.026 rad)^2 beyond 25 s, light), so the equivalent falls as 1/T at longer lags; the body-rate spectrum over
-0.01-0.05 Hz (also printed, the value this replaced) is its short-lag limit and overstated the pitch axis 2.7-fold
-at 25 s (and understated the roll axis, whose rotation is slow).
+Flies the profile (run 0 of each seed) at each turbulence level and prints per body axis (roll, pitch, yaw), Theta(t)
+the integral of the inertial body rate w_ib (its mean over the approach removed):
+- the white-noise equivalent of the rotation over a lag T, Var(Theta(t + T) - Theta(t)) / T (rad^2/s; the filter's
+  gyro axis noise before 2026-12-05, at T = 25 s), and the body-rate PSD over 0.01-0.05 Hz (the one before that);
+- Var(Theta - mean) (rad^2) and the 1/e time of Theta's autocorrelation (s): the bounded first-order attitude error
+  (S + M) Theta's variance per unit sf^2 and its correlation time (light: 4.29e-4 / 6.45e-4 / 4.86e-4 rad^2, 1.1 /
+  5.0 / 3.3 s; the structure function saturates at 2 Var by 10 s: the rotation is bounded);
+- with --drift, sf_drift_q: the exact attitude error -int C_bn (S + M) w_ib dt over `draws` unit draws of S and of M,
+  less its first-order part, its variance fitted as q t (rad^2/s per unit sf^2 and per unit mis^2): the unbounded
+  part (the mean rate's ramp and the Dutch roll's coning rectified into the pitch axis) that the filter carries.
 """
 
 from __future__ import annotations
@@ -61,6 +61,42 @@ def rotation_tau(w: np.ndarray, dt: float, max_lag_s: float = 120.0) -> np.ndarr
     return out
 
 
+def _offdiag(m: np.ndarray) -> np.ndarray:
+    """(3, 3) matrix with the 6 values m off the diagonal (sensors/imu.py's misalignment order does not matter for
+    a variance of independent draws)."""
+    out = np.zeros((3, 3))
+    out[[0, 0, 1, 1, 2, 2], [1, 2, 0, 2, 0, 1]] = m
+    return out
+
+
+def sf_drift_q(w: np.ndarray, c_bn: np.ndarray, dt: float, draws: int = 200, seed: int = 0) -> np.ndarray:
+    """(2, 3) white rate-noise equivalents (rad^2/s per unit sf^2, row 0, and per unit mis^2, row 1; body axes x, y,
+    z) of the part of the exact scale-factor / misalignment attitude error that the bounded first-order tilt leaves.
+
+    Exact: psi(t) = -int_0^t C_bn (S + M) w_ib dt' (nav frame; the INS attitude error of a gyro error (S + M) w_ib).
+    First order: -C_bn(0) (S + M) (Theta(t) - Theta(0)), Theta the integral of w_ib less its mean (the eps states).
+    The rest d(t) (in the start's body axes, C_bn(0)' d) holds (S + M) times the mean body rate (the Earth and
+    transport rates, the attitude's trend: a ramp) and the rectification of the rotating C_bn over the airframe's
+    oscillation (coning: Theta x (S + M) Theta', second order in the rotation), both unbounded; its variance over
+    `draws` unit draws of S (diagonal) and of M (off-diagonal), fitted as q t through the origin over the approach."""
+    rng = np.random.default_rng(seed)
+    th = np.cumsum(w - w.mean(axis=0), axis=0) * dt
+    th = th - th[0]
+    t = np.arange(1, len(w) + 1) * dt
+    c0t = c_bn[0].T
+    out = np.zeros((2, 3))
+    for row in range(2):
+        acc = np.zeros((len(w), 3))
+        for _ in range(draws):
+            m = np.diag(rng.standard_normal(3)) if row == 0 else _offdiag(rng.standard_normal(6))
+            exact = -np.cumsum(np.einsum("nij,nj->ni", c_bn, w @ m.T), axis=0) * dt
+            d = exact @ c0t.T + th @ m.T  # C0' exact - (-(S + M) Theta), body axes of the start
+            acc += d * d
+        v = acc / draws
+        out[row] = (t @ v) / (t @ t)
+    return out
+
+
 def rate_psd(w: np.ndarray, dt: float) -> np.ndarray:
     """Two-sided PSD (rad^2/s^2/Hz) of each column of w (n, 3) averaged over RATE_BAND_HZ."""
     f, p = welch(w - w.mean(axis=0), fs=1.0 / dt, nperseg=min(len(w), int(round(128.0 / dt))), axis=0)
@@ -74,6 +110,8 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4, 5, 6])
     ap.add_argument("--turbulence", nargs="+", default=["light", "moderate", "severe"])
     ap.add_argument("--lag-s", type=float, default=LAG_S)
+    ap.add_argument("--drift", action="store_true", help="also sf_drift_q (slow: 400 exact propagations a seed)")
+    ap.add_argument("--draws", type=int, default=200)
     a = ap.parse_args()
     from approachsim.flight.run import Approach
     from approachsim.profile import parse_profile
@@ -82,7 +120,7 @@ def main() -> None:
     prof0 = parse_profile(data, source=a.profile.resolve())
     for level in a.turbulence:
         prof = replace(prof0, environment=replace(prof0.environment, turbulence=level))
-        q, r, v, t = [], [], [], []
+        q, r, v, t, dq = [], [], [], [], []
         for seed in a.seeds:
             tr = Approach(prof).fly(seed=seed, run=0).truth
             w, dt = np.asarray(tr.w_ib_body), float(tr.t_s[1] - tr.t_s[0])
@@ -90,6 +128,9 @@ def main() -> None:
             r.append(rate_psd(w, dt))
             v.append(rotation_var(w, dt))
             t.append(rotation_tau(w, dt))
+            if a.drift:
+                from approachsim.nav import ins
+                dq.append(sf_drift_q(w, ins.cbn_from_quaternion(np.asarray(tr.q_nb)), dt, a.draws))
         s, se = np.mean(q, axis=0), np.std(q, axis=0, ddof=1) / np.sqrt(len(q))
         b = np.mean(r, axis=0)
         print(f"{level:9s} rotation over {a.lag_s:g} s: roll {s[0]:.3g} pitch {s[1]:.3g} yaw {s[2]:.3g} rad^2/s "
@@ -101,6 +142,12 @@ def main() -> None:
               f"(+- {vs[0]:.2g}, "
               f"{vs[1]:.2g}, {vs[2]:.2g}); 1/e time of Theta: roll {tm[0]:.3g} pitch {tm[1]:.3g} yaw {tm[2]:.3g} s "
               f"(+- {ts[0]:.2g}, {ts[1]:.2g}, {ts[2]:.2g}); per seed tau {np.round(t, 1).tolist()}")
+        if a.drift:
+            dm, ds = np.mean(dq, axis=0), np.std(dq, axis=0, ddof=1) / np.sqrt(len(dq))
+            print(f"{level:9s} unbounded scale-factor tilt, rad^2/s per unit sf^2: x {dm[0, 0]:.3g} y {dm[0, 1]:.3g} "
+                  f"z {dm[0, 2]:.3g} (+- {ds[0, 0]:.2g}, {ds[0, 1]:.2g}, {ds[0, 2]:.2g}); per unit mis^2: x "
+                  f"{dm[1, 0]:.3g} y {dm[1, 1]:.3g} z {dm[1, 2]:.3g} (+- {ds[1, 0]:.2g}, {ds[1, 1]:.2g}, "
+                  f"{ds[1, 2]:.2g})")
 
 
 if __name__ == "__main__":

@@ -216,9 +216,9 @@ class ErrorNoise:
     gyro_axis_q_x: float = 0.0
     gyro_axis_q_y: float = 0.0
     gyro_axis_q_z: float = 0.0
-    """White rate noise of the gyro scale-factor / misalignment errors on body axes x, y, z, rad^2/s: (S + M) w_ib
-    at the airframe's rotation over the aided filter's velocity-error time (nav/noise.py gyro_axis_q); rotated to
-    NED, added to the attitude's ARW."""
+    """White rate noise of the gyro scale-factor / misalignment errors on body axes x, y, z, rad^2/s: the unbounded
+    part of the attitude error (S + M) w_ib makes on the flown airframe (nav/noise.py gyro_axis_q); rotated to NED,
+    added to the attitude's ARW."""
     giz_sigma_m: float = 0.0
     giz_gradient_sigma_m: float = 0.0
     giz_tau_s: float = 1800.0

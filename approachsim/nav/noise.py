@@ -68,19 +68,23 @@ the gradient states). Why the troposphere: per channel it made the DFMC filter's
 with gtz).
 
 Gyro scale-factor and misalignment errors (`gyro_axis_q`): the IMU's (S + M) w_ib (random constants per run, the
-grade's sigmas) is process noise, not 9 filter states. Integrated, it is an attitude error (S + M) Theta(t), Theta the
-integral of the body rate: in light turbulence the 737 rotates a few degrees and back, and 100 ppm of that is a few
-microradians of tilt that accelerates the horizontal velocity error until the aiding takes it out. The filter
-carries it as a white noise of the attitude error's rate per body axis, q_k = sf^2 W_k + mis^2 (W_i + W_j), W_k the
-white-noise equivalent of the airframe's rotation over the aided filter's velocity-error correlation time T = 25 s,
-Var(Theta_k(t + T) - Theta_k(t)) / T (BODY_ROTATION_Q, measured on the flown airframe by tools/body_rate_psd.py):
-the noise's increments over T have the variance sf^2 Var(delta Theta(T)) the truth's have. The body-rate spectrum over
-0.01-0.05 Hz, used before, is that equivalent's short-lag limit; the rotation being bounded, it overstated the pitch
-axis 2.7-fold at 25 s and, with the converged start's draw fixed (nav/initial.py conditioner), left the horizontal
-velocity over-claimed (default profile, seeds 1-2: e^2/P 0.81-0.93; docs/consistency.md). States would need the body
-rate in the compiled error dynamics (every epoch kernel's inputs), 9 more states in every covariance, and would
-estimate quantities that, at 100 ppm and 0.02 mrad, the approach's few degrees of rotation cannot observe. The
-accelerometer's scale factor and misalignment are in the ba prior (under 1 g they look like a bias).
+grade's sigmas) is process noise, not 9 filter states. It makes the INS attitude error -int C_bn (S + M) w_ib dt.
+Its first-order part -C_bn(0) (S + M) (Theta(t) - Theta(0)), Theta the integral of the body rate, is bounded (light
+turbulence: Var(Theta - mean) 4.29e-4 / 6.45e-4 / 4.86e-4 rad^2, 1/e times 1.1 / 5.0 / 3.3 s: a tilt of 2-3 urad
+at nav-2.0, decorrelated within seconds) and moves the aided velocity too little to matter: carried as three
+Gauss-Markov states (branch i39g) it changed no pooled e^2/P by more than 0.03 and, alone, left the filter as
+over-confident as no model (default profile, seeds 1-4: horizontal velocity 1.39 / 1.94). The rest is not bounded: the
+mean body rate (the Earth and transport rates, the attitude's trend) times S + M is a ramp, and the rotating C_bn
+rectifies the Dutch roll's roll-yaw coning into the pitch axis (Theta x S Theta', second order in the rotation).
+Propagated exactly over draws of S and M on the flown truth, its variance grows as q t: the filter carries it as a
+white noise of the attitude error's rate per body axis, q_k = sf^2 D_k + mis^2 E_k (SF_DRIFT_Q, measured by
+tools/body_rate_psd.py --drift), rotated to NED. The white noise matched to the rotation's increments over the
+filter's 25 s velocity-error time used before (the first-order part's, 2-13 times this) over-claimed the horizontal
+velocity (e^2/P 0.86-0.92 pooled over 20 seeds in every case of the consistency suite, docs/consistency.md). States
+would need the body rate in the compiled error dynamics (every epoch kernel's inputs), 9 more states in every
+covariance, and would estimate quantities that, at 100 ppm and 0.02 mrad, the approach's few degrees of rotation
+cannot observe. The accelerometer's scale factor and misalignment are in the ba prior (under 1 g they look like a
+bias).
 """
 
 from __future__ import annotations
@@ -109,16 +113,21 @@ SKY_SIN_EL = np.linspace(np.sin(np.radians(5.0)), 1.0, 16)
 """The reference sky of `slow_tau_s`: 16 elevations equally spaced in sin(el) from 5 deg to the zenith (equal solid
 angle above the default 5 deg mask)."""
 
-BODY_ROTATION_Q: dict[str, tuple[float, float, float]] = {
-    "none": (0.0, 0.0, 0.0),
-    "light": (3.08e-5, 5.23e-5, 3.51e-5),
-    "moderate": (7.44e-5, 1.15e-4, 8.05e-5),
-    "severe": (1.67e-4, 2.59e-4, 1.81e-4),
+SF_DRIFT_Q: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
+    "none": ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
+    "light": ((1.88e-6, 2.61e-5, 1.83e-6), (2.10e-5, 3.68e-6, 1.81e-5)),
+    "moderate": ((8.91e-6, 1.45e-4, 3.01e-6), (1.13e-4, 1.16e-5, 1.06e-4)),
+    "severe": ((4.51e-5, 7.34e-4, 1.52e-5), (5.72e-4, 5.87e-5, 5.37e-4)),
 }
-"""White-noise equivalent of the airframe's rotation (roll, pitch, yaw) over the aided filter's velocity-error
-correlation time, Var(Theta(t + 25 s) - Theta(t)) / 25 s, rad^2/s, by turbulence level: tools/body_rate_psd.py on
-the default profile's 737 (seeds 1-6; light +- 1.9e-6, 7.5e-6, 2.8e-6 over the seeds); severe, beyond the 737's
-approach limit, is moderate x (75 / 50)^2, the Dryden gust variance ratio (engineering choice)."""
+"""The unbounded part of the gyro scale-factor / misalignment attitude error as white rate noise per body axis (x, y,
+z), rad^2/s per unit sf^2 (first) and per unit mis^2 (second), by turbulence level: tools/body_rate_psd.py --drift on
+the default profile's 737 (seeds 1-6, 200 unit draws of S and of M each): the exact error -int C_bn (S + M) w_ib dt
+less its bounded first-order part -C_bn(0) (S + M) (Theta(t) - Theta(0)), its variance fitted as q t over the approach
+(light +- 9.9e-7, 3.0e-6, 7.5e-7 and 2.4e-6, 1.4e-6, 2.2e-6 over the seeds). The pitch axis's sf part is the Dutch
+roll's coning (roll and yaw in quadrature rectify into it: Theta x S Theta') and the ramp of the mean pitch rate;
+moderate / light 5.6, the square of the rotation variance ratio (2.3), as a second-order rectification scales.
+Severe, beyond the 737's approach limit, is moderate x 2.25^2 (the Dryden gust variance ratio (75 / 50)^2, squared;
+engineering choice)."""
 
 PSEUDOLITE_CLOCK = ("ocxo", 30.0, 0.03)
 """An unsynchronized pseudolite's transmitter clock: oscillator, bias and drift 1-sigma at the start (m, m/s)."""
@@ -169,7 +178,7 @@ class NoiseModel:
     baro_ref_m: float = 0.0
     """The baro scale factor's reference H_ref: the altimeter-setting reference (the field's height), m."""
     turbulence: str = "none"
-    """The environment's turbulence level (BODY_ROTATION_Q): the body rotation the gyro axis errors act on."""
+    """The environment's turbulence level (SF_DRIFT_Q): the body rotation the gyro axis errors act on."""
     gbas_geometry: tuple[float, float, float] = REFERENCE_GEOMETRY
     """GBAS: (x_air m, dh m, v_air m/s) of the channel noise and P0, the approach's start (gbas.approach_geometry;
     nav/system.py); the epochs move the slow state to the aircraft's geometry (nav/gbas_scale.py)."""
@@ -305,13 +314,12 @@ class NoiseModel:
 
     def gyro_axis_q(self) -> tuple[float, float, float]:
         """White rate noise (rad^2/s) on body axes x, y, z for the gyro scale-factor and misalignment errors the
-        filter has no states for: the attitude error (S + M) Theta, S and M random constants of 1-sigma gyro_sf and
-        gyro_misalign_rad (the grade), Theta the body's rotation, white-noise equivalent W_k over the filter's
-        velocity-error time at the turbulence level (BODY_ROTATION_Q), q_k = sf^2 W_k + mis^2 (W_i + W_j). Why this
-        form, and why not 9 states: module docstring."""
+        filter has no states for: the unbounded part of the attitude error they make, S and M random constants of
+        1-sigma gyro_sf and gyro_misalign_rad (the grade), q_k = sf^2 D_k + mis^2 E_k (SF_DRIFT_Q at the turbulence
+        level). Why this form, and why not 9 states: module docstring."""
         g = PRESETS[self.sensors.imu.grade]
-        s = np.asarray(BODY_ROTATION_Q[self.turbulence])
-        q = g.gyro_sf**2 * s + g.gyro_misalign_rad**2 * (s.sum() - s)
+        d, e = (np.asarray(a, dtype=float) for a in SF_DRIFT_Q[self.turbulence])
+        q = g.gyro_sf**2 * d + g.gyro_misalign_rad**2 * e
         return float(q[0]), float(q[1]), float(q[2])
 
     def channel_qd(self, qd: Array, el_rad: Array, dt_s: float) -> Array:

@@ -127,7 +127,7 @@ class NavSystem:
               runway: geo.RunwayFrame | None = None, terrain: Any = None, turbulence: str = "none",
               gbas_geometry: tuple[float, float, float] = REFERENCE_GEOMETRY) -> NavSystem:
         """From configs; runway defaults to a frame at SFO 28R, terrain to flat at the threshold height; turbulence
-        the environment's level (nav/noise.py BODY_ROTATION_Q); gbas_geometry the approach's start (GBAS only)."""
+        the environment's level (nav/noise.py SF_DRIFT_Q); gbas_geometry the approach's start (GBAS only)."""
         rwy = runway or geo.RunwayFrame(np.radians(37.6117), np.radians(-122.3581), 4.0, np.radians(298.0))
         return cls(nav=nav, sensors=sensors, runway=rwy, terrain_h=TerrainDatabase(rwy, terrain),
                    filter=nav.make_filter(), layout=layout_for(nav, sensors), turbulence=turbulence,

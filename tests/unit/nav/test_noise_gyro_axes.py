@@ -1,6 +1,6 @@
-"""nav/noise.py's gyro scale-factor / misalignment process noise: q_k = sf^2 S_k + mis^2 (S_i + S_j) per body axis
-from the grade and the turbulence level's rotation over the filter's velocity-error time, rotated into NED on top
-of the ARW."""
+"""nav/noise.py's gyro scale-factor / misalignment process noise: q_k = sf^2 D_k + mis^2 E_k per body axis from the
+grade and the turbulence level's unbounded scale-factor attitude error (SF_DRIFT_Q), rotated into NED on top of the
+ARW."""
 
 from __future__ import annotations
 
@@ -18,15 +18,14 @@ DEFAULT = Path(__file__).resolve().parents[3] / "profiles" / "default.toml"
 
 
 def test_gyro_axis_noise_is_the_grade_times_the_body_rotation():
-    """Default profile (nav-2.0: 100 ppm, 0.02 mrad; light turbulence: roll 3.08e-5, pitch 5.23e-5, yaw 3.51e-5
-    rad^2/s), written out; calm air gives none."""
+    """Default profile (nav-2.0: 100 ppm, 0.02 mrad; light turbulence: per unit sf^2 1.88e-6, 2.61e-5, 1.83e-6 and
+    per unit mis^2 2.10e-5, 3.68e-6, 1.81e-5 rad^2/s), written out; calm air gives none."""
     nav = NavSystem.from_profile(load_profile(DEFAULT))
     assert nav.turbulence == "light"
-    s = np.array([3.08e-5, 5.23e-5, 3.51e-5])
-    want = 1e-4**2 * s + 2e-5**2 * (s.sum() - s)
+    want = 1e-4**2 * np.array([1.88e-6, 2.61e-5, 1.83e-6]) + 2e-5**2 * np.array([2.10e-5, 3.68e-6, 1.81e-5])
     nz = nav.noise_model.noise(None)
     np.testing.assert_allclose([nz.gyro_axis_q_x, nz.gyro_axis_q_y, nz.gyro_axis_q_z], want, rtol=1e-12)
-    assert want[1] > 200 * nz.gyro_arw_rad_sqrts**2  # the pitch axis: ~230 times the grade's ARW^2
+    assert want[1] > 100 * nz.gyro_arw_rad_sqrts**2  # the pitch axis (the Dutch roll's coning): ~110 x the ARW^2
     calm = replace(nav, turbulence="none").noise_model.noise(None)
     assert (calm.gyro_axis_q_x, calm.gyro_axis_q_y, calm.gyro_axis_q_z) == (0.0, 0.0, 0.0)
 
