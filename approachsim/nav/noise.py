@@ -72,7 +72,7 @@ grade's sigmas) is process noise, not 9 filter states. It makes the INS attitude
 Its first-order part -C_bn(0) (S + M) (Theta(t) - Theta(0)), Theta the integral of the body rate, is bounded (light
 turbulence: Var(Theta - mean) 4.29e-4 / 6.45e-4 / 4.86e-4 rad^2, 1/e times 1.1 / 5.0 / 3.3 s: a tilt of 2-3 urad
 at nav-2.0, decorrelated within seconds) and moves the aided velocity too little to matter: carried as three
-Gauss-Markov states (branch i39g) it changed no pooled e^2/P by more than 0.03 and, alone, left the filter as
+Gauss-Markov states (branch i39g) it changed no pooled e^2/P by more than 0.031 and, alone, left the filter as
 over-confident as no model (default profile, seeds 1-4: horizontal velocity 1.39 / 1.94). The rest is not bounded: the
 mean body rate (the Earth and transport rates, the attitude's trend) times S + M is a ramp, and the rotating C_bn
 rectifies the Dutch roll's roll-yaw coning into the pitch axis (Theta x S Theta', second order in the rotation).
