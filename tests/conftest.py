@@ -15,6 +15,7 @@ import pytest
 
 LONGEST_FIRST = (
     "tests/integration/test_wheel_install.py",  # ~170 s (a fresh install compiles its kernels)
+    "tests/integration/test_nav_consistency_pooled.py",  # ~100 s (12 flights, 1440 navigation runs)
     "tests/integration/test_nav_adaptive_damping.py",  # ~90 s
     "tests/unit/nav/test_carrier_engine.py",  # ~40 s each below
     "tests/unit/nav/test_fde.py",
