@@ -104,7 +104,24 @@ def rate_psd(w: np.ndarray, dt: float) -> np.ndarray:
     return 0.5 * p[m].mean(axis=0)
 
 
+def _one_flight(profile: Path, level: str, seed: int, lag_s: float, drift: bool, draws: int) -> tuple:
+    """One flight (run 0 of `seed`) at turbulence `level`: (rotation_q, rate_psd, rotation_var, rotation_tau,
+    sf_drift_q or None)."""
+    from approachsim.flight.run import Approach
+    from approachsim.nav import ins
+    from approachsim.profile import parse_profile
+
+    prof0 = parse_profile(tomllib.loads(profile.read_text(encoding="utf-8")), source=profile.resolve())
+    prof = replace(prof0, environment=replace(prof0.environment, turbulence=level))
+    tr = Approach(prof).fly(seed=seed, run=0).truth
+    w, dt = np.asarray(tr.w_ib_body), float(tr.t_s[1] - tr.t_s[0])
+    dq = sf_drift_q(w, ins.cbn_from_quaternion(np.asarray(tr.q_nb)), dt, draws) if drift else None
+    return rotation_q(w, dt, lag_s), rate_psd(w, dt), rotation_var(w, dt), rotation_tau(w, dt), dq
+
+
 def main() -> None:
+    from concurrent.futures import ProcessPoolExecutor
+
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("profile", type=Path)
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4, 5, 6])
@@ -112,25 +129,13 @@ def main() -> None:
     ap.add_argument("--lag-s", type=float, default=LAG_S)
     ap.add_argument("--drift", action="store_true", help="also sf_drift_q (slow: 400 exact propagations a seed)")
     ap.add_argument("--draws", type=int, default=200)
+    ap.add_argument("--workers", type=int, default=1)
     a = ap.parse_args()
-    from approachsim.flight.run import Approach
-    from approachsim.profile import parse_profile
-
-    data = tomllib.loads(a.profile.read_text(encoding="utf-8"))
-    prof0 = parse_profile(data, source=a.profile.resolve())
     for level in a.turbulence:
-        prof = replace(prof0, environment=replace(prof0.environment, turbulence=level))
-        q, r, v, t, dq = [], [], [], [], []
-        for seed in a.seeds:
-            tr = Approach(prof).fly(seed=seed, run=0).truth
-            w, dt = np.asarray(tr.w_ib_body), float(tr.t_s[1] - tr.t_s[0])
-            q.append(rotation_q(w, dt, a.lag_s))
-            r.append(rate_psd(w, dt))
-            v.append(rotation_var(w, dt))
-            t.append(rotation_tau(w, dt))
-            if a.drift:
-                from approachsim.nav import ins
-                dq.append(sf_drift_q(w, ins.cbn_from_quaternion(np.asarray(tr.q_nb)), dt, a.draws))
+        with ProcessPoolExecutor(max_workers=a.workers) as ex:
+            res = list(ex.map(_one_flight, *zip(*[(a.profile, level, s, a.lag_s, a.drift, a.draws)
+                                                    for s in a.seeds], strict=True)))
+        q, r, v, t, dq = (list(x) for x in zip(*res, strict=True))
         s, se = np.mean(q, axis=0), np.std(q, axis=0, ddof=1) / np.sqrt(len(q))
         b = np.mean(r, axis=0)
         print(f"{level:9s} rotation over {a.lag_s:g} s: roll {s[0]:.3g} pitch {s[1]:.3g} yaw {s[2]:.3g} rad^2/s "
@@ -147,7 +152,7 @@ def main() -> None:
             print(f"{level:9s} unbounded scale-factor tilt, rad^2/s per unit sf^2: x {dm[0, 0]:.3g} y {dm[0, 1]:.3g} "
                   f"z {dm[0, 2]:.3g} (+- {ds[0, 0]:.2g}, {ds[0, 1]:.2g}, {ds[0, 2]:.2g}); per unit mis^2: x "
                   f"{dm[1, 0]:.3g} y {dm[1, 1]:.3g} z {dm[1, 2]:.3g} (+- {ds[1, 0]:.2g}, {ds[1, 1]:.2g}, "
-                  f"{ds[1, 2]:.2g})")
+                  f"{ds[1, 2]:.2g}); per seed y (sf): {np.round(np.array(dq)[:, 0, 1], 7).tolist()}")
 
 
 if __name__ == "__main__":

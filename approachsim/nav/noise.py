@@ -78,13 +78,13 @@ mean body rate (the Earth and transport rates, the attitude's trend) times S + M
 rectifies the Dutch roll's roll-yaw coning into the pitch axis (Theta x S Theta', second order in the rotation).
 Propagated exactly over draws of S and M on the flown truth, its variance grows as q t: the filter carries it as a
 white noise of the attitude error's rate per body axis, q_k = sf^2 D_k + mis^2 E_k (SF_DRIFT_Q, measured by
-tools/body_rate_psd.py --drift), rotated to NED. The white noise matched to the rotation's increments over the
-filter's 25 s velocity-error time used before (the first-order part's, 2-13 times this) over-claimed the horizontal
-velocity (e^2/P 0.86-0.92 pooled over 20 seeds in every case of the consistency suite, docs/consistency.md). States
-would need the body rate in the compiled error dynamics (every epoch kernel's inputs), 9 more states in every
-covariance, and would estimate quantities that, at 100 ppm and 0.02 mrad, the approach's few degrees of rotation
-cannot observe. The accelerometer's scale factor and misalignment are in the ba prior (under 1 g they look like a
-bias).
+tools/body_rate_psd.py --drift over 100 flights), rotated to NED. The white noise matched to the rotation's
+increments over the filter's 25 s velocity-error time used before (the first-order part's, 1.4-12 times this)
+over-claimed the horizontal velocity (e^2/P 0.86-0.92 pooled over 20 seeds in every case of the consistency
+suite, docs/consistency.md). States would need the body rate in the compiled error dynamics (every epoch kernel's
+inputs), 9 more states in every covariance, and would estimate quantities that, at 100 ppm and 0.02 mrad, the
+approach's few degrees of rotation cannot observe. The accelerometer's scale factor and misalignment are in the ba
+prior (under 1 g they look like a bias).
 """
 
 from __future__ import annotations
@@ -115,19 +115,20 @@ angle above the default 5 deg mask)."""
 
 SF_DRIFT_Q: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
     "none": ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
-    "light": ((1.88e-6, 2.61e-5, 1.83e-6), (2.10e-5, 3.68e-6, 1.81e-5)),
-    "moderate": ((8.91e-6, 1.45e-4, 3.01e-6), (1.13e-4, 1.16e-5, 1.06e-4)),
-    "severe": ((4.51e-5, 7.34e-4, 1.52e-5), (5.72e-4, 5.87e-5, 5.37e-4)),
+    "light": ((2.20e-6, 4.02e-5, 2.05e-6), (3.15e-5, 4.14e-6, 2.80e-5)),
+    "moderate": ((8.81e-6, 2.07e-4, 7.02e-6), (1.63e-4, 1.53e-5, 1.48e-4)),
+    "severe": ((4.46e-5, 1.05e-3, 3.55e-5), (8.25e-4, 7.75e-5, 7.49e-4)),
 }
 """The unbounded part of the gyro scale-factor / misalignment attitude error as white rate noise per body axis (x, y,
 z), rad^2/s per unit sf^2 (first) and per unit mis^2 (second), by turbulence level: tools/body_rate_psd.py --drift on
-the default profile's 737 (seeds 1-6, 200 unit draws of S and of M each): the exact error -int C_bn (S + M) w_ib dt
-less its bounded first-order part -C_bn(0) (S + M) (Theta(t) - Theta(0)), its variance fitted as q t over the approach
-(light +- 9.9e-7, 3.0e-6, 7.5e-7 and 2.4e-6, 1.4e-6, 2.2e-6 over the seeds). The pitch axis's sf part is the Dutch
-roll's coning (roll and yaw in quadrature rectify into it: Theta x S Theta') and the ramp of the mean pitch rate;
-moderate / light 5.6, the square of the rotation variance ratio (2.3), as a second-order rectification scales.
-Severe, beyond the 737's approach limit, is moderate x 2.25^2 (the Dryden gust variance ratio (75 / 50)^2, squared;
-engineering choice)."""
+the default profile's 737, 100 flights (seeds 101-200, run 0; 200 unit draws of S and of M each): the exact error
+-int C_bn (S + M) w_ib dt less its bounded first-order part -C_bn(0) (S + M) (Theta(t) - Theta(0)), its variance
+fitted as q t over the approach, averaged over the flights (light +- 2.9e-7, 1.5e-6, 2.8e-7 and 1.2e-6, 4.2e-7,
+1.1e-6; one flight's pitch figure ranges 0.4-2x the mean, skewed: the first measurement on seeds 1-6 gave 0.65 of
+it). The pitch axis's sf part is the Dutch roll's coning (roll and yaw in quadrature rectify into it: Theta x S
+Theta') and the ramp of the mean pitch rate; moderate / light 5.2, about the square of the rotation variance ratio, as
+a second-order rectification scales. Severe, beyond the 737's approach limit, is moderate x 2.25^2 (the Dryden gust
+variance ratio (75 / 50)^2, squared; engineering choice)."""
 
 PSEUDOLITE_CLOCK = ("ocxo", 30.0, 0.03)
 """An unsynchronized pseudolite's transmitter clock: oscillator, bias and drift 1-sigma at the start (m, m/s)."""

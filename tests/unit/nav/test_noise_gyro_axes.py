@@ -18,14 +18,14 @@ DEFAULT = Path(__file__).resolve().parents[3] / "profiles" / "default.toml"
 
 
 def test_gyro_axis_noise_is_the_grade_times_the_body_rotation():
-    """Default profile (nav-2.0: 100 ppm, 0.02 mrad; light turbulence: per unit sf^2 1.88e-6, 2.61e-5, 1.83e-6 and
-    per unit mis^2 2.10e-5, 3.68e-6, 1.81e-5 rad^2/s), written out; calm air gives none."""
+    """Default profile (nav-2.0: 100 ppm, 0.02 mrad; light turbulence: per unit sf^2 2.20e-6, 4.02e-5, 2.05e-6 and
+    per unit mis^2 3.15e-5, 4.14e-6, 2.80e-5 rad^2/s), written out; calm air gives none."""
     nav = NavSystem.from_profile(load_profile(DEFAULT))
     assert nav.turbulence == "light"
-    want = 1e-4**2 * np.array([1.88e-6, 2.61e-5, 1.83e-6]) + 2e-5**2 * np.array([2.10e-5, 3.68e-6, 1.81e-5])
+    want = 1e-4**2 * np.array([2.20e-6, 4.02e-5, 2.05e-6]) + 2e-5**2 * np.array([3.15e-5, 4.14e-6, 2.80e-5])
     nz = nav.noise_model.noise(None)
     np.testing.assert_allclose([nz.gyro_axis_q_x, nz.gyro_axis_q_y, nz.gyro_axis_q_z], want, rtol=1e-12)
-    assert want[1] > 100 * nz.gyro_arw_rad_sqrts**2  # the pitch axis (the Dutch roll's coning): ~110 x the ARW^2
+    assert want[1] > 100 * nz.gyro_arw_rad_sqrts**2  # the pitch axis (the Dutch roll's coning): ~170 x the ARW^2
     calm = replace(nav, turbulence="none").noise_model.noise(None)
     assert (calm.gyro_axis_q_x, calm.gyro_axis_q_y, calm.gyro_axis_q_z) == (0.0, 0.0, 0.0)
 
