@@ -350,9 +350,11 @@ class NoiseModel:
         d[lay.index["dv"]] = ie.velocity_mps**2
         d[lay.index["psi"]] = [ie.tilt_rad**2, ie.tilt_rad**2, ie.heading_rad**2]
         d[lay.index["bg"]] = g.gyro_bias_radps**2 + g.gyro_bi_radps**2
-        # scale factor and misalignment under 1 g look like a bias to a level accelerometer triad
-        d[lay.index["ba"]] = (g.accel_bias_mps2**2 + g.accel_bi_mps2**2
-                              + (9.8 * g.accel_misalign_rad) ** 2 + (9.8 * g.accel_sf) ** 2)
+        # scale factor and misalignment under 1 g look like a bias to a level accelerometer triad: (S + M) f_b with
+        # f_b = (0, 0, -g) puts one misalignment element on each horizontal body axis (x, y) and the scale factor on
+        # the vertical (z), not both on every axis
+        level = np.array([9.8 * g.accel_misalign_rad, 9.8 * g.accel_misalign_rad, 9.8 * g.accel_sf])
+        d[lay.index["ba"]] = g.accel_bias_mps2**2 + g.accel_bi_mps2**2 + level**2
         d[lay.i("bb")] = nz.baro_bias_sigma_m**2
         if lay.has("sb"):
             d[lay.i("sb")] = self.sensors.baro.filter_scale_sigma**2
