@@ -58,6 +58,7 @@ from approachsim.nav import errormodel as em
 from approachsim.nav import ins
 from approachsim.nav import reduced as rd
 from approachsim.nav.engine import EpochEngine, RunDatabase, StatusBuffer, stacked_new_arcs
+from approachsim.nav.initial import sb_reference
 from approachsim.nav.navigator import NavRun, StatusLog, _stacked_observations, true_error_rows
 from approachsim.nav.observations import Observations
 from approachsim.nav.system import tuned_records
@@ -150,7 +151,7 @@ def bank_pass(nav: Any, truth: Any, records: dict[str, Any], modes: Array, rng: 
     used = np.flatnonzero(np.any(np.asarray(gnss.valid, dtype=bool)[0], axis=0))
     return _core(nav, truth, modes, m, epoch_rows, (runs[0].fs.x, np.asarray(runs[0].fs.P, dtype=float),
                  runs[0].db_error), rows[0, epoch_rows::epoch_rows], None if hb_full is None else hb_full[0], o, used,
-                 runs[0].arcs, memo=memo, x_off=x_off)
+                 runs[0].arcs, memo=memo, x_off=x_off, sb_ref=sb_reference(states))
 
 
 def _baro_held(nav: Any, records: dict[str, Any], truth: Any, m: int) -> tuple[Array, Array] | None:
@@ -211,20 +212,21 @@ def bank_pass_group(nav: Any, truth: Any, group: GroupInputs, k: int, modes: Arr
     x_hat, P = group.keep["start"][k]
     main = group.keep["reduced_runs"][k] if "reduced_runs" in group.keep else None
     return _core(nav, truth, modes, m, er, (x_hat, P, group.keep["db"][k]), group.keep["ins_epoch_rows"][k],
-                 None if hb is None else hb[0], o, used, main=main, memo=memo)
+                 None if hb is None else hb[0], o, used, main=main, memo=memo, sb_ref=group.keep.get("sb_ref", 0.0))
 
 
 def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, start: tuple[Array, Array, Any],
           ins_ep: Array, hb1: Array | None, o: dict[str, Any], used: Array,
           arcs0: Array | None = None, main: Any = None, memo: TruthMemo | None = None,
-          x_off: Array | None = None) -> BankPass | None:
+          x_off: Array | None = None, sb_ref: float = 0.0) -> BankPass | None:
     """The pass from the run's start = (x_hat, P_conv, its terrain-database error), its INS states at the epochs
     ins_ep (E, 16), its baro held for the damping loop hb1 (m,) or None, its stacked observations o (one run) and
     the GNSS channels it measures; carrier phase: arcs0 (k,) the start's carrier arc ids (None: none yet), from
     which each copy's new arcs (its ambiguity resets) follow as in Navigator.compiled_pass. main: the group pass's
     own filter of the run on its reduced state (nav/reduced.ReducedRun), which is copy 0 (the same start, INS,
     observations and models in the same compiled pass): taken as copy 0 when its channels are the copies' (only the
-    sub-filters are run), else None. memo: the truth's TruthMemo (the reference, the epoch models)."""
+    sub-filters are run), else None. memo: the truth's TruthMemo (the reference, the epoch models). sb_ref: the
+    reference's baro scale factor (nav/initial.sb_reference, as the group's pass took it)."""
     x_hat, P_conv, db_error = start
     lay = nav.layout
     eng = EpochEngine(nav)
@@ -334,7 +336,8 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, start: tu
         f_gio = -np.expm1(-2.0 * dt_e / nz.gio_tau_s)
         kcp.bank_epochs(X, P3, phi, qd, ref, kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r, gio_r),
                         ins_y,
-                        kg.Obs(baro_h, o["baro_r"], radalt_h, ref_agl, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho,
+                        kg.Obs(baro_h, o["baro_r"], radalt_h, ref_agl, sb_ref, dbp, db_x, db_u, rho, r_sv, sig, cp,
+                               pl_rho,
                                r_pl, pl_sig), new, rows,
                         kg.PassOut(codes, nu, S, n_rows, x_out, pd, pnav, np.zeros((C, E, 0, 0)), np.zeros((C, 0)), 0),
                         scr)
@@ -348,7 +351,8 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, start: tu
                         kg.ChannelQd(c(ch_gse[1:]), c(ch_gmp[1:]), none, f_gse, f_gmp, np.zeros(E), c(gse_r[1:]),
                                      none),
                         c(ins_y[1:]),
-                        kg.Obs(c(baro_h[1:]), o["baro_r"], c(radalt_h[1:]), ref_agl, c(dbp[1:]), db_x, c(db_u[1:]),
+                        kg.Obs(c(baro_h[1:]), o["baro_r"], c(radalt_h[1:]), ref_agl, sb_ref, c(dbp[1:]), db_x,
+                               c(db_u[1:]),
                                c(rho[1:]), c(r_sv[1:]), c(sig[1:]), none, c(pl_rho[1:]), r_pl, pl_sig),
                         np.zeros((C - 1, E, 0), np.int64), rows,
                         kg.PassOut(*s1, np.zeros((C - 1, E, 0, 0)), np.zeros((C - 1, 0)), 0), scr)
@@ -360,7 +364,8 @@ def _core(nav: Any, truth: Any, modes: Array, m: int, epoch_rows: int, start: tu
         none = np.zeros((C, E, 0))
         kcp.bank_epochs(X, P3, phi, qd, ref, kg.ChannelQd(ch_gse, ch_gmp, none, f_gse, f_gmp, np.zeros(E), gse_r, none),
                         ins_y,
-                        kg.Obs(baro_h, o["baro_r"], radalt_h, ref_agl, dbp, db_x, db_u, rho, r_sv, sig, none, pl_rho,
+                        kg.Obs(baro_h, o["baro_r"], radalt_h, ref_agl, sb_ref, dbp, db_x, db_u, rho, r_sv, sig, none,
+                               pl_rho,
                                r_pl, pl_sig), np.zeros((C, E, 0), np.int64), rows,
                         kg.PassOut(codes, nu, S, n_rows, x_out, pd, pnav, np.zeros((C, E, 0, 0)), np.zeros((C, 0)), 0),
                         scr)

@@ -706,7 +706,7 @@ class NavInTheLoop:
         fe.X[0] = run.fs.x
         db = nav.dbs[0]
         e = fe.e
-        obs = kg.Obs(baro_h, baro_r, radalt_h, 0.0, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig, fe.no_cp, pl_rho,
+        obs = kg.Obs(baro_h, baro_r, radalt_h, 0.0, 0.0, db.dbp2, db.db_x, db.db_u2, rho, r_sv, sig, fe.no_cp, pl_rho,
                      r_pl, pl_sig)
         model = kg.ErrorModel(eng.lay, q, gse, gmp, eng.loop, fe.no_gio, 1.0, gse_r, fe.no_gio)
         args = (nw, fe.X, fe.P, e, model, held,

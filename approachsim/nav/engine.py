@@ -282,8 +282,10 @@ class EpochEngine:
         f = system.filter
         return isinstance(f, KalmanFilter) and f.policy is optimal_policy and system.shares_covariance()
 
-    def _obs(self, obs: Observations, members: list[int], dbs: list[RunDatabase], ref_agl_m: float = 0.0) -> kg.Obs:
-        """The members' observations for core/nav/epoch.class_epoch (core/nav/groups.Obs)."""
+    def _obs(self, obs: Observations, members: list[int], dbs: list[RunDatabase], ref_agl_m: float = 0.0,
+             ref_sb: float = 0.0) -> kg.Obs:
+        """The members' observations for core/nav/epoch.class_epoch (core/nav/groups.Obs); ref_agl_m, ref_sb: the
+        shared rows' reference height above the terrain (m) and baro scale factor."""
         M = len(members)
         if M == 1:
             i = members[0]
@@ -314,15 +316,16 @@ class EpochEngine:
             dbp = np.stack([d.dbp for d in dbs])
             db_x = dbs[0].db_x
             db_u = np.stack([d.db_u for d in dbs]) if db_x.size else np.zeros((M, 0))
-        return kg.Obs(baro_h, baro_r, radalt_h, ref_agl_m, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho, r_pl, pl_sig)
+        return kg.Obs(baro_h, baro_r, radalt_h, ref_agl_m, ref_sb, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho, r_pl,
+                      pl_sig)
 
     def epoch(self, X: Array, P: Array, phi: Array, qd: Array, own: bool, ref_y: Array, ins_y: Array,
               obs: Observations, members: list[int], t_s: float, statuses: list[StatusBuffer],
-              dbs: list[RunDatabase], ref_agl_m: float = 0.0) -> None:
+              dbs: list[RunDatabase], ref_agl_m: float = 0.0, ref_sb: float = 0.0) -> None:
         """One epoch of the members (indices into obs's runs) with estimates X (M, n) and covariance P, in place
         (core/nav/epoch.class_epoch); each member's status records go to its buffer."""
         M = len(members)
-        o = self._obs(obs, members, dbs, ref_agl_m)
+        o = self._obs(obs, members, dbs, ref_agl_m, ref_sb)
         if self._nu.shape[0] < M:
             self._nu = np.zeros((M, _MAX_ROWS))
         nu = self._nu[:M]
@@ -375,7 +378,7 @@ class EpochEngine:
 
     def singletons(self, X: Array, P3: Array, phi2: Array, qd2: Array, held: Array, obs: Observations, t_s: float,
                    dt: float, ins_y: Array, ref_y: Array, ref_agl_m: float, statuses: list[StatusBuffer],
-                   db_stack: tuple[Array, Array, Array], new: Array | None = None) -> None:
+                   db_stack: tuple[Array, Array, Array], new: Array | None = None, ref_sb: float = 0.0) -> None:
         """The shared-mode epoch of N runs each its own class (core/nav/epoch.copies_epoch), in place on X (N, n)
         and P3 (N, n, n); phi2, qd2 (2, n, n) the model without / with the damping loop held, held (N,) int; the
         GPS channel states' Qd at each run's own elevations; db_stack: the runs' databases (`stack`); new (N, k):
@@ -432,8 +435,8 @@ class EpochEngine:
         n_rows = np.zeros(N, dtype=np.int64)
         ke.copies_epoch(X, P3, phi2, qd2, held, ref_y, np.ascontiguousarray(ins_y),
                         kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r, gio_r),
-                        kg.Obs(baro_h, baro_r, radalt_h, ref_agl_m, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho, r_pl,
-                               pl_sig), new, self.rows, kg.Out(codes, nu, S), n_rows, self.scr)
+                        kg.Obs(baro_h, baro_r, radalt_h, ref_agl_m, ref_sb, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho,
+                               r_pl, pl_sig), new, self.rows, kg.Out(codes, nu, S), n_rows, self.scr)
         for i in range(N):
             k = n_rows[i]
             statuses[i].add_epoch(codes[i, :k], t_s, nu[i, :k], S[i, :k])

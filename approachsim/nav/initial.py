@@ -82,9 +82,10 @@ _PSD_TOL = 1e-9
 """Relative tolerance of the Pi_ss >= P_conv[s, s] check (eigenvalues of Pi^-1/2 P_conv Pi^-1/2 above 1)."""
 
 
-def _segment(system: Any, truth: Any, obs: Observations, row: int, P0: Array) -> tuple[Array, Array, list]:
+def _segment(system: Any, truth: Any, obs: Observations, row: int, P0: Array, sb_ref: float = 0.0
+             ) -> tuple[Array, Array, list]:
     """Phi, Qd over one aiding interval and the scalar measurement rows valid at truth row `row` (the segment
-    flown at the start state)."""
+    flown at the start state), linearized at the baro scale factor sb_ref (the day's: sb_reference)."""
     lay = system.layout
     ref = ins.InsState(truth.lat_rad[row:row + 1], truth.lon_rad[row:row + 1], truth.h_m[row:row + 1],
                        truth.v_ned[row:row + 1], ins.cbn_from_quaternion(truth.q_nb[row:row + 1]), np.zeros(1))
@@ -96,6 +97,8 @@ def _segment(system: Any, truth: Any, obs: Observations, row: int, P0: Array) ->
     phi, qd = em.discretize(F, Qc, 1.0 / system.nav.aiding_rate_hz)
     r_ref = ins.position_ecef(ref)[0]
     x0 = np.zeros(lay.n)
+    if lay.has("sb"):
+        x0[lay.i("sb")] = sb_ref
     t = float(truth.t_s[row])
     ref_obs = system.rows.reference_obs(obs, 0, float(ref.h_m[0]), r_ref)
     # code only: the carrier's arcs begin at the approach's first sample (sensors/gnss/carrier.py), so the segment
@@ -106,14 +109,15 @@ def _segment(system: Any, truth: Any, obs: Observations, row: int, P0: Array) ->
 
 
 def converged_covariance(system: Any, truth: Any, obs: Observations, row: int, P0: Array,
-                         converge_s: float) -> Array:
+                         converge_s: float, sb_ref: float = 0.0) -> Array:
     """P_conv (n, n): the optimal filter's covariance after converge_s (s) of aiding at truth row `row` from P0,
-    with the measurements available in obs (NavSystem.observations at the row; the first run's schedule).
+    with the measurements available in obs (NavSystem.observations at the row; the first run's schedule), the
+    model linearized at the baro scale factor sb_ref (sb_reference).
 
     The filter's own recursion, one scalar Joseph update per row, compiled (core/nav/kalman.riccati: the states
     never measured and not coupled evolve alone, an exact reduction); converged_covariance_reference is the same
     recursion in numpy (the test oracle)."""
-    phi, qd, rows = _segment(system, truth, obs, row, P0)
+    phi, qd, rows = _segment(system, truth, obs, row, P0, sb_ref)
     epochs = int(round(converge_s * system.nav.aiding_rate_hz))
     n = P0.shape[0]
     H = np.stack([m.h for m in rows]) if rows else np.zeros((0, n))  # (k, n): the epoch's scalar rows
@@ -124,10 +128,10 @@ def converged_covariance(system: Any, truth: Any, obs: Observations, row: int, P
 
 
 def converged_covariance_reference(system: Any, truth: Any, obs: Observations, row: int, P0: Array,
-                                   converge_s: float) -> Array:
+                                   converge_s: float, sb_ref: float = 0.0) -> Array:
     """converged_covariance with one Joseph update per scalar row, the filter's own sequential form: the test
     oracle and the benchmark's reference (benchmarks/bench_start.py)."""
-    phi, qd, rows = _segment(system, truth, obs, row, P0)
+    phi, qd, rows = _segment(system, truth, obs, row, P0, sb_ref)
     P = np.array(P0, dtype=float)
     eye = np.eye(P.shape[0])
     for _ in range(int(round(converge_s * system.nav.aiding_rate_hz))):
@@ -246,6 +250,11 @@ class Prepared:
     P_conv: Array
     cond: Conditioner
 
+def sb_reference(states: SensorStates | None) -> float:
+    """The baro scale factor the shared covariance is linearized at: the day's (SensorStates.sb_day, the same for
+    every run on the truth), 0 without realized states or a baro (nav/shared.py SharedCovariance.sb_ref)."""
+    return 0.0 if states is None or states.sb_day is None else float(states.sb_day)
+
 
 def draw(system: Any, truth: Any, obs: Observations, states: SensorStates, rngs: list[np.random.Generator],
          row: int, P0: Array, prepared: Prepared | None = None) -> tuple[Array, Array, Prepared]:
@@ -257,7 +266,8 @@ def draw(system: Any, truth: Any, obs: Observations, states: SensorStates, rngs:
         raise ValueError(f"converged start: {states.runs} runs of sensor states for {len(rngs)} runs")
     s, x_s = sensor_vector(lay, states, P0)
     if prepared is None:
-        P_conv = converged_covariance(system, truth, obs, row, P0, system.nav.initial_error.converge_s)
+        P_conv = converged_covariance(system, truth, obs, row, P0, system.nav.initial_error.converge_s,
+                                      sb_reference(states))
         prepared = Prepared(P_conv, conditioner(P_conv, P0[np.ix_(s, s)], s))
     if not np.array_equal(prepared.cond.s, s):
         raise ValueError("converged start: the prepared start has other sensor states than these runs")

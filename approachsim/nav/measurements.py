@@ -70,21 +70,33 @@ def _row(layout: StateLayout) -> Array:
 
 
 def baro(layout: StateLayout, h_ins_m: float, h_baro_m: float, sigma_m: float, t_s: float,
-         name: str = "baro", h_ref_m: float = 0.0, dp_d_hat_m: float = 0.0) -> ScalarMeasurement:
-    """Baro altitude difference: h = [-1 at dp_D, -1 at bb, -(h - H_ref) at sb]; R = sigma^2 (white noise), m;
-    h_ref_m = H_ref the altimeter setting's reference (the field), m.
+         name: str = "baro", h_ref_m: float = 0.0, dp_d_hat_m: float = 0.0, sb_hat: float = 0.0
+         ) -> ScalarMeasurement:
+    """Baro altitude difference: h = [-(1 + sb_hat) at dp_D, -1 at bb, -(h - H_ref) at sb]; R = sigma^2 (white
+    noise), m; h_ref_m = H_ref the altimeter setting's reference (the field), m; sb_hat the estimate's scale factor.
+
+    The baro reads h_B = h + (h - H_ref) S + B + v of the true height h = h_ins + dp_D, so a height error moves it by
+    (1 + S) dp_D: the EKF's dp_D coefficient is -(1 + sb_hat). With -1 the row under-stated the baro's sensitivity by
+    S (12 % at ISA -30 uncorrected): the filter's height over-claimed on cold days and under-claimed on hot ones
+    (issue 39: e^2 / P 1.06 at ISA -30, 0.92 at ISA +30, 0.97 on the ISA day, the same seeds; docs/consistency.md).
 
     h in the sb column is the navigation's height h_ins + dp_D_hat (dp_d_hat_m: the estimate's dp_D), not the INS
     height: the damping loop drags the INS toward a baro that is off by sb (h - H_ref) (117 m at 985 m above a
     5434 ft field at ISA -30), so h_ins is off by as much, and sb times that (14 m) would be a model error in the row;
-    with it the estimate ran away (issue 39: KDEN ISA -30, 98 m vertical error). h x_hat is then the exact
-    prediction -dp_D - bb - (h_ins + dp_D - H_ref) sb at the estimate (the EKF's, less its sb dp_D Jacobian term)."""
+    with it the estimate ran away (issue 39: KDEN ISA -30, 98 m vertical error). z is the EKF's linearization
+    z - g(x_hat) + h x_hat = (h_ins - h_baro) - sb_hat dp_D_hat (module docstring), g(x_hat) = -dp_D - bb -
+    (h_ins + dp_D - H_ref) sb the prediction at the estimate: h x_hat exceeds it by sb dp_D, the bilinear term
+    counted twice by the Jacobian."""
     h = _row(layout)
     h[layout.i("dp", 2)] = -1.0  # dh = -dp_D
     h[layout.i("bb")] = -1.0
     if layout.has("sb"):
+        h[layout.i("dp", 2)] = -(1.0 + sb_hat)
         h[layout.i("sb")] = -(h_ins_m + dp_d_hat_m - h_ref_m)
-    return ScalarMeasurement(z=float(h_ins_m - h_baro_m), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
+    z = h_ins_m - h_baro_m
+    if layout.has("sb"):
+        z = z - sb_hat * dp_d_hat_m
+    return ScalarMeasurement(z=float(z), h=h, r=float(sigma_m**2), name=name, t_s=t_s)
 
 
 def radalt(

@@ -506,7 +506,8 @@ class Navigator:
         ins_y = np.ascontiguousarray(self.rows[self.ins_of][:, e_rows])
         done = -1
         if per_run_sky and k and lay.has("gse") and not eng.carrier:  # each run on its reduced state
-            args = (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse,
+            args = (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, sh.sb_ref, held, ch_gse, ch_gmp,
+                    f_gse,
                     f_gmp, gse_r, ins_y, baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl,
                     pl_sig)
             self.reduced_runs = []
@@ -520,7 +521,8 @@ class Navigator:
             done = ke.shared_pass(X, P3, model,
                                   kg.Track(dt, ref, ref_cbn, f_ref), held,
                                   kg.ChannelQd(ch_gse, ch_gmp, ch_gio, f_gse, f_gmp, f_gio, gse_r, gio_r), ins_y,
-                                  kg.Obs(baro_h, baro_r, radalt_h, ref_agl, dbp, db_x, db_u, rho, r_sv, sig, cp, pl_rho,
+                                  kg.Obs(baro_h, baro_r, radalt_h, ref_agl, sh.sb_ref, dbp, db_x, db_u, rho, r_sv,
+                                         sig, cp, pl_rho,
                                          r_pl, pl_sig), new, eng.rows,
                                   kg.PassOut(codes, nu, S, n_rows, x_out, pd, pnav, p33, pcc, self._ic), eng.scr)
         if done != E:

@@ -184,14 +184,15 @@ def _make_cut(model: EpochModels, red: em.StateLayout) -> tuple[Array, Array]:
 def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tuple, ic: int,
                        runs_out: list | None = None, valid: Array | None = None, memo: TruthMemo | None = None) -> int:
     """shared_pass for per-run-sky runs, each on its reduced state. args: shared_pass's inputs (X, P3, lay, q, gse,
-    gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse, f_gmp, gse_r, ins_y, baro_h, baro_r,
+    gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, ref_sb, held, ch_gse, ch_gmp, f_gse, f_gmp, gse_r, ins_y, baro_h,
+    baro_r,
     radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig) without carrier phase; out: its outputs
     (codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav), filled here; ic the clock state's index; runs_out: each
     run's ReducedRun appended (what the integrity bank's copy 0 computes again: campaign/bankpass.py); valid (N, k):
     the channels each run's record has valid (kept as the bank keeps them, so that its copy 0 is this); memo: the
     truth's TruthMemo, where the runs' banks find the models (`models`). Returns E, or -1 with nothing changed when a
     model cannot be reduced (the caller runs shared_pass)."""
-    (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, held, ch_gse, ch_gmp, f_gse, f_gmp, gse_r,
+    (X, P3, lay, q, gse, gmp, loop, dt, ref, ref_cbn, f_ref, ref_agl, ref_sb, held, ch_gse, ch_gmp, f_gse, f_gmp, gse_r,
      ins_y, baro_h, baro_r, radalt_h, dbp, db_x, db_u, rho, r_sv, sig, pl_rho, r_pl, pl_sig) = args
     codes, nu, S, n_rows, x_out, p33, pcc, pd, pnav = out
     N, E = held.shape
@@ -226,7 +227,8 @@ def reduced_singletons(system: Any, truth: Any, eng: Any, args: tuple, out: tupl
                         kg.ChannelQd(np.ascontiguousarray(ch_gse[sel]), np.ascontiguousarray(ch_gmp[sel]), none, f_gse,
                                      f_gmp, np.zeros(E), np.ascontiguousarray(gse_r[sel] if gse_r.shape[2] else
                                                                               gse_r[i:i + 1]), none), ins_y[i:i + 1],
-                        kg.Obs(baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], ref_agl, dbp[i:i + 1], db_x, db_u[i:i + 1],
+                        kg.Obs(baro_h[i:i + 1], baro_r, radalt_h[i:i + 1], ref_agl, ref_sb, dbp[i:i + 1], db_x,
+                               db_u[i:i + 1],
                                np.ascontiguousarray(rho[sel]), np.ascontiguousarray(r_sv[sel]),
                                np.ascontiguousarray(sig[sel]), none, pl_rho[i:i + 1], r_pl, pl_sig),
                         np.zeros((1, E, 0), np.int64), eng.rows._replace(lay=red.packed),

@@ -97,8 +97,9 @@ class MeasurementRows:
         if obs.baro_h_m is not None and np.isfinite(obs.baro_h_m[i]):
             hb, sb = float(obs.baro_h_m[i]), float(obs.baro_sigma_m)
             h_ref = float(self.runway.threshold_h_m)
-            out.append(Row(Source(BARO), lambda x: meas.baro(lay, h, hb, sb, t, h_ref_m=h_ref,
-                                                                    dp_d_hat_m=float(x[lay.i("dp", 2)]))))
+            out.append(Row(Source(BARO), lambda x: meas.baro(
+                lay, h, hb, sb, t, h_ref_m=h_ref, dp_d_hat_m=float(x[lay.i("dp", 2)]),
+                sb_hat=float(x[lay.i("sb")]) if lay.has("sb") else 0.0)))
         if obs.radalt_h_m is not None and np.isfinite(obs.radalt_h_m[i]):
             hr = float(obs.radalt_h_m[i])
             sr = self.radalt_sigma_m(hr)

@@ -42,17 +42,25 @@ class SharedCovariance:
     """(rows // epoch_rows + 1, 3, 3) the truth's body-to-NED matrix at every epoch row (the reference's attitude)."""
     per_run_sky: bool = False
     """The runs have their own GPS skies: every run is its own class from the start, in any batch."""
+    sb_ref: float = 0.0
+    """The reference's baro scale factor: the day's (sensors/states.SensorStates.sb_day), the same for every run,
+    where the shared baro rows take their dp_D coefficient -(1 + sb) (a run's own estimate would make the
+    covariance depend on the batch); 0 without a baro scale-factor state or realized states."""
 
     @classmethod
-    def start(cls, runs: list, truth: Truth, m: int, epoch_rows: int, per_run_sky: bool) -> SharedCovariance:
-        """Classes at the start: one per run with per-run skies, else one for all (the runs' start covariance)."""
+    def start(cls, runs: list, truth: Truth, m: int, epoch_rows: int, per_run_sky: bool,
+              sb_ref: float = 0.0) -> SharedCovariance:
+        """Classes at the start: one per run with per-run skies, else one for all (the runs' start covariance);
+        sb_ref the reference's baro scale factor (the field's doc)."""
         n = len(runs)
         c_bn = ins.cbn_from_quaternion(truth.q_nb[:m + 1])
         f_ref = np.einsum("nij,nj->ni", c_bn[:m], truth.f_body[:m])
         ref_cbn = c_bn[::epoch_rows].copy()
         if per_run_sky:
-            return cls(np.array([r.fs.P for r in runs], dtype=float), np.arange(n), f_ref, epoch_rows, ref_cbn, True)
-        return cls(np.array([runs[0].fs.P], dtype=float), np.zeros(n, dtype=int), f_ref, epoch_rows, ref_cbn)
+            return cls(np.array([r.fs.P for r in runs], dtype=float), np.arange(n), f_ref, epoch_rows, ref_cbn, True,
+                       float(sb_ref))
+        return cls(np.array([runs[0].fs.P], dtype=float), np.zeros(n, dtype=int), f_ref, epoch_rows, ref_cbn, False,
+                   float(sb_ref))
 
     @property
     def singletons(self) -> bool:
@@ -129,6 +137,8 @@ class SharedCovariance:
         r_ins = ins.position_ecef(s)
         r_ref = ins.position_ecef(ref)[0]
         x0 = np.zeros(lay.n)
+        if lay.has("sb"):  # the rows at the reference's scale factor
+            x0[lay.i("sb")] = self.sb_ref
         eye = np.eye(lay.n)
         for c, members in self.classes():
             i0 = members[0]
@@ -188,7 +198,8 @@ class SharedCovariance:
             P = self.P[c]  # its own array (split copies)
             ins_y = nav.x[nav.ins_of[members]]
             nav.engine.epoch(X, P, phi, qd, False, ref_y[0], ins_y, obs, members, t,
-                             [runs[i].statuses for i in members], [nav.dbs[i] for i in members], ref_agl)
+                             [runs[i].statuses for i in members], [nav.dbs[i] for i in members], ref_agl,
+                             self.sb_ref)
             for j, i in enumerate(members):
                 runs[i].fs = FilterState(x=X[j], P=P, memory=runs[i].fs.memory)
 
@@ -205,6 +216,7 @@ class SharedCovariance:
         phi2 = np.stack([models.get(False, models.get(True))[0], models.get(True, models.get(False))[0]])
         qd2 = np.stack([models.get(False, models.get(True))[1], models.get(True, models.get(False))[1]])
         nav.engine.singletons(X, self.P, phi2, qd2, np.array(held, dtype=np.int64), obs, t, dt_epoch,
-                              nav.x[nav.ins_of], ref_y, ref_agl, [r.statuses for r in runs], nav.db_stack, new)
+                              nav.x[nav.ins_of], ref_y, ref_agl, [r.statuses for r in runs], nav.db_stack, new,
+                              ref_sb=self.sb_ref)
         for i, r in enumerate(runs):
             r.fs = FilterState(x=X[i], P=self.P[i], memory=r.fs.memory)

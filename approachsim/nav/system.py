@@ -271,9 +271,11 @@ class NavSystem:
         truth's memo it is made once for the same inputs (an integrity bank that starts its run again, off the
         group's pass, finds it there instead of repeating the 600 s Riccati recursion and the eigen-decompositions):
         keyed by this system (a value: nav/sensors/runway/terrain) and the bytes of everything else initial.draw
-        reads (the row, P0, the run's observations at the row, the sensor states' indices)."""
+        reads (the row, P0, the run's observations at the row, the sensor states' indices, the day's baro scale)."""
         s_idx, _ = initial.sensor_vector(self.layout, states, P0)
-        parts = [np.asarray(P0, dtype=float).tobytes(), str(row).encode(), np.asarray(s_idx).tobytes()]
+        sb_ref = initial.sb_reference(states)
+        parts = [np.asarray(P0, dtype=float).tobytes(), str(row).encode(), np.asarray(s_idx).tobytes(),
+                 repr(sb_ref).encode()]
         for f in fields(obs):
             v = getattr(obs, f.name)
             parts.append(f.name.encode())
@@ -281,7 +283,7 @@ class NavSystem:
         key = (self, hashlib.blake2b(b"\0".join(parts), digest_size=20).digest())
 
         def make() -> initial.Prepared:
-            P_conv = initial.converged_covariance(self, truth, obs, row, P0, self.nav.initial_error.converge_s)
+            P_conv = initial.converged_covariance(self, truth, obs, row, P0, self.nav.initial_error.converge_s, sb_ref)
             return initial.Prepared(P_conv, initial.conditioner(P_conv, P0[np.ix_(s_idx, s_idx)], s_idx))
 
         return memoized(memo, truth, "system.prepared", key, make, keep=PREPARED_KEEP)
@@ -344,7 +346,8 @@ class NavSystem:
         once for all of them (feed-forward only; checked). keep: a dict that receives what the runs' integrity
         banks reuse (campaign/bankpass.py, open loop): "start" [(x_hat (n,), P (n, n))] each run's filter start,
         "db" its terrain-database error, "ins_epoch_rows" (N, E, 16) the INS states at the aiding epochs (rows
-        epoch_rows, 2 epoch_rows, ...; packed, kernels/strapdown.py), "epoch_rows", "feed_forward". memo: the
+        epoch_rows, 2 epoch_rows, ...; packed, kernels/strapdown.py), "epoch_rows", "feed_forward", "sb_ref" the
+        shared covariance's baro scale factor (initial.sb_reference). memo: the
         truth's TruthMemo (approachsim/memo.py), owned by the caller that shares the truth among runs (the campaign's
         open-loop group): the converged starts and the reduced pass's epoch models are kept there for the runs'
         integrity banks.
@@ -369,7 +372,8 @@ class NavSystem:
         el0 = None if gnss is None else (gnss.elevation_rad[:, 0] if sky else gnss.elevation_rad[0])
         s, runs = self.start(truth, gens, elevation_rad=None if el0 is None else (el0[0] if sky else el0), obs=obs0,
                              states=states, elevation_per_run=el0 if sky else None, memo=memo)
-        shared = (SharedCovariance.start(runs, truth, m, epoch_rows, obs0.per_run_sky) if shared_covariance
+        sb_ref = initial.sb_reference(states)
+        shared = (SharedCovariance.start(runs, truth, m, epoch_rows, obs0.per_run_sky, sb_ref) if shared_covariance
                   else None)
         ins_of = None
         if copies:  # one INS for all: every copy must start from the same INS state on the same increments (the
@@ -384,6 +388,7 @@ class NavSystem:
             keep["start"] = [(np.array(r.fs.x, dtype=float), np.array(self.filter.covariance(r.fs), dtype=float))
                              for r in runs]
             keep["db"] = [r.db_error for r in runs]
+            keep["sb_ref"] = sb_ref
         nav = Navigator(self, s, runs, float(truth.t_s[0]), m + 1, shared=shared, ins_of=ins_of)
         if keep is not None:
             keep["feed_forward"] = not self.nav.feedback

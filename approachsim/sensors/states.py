@@ -77,6 +77,10 @@ class SensorStates:
     amb: Array | None = None
     giz: Array | None = None
     gtz: Array | None = None
+    sb_day: float | None = None
+    """The day's deterministic baro scale factor at the row (sb without the drawn S: temperature, inversion,
+    geopotential height; the same for every run on the truth): the shared covariance's linearization point of the
+    baro's dp_D coefficient -(1 + sb) (nav/measurements.baro), None without a baro."""
 
     @property
     def runs(self) -> int:
@@ -94,11 +98,12 @@ class SensorStates:
 
     def take(self, i: int) -> SensorStates:
         """The states of run i alone (run axis kept, length 1)."""
-        kw = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "row"}
-        return SensorStates(self.row, **{k: None if v is None else v[i:i + 1] for k, v in kw.items()})
+        kw = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in ("row", "sb_day")}
+        return SensorStates(self.row, **{k: None if v is None else v[i:i + 1] for k, v in kw.items()},
+                            sb_day=self.sb_day)
 
 
-STATE_GROUPS = tuple(f.name for f in fields(SensorStates) if f.name != "row")
+STATE_GROUPS = tuple(f.name for f in fields(SensorStates) if f.name not in ("row", "sb_day"))
 """The filter state groups a SensorStates can carry."""
 
 
@@ -227,12 +232,13 @@ def _imu(at: _At, kind: str) -> Array | None:
             + np.einsum("nij,j->ni", m, inc))
 
 
-def _baro(at: _At) -> tuple[Array, Array] | None:
+def _baro(at: _At, drawn_scale: bool = True) -> tuple[Array, Array] | None:
     """(bb, sb) (N,) of the filter's baro row h_B = h + bb + sb (h - H_ref) + v at the sample's truth row: the
     deterministic error of the day (temperature, an inversion, a QNH rounding or setting error, geopotential height;
     sensors/baro.py) split as the filter sees it, b0 = the noise-free indication at the field less its elevation
     into bb with the drawn slow errors, the rest of the noise-free error at the row (with the drawn scale factor S)
-    into sb. Exact at the row by construction; the split is the line through the field and the row."""
+    into sb. Exact at the row by construction; the split is the line through the field and the row. drawn_scale
+    False: the drawn S left out (SensorStates.sb_day: the day's part alone, the same for every run)."""
     s = at.sample("baro")
     if s is None:
         return None
@@ -240,6 +246,8 @@ def _baro(at: _At) -> tuple[Array, Array] | None:
     sensor = at.suite.sensors["baro"]
     baro = getattr(sensor, "sensor", sensor)  # a Faulted baro's own model
     sf = np.asarray(e.constants["scale_factor"], dtype=float).reshape(-1)
+    if not drawn_scale:
+        sf = np.zeros(1)
     k = int(e.rows[j])
     dt = None
     if baro.lag_s > 0.0:  # the truth's step; at the closed loop's start (row 1 not flown) the draw's grid gives it
@@ -300,7 +308,9 @@ def start_states(suite: Any, truth: Any, errors: Any, row: int = 0) -> SensorSta
     """The realized sensor error states at truth row `row` of the runs in `errors` (SuiteErrors from
     SensorSuite.draw; run axis first, length 1 when drawn for one run)."""
     at = _At(suite, truth, errors, int(row))
-    return SensorStates(int(row), **{g: _EXTRACT[g](at) for g in STATE_GROUPS})
+    day = _baro(at, drawn_scale=False)
+    return SensorStates(int(row), **{g: _EXTRACT[g](at) for g in STATE_GROUPS},
+                        sb_day=None if day is None else float(day[1][0]))
 
 
 

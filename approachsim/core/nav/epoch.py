@@ -129,7 +129,11 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, o
         if own:
             nu[0], _ = km.baro(lay, X[0], ins[0, 2], baro_h[0], 0.0, h, rows.baro_ref)
         else:
+            if lay[ek.L_SB] >= 0:  # the row at the reference's scale factor (the day's: obs.ref_sb)
+                x0[lay[ek.L_SB]] = obs.ref_sb
             km.baro(lay, x0, ref[2], baro_h[0], 0.0, h, rows.baro_ref)
+            if lay[ek.L_SB] >= 0:
+                x0[lay[ek.L_SB]] = 0.0
             for m in range(M):
                 nu[m] = km.baro_nu(lay, X[m], ins[m, 2], baro_h[m], rows.baro_ref)
         k = _update(X, P, h, obs.baro_r, nu, CODE_BARO, k, out, b, kc)
@@ -255,7 +259,7 @@ def _any(a: np.ndarray) -> np.ndarray:
 @njit(cache=True, inline="always")
 def _any_obs(obs: Obs) -> Obs:
     """obs with the per-member arrays as copies_epoch types them (strided views of the same elements)."""
-    return Obs(obs.baro_h[::1], obs.baro_r, obs.radalt_h[::1], obs.ref_agl, obs.dbp, obs.db_x, obs.db_u,
+    return Obs(obs.baro_h[::1], obs.baro_r, obs.radalt_h[::1], obs.ref_agl, obs.ref_sb, obs.dbp, obs.db_x, obs.db_u,
                obs.rho[:, ::1], obs.r_sv[:, ::1], obs.sig[::1], obs.cp[:, ::1], obs.pl_rho[:, ::1], obs.r_pl[:, ::1],
                obs.pl_sig)
 
@@ -344,7 +348,8 @@ def copies_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndar
         reset = _any_new(new[i])
         ready = last == hd and not reset
         phi = _with_resets(phi_h[hd], qd_tmp, lay, new[i], rows.amb_prior, scr.phi_tmp)
-        obs_i = Obs(obs.baro_h[i:i + 1], obs.baro_r, obs.radalt_h[i:i + 1], obs.ref_agl, obs.dbp[i:i + 1], obs.db_x,
+        obs_i = Obs(obs.baro_h[i:i + 1], obs.baro_r, obs.radalt_h[i:i + 1], obs.ref_agl, obs.ref_sb, obs.dbp[i:i + 1],
+                    obs.db_x,
                     obs.db_u[i:i + 1], obs.rho[i:i + 1], obs.r_sv[i], obs.sig[i], obs.cp[i:i + 1],
                     obs.pl_rho[i:i + 1], _any(obs.r_pl), obs.pl_sig)
         n_rows[i] = class_epoch(X[i:i + 1], P3[i], phi, qd_tmp, False, ref, ins[i:i + 1], rows, obs_i,
@@ -362,7 +367,8 @@ def pass_epoch(X: np.ndarray, P3: np.ndarray, phi_h: np.ndarray, qd_h: np.ndarra
     copies_epoch(X, P3, phi_h, qd_h, which[:, e], ref, ins[:, e],
                  ChannelQd(chan.gse[:, e], chan.gmp[:, e], chan.gio[:, e], chan.f_gse[e], chan.f_gmp[e],
                            chan.f_gio[e], chan.gse_r[:, e], chan.gio_r[:, e]),
-                 Obs(obs.baro_h[:, e], obs.baro_r[e], obs.radalt_h[:, e], obs.ref_agl[e], obs.dbp, obs.db_x, obs.db_u,
+                 Obs(obs.baro_h[:, e], obs.baro_r[e], obs.radalt_h[:, e], obs.ref_agl[e], obs.ref_sb, obs.dbp,
+                     obs.db_x, obs.db_u,
                      obs.rho[:, e], obs.r_sv[:, e], obs.sig[:, e], obs.cp[:, e], obs.pl_rho[:, e], obs.r_pl,
                      obs.pl_sig[e]),
                  new[:, e], rows, Out(out.codes[:, e], out.nu[:, e], out.S[:, e]), out.n_rows[:, e], scr)

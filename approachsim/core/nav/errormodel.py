@@ -235,7 +235,7 @@ def dynamics(lay: np.ndarray, q: np.ndarray, gse_sigma: np.ndarray, gmp_sigma: n
     if iac >= 0:
         i_h, i_v = ip + 2, iv + 2  # dp_D = -dh, dv_D = -dv_up
         F[i_v, iac] += 1.0
-        if not held:  # loop error e = -dp_D - bb - (h - H_ref) sb
+        if not held:  # loop error e = -dp_D - bb - (h - H_ref) sb (nav/errormodel.dynamics_reference: why -1)
             isb = lay[L_SB]
             for row, g in ((i_h, loop[1]), (i_v, loop[2]), (iac, loop[3])):
                 F[row, i_h] += g * -1.0

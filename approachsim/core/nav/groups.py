@@ -66,6 +66,9 @@ class Obs(NamedTuple):
     """Radar altimeter heights above the terrain (M,), m."""
     ref_agl: float
     """The reference's height above the terrain (shared rows' radar-altimeter sigma), m."""
+    ref_sb: float
+    """The reference's baro scale factor (the shared baro row's dp_D coefficient -(1 + sb); the day's,
+    sensors/states.SensorStates.sb_day; 0 without a baro scale-factor state)."""
     dbp: np.ndarray
     """Each member's terrain-database error parameters (M, 4) (core/nav/measurements.database_error)."""
     db_x: np.ndarray

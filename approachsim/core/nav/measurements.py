@@ -98,13 +98,14 @@ def baro_nu(lay: np.ndarray, x_hat: np.ndarray, h_ins: float, h_baro: float, h_r
 @njit(cache=True)
 def baro(lay: np.ndarray, x_hat: np.ndarray, h_ins: float, h_baro: float, sigma: float, h: np.ndarray,
          h_ref: float) -> tuple[float, float]:
-    """Baro altitude difference z = h_ins - h_baro (m): h = -1 at dp_D, -1 at bb, -(h_ins + dp_D_hat - H_ref) at sb
-    (into h (n,); the navigation's height, x_hat's dp_D), H_ref = h_ref the altimeter-setting reference (m);
-    returns (nu, r = sigma^2)."""
+    """Baro altitude difference z = h_ins - h_baro (m): h = -(1 + sb_hat) at dp_D (-1 without an sb state), -1 at bb,
+    -(h_ins + dp_D_hat - H_ref) at sb (into h (n,); the navigation's height, x_hat's dp_D and sb), H_ref = h_ref the
+    altimeter-setting reference (m); returns (nu, r = sigma^2) (nav/measurements.baro)."""
     h[:] = 0.0
     h[lay[ek.L_DP] + 2] = -1.0
     h[lay[ek.L_BB]] = -1.0
     if lay[ek.L_SB] >= 0:
+        h[lay[ek.L_DP] + 2] = -1.0 - x_hat[lay[ek.L_SB]]
         h[lay[ek.L_SB]] = -(h_ins + x_hat[lay[ek.L_DP] + 2] - h_ref)
     return baro_nu(lay, x_hat, h_ins, h_baro, h_ref), sigma**2
 
