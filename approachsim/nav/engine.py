@@ -321,15 +321,17 @@ class EpochEngine:
 
     def epoch(self, X: Array, P: Array, phi: Array, qd: Array, own: bool, ref_y: Array, ins_y: Array,
               obs: Observations, members: list[int], t_s: float, statuses: list[StatusBuffer],
-              dbs: list[RunDatabase], ref_agl_m: float = 0.0, ref_sb: float = 0.0) -> None:
+              dbs: list[RunDatabase], ref_agl_m: float = 0.0, ref_sb: float = 0.0, x_ready: bool = False) -> None:
         """One epoch of the members (indices into obs's runs) with estimates X (M, n) and covariance P, in place
-        (core/nav/epoch.class_epoch); each member's status records go to its buffer."""
+        (core/nav/epoch.class_epoch); each member's status records go to its buffer. x_ready: X holds the
+        predictions already (phi predicts P only: the per-run estimate's own model, nav/errormodel.MeanModel)."""
         M = len(members)
         o = self._obs(obs, members, dbs, ref_agl_m, ref_sb)
         if self._nu.shape[0] < M:
             self._nu = np.zeros((M, _MAX_ROWS))
         nu = self._nu[:M]
-        k = ke.class_epoch(X, P, phi, qd, own, ref_y, ins_y, self.rows, o, kg.Out(self.codes, nu, self.S), self.scr)
+        k = ke.class_epoch(X, P, phi, qd, own, ref_y, ins_y, self.rows, o, kg.Out(self.codes, nu, self.S), self.scr,
+                           False, x_ready)
         for j in range(M):
             statuses[j].add_epoch(self.codes[:k], t_s, nu[j, :k], self.S[:k])
 

@@ -61,8 +61,9 @@ the noise packed once per frozen object: `StateLayout.packed`, `kernel_noise`); 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property, lru_cache
+from typing import Any
 
 import numpy as np
 from scipy.linalg import expm
@@ -318,19 +319,64 @@ def _dw_in(lat: float, h: float, v: Array, r_n: float, r_e: float) -> tuple[Arra
 
 
 def linear_height(layout: StateLayout, h_ins_m: float, x_hat: Array, v_down_ins_mps: float = 0.0,
-                  dt_s: float = 0.0) -> float:
+                  dt_s: float = 0.0, F_start: Array | None = None) -> float:
     """The height (m) the per-run error model is linearized at over an aiding interval of dt_s ending at the INS
     height h_ins_m and down velocity v_down_ins_mps: the INS height, or with a baro scale-factor state the
     navigation's, h_ins + dp_D_hat, with the damping loop at the interval's midpoint (with v_D - dv_D_hat;
     core/nav/errormodel.interval_height:
     the damping loop drags the INS toward a baro off by sb (h - H_ref), and the loop's sb coefficient -(h - H_ref)
-    must be the true height's along the interval; nav/measurements.baro says why)."""
+    must be the true height's along the interval; nav/measurements.baro says why). F_start: the interval's model
+    taken at that height first; with it dp_D_hat is moved to the interval's end by its rate (core/nav/errormodel.
+    end_height), as the compiled per-run epoch does (core/nav/epoch.run_epoch)."""
     if not layout.has("sb"):
         return h_ins_m
     if not layout.has("ac"):  # no damping loop: the INS height and the estimate, as before the interval's midpoint
         return h_ins_m + float(x_hat[layout.i("dp", 2)])
-    return ek.interval_height(layout.packed, h_ins_m + float(x_hat[layout.i("dp", 2)]),
-                              v_down_ins_mps - float(x_hat[layout.i("dv", 2)]), dt_s)
+    h_nav = h_ins_m + float(x_hat[layout.i("dp", 2)])
+    if F_start is not None:
+        h_nav = float(ek.end_height(layout.packed, np.ascontiguousarray(F_start, dtype=float),
+                                    np.ascontiguousarray(x_hat, dtype=float), h_nav, float(dt_s)))
+    return ek.interval_height(layout.packed, h_nav, v_down_ins_mps - float(x_hat[layout.i("dv", 2)]), dt_s)
+
+
+def loop_jacobian(layout: StateLayout, F: Array, loop: vl.LoopGains | None, loop_held: bool, sb: float
+                  ) -> Array | None:
+    """The EKF's Jacobian of an interval's model F of the estimate at its baro scale factor sb: a copy of F with the
+    damping loop's rows at dp_D taking -g sb more (core/nav/errormodel.loop_jacobian says why), or None when F is
+    the Jacobian as it is (no sb state, no loop, or the loop held). loop: the gains F was built with."""
+    Fj = np.array(F, dtype=float, order="C")
+    lv = kernel_loop(loop if layout.has("ac") else None)
+    if not ek.loop_jacobian(layout.packed, lv, bool(loop_held), float(sb), Fj, np.empty(3)):
+        return None
+    return Fj
+
+
+def predict_mean(F: Array, phi: Array, x: Array, dt_s: float) -> Array:
+    """The estimate x (n,) predicted over dt_s by its own model F where the covariance takes the Jacobian's Phi
+    (core/nav/errormodel.predict_mean: exp(F dt) x on F's coupled states, Phi x on the rest); a new array."""
+    out = np.array(x, dtype=float)
+    ek.predict_mean(np.ascontiguousarray(F, dtype=float), np.ascontiguousarray(phi, dtype=float), out, float(dt_s))
+    return out
+
+
+@dataclass(frozen=True)
+class MeanModel:
+    """An interval's model of the estimate where the covariance takes another (`loop_jacobian`): F (n, n) the
+    estimate's continuous model over dt_s (s)."""
+
+    F: Array
+    dt_s: float
+
+    def predict(self, phi: Array, x: Array) -> Array:
+        """x predicted by F (`predict_mean`; phi the covariance's, for the decoupled states); a new array."""
+        return predict_mean(self.F, phi, x, self.dt_s)
+
+    @staticmethod
+    def predict_state(filt: Any, fs: Any, phi: Array, qd: Array, mean: MeanModel | None) -> Any:
+        """filt.predict(fs, phi, qd) (a nav.base.NavFilter and its FilterState), its estimate from `mean` when
+        given."""
+        out = filt.predict(fs, phi, qd)
+        return out if mean is None else replace(out, x=mean.predict(phi, fs.x))
 
 
 def interval_height(layout: StateLayout, h_m: float, v_down_mps: float, dt_s: float) -> float:

@@ -58,6 +58,7 @@ from approachsim.integrity.requirements import (
 )
 from approachsim.nav.base import FilterState, NavFilter, ScalarMeasurement, UpdateStatus
 from approachsim.nav.config import FdeConfig
+from approachsim.nav.errormodel import MeanModel
 from approachsim.nav.observations import FIX, Source
 from approachsim.records import ExclusionEvent
 
@@ -119,6 +120,8 @@ class _Epoch:
     phi: Array
     qd: Array
     rows: list[Row]
+    mean: MeanModel | None = None
+    """The estimate's own model over the interval when the covariance's differs (nav/errormodel.loop_jacobian)."""
     correction: Array | None = None
     """Feedback: the error estimate the INS received after this epoch's updates (reset groups only)."""
 
@@ -214,7 +217,7 @@ class FdeState:
             self.windows[name] = deque([(i, w) for i, w in self.windows[name] if i < first],
                                        maxlen=self.config.window)
         for e, nxt in zip(hist[:-1], hist[1:], strict=True):
-            fs = filt.predict(fs, e.phi, e.qd)
+            fs = MeanModel.predict_state(filt, fs, e.phi, e.qd, e.mean)
             self._commit(e.index, self._test(filt, fs, self._rows(e.rows, fs.x)))
             for r in e.rows:
                 if r.source.unit not in self.excluded:
@@ -225,17 +228,18 @@ class FdeState:
         return fs
 
     def epoch(self, filt: NavFilter, fs_prev: FilterState, phi: Array, qd: Array,
-              rows: list[Row], t_s: float, r_rwy_m: Array
+              rows: list[Row], t_s: float, r_rwy_m: Array, mean: MeanModel | None = None
               ) -> tuple[FilterState, list[UpdateStatus]]:
         """Predict, test, exclude (rolling back), update with the remaining measurements, protect.
 
         r_rwy_m (3,): the aircraft in the runway frame (along, cross, height above the threshold), m, for the
-        alert limits. Returns the filter state after the updates and the status of every measurement (excluded
-        ones with weight 0, not accepted)."""
+        alert limits. mean: the estimate's own model over the interval where the covariance's phi differs
+        (nav/errormodel.MeanModel). Returns the filter state after the updates and the status of every measurement
+        (excluded ones with weight 0, not accepted)."""
         k = self.count
         self.count += 1
-        self.history.append(_Epoch(k, fs_prev, phi, qd, rows))
-        fs = filt.predict(fs_prev, phi, qd)
+        self.history.append(_Epoch(k, fs_prev, phi, qd, rows, mean))
+        fs = MeanModel.predict_state(filt, fs_prev, phi, qd, mean)
         unprotectable = False
         while True:
             test = self._test(filt, fs, self._rows(rows, fs.x))
@@ -248,7 +252,7 @@ class FdeState:
                 break
             self.excluded.add(src.unit)  # a satellite's code and carrier go together (observations.Source.unit)
             self.events.append(ExclusionEvent(t_s, src.unit, src.channel, kind, stat, thr))
-            fs = filt.predict(self._rollback(filt), phi, qd)
+            fs = MeanModel.predict_state(filt, self._rollback(filt), phi, qd, mean)
         self._commit(k, test)
         statuses: list[UpdateStatus] = []
         used: set[Source] = set()

@@ -339,27 +339,38 @@ class Navigator:
                 r_ins = ins.position_ecef(s)
             noise = system.noise(obs.elevations(i))
             h_lin = em.linear_height(lay, float(s.h_m[i]), run.fs.x, float(s.v_ned[i, 2]), dt_epoch)
+            if lay.has("sb") and lay.has("ac"):  # dp_D_hat at the interval's end by the model's rate (run_epoch's)
+                F0, _ = em.dynamics(lay, float(s.lat_rad[i]), h_lin, s.v_ned[i], f_ned_mean[i], s.c_bn[i], noise,
+                                    system.loop_slopes(run.fs, h_lin, noise), loop_held=held)
+                h_lin = em.linear_height(lay, float(s.h_m[i]), run.fs.x, float(s.v_ned[i, 2]), dt_epoch, F0)
             gains = system.loop_slopes(run.fs, h_lin, noise)
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), h_lin, s.v_ned[i],
                                 f_ned_mean[i], s.c_bn[i], noise, gains, loop_held=held)
             self.interval_F[i] = F
-            phi, qd = em.discretize(F, Qc, dt_epoch)
+            # the covariance by the EKF's Jacobian, the estimate by its own model F (core/nav/errormodel.loop_jacobian)
+            F_jac = em.loop_jacobian(lay, F, gains, held, float(run.fs.x[lay.i("sb")]) if lay.has("sb") else 0.0)
+            phi, qd = em.discretize(F if F_jac is None else F_jac, Qc, dt_epoch)
             if self.gbas_scale is not None and obs.has_gnss:  # the channel states at the INS's geometry
                 phi, qd = self.gbas_scale.apply(phi, qd, obs.elevations(i), self.x[self.ins_of[i]], dt_epoch, noise)
             if new is not None:
                 phi, qd = reset_arcs(lay, phi, qd, new, self._amb_prior())
+            mean = None if F_jac is None else em.MeanModel(F, dt_epoch)
             if self.engine is not None and run.fde is None:  # the compiled updates on the numpy discretization
                 X, P = run.fs.x.copy()[None], np.array(run.fs.P, dtype=float)
+                if mean is not None:
+                    X[0] = mean.predict(phi, X[0])
                 y = self.x[self.ins_of[i]:self.ins_of[i] + 1]
-                self.engine.epoch(X, P, phi, qd, True, y[0], y, obs, [i], t, [run.statuses], [self.dbs[i]])
+                self.engine.epoch(X, P, phi, qd, True, y[0], y, obs, [i], t, [run.statuses], [self.dbs[i]],
+                                  x_ready=mean is not None)
                 run.fs = FilterState(x=X[0], P=P, memory=run.fs.memory)
                 continue
             rows = system.rows.epoch(s, i, r_ins[i], obs, t, db_error=run.db_error)
             if run.fde is not None:  # predict, test, exclude, update (nav/fde.py)
-                run.fs, sts = run.fde.epoch(filt, run.fs, phi, qd, rows, t, system.runway.from_ecef(r_ins[i]))
+                run.fs, sts = run.fde.epoch(filt, run.fs, phi, qd, rows, t, system.runway.from_ecef(r_ins[i]),
+                                            mean=mean)
                 run.statuses.extend(sts)
                 continue
-            fs = filt.predict(run.fs, phi, qd)
+            fs = em.MeanModel.predict_state(filt, run.fs, phi, qd, mean)
             for row in rows:
                 fs, st = filt.update(fs, row.build(fs.x))
                 run.statuses.append(st)

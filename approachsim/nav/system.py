@@ -176,7 +176,8 @@ class NavSystem:
         row = np.zeros(lay.n)
         row[lay.i("dp", 2)] = -1.0
         row[lay.i("bb")] = -1.0
-        if lay.has("sb"):
+        if lay.has("sb"):  # de/d(dp_D) = -(1 + sb) at the estimate (core/nav/errormodel.loop_jacobian)
+            row[lay.i("dp", 2)] = -(1.0 + float(fs.x[lay.i("sb")]))
             row[lay.i("sb")] = -(h_m - self.baro_ref_m)
         P = self.filter.covariance(fs)
         e_hat = float(row @ fs.x)

@@ -86,7 +86,8 @@ def _update(X: np.ndarray, P: np.ndarray, h: np.ndarray, r: float, nu: np.ndarra
 
 @njit(cache=True)
 def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, own: bool, ref: np.ndarray,
-                ins: np.ndarray, rows: Rows, obs: Obs, out: Out, scr: Scratch, csr_ready: bool = False) -> int:
+                ins: np.ndarray, rows: Rows, obs: Obs, out: Out, scr: Scratch, csr_ready: bool = False,
+                x_ready: bool = False) -> int:
     """Predict and update the M members of a class in place (module docstring); returns the number of rows.
 
     X (M, n) estimates; P (n, n) the class covariance; phi, qd (n, n) the epoch's model; own: the per-run EKF
@@ -95,6 +96,8 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, o
     sqrt((ra_pct h)^2 + ra_floor^2) at the measured height (own) or at obs.ref_agl (shared)); out: codes (R,),
     nu (M, R), S (R,); scr: h, b, ws. csr_ready: scr.ws already holds phi's nonzeros (kalman.csr; the caller's
     previous class_epoch had this same phi), so they are not collected again (the same numbers either way).
+    x_ready: X holds the members' predictions already (the per-run EKF's mean by its own model,
+    core/nav/errormodel.predict_mean): phi predicts P only.
     """
     M = X.shape[0]
     n = X.shape[1]
@@ -104,7 +107,7 @@ def class_epoch(X: np.ndarray, P: np.ndarray, phi: np.ndarray, qd: np.ndarray, o
     # predict: x_m <- Phi x_m ; P <- Phi P Phi' + Qd
     if not csr_ready:
         kk.csr(phi, ptr, col, val)
-    for m in range(M):
+    for m in range(M if not x_ready else 0):
         for i in range(n):
             acc = 0.0
             for p in range(ptr[i], ptr[i + 1]):
@@ -222,27 +225,43 @@ def run_epoch(X: np.ndarray, P: np.ndarray, model: ErrorModel, y: np.ndarray, f_
               dt: float, new: np.ndarray, rows: Rows, obs: Obs, out: Out, scr: Scratch) -> int:
     """The per-run EKF's whole epoch of one run: the error model (core/nav/errormodel.dynamics, core/nav/carrier.
     dynamics: model's constants) linearized about its INS state y (16,) (packed, core/nav/strapdown.py; with a baro
-    scale-factor state at the navigation's height y[2] + X[0, dp_D]) with the
+    scale-factor state at the navigation's height y[2] + X[0, dp_D], with the loop at the interval's midpoint and
+    dp_D moved to its end, core/nav/errormodel.end_height) with the
     interval's mean specific force f_ned (3,) NED m/s^2 and the damping loop held or not, discretized over dt (s)
     into scr.phi, scr.qd (scratch scr.F, scr.Qc), the ambiguities of the channels with new[c] != 0 reset to
     rows.amb_prior m^2 (core/nav/carrier.reset_ambiguities; new (k,), empty without carrier phase), then
-    class_epoch in own mode (X (1, n)). Returns the number of rows, or -1 when the model is too large for the
+    class_epoch in own mode (X (1, n)). With a baro scale-factor state and the loop on, Phi, Qd are the EKF's
+    Jacobian's and the estimate is predicted by its own model (core/nav/errormodel.loop_jacobian, predict_mean);
+    scr.F is the estimate's model. Returns the number of rows, or -1 when the model is too large for the
     compiled discretization (X, P untouched: the caller takes the numpy path)."""
     F, Qc, phi, qd = scr.F, scr.Qc, scr.phi, scr.qd
+    lay = model.lay
     c_bn = y[6:15].reshape(3, 3)
     h_lin = y[2]
-    if model.lay[ek.L_SB] >= 0:  # the loop's sb coefficient at the navigation's height, with the loop the interval's
-        iv = model.lay[ek.L_DV] + 2  # midpoint (nav/errormodel.linear_height): navigation = INS less the estimate
-        h_lin = ek.interval_height(model.lay, y[2] + X[0, model.lay[ek.L_DP] + 2], y[5] - X[0, iv], dt)
-    ek.dynamics(model.lay, model.q, model.gse, model.gmp, y[0], h_lin, y[3:6], f_ned, c_bn, model.loop, held, F, Qc)
-    kcar.dynamics(model.lay, model.gio, model.gio_tau, F, Qc)
-    if not ek.discretize(F, Qc, dt, phi, qd):
+    if lay[ek.L_SB] >= 0:  # the loop's sb coefficient at the navigation's height, with the loop the interval's
+        h_nav = y[2] + X[0, lay[ek.L_DP] + 2]  # midpoint (nav/errormodel.linear_height): navigation = INS less the
+        v_nav = y[5] - X[0, lay[ek.L_DV] + 2]  # estimate, its dp_D moved to the interval's end (ek.end_height)
+        if lay[ek.L_AC] >= 0:
+            ek.dynamics(lay, model.q, model.gse, model.gmp, y[0], ek.interval_height(lay, h_nav, v_nav, dt), y[3:6],
+                        f_ned, c_bn, model.loop, held, F, Qc)
+            h_nav = ek.end_height(lay, F, X[0], h_nav, dt)
+        h_lin = ek.interval_height(lay, h_nav, v_nav, dt)
+    ek.dynamics(lay, model.q, model.gse, model.gmp, y[0], h_lin, y[3:6], f_ned, c_bn, model.loop, held, F, Qc)
+    kcar.dynamics(lay, model.gio, model.gio_tau, F, Qc)
+    keep = np.empty(3)  # the covariance by the Jacobian, the estimate by its own model (ek.loop_jacobian)
+    jac = ek.loop_jacobian(lay, model.loop, held, X[0, lay[ek.L_SB]] if lay[ek.L_SB] >= 0 else 0.0, F, keep)
+    ok = ek.discretize(F, Qc, dt, phi, qd)
+    if jac:
+        ek.loop_mean(lay, keep, F)  # scr.F: the interval's model of the estimate (its rate, core/nav/output.py)
+    if not ok:
         return -1
-    ek.scale_channels(phi, model.lay[ek.L_GSE], model.gse_r)
-    ek.scale_channels(phi, model.lay[ek.L_GIO], model.gio_r)
-    kcar.reset_ambiguities(phi, qd, model.lay, new, rows.amb_prior)
+    ek.scale_channels(phi, lay[ek.L_GSE], model.gse_r)
+    ek.scale_channels(phi, lay[ek.L_GIO], model.gio_r)
+    kcar.reset_ambiguities(phi, qd, lay, new, rows.amb_prior)
+    if jac:
+        ek.predict_mean(F, phi, X[0], dt)
     return class_epoch(X, P, phi, qd, True, y, _any(y.reshape(1, 16)), rows, _any_obs(obs), _any_out(out), scr,
-                       False)
+                       False, jac)
 
 
 # One compilation of class_epoch. The bank's copies (copies_epoch) hand it the per-copy rows of their (N, E) pass
