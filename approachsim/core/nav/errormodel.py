@@ -322,9 +322,10 @@ def predict_mean(F: np.ndarray, phi: np.ndarray, x: np.ndarray, dt: float) -> No
     states: Phi's row there is its diagonal, which carries the interval's per-state changes, scale_channels and
     carrier.reset_ambiguities, that F does not).
 
-    exp(F dt) x by its Taylor series (Al-Mohy & Higham's expmv idea, plain): s = ceil(2 |F dt|_inf) equal steps,
-    so that each term of a step is at most half the one before; the terms of a step added until every state's is
-    within 2^-53 of its running sum (at most 40 terms: 2^-40 / 40! of the first)."""
+    exp(F dt) x by its Taylor series (Al-Mohy & Higham's expmv idea, plain): s = ceil(|F dt|_inf / 2) equal steps,
+    so that a step's term k is at most 2 / k of term k - 1; the terms of a step added until every state's is within
+    2^-53 of its running sum (at most 40 terms: 2^40 / 40! < 1e-35 of the first). Half-norm steps took twice the
+    time (50 against 24 us on the default's 75 states, ||F||_inf 16 from the specific force) and rounded no better."""
     n = x.shape[0]
     norm = 0.0
     nnz = 0
@@ -342,7 +343,7 @@ def predict_mean(F: np.ndarray, phi: np.ndarray, x: np.ndarray, dt: float) -> No
     x0 = x.copy()
     term = np.empty(n)
     nxt = np.empty(n)
-    steps = max(1, int(math.ceil(2.0 * norm * dt)))
+    steps = max(1, int(math.ceil(0.5 * norm * dt)))
     h = dt / steps
     for _ in range(steps):
         for i in range(n):
