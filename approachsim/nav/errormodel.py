@@ -361,15 +361,27 @@ def predict_mean(F: Array, phi: Array, x: Array, dt_s: float) -> Array:
 
 @dataclass(frozen=True)
 class MeanModel:
-    """An interval's model of the estimate where the covariance takes another (`loop_jacobian`): F (n, n) the
-    estimate's continuous model over dt_s (s)."""
+    """An interval's model of the estimate where the covariance takes another: x' = F x + b over dt_s (s), F (n, n)
+    the estimate's continuous model (`loop_jacobian`: the covariance's is the Jacobian), b (n,) a constant pull
+    beyond it or None (an adaptive damping loop's E[k(e)] beyond its slope, NavSystem.loop_offset)."""
 
     F: Array
     dt_s: float
+    b: Array | None = None
 
     def predict(self, phi: Array, x: Array) -> Array:
-        """x predicted by F (`predict_mean`; phi the covariance's, for the decoupled states); a new array."""
-        return predict_mean(self.F, phi, x, self.dt_s)
+        """x predicted by F and b (`predict_mean`; phi the covariance's, for the decoupled states); a new array. With
+        b, the action of exp on the augmented [[F, b], [0, 0]] on (x, 1)."""
+        if self.b is None:
+            return predict_mean(self.F, phi, x, self.dt_s)
+        n = self.F.shape[0]
+        Fa = np.zeros((n + 1, n + 1))
+        Fa[:n, :n] = self.F
+        Fa[:n, n] = self.b
+        pa = np.zeros((n + 1, n + 1))
+        pa[:n, :n] = phi
+        pa[n, n] = 1.0
+        return predict_mean(Fa, pa, np.append(x, 1.0), self.dt_s)[:n]
 
     @staticmethod
     def predict_state(filt: Any, fs: Any, phi: Array, qd: Array, mean: MeanModel | None) -> Any:

@@ -354,7 +354,8 @@ class Navigator:
                 phi, qd = self.gbas_scale.apply(phi, qd, obs.elevations(i), self.x[self.ins_of[i]], dt_epoch, noise)
             if new is not None:
                 phi, qd = reset_arcs(lay, phi, qd, new, self._amb_prior())
-            mean = None if F_jac is None else em.MeanModel(F, dt_epoch)
+            pull = None if held else system.loop_offset(run.fs, h_lin, noise, gains)
+            mean = None if F_jac is None and pull is None else em.MeanModel(F, dt_epoch, pull)
             if self.engine is not None and run.fde is None:  # the compiled updates on the numpy discretization
                 X, P = run.fs.x.copy()[None], np.array(run.fs.P, dtype=float)
                 if mean is not None:

@@ -163,34 +163,57 @@ class NavSystem:
         """The INS damping-loop gains (None without a loop)."""
         return self.nav.loop_gains()
 
-    def loop_slopes(self, fs: FilterState, h_m: float, noise: em.ErrorNoise) -> vl.LoopGains | None:
-        """The damping loop as the error model sees it: constant gains as they are; for the adaptive tanh /
-        sinh forms the *statistical linearization* E[dk/de] of each branch over the loop error
-        e ~ N(e_hat, var), e_hat = -dp_D - bb - S (h - H_ref) from the estimate, var = its variance + the baro noise
-        (5-point Gauss-Hermite). The small-signal slope alone makes the filter claim a sigma it does not have
-        once |b e| ~ 1 (tanh saturates, sinh grows)."""
-        g = self.loop_gains()
-        if g is None or g.form == "constant":
-            return g
+    def _loop_error_nodes(self, fs: FilterState, h_m: float, noise: em.ErrorNoise) -> tuple[float, Array, Array]:
+        """(e_hat, e, w): the loop error at the estimate, e_hat = -dp_D - bb - (h - H_ref) sb (h the navigation's
+        height h_m: exact at the estimate, core/nav/errormodel.loop_jacobian), and the 5-point Gauss-Hermite nodes e
+        and weights w (summing to 1) of e ~ N(e_hat, var), var = the Jacobian row's P variance (de/d(dp_D) =
+        -(1 + sb)) + the baro noise."""
         lay = self.layout
         row = np.zeros(lay.n)
         row[lay.i("dp", 2)] = -1.0
         row[lay.i("bb")] = -1.0
-        if lay.has("sb"):  # de/d(dp_D) = -(1 + sb) at the estimate (core/nav/errormodel.loop_jacobian)
-            row[lay.i("dp", 2)] = -(1.0 + float(fs.x[lay.i("sb")]))
+        if lay.has("sb"):
             row[lay.i("sb")] = -(h_m - self.baro_ref_m)
-        P = self.filter.covariance(fs)
         e_hat = float(row @ fs.x)
+        if lay.has("sb"):
+            row[lay.i("dp", 2)] = -(1.0 + float(fs.x[lay.i("sb")]))
+        P = self.filter.covariance(fs)
         sd = float(np.sqrt(row @ P @ row + noise.baro_noise_sigma_m**2))
         z, w = np.polynomial.hermite_e.hermegauss(5)
-        e = e_hat + sd * z
-        w = w / w.sum()
+        return e_hat, e_hat + sd * z, w / w.sum()
+
+    def loop_slopes(self, fs: FilterState, h_m: float, noise: em.ErrorNoise) -> vl.LoopGains | None:
+        """The damping loop as the error model sees it: constant gains as they are; for the adaptive tanh /
+        sinh forms the *statistical linearization* E[dk/de] of each branch over the loop error
+        e ~ N(e_hat, var) (`_loop_error_nodes`; 5-point Gauss-Hermite). The small-signal slope alone makes the
+        filter claim a sigma it does not have once |b e| ~ 1 (tanh saturates, sinh grows)."""
+        g = self.loop_gains()
+        if g is None or g.form == "constant":
+            return g
+        _, e, w = self._loop_error_nodes(fs, h_m, noise)
 
         def slope(c: float, b: float) -> float:
             d = 1.0 / np.cosh(b * e) ** 2 if g.form == "tanh" else np.cosh(b * e)  # d/de f(b e) / b
             return float(c * b * (w @ d))
 
         return vl.LoopGains(slope(g.c1, g.b1_per_m), slope(g.c2, g.b2_per_m), g.c3)
+
+    def loop_offset(self, fs: FilterState, h_m: float, noise: em.ErrorNoise, slopes: vl.LoopGains | None
+                    ) -> Array | None:
+        """The estimate's loop pull beyond the error model's slopes (`loop_slopes`): b (n,) with E[k1(e)] - s1 e_hat
+        at dp_D (m/s) and E[k2(e)] - s2 e_hat at dv_D (m/s^2), the statistical linearization's constant term
+        (nav/errormodel.MeanModel adds it to the estimate's F x). F x_hat alone gives the estimate s e_hat, right for a
+        linear loop but not for tanh / sinh with the loop error tens of metres (an uncorrected cold day: tanh's
+        pull saturated at C while s e_hat grows with e_hat). None for constant gains or no loop."""
+        g = self.loop_gains()
+        if g is None or g.form == "constant" or slopes is None:
+            return None
+        e_hat, e, w = self._loop_error_nodes(fs, h_m, noise)
+        k1, k2 = vl.branch_corrections(g, e)
+        b = np.zeros(self.layout.n)
+        b[self.layout.i("dp", 2)] = float(w @ k1) - slopes.c1 * e_hat
+        b[self.layout.i("dv", 2)] = float(w @ k2) - slopes.c2 * e_hat
+        return b
 
     def shares_covariance(self) -> bool:
         """Whether runs on one truth can share one covariance (`run(..., shared_covariance=True)`): the optimal

@@ -9,6 +9,9 @@ prediction exp(F dt) x against scipy's matrix exponential.
 
 from __future__ import annotations
 
+import math
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.linalg import expm
@@ -153,3 +156,49 @@ def test_predict_mean_is_the_exponential_on_coupled_states_and_phi_on_the_rest(d
     np.testing.assert_array_less(np.abs(got - want)[~lone], tol[~lone])
     np.testing.assert_array_equal(got[lone], np.diag(phi)[lone] * x[lone])
     assert lone[gse.start] and not lone[LAY.i("dp", 2)]
+
+
+@pytest.mark.parametrize("form", ["tanh", "sinh"])
+def test_an_adaptive_loops_estimate_takes_its_pull_not_its_slope(form):
+    """NavSystem.loop_offset: the estimate's C1 / C2 branch terms are E[k(e)] over e ~ N(e_hat, var) (the
+    statistical linearization's constant term), F's slope s times e_hat plus the offset b. Checked against the
+    expectation by adaptive quadrature; on a cold day's loop error (e_hat ~ -90 m, tanh saturated) the pull is
+    -C1 where s e_hat is nearly 0."""
+    from dataclasses import replace
+
+    from scipy import integrate, stats
+
+    from approachsim.nav.base import FilterState
+    from approachsim.nav.system import NavSystem
+    from approachsim.profile import load_profile
+
+    prof = load_profile(Path(__file__).resolve().parents[3] / "profiles" / "default.toml")
+    cfg = replace(prof.nav, baro_loop=form)
+    system = NavSystem.build(cfg, prof.sensors, prof.runway.frame, prof.terrain)
+    lay = system.layout
+    g = system.loop_gains()
+    x = np.zeros(lay.n)
+    x[lay.i("sb")] = 0.1 if form == "tanh" else 0.002  # sinh grows: a moderate loop error for it
+    P = np.eye(lay.n) * 1e-6
+    P[lay.i("dp", 2), lay.i("dp", 2)] = 0.04
+    fs = FilterState(x=x, P=P)
+    noise = system.noise(None)
+    h_m = system.baro_ref_m + 900.0
+    s = system.loop_slopes(fs, h_m, noise)
+    b = system.loop_offset(fs, h_m, noise, s)
+    e_hat = -(h_m - system.baro_ref_m) * x[lay.i("sb")]
+    sd = np.sqrt((1.0 + x[lay.i("sb")]) ** 2 * 0.04 + 900.0**2 * 1e-6 + noise.baro_noise_sigma_m**2)
+    for c, bb, i in ((g.c1, g.b1_per_m, lay.i("dp", 2)), (g.c2, g.b2_per_m, lay.i("dv", 2))):
+        f = np.tanh if form == "tanh" else np.sinh
+        want = integrate.quad(lambda e, c=c, bb=bb, f=f: c * f(bb * e) * stats.norm.pdf(e, e_hat, sd),
+                              e_hat - 10 * sd, e_hat + 10 * sd, epsabs=0.0, epsrel=1e-12)[0]
+        slope = s.c1 if i == lay.i("dp", 2) else s.c2
+        # the 5-point Gauss-Hermite rule is exact to degree 9; its error is n! / (2n)! sd^10 f^(10)(xi), n = 5, and
+        # f^(10) of c f(b e) is b^10 times f's scale here (4x for cosh over the nodes' spread), plus quad's 1e-10
+        tol = 4 * math.factorial(5) / math.factorial(10) * (bb * sd) ** 10 * max(abs(want), c) + 1e-10 * c
+        assert abs(slope * e_hat + b[i] - want) <= tol, (slope * e_hat + b[i], want, tol)
+    if form == "tanh":
+        assert abs(b[lay.i("dp", 2)] + s.c1 * e_hat + g.c1) < 1e-6 * g.c1  # saturated: the pull is -C1
+        assert abs(s.c1 * e_hat) < 1e-3 * g.c1  # and the slope's share of it nearly nothing
+    const = NavSystem.build(replace(prof.nav, baro_loop="constant"), prof.sensors, prof.runway.frame, prof.terrain)
+    assert const.loop_offset(fs, h_m, noise, const.loop_slopes(fs, h_m, noise)) is None
