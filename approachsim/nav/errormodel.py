@@ -363,7 +363,7 @@ def predict_mean(F: Array, phi: Array, x: Array, dt_s: float) -> Array:
 class MeanModel:
     """An interval's model of the estimate where the covariance takes another: x' = F x + b over dt_s (s), F (n, n)
     the estimate's continuous model (`loop_jacobian`: the covariance's is the Jacobian), b (n,) a constant pull
-    beyond it or None (an adaptive damping loop's E[k(e)] beyond its slope, NavSystem.loop_offset)."""
+    beyond it or None (an adaptive damping loop's E[k(e)] beyond its slope, NavSystem.loop_linearization)."""
 
     F: Array
     dt_s: float

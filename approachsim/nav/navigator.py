@@ -343,7 +343,7 @@ class Navigator:
                 F0, _ = em.dynamics(lay, float(s.lat_rad[i]), h_lin, s.v_ned[i], f_ned_mean[i], s.c_bn[i], noise,
                                     system.loop_slopes(run.fs, h_lin, noise), loop_held=held)
                 h_lin = em.linear_height(lay, float(s.h_m[i]), run.fs.x, float(s.v_ned[i, 2]), dt_epoch, F0)
-            gains = system.loop_slopes(run.fs, h_lin, noise)
+            gains, pull = system.loop_linearization(run.fs, h_lin, noise)
             F, Qc = em.dynamics(lay, float(s.lat_rad[i]), h_lin, s.v_ned[i],
                                 f_ned_mean[i], s.c_bn[i], noise, gains, loop_held=held)
             self.interval_F[i] = F
@@ -354,7 +354,7 @@ class Navigator:
                 phi, qd = self.gbas_scale.apply(phi, qd, obs.elevations(i), self.x[self.ins_of[i]], dt_epoch, noise)
             if new is not None:
                 phi, qd = reset_arcs(lay, phi, qd, new, self._amb_prior())
-            pull = None if held else system.loop_offset(run.fs, h_lin, noise, gains)
+            pull = None if held else pull
             mean = None if F_jac is None and pull is None else em.MeanModel(F, dt_epoch, pull)
             if self.engine is not None and run.fde is None:  # the compiled updates on the numpy discretization
                 X, P = run.fs.x.copy()[None], np.array(run.fs.P, dtype=float)

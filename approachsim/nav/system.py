@@ -183,37 +183,34 @@ class NavSystem:
         return e_hat, e_hat + sd * z, w / w.sum()
 
     def loop_slopes(self, fs: FilterState, h_m: float, noise: em.ErrorNoise) -> vl.LoopGains | None:
-        """The damping loop as the error model sees it: constant gains as they are; for the adaptive tanh /
-        sinh forms the *statistical linearization* E[dk/de] of each branch over the loop error
-        e ~ N(e_hat, var) (`_loop_error_nodes`; 5-point Gauss-Hermite). The small-signal slope alone makes the
-        filter claim a sigma it does not have once |b e| ~ 1 (tanh saturates, sinh grows)."""
+        """The damping loop as the error model sees it (`loop_linearization`'s gains)."""
+        return self.loop_linearization(fs, h_m, noise)[0]
+
+    def loop_linearization(self, fs: FilterState, h_m: float, noise: em.ErrorNoise
+                           ) -> tuple[vl.LoopGains | None, Array | None]:
+        """(gains, b): the damping loop as the error model sees it. Constant gains as they are, b None. For the
+        adaptive tanh / sinh forms the *statistical linearization* of each branch over the loop error
+        e ~ N(e_hat, var) (`_loop_error_nodes`; 5-point Gauss-Hermite): the slopes s = E[dk/de] (the gains, F's and
+        so the covariance's; the small-signal slope alone makes the filter claim a sigma it does not have once
+        |b e| ~ 1: tanh saturates, sinh grows), and the constant term b (n,), E[k1(e)] - s1 e_hat at dp_D (m/s) and
+        E[k2(e)] - s2 e_hat at dv_D (m/s^2), the estimate's pull beyond s e_hat (nav/errormodel.MeanModel adds it
+        to F x): with the loop error tens of metres (an uncorrected cold day) tanh's pull is saturated at C while
+        s e_hat is near 0."""
         g = self.loop_gains()
         if g is None or g.form == "constant":
-            return g
-        _, e, w = self._loop_error_nodes(fs, h_m, noise)
+            return g, None
+        e_hat, e, w = self._loop_error_nodes(fs, h_m, noise)
 
         def slope(c: float, b: float) -> float:
             d = 1.0 / np.cosh(b * e) ** 2 if g.form == "tanh" else np.cosh(b * e)  # d/de f(b e) / b
             return float(c * b * (w @ d))
 
-        return vl.LoopGains(slope(g.c1, g.b1_per_m), slope(g.c2, g.b2_per_m), g.c3)
-
-    def loop_offset(self, fs: FilterState, h_m: float, noise: em.ErrorNoise, slopes: vl.LoopGains | None
-                    ) -> Array | None:
-        """The estimate's loop pull beyond the error model's slopes (`loop_slopes`): b (n,) with E[k1(e)] - s1 e_hat
-        at dp_D (m/s) and E[k2(e)] - s2 e_hat at dv_D (m/s^2), the statistical linearization's constant term
-        (nav/errormodel.MeanModel adds it to the estimate's F x). F x_hat alone gives the estimate s e_hat, right for a
-        linear loop but not for tanh / sinh with the loop error tens of metres (an uncorrected cold day: tanh's
-        pull saturated at C while s e_hat grows with e_hat). None for constant gains or no loop."""
-        g = self.loop_gains()
-        if g is None or g.form == "constant" or slopes is None:
-            return None
-        e_hat, e, w = self._loop_error_nodes(fs, h_m, noise)
+        s = vl.LoopGains(slope(g.c1, g.b1_per_m), slope(g.c2, g.b2_per_m), g.c3)
         k1, k2 = vl.branch_corrections(g, e)
         b = np.zeros(self.layout.n)
-        b[self.layout.i("dp", 2)] = float(w @ k1) - slopes.c1 * e_hat
-        b[self.layout.i("dv", 2)] = float(w @ k2) - slopes.c2 * e_hat
-        return b
+        b[self.layout.i("dp", 2)] = float(w @ k1) - s.c1 * e_hat
+        b[self.layout.i("dv", 2)] = float(w @ k2) - s.c2 * e_hat
+        return s, b
 
     def shares_covariance(self) -> bool:
         """Whether runs on one truth can share one covariance (`run(..., shared_covariance=True)`): the optimal

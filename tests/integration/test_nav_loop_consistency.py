@@ -36,7 +36,7 @@ RUNS = 20
         ("tanh", "converged"),
         # from the independent diagonal prior (5 m vertical: the tanh loop saturates at |b e| ~ 2.5) the filter
         # under-claimed the vertical velocity error (normalized 2.9 instead of 1; NEES ~12.7 of 9) until the
-        # estimate took the loop's pull E[k(e)], not its slope times e_hat (NavSystem.loop_offset, issue 39)
+        # estimate took the loop's pull E[k(e)], not its slope times e_hat (NavSystem.loop_linearization, issue 39)
         ("tanh", "prior"),
     ],
 )

@@ -160,7 +160,7 @@ def test_predict_mean_is_the_exponential_on_coupled_states_and_phi_on_the_rest(d
 
 @pytest.mark.parametrize("form", ["tanh", "sinh"])
 def test_an_adaptive_loops_estimate_takes_its_pull_not_its_slope(form):
-    """NavSystem.loop_offset: the estimate's C1 / C2 branch terms are E[k(e)] over e ~ N(e_hat, var) (the
+    """NavSystem.loop_linearization: the estimate's C1 / C2 branch terms are E[k(e)] over e ~ N(e_hat, var) (the
     statistical linearization's constant term), F's slope s times e_hat plus the offset b. Checked against the
     expectation by adaptive quadrature; on a cold day's loop error (e_hat ~ -90 m, tanh saturated) the pull is
     -C1 where s e_hat is nearly 0."""
@@ -184,8 +184,7 @@ def test_an_adaptive_loops_estimate_takes_its_pull_not_its_slope(form):
     fs = FilterState(x=x, P=P)
     noise = system.noise(None)
     h_m = system.baro_ref_m + 900.0
-    s = system.loop_slopes(fs, h_m, noise)
-    b = system.loop_offset(fs, h_m, noise, s)
+    s, b = system.loop_linearization(fs, h_m, noise)
     e_hat = -(h_m - system.baro_ref_m) * x[lay.i("sb")]
     sd = np.sqrt((1.0 + x[lay.i("sb")]) ** 2 * 0.04 + 900.0**2 * 1e-6 + noise.baro_noise_sigma_m**2)
     for c, bb, i in ((g.c1, g.b1_per_m, lay.i("dp", 2)), (g.c2, g.b2_per_m, lay.i("dv", 2))):
@@ -201,4 +200,4 @@ def test_an_adaptive_loops_estimate_takes_its_pull_not_its_slope(form):
         assert abs(b[lay.i("dp", 2)] + s.c1 * e_hat + g.c1) < 1e-6 * g.c1  # saturated: the pull is -C1
         assert abs(s.c1 * e_hat) < 1e-3 * g.c1  # and the slope's share of it nearly nothing
     const = NavSystem.build(replace(prof.nav, baro_loop="constant"), prof.sensors, prof.runway.frame, prof.terrain)
-    assert const.loop_offset(fs, h_m, noise, const.loop_slopes(fs, h_m, noise)) is None
+    assert const.loop_linearization(fs, h_m, noise)[1] is None
